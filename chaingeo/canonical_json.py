@@ -1,0 +1,52 @@
+"""Canonical JSON: sorted keys, two-space indent, short lists on one line, a final newline.
+
+The same value always gives the same bytes, so files diff cleanly and hash stably.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Mapping, Sequence
+
+_SCALARS = (str, int, float, bool, type(None))
+
+
+def _is_flat(value: object) -> bool:
+    """A list of scalars, or a list of lists of scalars (voxel lists): written on one line."""
+    if not isinstance(value, list | tuple):
+        return False
+    return all(
+        isinstance(v, _SCALARS)
+        or (isinstance(v, list | tuple) and all(isinstance(w, _SCALARS) for w in v))
+        for v in value
+    )
+
+
+def _encode(value: object, indent: int) -> str:
+    pad = "  " * indent
+    inner = "  " * (indent + 1)
+    if isinstance(value, Mapping):
+        if not value:
+            return "{}"
+        keys = sorted(value)
+        if any(not isinstance(k, str) for k in keys):
+            raise TypeError("canonical JSON needs string keys")
+        items = [f"{inner}{json.dumps(k)}: {_encode(value[k], indent + 1)}" for k in keys]
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if isinstance(value, list | tuple):
+        if _is_flat(value):
+            return json.dumps(value, separators=(", ", ": "), allow_nan=False)
+        items = [f"{inner}{_encode(v, indent + 1)}" for v in value]
+        return "[\n" + ",\n".join(items) + "\n" + pad + "]"
+    if isinstance(value, _SCALARS):
+        return json.dumps(value, allow_nan=False)
+    raise TypeError(f"not JSON-serialisable: {type(value).__name__}")
+
+
+def dumps(value: Mapping[str, object] | Sequence[object]) -> str:
+    return _encode(value, 0) + "\n"
+
+
+def sha256_hex(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()

@@ -1,0 +1,53 @@
+"""The ``chain`` command: a thin face over the toolkit.
+
+Each subcommand lives in its own module under :mod:`chaingeo.commands` and exposes
+``register(subparsers)``; heavy imports happen inside the command, so ``chain --help`` is fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from chaingeo.level import LevelError
+
+#: Subcommand modules, in the order ``chain --help`` lists them.
+COMMANDS: tuple[str, ...] = (
+    "chaingeo.commands.validate",
+    "chaingeo.commands.convert",
+    "chaingeo.commands.bench",
+)
+
+
+class CommandError(Exception):
+    """A user-facing failure: printed as one line, exit status 2."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="chain",
+        description="CHAIN-geo: exact discrete-geometry levels, solvers and agent evaluation.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 0
+    try:
+        return int(args.func(args) or 0)
+    except (CommandError, LevelError, FileNotFoundError, ValueError) as e:
+        print(f"chain {args.command}: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

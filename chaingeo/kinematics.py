@@ -1,0 +1,185 @@
+"""Exact puzzle kinematics: the reference semantics of a move (pure Python, set based).
+
+This module is the specification that every faster search is tested against. A move translates
+a group of pieces of one part along an axis by ``k >= 1`` units, or to infinity; it is legal
+when no unit step on the way makes a voxel of the group meet a voxel of the rest of the part.
+A move to infinity splits the part in two; the disassembly is done when every part is one piece.
+Each move is one step whatever its distance (BurrTools' convention).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Final
+
+from chaingeo.geometry import Cell, Shape
+
+DIRECTIONS: Final[dict[str, Cell]] = {
+    "+x": (1, 0, 0),
+    "-x": (-1, 0, 0),
+    "+y": (0, 1, 0),
+    "-y": (0, -1, 0),
+    "+z": (0, 0, 1),
+    "-z": (0, 0, -1),
+}
+OPPOSITE: Final[dict[str, str]] = {
+    "+x": "-x",
+    "-x": "+x",
+    "+y": "-y",
+    "-y": "+y",
+    "+z": "-z",
+    "-z": "+z",
+}
+
+
+class MoveError(ValueError):
+    """A move that the kinematics forbids; ``reason`` says why in words a user can act on."""
+
+    def __init__(self, move: Move, reason: str) -> None:
+        super().__init__(f"{move.describe()}: {reason}")
+        self.move = move
+        self.reason = reason
+
+
+@dataclass(frozen=True, order=True)
+class Move:
+    """Translate ``pieces`` together along ``direction`` by ``distance`` (None: to infinity)."""
+
+    pieces: tuple[str, ...]
+    direction: str
+    distance: int | None
+
+    def __post_init__(self) -> None:
+        if self.direction not in DIRECTIONS:
+            raise ValueError(f"unknown direction {self.direction!r}; use one of {list(DIRECTIONS)}")
+        if self.distance is not None and self.distance < 1:
+            raise ValueError(f"distance must be >= 1 or None (to infinity), got {self.distance}")
+        if not self.pieces:
+            raise ValueError("a move needs at least one piece")
+        if len(set(self.pieces)) != len(self.pieces):
+            raise ValueError(f"a piece is named twice in {list(self.pieces)}")
+        object.__setattr__(self, "pieces", tuple(sorted(self.pieces)))
+
+    def describe(self) -> str:
+        dist = "inf" if self.distance is None else str(self.distance)
+        return f"move {'+'.join(self.pieces)} {self.direction} {dist}"
+
+    def to_json(self) -> dict[str, object]:
+        return {"pieces": list(self.pieces), "direction": self.direction, "distance": self.distance}
+
+    def inverse(self) -> Move:
+        """The same group moving back the same way (an infinite move inverts to an infinite one)."""
+        return Move(self.pieces, OPPOSITE[self.direction], self.distance)
+
+
+def _shifted(cells: Iterable[Cell], d: Cell, k: int) -> set[Cell]:
+    return {(x + d[0] * k, y + d[1] * k, z + d[2] * k) for x, y, z in cells}
+
+
+def _max_free_run(group: frozenset[Cell], rest: frozenset[Cell], d: Cell) -> int | None:
+    """Largest k such that steps 1..k are all collision-free, or None if the group never meets
+    the rest again (it can leave to infinity)."""
+    if not rest:
+        return None
+    axis = next(i for i in range(3) if d[i])
+    # After passing the far side of the rest, no collision can happen any more.
+    span = max(c[axis] for c in rest) - min(c[axis] for c in rest)
+    gspan = max(c[axis] for c in group) - min(c[axis] for c in group)
+    limit = span + gspan + 2
+    for k in range(1, limit + 1):
+        if not _shifted(group, d, k).isdisjoint(rest):
+            return k - 1
+    return None
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """Pieces (in their assembled position) with integer offsets, grouped into parts.
+
+    ``parts`` lists the sub-puzzles still to take apart (and finished singletons); pieces of
+    different parts never interact again.
+    """
+
+    shapes: Mapping[str, Shape]
+    offsets: Mapping[str, Cell]
+    parts: tuple[frozenset[str], ...]
+
+    @staticmethod
+    def assembled(shapes: Mapping[str, Shape]) -> Assembly:
+        names = sorted(shapes)
+        return Assembly(
+            shapes=dict(shapes),
+            offsets={n: (0, 0, 0) for n in names},
+            parts=(frozenset(names),),
+        )
+
+    def cells_of(self, name: str) -> frozenset[Cell]:
+        ox, oy, oz = self.offsets[name]
+        return frozenset((x + ox, y + oy, z + oz) for x, y, z in self.shapes[name])
+
+    def part_of(self, name: str) -> frozenset[str]:
+        for p in self.parts:
+            if name in p:
+                return p
+        raise KeyError(name)
+
+    def is_separated(self) -> bool:
+        return all(len(p) == 1 for p in self.parts)
+
+    def free_distance(self, pieces: Sequence[str], direction: str) -> int | None:
+        """How far the group can travel in ``direction``: 0 if blocked, None for unlimited."""
+        part = self.part_of(pieces[0])
+        group = frozenset(c for n in pieces for c in self.cells_of(n))
+        rest = frozenset(c for n in sorted(part - set(pieces)) for c in self.cells_of(n))
+        return _max_free_run(group, rest, DIRECTIONS[direction])
+
+    def check(self, move: Move) -> None:
+        """Raise :class:`MoveError` unless ``move`` is legal here."""
+        unknown = [n for n in move.pieces if n not in self.shapes]
+        if unknown:
+            raise MoveError(move, f"unknown piece(s) {unknown}")
+        part = self.part_of(move.pieces[0])
+        if any(n not in part for n in move.pieces):
+            raise MoveError(move, "the pieces belong to different, already separated parts")
+        if set(move.pieces) == part:
+            raise MoveError(move, "the group is a whole part: nothing to move it against")
+        free = self.free_distance(move.pieces, move.direction)
+        if move.distance is None:
+            if free is not None:
+                raise MoveError(move, f"blocked after {free} unit(s); it cannot leave")
+        elif free is not None and free < move.distance:
+            raise MoveError(move, f"blocked after {free} unit(s), {move.distance} asked")
+
+    def apply(self, move: Move) -> Assembly:
+        """The assembly after ``move`` (checked); this object is left unchanged."""
+        self.check(move)
+        group = frozenset(move.pieces)
+        if move.distance is None:
+            part = self.part_of(move.pieces[0])
+            parts = (*tuple(p for p in self.parts if p != part), group, part - group)
+            return Assembly(self.shapes, self.offsets, _sorted_parts(parts))
+        d = DIRECTIONS[move.direction]
+        k = move.distance
+        offsets = dict(self.offsets)
+        for n in move.pieces:
+            x, y, z = offsets[n]
+            offsets[n] = (x + d[0] * k, y + d[1] * k, z + d[2] * k)
+        return Assembly(self.shapes, offsets, self.parts)
+
+
+def _sorted_parts(parts: Iterable[frozenset[str]]) -> tuple[frozenset[str], ...]:
+    return tuple(sorted(parts, key=lambda p: sorted(p)))
+
+
+def replay_disassembly(shapes: Mapping[str, Shape], moves: Sequence[Move]) -> Assembly:
+    """Apply ``moves`` from the assembled state; raise :class:`MoveError` at the first bad one."""
+    state = Assembly.assembled(shapes)
+    for m in moves:
+        state = state.apply(m)
+    return state
+
+
+def disassembly_of_assembly_plan(moves: Sequence[Move]) -> list[Move]:
+    """An assembly plan is a disassembly played backwards: reverse it and invert each move."""
+    return [m.inverse() for m in reversed(moves)]

@@ -1,0 +1,1 @@
+"""Level generation at scale: pure functions of (config, seed, index)."""

@@ -1,0 +1,1 @@
+"""Exact solvers: exact cover, disassembly search, plan search. Import nothing above them."""
