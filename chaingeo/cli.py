@@ -1,23 +1,25 @@
 """The ``chain`` command: a thin face over the toolkit.
 
 Each subcommand lives in its own module under :mod:`chaingeo.commands` and exposes
-``register(subparsers)``; heavy imports happen inside the command, so ``chain --help`` is fast.
+``register(subparsers)``; modules are discovered, so adding a command touches no shared file.
+Heavy imports happen inside each command, so ``chain --help`` stays fast.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import pkgutil
 import sys
 from collections.abc import Sequence
 
+import chaingeo.commands
 from chaingeo.level import LevelError
 
-#: Subcommand modules, in the order ``chain --help`` lists them.
-COMMANDS: tuple[str, ...] = (
-    "chaingeo.commands.validate",
-    "chaingeo.commands.convert",
-    "chaingeo.commands.bench",
+#: Subcommand modules, alphabetical (the order ``chain --help`` lists them).
+COMMANDS: tuple[str, ...] = tuple(
+    f"chaingeo.commands.{m.name}"
+    for m in sorted(pkgutil.iter_modules(chaingeo.commands.__path__), key=lambda m: m.name)
 )
 
 

@@ -134,6 +134,28 @@ class Assembly:
         rest = frozenset(c for n in sorted(part - set(pieces)) for c in self.cells_of(n))
         return _max_free_run(group, rest, DIRECTIONS[direction])
 
+    def clearance(self, pieces: Sequence[str], direction: str) -> int:
+        """Distance after which the group's span along the axis has passed the rest's span:
+        from there on it can never meet the rest again, so a move that far is a removal."""
+        d = DIRECTIONS[direction]
+        axis = next(i for i in range(3) if d[i])
+        part = self.part_of(pieces[0])
+        group = [c[axis] for n in pieces for c in self.cells_of(n)]
+        rest = [c[axis] for n in sorted(part - set(pieces)) for c in self.cells_of(n)]
+        if d[axis] > 0:
+            return max(rest) - min(group) + 1
+        return max(group) - min(rest) + 1
+
+    def blockers(self, name: str, direction: str) -> list[str]:
+        """Pieces of the same part that a one-unit step of ``name`` alone would hit."""
+        d = DIRECTIONS[direction]
+        moved = _shifted(self.cells_of(name), d, 1)
+        return [
+            other
+            for other in sorted(self.part_of(name) - {name})
+            if not moved.isdisjoint(self.cells_of(other))
+        ]
+
     def check(self, move: Move) -> None:
         """Raise :class:`MoveError` unless ``move`` is legal here."""
         unknown = [n for n in move.pieces if n not in self.shapes]
@@ -151,21 +173,105 @@ class Assembly:
         elif free is not None and free < move.distance:
             raise MoveError(move, f"blocked after {free} unit(s), {move.distance} asked")
 
+    def removes(self, move: Move) -> bool:
+        """Does this (legal) move take its group out of the part? True for distance None and for
+        a finite move long enough to clear the rest for good."""
+        if move.distance is None:
+            return True
+        if self.free_distance(move.pieces, move.direction) is not None:
+            return False
+        return move.distance >= self.clearance(move.pieces, move.direction)
+
     def apply(self, move: Move) -> Assembly:
         """The assembly after ``move`` (checked); this object is left unchanged."""
         self.check(move)
         group = frozenset(move.pieces)
-        if move.distance is None:
+        if self.removes(move):
             part = self.part_of(move.pieces[0])
             parts = (*tuple(p for p in self.parts if p != part), group, part - group)
             return Assembly(self.shapes, self.offsets, _sorted_parts(parts))
         d = DIRECTIONS[move.direction]
         k = move.distance
+        assert k is not None  # distance None always removes
         offsets = dict(self.offsets)
         for n in move.pieces:
             x, y, z = offsets[n]
             offsets[n] = (x + d[0] * k, y + d[1] * k, z + d[2] * k)
         return Assembly(self.shapes, offsets, self.parts)
+
+
+class SearchLimitError(RuntimeError):
+    """A search or enumeration stopped at its cap; the message says which cap and how to lift it."""
+
+
+def movable_groups(state: Assembly, direction: str, limit: int = 4096) -> list[tuple[str, ...]]:
+    """Every group of one part that can take a unit step (or more) in ``direction``.
+
+    A group can step exactly when it is closed under "is blocked by": whoever blocks a member
+    must come along. So the groups are the proper, non-empty closed subsets of each part; they
+    are enumerated from the blocking relation, never by trying all subsets.
+    """
+    out: list[tuple[str, ...]] = []
+    for part in state.parts:
+        if len(part) < 2:
+            continue
+        names = sorted(part)
+        needs = {n: frozenset(state.blockers(n, direction)) for n in names}
+        closure: dict[str, frozenset[str]] = {}
+        for n in names:
+            seen = {n}
+            stack = [n]
+            while stack:
+                for b in needs[stack.pop()]:
+                    if b not in seen:
+                        seen.add(b)
+                        stack.append(b)
+            closure[n] = frozenset(seen)
+        found = _unions_of_closures(part, closure, limit, direction)
+        out.extend(tuple(sorted(g)) for g in found)
+    return sorted(out, key=lambda g: (len(g), g))
+
+
+def _unions_of_closures(
+    part: frozenset[str], closure: Mapping[str, frozenset[str]], limit: int, direction: str
+) -> set[frozenset[str]]:
+    """Closed sets are exactly the unions of single-piece closures: grow them breadth first."""
+    found: set[frozenset[str]] = set()
+    frontier = [c for c in closure.values() if c != part]
+    found.update(frontier)
+    while frontier:
+        nxt_frontier: list[frozenset[str]] = []
+        for current in frontier:
+            for n in sorted(part - current):
+                nxt = current | closure[n]
+                if nxt != part and nxt not in found:
+                    found.add(nxt)
+                    nxt_frontier.append(nxt)
+            if len(found) > limit:
+                raise SearchLimitError(
+                    f"more than {limit} movable groups along {direction}; raise the limit"
+                )
+        frontier = nxt_frontier
+    return found
+
+
+def legal_moves(state: Assembly, max_group: int | None = None) -> list[Move]:
+    """All legal moves, sorted: each movable group, each direction, every distance it can go
+    (finite steps short of clearing the rest, and one removal when it can leave)."""
+    moves: list[Move] = []
+    for direction in DIRECTIONS:
+        for group in movable_groups(state, direction):
+            if max_group is not None and len(group) > max_group:
+                continue
+            free = state.free_distance(group, direction)
+            if free is None:
+                moves.extend(
+                    Move(group, direction, k) for k in range(1, state.clearance(group, direction))
+                )
+                moves.append(Move(group, direction, None))
+            else:
+                moves.extend(Move(group, direction, k) for k in range(1, free + 1))
+    return sorted(moves, key=lambda m: (m.pieces, m.direction, m.distance is None, m.distance or 0))
 
 
 def _sorted_parts(parts: Iterable[frozenset[str]]) -> tuple[frozenset[str], ...]:
