@@ -137,14 +137,16 @@ class _Solver:
         result: Separation | None = None
         while result is None and not s.exhausted:
             # Like BurrTools, prefer taking out single pieces (then smaller groups) first.
-            for r in sorted(s.expand_layer(), key=lambda r: (r.mask.bit_count(), r.node)):
-                rm, roff, lm, loff = s.split(r)
+            found = sorted(s.expand_layer(), key=lambda r: (r.mask.bit_count(), r.node))
+            for sp in s.unique_splits(found):
+                rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
                 removed = self.greedy(rm, roff) if len(rm) > 1 else None
                 if len(rm) > 1 and removed is None:
                     continue
                 left = self.greedy(lm, loff) if len(lm) > 1 else None
                 if len(lm) > 1 and left is None:
                     continue
+                r = sp.removal
                 moves = (*s.path_to(r.node), s.local_move(r.mask, r.direction, None))
                 result = Separation(moves, removed, left)
                 break
@@ -174,8 +176,9 @@ class _Solver:
         s = self.search(members, offsets)
         best, best_plan = budget, None
         while not s.exhausted and s.depth + 1 + (n - 2) < best:
-            for r in s.expand_layer():
-                rm, roff, lm, loff = s.split(r)
+            for sp in s.unique_splits(s.expand_layer()):
+                r = sp.removal
+                rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
                 base = r.depth + 1
                 if base + (len(rm) - 1) + (len(lm) - 1) >= best:
                     continue

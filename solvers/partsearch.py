@@ -102,6 +102,17 @@ class Removal:
     direction: int
 
 
+@dataclass(frozen=True)
+class Split:
+    """A removal and the two parts it leaves: members (global indices) and their offsets."""
+
+    removal: Removal
+    removed: tuple[int, ...]
+    removed_offsets: np.ndarray
+    left: tuple[int, ...]
+    left_offsets: np.ndarray
+
+
 class PartSearch:
     """Layered breadth-first search of one part from one configuration."""
 
@@ -233,6 +244,28 @@ class PartSearch:
             out.append(self.local_move(int(m[0]), int(m[1]), int(m[2])))
             node = int(self.parent[node])
         return out[::-1]
+
+    def unique_splits(self, removals: Sequence[Removal]) -> list[Split]:
+        """The removals that lead to different sub-problems (which pieces go, and the
+        configurations of both sides), first occurrence kept, in the given order."""
+        if not removals:
+            return []
+        n = self.n
+        full = (1 << n) - 1
+        nodes = np.array([r.node for r in removals], dtype=np.int64)
+        canon = np.array([min(r.mask, full ^ r.mask) for r in removals], dtype=np.int64)
+        keep: list[int] = []
+        for c in dict.fromkeys(canon.tolist()):
+            idx = np.nonzero(canon == c)[0]
+            inside = [i for i in range(n) if c >> i & 1]
+            outside = [i for i in range(n) if not c >> i & 1]
+            offs = self.states[nodes[idx]].astype(np.int64).reshape(len(idx), n, 3)
+            a = offs[:, inside] - offs[:, inside[:1]]
+            b = offs[:, outside] - offs[:, outside[:1]]
+            rows = np.concatenate([a.reshape(len(idx), -1), b.reshape(len(idx), -1)], axis=1)
+            _, first = np.unique(rows, axis=0, return_index=True)
+            keep.extend(int(idx[j]) for j in first)
+        return [Split(removals[i], *self.split(removals[i])) for i in sorted(keep)]
 
     def split(
         self, removal: Removal
