@@ -1,0 +1,88 @@
+"""The generator's thin layer over the exact-cover engine (:mod:`solvers.cover`).
+
+Two questions are asked of it: how hard is a packing to find (nodes of a plain dancing-links
+search with MRV column choice to the first packing, the CHAIN generator's difficulty proxy;
+the engine is pinned so the figure means the same on every box) and how many packings exist
+(counted with symmetry reduction, up to a node budget). Easy mode also draws packings of a
+piece multiset in a seeded random order.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any, Final
+
+import numpy as np
+
+from chaingeo.geometry import Shape
+from solvers.cover import (
+    CoverLimitError,
+    CoverSearch,
+    count_solutions,
+    cover_problem,
+    random_solutions,
+)
+
+#: Engine whose node counts are the difficulty proxy (fixed: node counts differ by engine).
+EFFORT_ENGINE: Final = "dlx"
+
+
+@dataclass(frozen=True)
+class SearchEffort:
+    nodes_first: int  # dancing-links nodes to the first packing (no symmetry reduction)
+    solutions: int | None  # every packing; None when counting exceeded the node budget
+    distinct: int | None  # packings up to the box's rotations (and reflections if they apply)
+    nodes_count: int  # nodes spent counting (with symmetry reduction)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "engine": EFFORT_ENGINE,
+            "nodes_first": self.nodes_first,
+            "solutions": self.solutions,
+            "distinct": self.distinct,
+            "nodes_count": self.nodes_count,
+        }
+
+
+def _named(shapes: Sequence[Shape]) -> dict[str, Shape]:
+    return {f"p{i:02d}": s.normalized() for i, s in enumerate(shapes)}
+
+
+def first_packing_nodes(shapes: Sequence[Shape], box: Sequence[int]) -> int:
+    """Dancing-links nodes to the first packing of ``shapes`` in ``box`` (ValueError if none)."""
+    dims = tuple(int(v) for v in box)
+    search = CoverSearch(cover_problem(_named(shapes), dims), engine=EFFORT_ENGINE)
+    if next(iter(search.batches(1)), None) is None:
+        raise ValueError(f"the pieces do not pack the {list(dims)} box")
+    return int(search.stats.nodes)
+
+
+def search_effort(
+    shapes: Sequence[Shape], box: Sequence[int], nodes_first: int, *, count_limit: int
+) -> SearchEffort:
+    """Add the packing count to ``nodes_first``; counting stops after ``count_limit`` nodes
+    (the count is then None) and 0 skips it."""
+    if count_limit <= 0:
+        return SearchEffort(nodes_first, None, None, 0)
+    dims = tuple(int(v) for v in box)
+    try:
+        res = count_solutions(_named(shapes), dims, node_limit=count_limit)
+    except CoverLimitError as e:
+        return SearchEffort(nodes_first, None, None, e.stats.nodes)
+    return SearchEffort(nodes_first, res.solutions, res.distinct, res.stats.nodes)
+
+
+def random_packings(
+    shapes: Sequence[Shape], box: Sequence[int], seed: int, limit: int
+) -> Iterator[list[Shape]]:
+    """Up to ``limit`` packings of ``shapes`` in a seeded random order, placements aligned to
+    ``shapes`` (identical pieces are interchangeable, so each packing comes once)."""
+    pieces = _named(shapes)
+    dims = tuple(int(v) for v in box)
+    rng = np.random.default_rng(seed)
+    for n, sol in enumerate(random_solutions(pieces, dims, rng)):
+        if n >= limit:
+            return
+        placed = dict(sol.placements)
+        yield [placed[name] for name in pieces]
