@@ -20,8 +20,8 @@ face, no isolated piece, and (by default) a linear assembly. Attempts first use
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any, Final
 
 import numpy as np
@@ -43,22 +43,11 @@ from generator.partition import (
     random_sizes,
     repair,
 )
+from generator.result import ATTEMPTS_KEY, Rejection
 
 GENERATOR: Final = "chaingeo.generator.stacking"
 #: Bump when a change to the algorithm changes what a (config, seed, index) produces.
 VERSION: Final = "1"
-#: Key of ``Level.stats`` holding the reasons earlier attempts of the same item failed.
-ATTEMPTS_KEY: Final = "rejected_attempts"
-
-
-@dataclass(frozen=True)
-class Rejection:
-    """No level for this (config, seed, index): the last reason, and every attempt's reason."""
-
-    reason: str
-    seed: int
-    index: int
-    attempts: Mapping[str, int] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
