@@ -177,17 +177,20 @@ def _joblib(job: GenerationJob, n_jobs: int) -> Iterator[ItemResult]:
 
 
 def _dask(job: GenerationJob, address: str) -> Iterator[ItemResult]:
-    from distributed import Client, wait
+    from distributed import Client, as_completed
 
     with Client(address, set_as_default=False) as client:
+        done = as_completed(loop=client.loop)
 
         def submit(i: int) -> Any:
-            return client.submit(
+            fut = client.submit(
                 run_item, job.make, job.config, job.seed, i, job.pictures, pure=False
             )
+            done.add(fut)
+            return fut
 
         def wait_first(live: list[Any]) -> Iterable[Any]:
-            return wait(live, return_when="FIRST_COMPLETED").done
+            return [next(done)]
 
         window = max(2, 2 * sum(client.nthreads().values()))
         yield from _ordered(submit, wait_first, client.cancel, job.indices, window)

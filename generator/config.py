@@ -155,7 +155,11 @@ def stacking_config(box: tuple[int, int, int], mode: str, **overrides: Any) -> S
         fields["max_piece_cells"] = EASY_MAX_PIECE_CELLS
     if mode == "hard" and limits is not None:
         fields["min_nodes"] = limits.hard_min_nodes
-    if mode == "mid" and min(box) == 2 and volume == 8:
+    if volume <= 12:
+        # With 4-cell pieces a box this small holds too few distinct puzzles (2x2x3: two
+        # easy, two mid), so it starts at 3 cells.
+        fields["min_piece"] = 3
+    if mode == "mid" and volume == 8:
         # Planar pieces of 3..5 cells fill a 2x2x2 box only as two 2x2 plates (the easy
         # level); pieces grown in a plane and completed off it give the mid level.
         fields["planar"] = False

@@ -2,7 +2,8 @@
 
 Two questions are asked of it: how hard is a packing to find (nodes of a plain dancing-links
 search with MRV column choice to the first packing, the CHAIN generator's difficulty proxy;
-the engine is pinned so the figure means the same on every box) and how many packings exist
+the engine is pinned and the pieces are listed in canonical order, so the figure depends only
+on the multiset of pieces and the box) and how many packings exist
 (counted with symmetry reduction, up to a node budget). Easy mode also draws packings of a
 piece multiset in a seeded random order.
 """
@@ -45,14 +46,23 @@ class SearchEffort:
         }
 
 
-def _named(shapes: Sequence[Shape]) -> dict[str, Shape]:
-    return {f"p{i:02d}": s.normalized() for i, s in enumerate(shapes)}
+def _named(shapes: Sequence[Shape]) -> tuple[dict[str, Shape], list[str]]:
+    """Pieces named in canonical order (so search figures do not depend on how the pieces
+    are listed or turned), and the name given to each input shape."""
+    canon = [s.canonical() for s in shapes]
+    rank = sorted(range(len(shapes)), key=lambda i: (len(canon[i]), canon[i].cells, i))
+    names = [""] * len(shapes)
+    pieces: dict[str, Shape] = {}
+    for r, i in enumerate(rank):
+        names[i] = f"p{r:02d}"
+        pieces[names[i]] = canon[i]
+    return pieces, names
 
 
 def first_packing_nodes(shapes: Sequence[Shape], box: Sequence[int]) -> int:
     """Dancing-links nodes to the first packing of ``shapes`` in ``box`` (ValueError if none)."""
     dims = tuple(int(v) for v in box)
-    search = CoverSearch(cover_problem(_named(shapes), dims), engine=EFFORT_ENGINE)
+    search = CoverSearch(cover_problem(_named(shapes)[0], dims), engine=EFFORT_ENGINE)
     if next(iter(search.batches(1)), None) is None:
         raise ValueError(f"the pieces do not pack the {list(dims)} box")
     return int(search.stats.nodes)
@@ -67,7 +77,7 @@ def search_effort(
         return SearchEffort(nodes_first, None, None, 0)
     dims = tuple(int(v) for v in box)
     try:
-        res = count_solutions(_named(shapes), dims, node_limit=count_limit)
+        res = count_solutions(_named(shapes)[0], dims, node_limit=count_limit)
     except CoverLimitError as e:
         return SearchEffort(nodes_first, None, None, e.stats.nodes)
     return SearchEffort(nodes_first, res.solutions, res.distinct, res.stats.nodes)
@@ -78,11 +88,11 @@ def random_packings(
 ) -> Iterator[list[Shape]]:
     """Up to ``limit`` packings of ``shapes`` in a seeded random order, placements aligned to
     ``shapes`` (identical pieces are interchangeable, so each packing comes once)."""
-    pieces = _named(shapes)
+    pieces, names = _named(shapes)
     dims = tuple(int(v) for v in box)
     rng = np.random.default_rng(seed)
     for n, sol in enumerate(random_solutions(pieces, dims, rng)):
         if n >= limit:
             return
         placed = dict(sol.placements)
-        yield [placed[name] for name in pieces]
+        yield [placed[name] for name in names]

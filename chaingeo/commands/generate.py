@@ -104,9 +104,10 @@ def stacking_config_from_args(args: argparse.Namespace) -> Any:
         if args.box or args.mode:
             raise CommandError("give either --config or --box/--mode, not both")
         return get_config(args.config).replace(**overrides)
-    if not (args.box and args.mode):
+    box = parse_box(args.box) if args.box else None
+    if box is None or not args.mode:
         raise CommandError("--box and --mode are required (or --config NAME)")
-    return stacking_config(parse_box(args.box), args.mode, **overrides)
+    return stacking_config(box, args.mode, **overrides)
 
 
 def _run_stacking(args: argparse.Namespace) -> int:
