@@ -15,6 +15,7 @@ number of workers. Output folder::
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import sys
@@ -177,10 +178,9 @@ def _joblib(job: GenerationJob, n_jobs: int) -> Iterator[ItemResult]:
 
 
 def _dask(job: GenerationJob, address: str) -> Iterator[ItemResult]:
-    from distributed import Client, as_completed
-
-    with Client(address, set_as_default=False) as client:
-        done = as_completed(loop=client.loop)
+    distributed = _distributed()
+    with distributed.Client(address, set_as_default=False) as client:
+        done = distributed.as_completed(loop=client.loop)
 
         def submit(i: int) -> Any:
             fut = client.submit(
@@ -198,10 +198,16 @@ def _dask(job: GenerationJob, address: str) -> Iterator[ItemResult]:
 
 def dask_workers(address: str) -> int:
     """Worker threads of the Dask cluster at ``address``."""
-    from distributed import Client
-
-    with Client(address, set_as_default=False) as client:
+    with _distributed().Client(address, set_as_default=False) as client:
         return int(sum(client.nthreads().values()))
+
+
+def _distributed() -> Any:
+    """The ``distributed`` package (the ``dask`` extra), untyped: its annotations are partial."""
+    try:
+        return importlib.import_module("distributed")
+    except ImportError:
+        raise GenerationError("--dask needs the dask extra: pip install 'chaingeo[dask]'") from None
 
 
 # ---------------------------------------------------------------------------------------------
