@@ -15,6 +15,14 @@
 Every level has connected pieces with sizes in ``[min_piece, max_piece_cells]``, no filled 2x3
 face, no isolated piece, and (by default) a linear assembly. Attempts first use
 ``config.min_piece`` and then fall back to ``config.fallback_min_piece`` (4 then 3).
+
+The stored solution is the carved (or, in easy mode, the engine's) packing; pieces are listed
+in a random order (colours carry no hint) and handed to the agent in a random rotation.
+``Level.stats``: ``mode``, ``min_piece`` (the stage that succeeded), ``pieces``, ``attempts``,
+``rejected_attempts`` (reason -> count for the failed attempts before), ``repair_moves``,
+``exact_cover`` (``nodes_first``: dancing-links nodes to a first packing, ``solutions`` and
+``distinct`` packings, ``nodes_count``; see :mod:`generator.packing`) and ``linear_assembly``
+(``[piece, direction it slides in]`` in insertion order, or None).
 """
 
 from __future__ import annotations

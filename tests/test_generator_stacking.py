@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from chaingeo.level import Level, level_bytes, revalidate
 from generator.checks import level_problems
@@ -158,3 +160,21 @@ def test_without_linear_assembly_rule_levels_still_verify() -> None:
     cfg = stacking_config((2, 3, 3), "hard", linear_assembly=False)
     level = _level(cfg, 2, 0)
     assert level_problems(level, cfg) == []
+
+
+@settings(max_examples=12)
+@given(
+    st.sampled_from(["2x2x3-easy", "2x2x4-mid", "2x3x3-mid", "2x3x3-hard", "2x2x4-easy"]),
+    st.integers(0, 2**32),
+    st.integers(0, 10_000),
+)
+def test_every_outcome_is_a_sound_level_or_a_counted_rejection(
+    name: str, seed: int, index: int
+) -> None:
+    cfg = get_config(name).replace(attempts=40)
+    out = make(cfg, seed, index)
+    if isinstance(out, Rejection):
+        assert out.reason in out.attempts and sum(out.attempts.values()) <= cfg.attempts
+    else:
+        assert level_problems(out, cfg) == []
+        assert out.stats["attempts"] <= cfg.attempts
