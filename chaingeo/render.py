@@ -33,17 +33,16 @@ from chaingeo.raster import (
     FloatArray,
     Projector,
     arrow,
-    centered_text,
     draw_faces,
     fit,
     fit_centre,
-    font,
     frame_corners,
     line,
     oblique_camera,
     parse_color,
     png_bytes,
     polygon,
+    put_text,
     scaled,
     text_color,
     visible_faces,
@@ -181,16 +180,14 @@ class _Layout:
     size: int
     title_px: int
     tick_px: int
-    edge_px: int  # cube edge width at the supersampled resolution
 
     @staticmethod
     def of(size: int) -> _Layout:
-        return _Layout(
-            size,
-            max(11, size // 34),
-            max(10, size // 30),
-            max(2, round(size * _SUPERSAMPLE / 340)),
-        )
+        return _Layout(size, max(11, size // 34), max(10, size // 30))
+
+    def edge_px(self, scale: int) -> int:
+        """Cube edge width when drawing at ``scale`` times the final size."""
+        return max(1, round(self.size * scale / 340))
 
 
 def _plane_is_back(axis: int, side: str, cam: Camera) -> bool:
@@ -211,9 +208,10 @@ def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
     return np.array(pts)
 
 
-def _draw_walls(draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector) -> None:
+def _draw_walls(
+    draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector, width: int
+) -> None:
     """Back walls and floor with a line per cell boundary, so empty cells can be counted."""
-    width = max(1, _SUPERSAMPLE)
     for axis in (2, 0, 1):
         for side in ("lo", "hi"):
             if not _plane_is_back(axis, side, cam):
@@ -221,14 +219,17 @@ def _draw_walls(draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Pro
             fill = _FLOOR if axis == 2 and side == "lo" else _WALL
             polygon(draw, proj(_wall_corners(scene, axis, side)), fill=fill)
             b, c = [i for i in range(3) if i != axis]
-            fixed = scene.lo[axis] if side == "lo" else scene.hi[axis]
+            ends: list[list[float]] = []
             for along, across in ((b, c), (c, b)):
                 for t in range(scene.lo[along], scene.hi[along] + 1):
-                    p, q = [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]
-                    p[axis] = q[axis] = fixed
-                    p[along] = q[along] = t
-                    p[across], q[across] = scene.lo[across], scene.hi[across]
-                    line(draw, proj(p), proj(q), _GRID, width)
+                    for at in (scene.lo[across], scene.hi[across]):
+                        p = [0.0, 0.0, 0.0]
+                        p[axis] = scene.lo[axis] if side == "lo" else scene.hi[axis]
+                        p[along], p[across] = t, at
+                        ends.append(p)
+            pix = proj(np.array(ends)).tolist()
+            for i in range(0, len(pix), 2):
+                draw.line([tuple(pix[i]), tuple(pix[i + 1])], fill=_GRID, width=width)
 
 
 def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArray, FloatArray]]:
@@ -252,10 +253,11 @@ def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArra
 
 
 def _draw_ticks(
-    draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector, lay: _Layout
+    image: Image.Image, scene: _Scene, cam: Camera, proj: Projector, lay: _Layout
 ) -> None:
     """1-based cell indices along one frame edge per displayed axis, then the axis name and an
     arrow pointing the way the index grows."""
+    draw = ImageDraw.Draw(image)
     centre = proj(np.add(scene.lo, scene.hi) / 2.0)
     for axis, spec in cam.tick_edges:
         base = np.array(
@@ -286,21 +288,17 @@ def _draw_ticks(
                 continue
             p = base.copy()
             p[axis] = c + 0.5
-            centered_text(draw, tuple(proj(p) + offset), str(c + 1), px, _TEXT)
+            put_text(image, proj(p) + offset, str(c + 1), px, _TEXT)
         # The arrow continues the row of numbers; the axis name sits just outside it.
         color = _AXIS_COLORS[axis]
         tail = b + offset + d * (px * 0.5)
         head = tail + d * (lay.tick_px * 1.2)
         arrow(draw, tail, head, color, max(2, lay.tick_px // 8))
         name_at = (tail + head) / 2 + normal * (lay.tick_px * 0.9)
-        centered_text(
-            draw, (float(name_at[0]), float(name_at[1])), _AXIS_NAMES[axis], lay.tick_px + 3, color
-        )
+        put_text(image, name_at, _AXIS_NAMES[axis], lay.tick_px + 3, color)
 
 
-def _draw_depth_labels(
-    draw: ImageDraw.ImageDraw, faces: Faces, cam: Camera, proj: Projector
-) -> None:
+def _draw_depth_labels(image: Image.Image, faces: Faces, cam: Camera, proj: Projector) -> None:
     """On each visible face of an axis view, the 1-based coordinate along the line of sight."""
     depth = cam.depth_axis
     assert depth is not None
@@ -317,13 +315,13 @@ def _draw_depth_labels(
         centre = proj.screen(faces.corners[i].mean(axis=0))
         fill = faces.fills[i]
         text = f"{prefix}{int(faces.cells[i][depth]) + 1}"
-        centered_text(draw, (float(centre[0]), float(centre[1])), text, px, text_color(fill))
+        put_text(image, centre, text, px, text_color(fill))
 
 
-def _title(draw: ImageDraw.ImageDraw, lines: Sequence[str], lay: _Layout) -> None:
+def _title(image: Image.Image, lines: Sequence[str], lay: _Layout) -> None:
     y = max(4, lay.size // 100)
     for text in lines:
-        draw.text((max(4, lay.size // 64), y), text, fill=_TEXT, font=font(lay.title_px))
+        put_text(image, (max(4, lay.size // 64), y), text, lay.title_px, _TEXT, anchor="la")
         y += int(lay.title_px * 1.25)
 
 
@@ -337,30 +335,35 @@ def _view_titles(cam: Camera, scene: _Scene) -> list[str]:
     ]
 
 
-def _render_view(scene: _Scene, cam: Camera, size: int) -> Image.Image:
-    lay = _Layout.of(size)
-    k = _SUPERSAMPLE
+def _view_projector(scene: _Scene, cam: Camera, lay: _Layout) -> Projector:
+    """The frame fitted into the picture, leaving room for the title and the axis labels."""
     top = lay.title_px * 2.6 + lay.tick_px * 1.9 + 8
     side = lay.tick_px * 2.8
-    content = (side, top, size - side, size - lay.tick_px * 2.8)
-    proj = fit(frame_corners(scene.lo, scene.hi), cam, content)
+    content = (side, top, lay.size - side, lay.size - lay.tick_px * 2.8)
+    return fit(frame_corners(scene.lo, scene.hi), cam, content)
+
+
+def _render_view(scene: _Scene, cam: Camera, size: int) -> Image.Image:
+    lay = _Layout.of(size)
+    # Axis views have only axis-parallel edges: no aliasing, so no supersampling needed.
+    k = _SUPERSAMPLE if cam.depth_axis is None else 1
+    proj = _view_projector(scene, cam, lay)
     big_proj = scaled(proj, k)
     big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
     draw = ImageDraw.Draw(big)
-    _draw_walls(draw, scene, cam, big_proj)
+    _draw_walls(draw, scene, cam, big_proj, k)
     for p, q in _frame_edges(scene, cam, back=True):
         line(draw, big_proj(p), big_proj(q), _FRAME, k)
     faces = visible_faces(scene.cells, scene.colors, cam)
-    draw_faces(draw, faces, big_proj, lay.edge_px)
+    draw_faces(draw, faces, big_proj, lay.edge_px(k))
     if scene.has_box:
         for p, q in _frame_edges(scene, cam, back=False):
             line(draw, big_proj(p), big_proj(q), _FRAME, k)
-    image = big.reduce(k)
-    small = ImageDraw.Draw(image)
-    _title(small, _view_titles(cam, scene), lay)
-    _draw_ticks(small, scene, cam, proj, lay)
+    image = big.reduce(k) if k > 1 else big
+    _title(image, _view_titles(cam, scene), lay)
+    _draw_ticks(image, scene, cam, proj, lay)
     if cam.depth_axis is not None and len(faces.cells):
-        _draw_depth_labels(small, faces, cam, proj)
+        _draw_depth_labels(image, faces, cam, proj)
     return image
 
 
@@ -376,13 +379,12 @@ def _render_tray(pieces: PieceMap, size: int) -> Image.Image:
     cam = CAMERAS["iso"]
     names = sorted(pieces)
     title_h = lay.title_px * 1.6 + 6
-    big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
     if not names:
-        image = big.reduce(k)
-        draw = ImageDraw.Draw(image)
-        _title(draw, ["TRAY: pieces not yet placed"], lay)
-        centered_text(draw, (size / 2, size / 2), "(the tray is empty)", lay.tick_px, _TEXT)
+        image = Image.new("RGB", (size, size), _BACKGROUND)
+        _title(image, ["TRAY: pieces not yet placed"], lay)
+        put_text(image, (size / 2, size / 2), "(the tray is empty)", lay.tick_px, _TEXT)
         return image
+    big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
     cols = math.ceil(math.sqrt(len(names)))
     rows = math.ceil(len(names) / cols)
     cell_w = size / cols
@@ -409,13 +411,13 @@ def _render_tray(pieces: PieceMap, size: int) -> Image.Image:
         rgb = parse_color(pieces[n][1])
         colors = np.tile(np.array(rgb, dtype=np.float64), (len(shapes[n]), 1))
         faces = visible_faces(shapes[n].voxels, colors, cam)
-        draw_faces(draw, faces, scaled(proj, k), lay.edge_px)
+        draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
         slots.append((f"{n} ({len(shapes[n])})", x0 + cell_w / 2, y0 + cell_h - label_h / 2))
     image = big.reduce(k)
     small = ImageDraw.Draw(image)
-    _title(small, ["TRAY: pieces not yet placed (name, number of cubes)"], lay)
+    _title(image, ["TRAY: pieces not yet placed (name, number of cubes)"], lay)
     for text, x, y in slots:
-        centered_text(small, (x, y), text, label_px, _TEXT)
+        put_text(image, (x, y), text, label_px, _TEXT)
     for c in range(1, cols):
         small.line([(c * cell_w, title_h), (c * cell_w, size)], fill=_GRID, width=1)
     for rr in range(1, rows):
@@ -450,6 +452,16 @@ def render_views(
 ) -> dict[str, bytes]:
     """PNG bytes per view of a scene; ``box`` is drawn as a wire frame (stacking) if given."""
     return {v: png_bytes(img) for v, img in render_images(pieces, box, views, size).items()}
+
+
+def view_projector(
+    pieces: PieceMap, box: Sequence[int] | None, view: str, size: int = DEFAULT_SIZE
+) -> Projector:
+    """Where world points land in the picture of ``view`` (pixels of the final image), for
+    anyone who annotates the pictures or checks them."""
+    _check_size(size)
+    _check_views([view])
+    return _view_projector(_scene(pieces, box), CAMERAS[view], _Layout.of(size))
 
 
 def render_tray_image(pieces: PieceMap, size: int = DEFAULT_SIZE) -> Image.Image:
