@@ -22,7 +22,8 @@ import numpy as np
 
 from chaingeo.level import Level, StackingSolution, stacking_level
 from chaingeo.piecesets import BEDLAM_SOLUTION
-from chaingeo.render import VIEWS, PieceMap, parse_color, render_tray, render_views
+from chaingeo.raster import parse_color
+from chaingeo.render import VIEWS, PieceMap, render_tray, render_views
 
 SIZE = 512
 GOAL_RATIO = 20.0
