@@ -21,13 +21,14 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 from PIL import Image, ImageDraw, ImageFont
+from zlib_ng import zlib_ng
 
 RGB = tuple[int, int, int]
 #: A colour as ``"#rrggbb"`` or an ``(r, g, b)`` triple.
 ColorLike = str | tuple[int, int, int]
 FloatArray = npt.NDArray[np.float64]
-#: zlib level for PNG: fast, and fixed so the same picture always gives the same bytes.
-PNG_COMPRESS_LEVEL: Final = 1
+#: Deflate level for PNG (zlib-ng): fast, and fixed so the same picture gives the same bytes.
+PNG_COMPRESS_LEVEL: Final = 2
 EDGE: Final[RGB] = (0, 0, 0)
 
 #: The six face normals, and for each the four corners of that face of the unit cube at the
@@ -273,20 +274,22 @@ def _png_chunk(tag: bytes, data: bytes) -> bytes:
 def png_bytes(image: Image.Image) -> bytes:
     """An 8-bit RGB PNG: IHDR, one IDAT, IEND; no metadata, no timestamps.
 
-    Written here rather than by Pillow because Pillow always tries five row filters per row for
-    RGB (12 ms for a 512 px view); flat-shaded pictures compress as well unfiltered (filter 0) in
-    under 2 ms. The bytes depend only on the pixels and on zlib at a fixed level.
+    Written here rather than by Pillow because Pillow tries five row filters on every row of an
+    RGB image (12 ms for a 512 px view); flat-shaded pictures compress as well unfiltered
+    (filter 0), and zlib-ng deflates them in about 0.4 ms (stock zlib: 1.3 ms). The bytes depend
+    only on the pixels and on the zlib-ng version, at a fixed level.
     """
-    rgb = np.asarray(image if image.mode == "RGB" else image.convert("RGB"), dtype=np.uint8)
-    h, w, _ = rgb.shape
-    rows = np.zeros((h, w * 3 + 1), dtype=np.uint8)  # first byte of each row: filter 0 (none)
-    rows[:, 1:] = rgb.reshape(h, w * 3)
+    rgb = image if image.mode == "RGB" else image.convert("RGB")
+    w, h = rgb.size
+    rows = np.empty((h, w * 3 + 1), dtype=np.uint8)
+    rows[:, 0] = 0  # each row starts with its filter type: 0, none
+    rows[:, 1:] = np.frombuffer(rgb.tobytes(), dtype=np.uint8).reshape(h, w * 3)
     header = struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)
     return b"".join(
         (
             b"\x89PNG\r\n\x1a\n",
             _png_chunk(b"IHDR", header),
-            _png_chunk(b"IDAT", zlib.compress(rows.tobytes(), PNG_COMPRESS_LEVEL)),
+            _png_chunk(b"IDAT", zlib_ng.compress(rows.data, PNG_COMPRESS_LEVEL)),
             _png_chunk(b"IEND", b""),
         )
     )
