@@ -270,3 +270,17 @@ def test_level_wrappers() -> None:
 def test_bad_input_raises_a_clear_error(call: object, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         call()  # type: ignore[operator]
+
+
+def test_chain_render_writes_the_pictures(tmp_path: Path) -> None:
+    from chaingeo.cli import main
+    from chaingeo.level import save_level
+
+    level = stacking_level("bedlam-known", "hard", (4, 4, 4), list(BEDLAM_SOLUTION.values()))
+    path = save_level(level, tmp_path / "bedlam.json")
+    assert main(["render", str(path), "--out", str(tmp_path / "pics"), "--size", "160"]) == 0
+    written = sorted(p.name for p in (tmp_path / "pics").iterdir())
+    assert written == sorted(f"bedlam-known-{v}.png" for v in (*VIEWS, "pieces"))
+    assert (tmp_path / "pics" / "bedlam-known-iso.png").read_bytes() == render_solution_views(
+        level, size=160
+    )["iso"]
