@@ -115,12 +115,12 @@ BOX_LIMITS: Final[dict[tuple[int, int, int], BoxLimits]] = {
     (2, 2, 3): BoxLimits(4, 0),
     (2, 2, 4): BoxLimits(4, 0),
     (2, 3, 3): BoxLimits(5, 10),
-    (2, 3, 4): BoxLimits(6, 20),
-    (2, 4, 4): BoxLimits(7, 40),
+    (2, 3, 4): BoxLimits(6, 30),
+    (2, 4, 4): BoxLimits(7, 60),
     (3, 3, 3): BoxLimits(6, 25),
-    (3, 3, 4): BoxLimits(8, 50),
-    (3, 4, 4): BoxLimits(10, 150),
-    (4, 4, 4): BoxLimits(13, 500),
+    (3, 3, 4): BoxLimits(8, 75),
+    (3, 4, 4): BoxLimits(10, 350),
+    (4, 4, 4): BoxLimits(13, 1000),
 }
 
 
