@@ -11,11 +11,9 @@ from collections import deque
 from collections.abc import Hashable, Sequence
 from functools import cache
 
-import numpy as np
-
 from chaingeo.actions import MoveAction
 from chaingeo.colors import assign_colors
-from chaingeo.geometry import NEIGHBOURS, Cell, Shape, box_cells, puzzle_signature
+from chaingeo.geometry import Cell, Shape, box_cells, puzzle_signature
 from chaingeo.kinematics import Move, disassembly_of_assembly_plan
 from chaingeo.level import (
     Level,
