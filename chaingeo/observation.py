@@ -4,7 +4,8 @@ Text follows the agent convention: cells are 1-based (converted by :mod:`chainge
 The pictures come from :mod:`chaingeo.render`, called from :func:`render_state` only. Stacking
 shows the box (placed pieces where they are) and the tray of unplaced pieces; a puzzle shows its
 largest part where it is and every other part laid out beside it along +x (parts apart never
-interact, so only their shapes matter), and in assembly also the target.
+interact, so only their shapes matter), and its goal as ``target``: assembled (assembly) or
+every piece apart (disassembly).
 """
 
 from __future__ import annotations
@@ -223,17 +224,30 @@ def scene(state: BaseState) -> tuple[PieceMap, tuple[int, int, int] | None, Piec
 
 
 def render_state(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> dict[str, bytes]:
-    """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (assembly)."""
-    from chaingeo import render
+    """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (puzzles)."""
+    import chaingeo.render as render
 
     pieces, box, tray = scene(state)
     images = dict(render.render_views(pieces, box, VIEWS, size))
     if state.level.family == "stacking":
         images["tray"] = render.render_tray(tray, size)
-    elif state.level.goal == "assemble":
-        target = {p.name: (p.shape, p.rgb) for p in state.level.pieces}
-        images["target"] = render.render_views(target, None, ("iso",), size)["iso"]
+    else:
+        images["target"] = render.render_views(target_scene(state), None, ("iso",), size)["iso"]
     return images
+
+
+def target_scene(state: BaseState) -> PieceMap:
+    """A puzzle's goal: assembled (assembly), or every piece apart side by side (disassembly)."""
+    pieces: PieceMap = {}
+    cursor = 0
+    for p in sorted(state.level.pieces, key=lambda p: p.name):
+        if state.level.goal == "assemble":
+            pieces[p.name] = (p.shape, p.rgb)
+            continue
+        shape = p.shape.translate((cursor - int(p.shape.min_corner[0]), 0, 0))
+        pieces[p.name] = (shape, p.rgb)
+        cursor += shape.extent[0] + _LAYOUT_GAP
+    return pieces
 
 
 def observe(

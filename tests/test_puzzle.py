@@ -17,7 +17,7 @@ from chaingeo.geometry import Shape
 from chaingeo.kinematics import DIRECTIONS, OPPOSITE, Move, MoveError, legal_moves
 from chaingeo.level import Level
 from chaingeo.puzzle import PuzzleState, normal_key
-from tests.env_levels import LOCK3, bfs_plan, puzzle_level, puzzle_levels
+from tests.env_levels import LOCK3, bfs_plan, puzzle_level, puzzle_levels, tube
 
 
 def level(level_id: str) -> Level:
@@ -217,3 +217,40 @@ def test_step_text_feedback_for_moves() -> None:
 
 def test_lock3_shapes_are_the_level_pieces() -> None:
     assert {p.name: p.shape for p in level("lock3-disassemble").pieces} == LOCK3
+
+
+def shortest(state: PuzzleState) -> int:
+    """Fewest actions to success, by breadth-first search over the state machine."""
+    seen = {state.key()}
+    frontier = [state]
+    depth = 0
+    while frontier:
+        if any(s.is_success() for s in frontier):
+            return depth
+        nxt: list[PuzzleState] = []
+        for s in frontier:
+            for a in s.legal_actions():
+                if isinstance(a, FinishAction):
+                    continue
+                child = s.clone()
+                child.apply(a)
+                if child.key() not in seen:
+                    seen.add(child.key())
+                    nxt.append(child)
+        frontier, depth = nxt, depth + 1
+    raise AssertionError("target unreachable")
+
+
+@pytest.mark.parametrize(
+    "shapes",
+    [
+        {"blue": Shape([(2, 0, 0), (2, 0, 1), (1, 0, 1)]), "red": Shape([(1, 0, 0)])},
+        tube(3, 1),
+    ],
+    ids=["arm", "tube"],
+)
+def test_two_piece_assembly_is_exactly_as_long_as_disassembly(shapes: dict[str, Shape]) -> None:
+    plan = bfs_plan(shapes)
+    assert plan is not None
+    assemble = PuzzleState(puzzle_level("two", shapes, plan, "assemble"))
+    assert shortest(assemble) == len(plan)
