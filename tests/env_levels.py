@@ -208,9 +208,16 @@ def puzzle_levels() -> tuple[Level, ...]:
         ("tube2", tube(3, 2), None),
         ("tube2-single", tube(3, 2), 1),
     ]
+    plans: list[tuple[str, dict[str, Shape], list[Move], int | None]] = []
     for name, shapes, mg in hand:
         plan = bfs_plan(dict(shapes), mg)
         assert plan is not None
+        plans.append((name, dict(shapes), plan, mg))
+    # a stored plan may take a piece out by a finite move long enough to clear the rest
+    plans.append(
+        ("lock3-finite", dict(LOCK3), [Move(("green",), "+z", 3), Move(("red",), "-x", 4)], None)
+    )
+    for name, shapes, plan, mg in plans:
         for goal in ("disassemble", "assemble"):
-            levels.append(puzzle_level(f"{name}-{goal}", dict(shapes), plan, goal, mg))
+            levels.append(puzzle_level(f"{name}-{goal}", shapes, plan, goal, mg))
     return tuple(levels)
