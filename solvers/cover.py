@@ -254,6 +254,8 @@ class _Budget:
     """Shares one node limit across the several searches of a count."""
 
     def __init__(self, node_limit: int | None) -> None:
+        if node_limit is not None and node_limit < 0:
+            raise CoverError(f"node_limit: must be >= 0, got {node_limit}")
         self.limit = node_limit
         self.stats = CoverStats()
         self.found = 0

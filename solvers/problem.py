@@ -8,7 +8,8 @@ except ``optional`` cells, which may stay empty (at most once).
 Rows are ``(type, placement)`` pairs, numbered type by type in placement order. The problem's
 symmetry group is the target's rotations, plus its reflections when ``reflections`` is asked for
 and the problem is mirror-invariant (every type's mirror image is a type with the same range);
-elements acting identically on the rows are merged, so the group acts faithfully.
+only symmetries mapping the optional cells onto themselves count, and elements acting
+identically on the rows are merged, so the group acts faithfully.
 """
 
 from __future__ import annotations
@@ -172,7 +173,12 @@ class CoverProblem:
         kept: list[tuple[IntArray, IntArray]] = []
         maps: list[Int32Array] = []
         seen: set[bytes] = set()
+        opt = np.asarray(sorted(self.optional), dtype=np.int32)
         for m, t in syms:
+            if len(opt) and not np.array_equal(
+                np.sort(cell_permutation(self.target, m, t)[opt]), opt
+            ):
+                continue  # must map the optional cells onto themselves
             rmap = self._row_map(m, t, by_shape)
             if rmap is None:
                 continue
