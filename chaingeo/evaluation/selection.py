@@ -1,0 +1,105 @@
+"""Verifier-based selection among candidate actions, and the hook for judges / reward models.
+
+With ``candidates = K > 1`` the agent is asked K times per turn. Each candidate's action is
+tried in a *clone* of the state (the verifier: the environment's own rules), which changes
+nothing and costs no step. A :class:`Judge` then orders the candidates, best first; the harness
+commits the first one. Built-in judges:
+
+- ``first``: verified-legal candidates first, otherwise in sampling order (plain verifier);
+- ``vote``: verified-legal first, then the action proposed most often (self-consistency);
+- ``progress``: a reward model without a network: prefers a candidate that solves the level,
+  then one after which the most legal actions remain (keeps options open), then sampling order.
+
+Register another (an LLM judge, a trained reward model) with :func:`register_judge`.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from chaingeo.agents.base import Reply, StateLike, StepResultLike
+
+
+@dataclass(frozen=True)
+class Candidate:
+    index: int
+    reply: Reply
+    result: StepResultLike | None  # the verifier's verdict in a clone (None: nothing to try)
+    after: StateLike | None  # the clone after the action (None when illegal or unreadable)
+
+    @property
+    def legal(self) -> bool:
+        return self.result is not None and self.result.legal
+
+
+class Judge:
+    name = "judge"
+
+    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+        """Candidate indices, best first (every index exactly once)."""
+        raise NotImplementedError
+
+
+class FirstLegal(Judge):
+    name = "first"
+
+    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+        return [c.index for c in sorted(candidates, key=lambda c: (not c.legal, c.index))]
+
+
+class Vote(Judge):
+    name = "vote"
+
+    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+        votes = Counter(c.result.action.to_text() for c in candidates if c.legal and c.result)
+
+        def key(c: Candidate) -> tuple[bool, int, int]:
+            n = votes[c.result.action.to_text()] if c.legal and c.result else 0
+            return (not c.legal, -n, c.index)
+
+        return [c.index for c in sorted(candidates, key=key)]
+
+
+class Progress(Judge):
+    name = "progress"
+
+    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+        def key(c: Candidate) -> tuple[bool, bool, int, int]:
+            if c.after is None:
+                return (True, True, 0, c.index)
+            return (False, not c.after.is_success(), -len(c.after.legal_actions()), c.index)
+
+        return [c.index for c in sorted(candidates, key=key)]
+
+
+JUDGES: dict[str, Callable[[], Judge]] = {
+    "first": FirstLegal,
+    "vote": Vote,
+    "progress": Progress,
+}
+
+
+def register_judge(name: str, factory: Callable[[], Judge]) -> None:
+    JUDGES[name] = factory
+
+
+def make_judge(name: str) -> Judge:
+    try:
+        return JUDGES[name]()
+    except KeyError:
+        raise ValueError(f"unknown judge {name!r}; known: {sorted(JUDGES)}") from None
+
+
+def verify(state: StateLike, replies: Sequence[Reply]) -> list[Candidate]:
+    """Try each reply's action in its own clone of ``state``."""
+    out = []
+    for i, reply in enumerate(replies):
+        if reply.action is None:
+            out.append(Candidate(i, reply, None, None))
+            continue
+        probe = state.clone()
+        result = probe.step_text(reply.action)
+        out.append(Candidate(i, reply, result, probe if result.legal else None))
+    return out
