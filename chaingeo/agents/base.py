@@ -103,6 +103,12 @@ class AgentError(RuntimeError):
     died): the episode is recorded with status ``error`` and can be retried with ``--resume``."""
 
 
+#: Options that say how to reach an agent, not how it behaves.
+TRANSPORT = frozenset(
+    {"base_url", "timeout", "max_retries", "backoff_base", "backoff_max", "api_key_env"}
+)
+
+
 @dataclass(frozen=True)
 class AgentSpec:
     """How to build an agent: registry name, options (logged), secrets (never logged)."""
@@ -112,7 +118,15 @@ class AgentSpec:
     secrets: Mapping[str, str] = field(default_factory=dict, repr=False)
 
     def to_json(self) -> dict[str, Any]:
-        return {"name": self.name, "options": dict(sorted(self.options.items()))}
+        """What defines the agent's behaviour (a resumed run must match it)."""
+        return {
+            "name": self.name,
+            "options": {k: v for k, v in sorted(self.options.items()) if k not in TRANSPORT},
+        }
+
+    def transport(self) -> dict[str, Any]:
+        """How it is reached (may change between a run and its resumption)."""
+        return {k: v for k, v in sorted(self.options.items()) if k in TRANSPORT}
 
     @property
     def label(self) -> str:

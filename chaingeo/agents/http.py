@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import email.utils
 import json
-import socket
 import time
 import urllib.error
 import urllib.request
@@ -105,7 +104,7 @@ class ChatClient:
                     f"HTTP {e.code} {detail}", parse_retry_after(e.headers.get("Retry-After"))
                 ) from None
             raise AgentError(f"{self.url}: HTTP {e.code} {detail}") from None
-        except (TimeoutError, socket.timeout) as e:
+        except TimeoutError as e:
             raise TransientError(f"timeout after {self.timeout}s ({e})") from None
         except urllib.error.URLError as e:
             raise TransientError(f"connection failed: {e.reason}") from None

@@ -290,6 +290,6 @@ def _with_images(obs: ObservationLike, images: Mapping[str, bytes]) -> Observati
     import dataclasses
 
     if dataclasses.is_dataclass(obs) and not isinstance(obs, type):
-        out: ObservationLike = dataclasses.replace(obs, images=dict(images))  # type: ignore[misc]
+        out: ObservationLike = dataclasses.replace(obs, images=dict(images))
         return out
     raise TypeError("observations must be dataclasses with an 'images' field")

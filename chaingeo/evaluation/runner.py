@@ -106,15 +106,16 @@ def _execute(tasks: Sequence[EpisodeTask], cfg: RunConfig) -> Iterator[EpisodeRe
         return
     if cfg.dask:
         try:
-            from distributed import Client, as_completed
+            import distributed
         except ImportError:
             raise ValueError(
                 "--dask needs the 'distributed' package: pip install 'chaingeo[cluster]'"
             ) from None
-        client = Client(cfg.dask)
+        client: Any = distributed.Client(cfg.dask)  # type: ignore[no-untyped-call]
         try:
             futures = client.map(run_episode, list(tasks), pure=False)
-            for fut in as_completed(futures):
+            completed: Any = distributed.as_completed(futures)  # type: ignore[no-untyped-call]
+            for fut in completed:
                 yield fut.result()
         finally:
             client.close()
@@ -161,7 +162,7 @@ def evaluate(
         levels=ids,
         seed=cfg.seed,
         samples=cfg.samples,
-        extra={"label": agent.label},
+        extra={"label": agent.label, "agent_transport": agent.transport()},
     )
     log = RunLog.create(run_dir, header, resume=cfg.resume, secrets=agent.secrets.values())
     done = log.finished_keys(retry_errors=cfg.retry_errors)

@@ -12,7 +12,7 @@ import json
 import threading
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from typing import Any
@@ -56,9 +56,10 @@ def _check_shape(body: Any, headers: Any, script: Script) -> str | None:
     for k in ("temperature", "top_p"):
         if not isinstance(body.get(k), int | float):
             return f"missing {k}"
-    if script.expect_key is not None:
-        if headers.get("Authorization") != f"Bearer {script.expect_key}":
-            return "wrong or missing bearer key"
+    if script.expect_key is not None and headers.get("Authorization") != (
+        f"Bearer {script.expect_key}"
+    ):
+        return "wrong or missing bearer key"
     return None
 
 
@@ -74,10 +75,8 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
             for k, v in (headers or {}).items():
                 self.send_header(k, v)
             self.end_headers()
-            try:
+            with suppress(BrokenPipeError, ConnectionResetError):
                 self.wfile.write(payload)
-            except (BrokenPipeError, ConnectionResetError):
-                pass
 
         def do_POST(self) -> None:
             n = int(self.headers.get("Content-Length", 0))
