@@ -81,7 +81,7 @@ class FakeState:
             self.steps_used += 1
         self.history.append(f"{text!r}: {feedback}")
         return FakeResult(
-            action if error is None else (action if error == "illegal" else None),
+            action if error is None else None,
             error is None,
             error,
             feedback,
