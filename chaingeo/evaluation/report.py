@@ -176,8 +176,20 @@ def table1(runs: Sequence[Run]) -> Table:
             "Solved/USD",
         ],
         rows,
-        [_text, _pct, _pct, _pct, _int, _int, _num(2), _num(2), _num(3), _tok, _num(4)]
-        + [_num(2), _num(2)],
+        [
+            _text,
+            _pct,
+            _pct,
+            _pct,
+            _int,
+            _int,
+            _num(2),
+            _num(2),
+            _num(3),
+            _tok,
+            _num(4),
+            *[_num(2)] * 2,
+        ],
     )
 
 
@@ -208,7 +220,7 @@ def protocol_table(runs: Sequence[Run]) -> Table:
             [label, a.puzzle, a.stacking, a.pass_at_1, b.puzzle, b.stacking, b.pass_at_1, delta]
         )
     return Table(
-        "Interactive vs one-shot (Pass@1, %; Δ = interactive − one-shot, points)",
+        "Interactive vs one-shot (Pass@1, %; Δ = interactive - one-shot, points)",
         [
             "Agent",
             "Interactive Puzzle",
