@@ -236,3 +236,16 @@ def test_a_program_that_dies_is_an_episode_error(tmp_path: Path) -> None:
     evaluate(_levels(1), spec, tmp_path / "x", FAKE, RunConfig(progress=False))
     (rec,) = _records(tmp_path / "x").values()
     assert rec["status"] == "error" and "exited" in rec["error"]
+
+
+def test_dask_runs_the_same_episodes(tmp_path: Path) -> None:
+    distributed = pytest.importorskip("distributed")
+    levels = _levels(2)
+    cfg = RunConfig(samples=2, seed=3, progress=False)
+    evaluate(levels, AgentSpec("random"), tmp_path / "local", FAKE, cfg)
+    with distributed.LocalCluster(
+        n_workers=1, processes=False, threads_per_worker=2, dashboard_address=None
+    ) as cluster:
+        dcfg = RunConfig(samples=2, seed=3, progress=False, dask=cluster.scheduler_address)
+        evaluate(levels, AgentSpec("random"), tmp_path / "dask", FAKE, dcfg)
+    assert _records(tmp_path / "dask") == _records(tmp_path / "local")
