@@ -107,8 +107,9 @@ class RandomAgent(_Seeded):
         return str(actions[int(self._rng.integers(len(actions)))].to_text())
 
 
-def _progress(action: Any) -> int:
-    """+1 for a step forward (place / take a piece out), -1 for a step back (pickup)."""
+def _step_kind(action: Any) -> int:
+    """+1 for a step forward (place / a move out to or in from infinity), -1 for a step back
+    (pickup), 0 otherwise: what an action does when the state says nothing more."""
     kind = type(action).__name__
     if kind == "PlaceAction":
         return 1
@@ -120,8 +121,21 @@ def _progress(action: Any) -> int:
     return 0
 
 
+def _progress(before: StateLike, action: Any, after: StateLike) -> int:
+    """How much closer ``after`` is to the goal: pieces in the box (stacking), parts apart
+    (disassembly) or joined (assembly), read from the state when it offers them."""
+    placed = getattr(after, "placed", None)
+    if isinstance(placed, Mapping):
+        return len(placed) - len(getattr(before, "placed", {}))
+    asm_after, asm_before = getattr(after, "assembly", None), getattr(before, "assembly", None)
+    if asm_after is not None and asm_before is not None:
+        delta = len(asm_after.parts) - len(asm_before.parts)
+        return -delta if getattr(after, "mode", "disassemble") == "assemble" else delta
+    return _step_kind(action)
+
+
 def _options_left(state: StateLike) -> int:
-    return sum(1 for a in state.legal_actions() if _progress(a) >= 0 and not _is_finish(a))
+    return sum(1 for a in state.legal_actions() if _step_kind(a) >= 0 and not _is_finish(a))
 
 
 class GreedyAgent(_Seeded):
@@ -148,7 +162,7 @@ class GreedyAgent(_Seeded):
             if after.is_success():
                 return str(a.to_text())
             novel = 0 if after.key() in self._seen else 1
-            scored.append((_progress(a), novel, float(self._rng.random()), a, after))
+            scored.append((_progress(state, a, after), novel, float(self._rng.random()), a, after))
         scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
         # Options left is the costly part: only for the best few by progress and novelty.
         top = _best_prefix(scored, self.lookahead)
