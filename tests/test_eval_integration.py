@@ -10,15 +10,15 @@ import pytest
 pytest.importorskip("chaingeo.state")
 pytest.importorskip("chaingeo.observation")
 
-from chaingeo.agents.base import AgentSpec  # noqa: E402
-from chaingeo.agents.baselines import oracle_plan  # noqa: E402
-from chaingeo.cli import main  # noqa: E402
-from chaingeo.colors import assign_colors  # noqa: E402
-from chaingeo.evaluation.episode import EpisodeTask, ProtocolConfig, run_episode  # noqa: E402
-from chaingeo.evaluation.runner import RunConfig, evaluate  # noqa: E402
-from chaingeo.geometry import Shape, puzzle_signature  # noqa: E402
-from chaingeo.kinematics import Move  # noqa: E402
-from chaingeo.level import (  # noqa: E402
+from chaingeo.agents.base import AgentSpec
+from chaingeo.agents.baselines import oracle_plan
+from chaingeo.cli import main
+from chaingeo.colors import assign_colors
+from chaingeo.evaluation.episode import EpisodeTask, ProtocolConfig, run_episode
+from chaingeo.evaluation.runner import RunConfig, evaluate
+from chaingeo.geometry import Shape, puzzle_signature
+from chaingeo.kinematics import Move
+from chaingeo.level import (
     Level,
     Piece,
     Provenance,
@@ -28,8 +28,8 @@ from chaingeo.level import (  # noqa: E402
     save_level,
     stacking_level,
 )
-from chaingeo.rules import PuzzleRules  # noqa: E402
-from tests.eval_support.fake_openai import Script, fake_openai, reply  # noqa: E402
+from chaingeo.rules import PuzzleRules
+from tests.eval_support.fake_openai import Script, fake_openai, reply
 
 ROOT = Path(__file__).resolve().parents[1]
 
