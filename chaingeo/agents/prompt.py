@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import base64
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Sequence
 from typing import Any, Final
 
 from chaingeo.agents.base import ObservationLike
@@ -66,36 +66,13 @@ def extract_plan(text: str) -> tuple[tuple[str, ...], str | None]:
     return (), "no <plan>...</plan> found in your reply"
 
 
-def _as_lines(value: Any) -> list[str]:
-    if value is None:
-        return []
-    if isinstance(value, str):
-        return [value] if value else []
-    if isinstance(value, Mapping):
-        return [f"{k}: {v}" for k, v in value.items()]
-    if isinstance(value, Iterable):
-        return [str(v) for v in value]
-    return [str(value)]
-
-
 def observation_text(obs: ObservationLike, feedback: str | None = None) -> str:
-    """The text part of a turn: task, colour table, history, budget, state, last feedback."""
-    parts = [obs.instruction.strip()]
-    table = _as_lines(getattr(obs, "color_table", None))
-    if table:
-        parts.append("Pieces:\n" + "\n".join(table))
-    history = _as_lines(getattr(obs, "history", None))
-    if history:
-        parts.append("Recent turns:\n" + "\n".join(history))
-    text_state = getattr(obs, "text_state", None)
-    if text_state:
-        parts.append("Current state:\n" + "\n".join(_as_lines(text_state)))
+    """The text part of a turn (the observation's own text), plus why the last reply could not
+    be read when that is the case (the environment never saw it, so its history cannot say)."""
+    text = obs.to_text()
     if feedback:
-        parts.append(f"Feedback on your last reply: {feedback}")
-    parts.append(f"Steps left: {obs.steps_left}")
-    if obs.images:
-        parts.append("Views: " + ", ".join(obs.images))
-    return "\n\n".join(p for p in parts if p)
+        text += f"\n\nFeedback on your last reply: {feedback}"
+    return text
 
 
 def user_content(

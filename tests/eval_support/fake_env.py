@@ -117,6 +117,12 @@ class FakeObservation:
     text_state: str | None = None
     images: dict[str, bytes] = field(default_factory=dict)
 
+    def to_text(self) -> str:
+        parts = [self.instruction, "\n".join(f"{k}: {v}" for k, v in self.color_table.items())]
+        parts += self.history + ([self.text_state] if self.text_state else [])
+        parts.append(f"Steps left: {self.steps_left}")
+        return "\n\n".join(parts)
+
 
 def _png(seed: int, view: int) -> bytes:
     img = Image.new("RGB", (8, 8), (seed * 37 % 256, view * 60 % 256, 90))
