@@ -16,6 +16,8 @@ def test_notebook_runs(path: Path, tmp_path: Path) -> None:
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     nb = nbformat.read(path, as_version=4)
+    for module in nb.metadata.get("chaingeo", {}).get("requires", []):
+        pytest.importorskip(module, reason=f"{path.name} needs {module}")
     env_before = os.environ.get("CHAIN_NOTEBOOK_TMP")
     os.environ["CHAIN_NOTEBOOK_TMP"] = str(tmp_path)  # notebooks write their runs here
     try:
