@@ -12,7 +12,9 @@ Protocols:
   but costs a step) until the level is solved, the agent says ``finish`` or the step budget is
   spent. With ``candidates > 1`` each turn asks the agent that many times and commits the
   candidate the judge ranks first after every one was checked in a cloned state.
-- ``oneshot`` (open loop): the agent sees one fixed view once and writes its whole plan, which
+- ``oneshot`` (open loop): the agent sees one fixed view once (plus the tray of pieces, or the
+  assembly target, where the level has one: they say what there is to place, not where things
+  are) and writes its whole plan, which
   is executed action by action with no feedback (a failed action costs its step and the plan
   goes on) until solved, finished, out of budget or out of actions.
 """
@@ -43,6 +45,8 @@ from chaingeo.evaluation.usage import Usage
 from chaingeo.level import Level, content_hash
 
 ProtocolName = Literal["interactive", "oneshot"]
+#: Pictures that show what the pieces or the goal are rather than the scene (kept in one-shot).
+AUXILIARY_VIEWS = ("tray", "target")
 
 
 @dataclass(frozen=True)
@@ -244,7 +248,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                     break
         else:
             obs = see(0)
-            view = {k: v for k, v in obs.images.items() if k == proto.oneshot_view}
+            keep = (proto.oneshot_view, *AUXILIARY_VIEWS)
+            view = {k: v for k, v in obs.images.items() if k in keep}
             obs = _with_images(obs, view)
             shown = images.names(obs)
             plan = agent.plan(
