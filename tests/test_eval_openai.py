@@ -194,3 +194,20 @@ def test_action_and_plan_extraction() -> None:
     )
     assert extract_plan("<action>a</action><action>b</action>") == (("a", "b"), None)
     assert extract_plan("<plan>take red")[1] == "your reply was cut off before </plan>"
+
+
+def test_a_key_from_the_environment_is_scrubbed_from_logs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("MY_KEY_VAR", KEY)
+    script = Script(
+        [reply(f"the key is {KEY} <action>take red</action>"), reply("<action>take green</action>")]
+    )
+    script.expect_key = KEY
+    with fake_openai(script) as url:
+        spec = AgentSpec("openai", {"model": "m", "base_url": url, "api_key_env": "MY_KEY_VAR"})
+        evaluate([_level()], spec, tmp_path / "run", FAKE, RunConfig(progress=False))
+    assert script.problems == []
+    text = (tmp_path / "run" / "episodes.jsonl").read_text()
+    assert KEY not in text and "the key is [REDACTED]" in text
+    assert KEY not in (tmp_path / "run" / "header.json").read_text()

@@ -249,3 +249,16 @@ def test_dask_runs_the_same_episodes(tmp_path: Path) -> None:
         dcfg = RunConfig(samples=2, seed=3, progress=False, dask=cluster.scheduler_address)
         evaluate(levels, AgentSpec("random"), tmp_path / "dask", FAKE, dcfg)
     assert _records(tmp_path / "dask") == _records(tmp_path / "local")
+
+
+def test_replaying_a_run_reproduces_it(tmp_path: Path) -> None:
+    levels = _levels(3)
+    cfg = RunConfig(samples=2, seed=4, progress=False)
+    evaluate(levels, AgentSpec("random"), tmp_path / "orig", FAKE, cfg)
+    spec = AgentSpec("replay", {"file": str(tmp_path / "orig")})
+    evaluate(levels, spec, tmp_path / "again", FAKE, cfg)
+    orig, again = _records(tmp_path / "orig"), _records(tmp_path / "again")
+    assert {k: [s["sent"] for s in r["steps"]] for k, r in orig.items()} == {
+        k: [s["sent"] for s in r["steps"]] for k, r in again.items()
+    }
+    assert {k: r["success"] for k, r in orig.items()} == {k: r["success"] for k, r in again.items()}

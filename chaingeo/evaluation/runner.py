@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import multiprocessing
+import os
 import sys
 import time
 from collections.abc import Iterator, Sequence
@@ -137,6 +138,15 @@ def _execute(tasks: Sequence[EpisodeTask], cfg: RunConfig) -> Iterator[EpisodeRe
                 fut.cancel()
 
 
+def _secrets(agent: AgentSpec) -> list[str]:
+    """Every secret the agent may send anywhere, to be scrubbed from whatever is logged."""
+    out = [v for v in agent.secrets.values() if v]
+    key = os.environ.get(str(agent.options.get("api_key_env", "OPENAI_API_KEY")))
+    if key:
+        out.append(key)
+    return out
+
+
 def evaluate(
     levels: Sequence[Level],
     agent: AgentSpec,
@@ -164,7 +174,7 @@ def evaluate(
         samples=cfg.samples,
         extra={"label": agent.label, "agent_transport": agent.transport()},
     )
-    log = RunLog.create(run_dir, header, resume=cfg.resume, secrets=agent.secrets.values())
+    log = RunLog.create(run_dir, header, resume=cfg.resume, secrets=_secrets(agent))
     done = log.finished_keys(retry_errors=cfg.retry_errors)
     tasks = [
         EpisodeTask(lv, s, cfg.seed, agent, protocol)
