@@ -92,13 +92,14 @@ def test_faults_are_retried_with_backoff(tmp_path: Path) -> None:
             {"fault": "429", "after": "0.2"},
             {"fault": "malformed"},
             {"fault": "timeout", "sleep": 0.8},
+            {"fault": "drop"},
             reply("<action>take red</action>"),
             reply("<action>take green</action>"),
         ]
     )
     (rec,) = _run(tmp_path, script, timeout=0.4)
     assert rec["success"] and rec["steps_used"] == 2
-    assert len(script.requests) == 6  # four faults, then two good answers
+    assert len(script.requests) == 7  # five faults, then two good answers
     assert rec["usage"]["calls"] == 2
 
 

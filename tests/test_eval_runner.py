@@ -262,3 +262,11 @@ def test_replaying_a_run_reproduces_it(tmp_path: Path) -> None:
         k: [s["sent"] for s in r["steps"]] for k, r in again.items()
     }
     assert {k: r["success"] for k, r in orig.items()} == {k: r["success"] for k, r in again.items()}
+
+
+def test_bad_agent_options_fail_before_anything_is_written(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match="needs a model"):
+        evaluate(_levels(1), AgentSpec("openai"), tmp_path / "r", FAKE, RunConfig(progress=False))
+    with pytest.raises(ValueError, match="unknown agent"):
+        evaluate(_levels(1), AgentSpec("nobody"), tmp_path / "r", FAKE, RunConfig(progress=False))
+    assert not (tmp_path / "r").exists()

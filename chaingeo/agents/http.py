@@ -11,6 +11,7 @@ the ``Authorization`` header and never into an error message.
 from __future__ import annotations
 
 import email.utils
+import http.client
 import json
 import time
 import urllib.error
@@ -108,8 +109,8 @@ class ChatClient:
             raise TransientError(f"timeout after {self.timeout}s ({e})") from None
         except urllib.error.URLError as e:
             raise TransientError(f"connection failed: {e.reason}") from None
-        except (ConnectionError, OSError) as e:  # reset mid-response, etc.
-            raise TransientError(f"connection failed: {e}") from None
+        except (ConnectionError, OSError, http.client.HTTPException) as e:  # cut mid-answer
+            raise TransientError(f"connection failed: {type(e).__name__} {e}") from None
         try:
             parsed = json.loads(raw)
         except (json.JSONDecodeError, UnicodeDecodeError):

@@ -162,6 +162,9 @@ def evaluate(
     prices = prices or PriceTable.load()
     if cfg.samples < 1:
         raise ValueError("samples must be >= 1")
+    from chaingeo.agents import make_agent
+
+    make_agent(agent).close()  # bad options fail here, before anything is written
     ids = [lv.id for lv in levels]
     if len(set(ids)) != len(ids):
         raise ValueError("duplicate level ids in the suite")

@@ -110,6 +110,15 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
                     {"Retry-After": str(entry["after"])},
                 )
                 return
+            elif fault == "drop":  # promise a long body, send half, hang up
+                self.send_response(200)
+                self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", "4000")
+                self.end_headers()
+                self.wfile.write(b'{"choices": [')
+                self.wfile.flush()
+                self.close_connection = True
+                return
             elif fault == "malformed":
                 self._send(200, b'{"choices": [ {"message": ')
                 return
