@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.agents.base import AgentError, AgentSpec
+from chaingeo.agents import AGENTS
+from chaingeo.agents.base import Agent, AgentError, AgentSpec, Reply, Turn
 from chaingeo.agents.http import ChatClient, RetryPolicy, parse_retry_after
 from chaingeo.agents.prompt import extract_action, extract_plan
 from chaingeo.evaluation.episode import ProtocolConfig
@@ -212,3 +213,57 @@ def test_a_key_from_the_environment_is_scrubbed_from_logs(
     text = (tmp_path / "run" / "episodes.jsonl").read_text()
     assert KEY not in text and "the key is [REDACTED]" in text
     assert KEY not in (tmp_path / "run" / "header.json").read_text()
+
+
+class _TwoWays(Agent):
+    """Candidate 0 is illegal; 1 and 2 are the first and last legal 'take'."""
+
+    name = "two-ways"
+    needs_state = True
+    uses_images = False
+
+    def act(self, turn: Turn) -> Reply:
+        assert turn.state is not None
+        acts = [a.to_text() for a in turn.state.legal_actions() if a.to_text() != "finish"]
+        text = ["take nobody", acts[0], acts[-1]][turn.candidate]
+        return Reply(text, text)
+
+
+def test_a_model_judge_picks_among_verified_candidates(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(AGENTS, "two-ways", lambda spec: _TwoWays())
+    level = stacking_level(
+        "t3", "easy", (3, 1, 1), [Shape([(0, 0, 0)]), Shape([(1, 0, 0)]), Shape([(2, 0, 0)])]
+    )
+    script = Script([reply("the last one <choice>2</choice>", 500, 10), reply("no idea", 400, 5)])
+    with fake_openai(script) as url:
+        proto = ProtocolConfig(
+            candidates=3,
+            judge="model",
+            judge_options={"model": "fake-model", "base_url": url, "backoff_base": 0.01},
+            env=FAKE.env,
+        )
+        evaluate([level], AgentSpec("two-ways"), tmp_path / "j", proto, RunConfig(progress=False))
+    assert script.problems == [] and len(script.requests) == 2
+    listing = script.requests[0]["body"]["messages"][1]["content"][-1]["text"]
+    assert listing.startswith("Candidates:\n1. take ") and "take nobody" not in listing
+    rec = json.loads((tmp_path / "j" / "episodes.jsonl").read_text())
+    chosen = [[c["chosen"] for c in s["candidates"]] for s in rec["steps"]]
+    # turn 1: the judge's choice (the last take); turn 2: no readable choice, verifier order;
+    # turn 3: one distinct legal action left, no call
+    assert chosen == [[False, False, True], [False, True, False], [False, True, False]]
+    assert rec["success"] and rec["steps_used"] == 3
+    assert rec["judge"] == {
+        "model": "fake-model",
+        "usage": {
+            "input_tokens": 900,
+            "output_tokens": 15,
+            "reasoning_tokens": 0,
+            "cached_tokens": 0,
+            "calls": 2,
+        },
+    }
+    assert rec["cost_usd"] is None  # fake-model has no price in the shipped table
+    head = json.loads((tmp_path / "j" / "header.json").read_text())
+    assert head["protocol"]["judge_options"] == {"model": "fake-model"}

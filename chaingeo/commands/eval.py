@@ -49,7 +49,16 @@ def register(sub: Any) -> None:
     p.add_argument("--samples", type=int, default=1, help="episodes per level (Pass@k, Avg@k)")
     p.add_argument("--candidates", type=int, default=1, help="candidates per turn (verifier)")
     p.add_argument(
-        "--judge", default="first", help="ranks verified candidates (first/vote/progress)"
+        "--judge",
+        default="first",
+        help="ranks verified candidates: first, vote, progress, or model (a VLM judge)",
+    )
+    p.add_argument(
+        "--judge-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="judge option, e.g. model=NAME base_url=URL (for --judge model), repeatable",
     )
     p.add_argument("--history-window", type=int, default=5)
     p.add_argument("--text-state", action="store_true", help="add every piece's cells as text")
@@ -159,6 +168,7 @@ def run(args: argparse.Namespace) -> int:
                     text_state=args.text_state,
                     candidates=args.candidates,
                     judge=args.judge,
+                    judge_options=dict(_option(o) for o in args.judge_option),
                 )
             except ValueError as e:
                 raise CommandError(str(e)) from None

@@ -31,6 +31,7 @@ from typing import Any, Literal
 import numpy as np
 
 from chaingeo.agents.base import (
+    TRANSPORT,
     AgentError,
     AgentSpec,
     ObservationLike,
@@ -40,7 +41,7 @@ from chaingeo.agents.base import (
     Turn,
 )
 from chaingeo.evaluation.logs import episode_key
-from chaingeo.evaluation.selection import make_judge, verify
+from chaingeo.evaluation.selection import Judge, make_judge, verify
 from chaingeo.evaluation.usage import Usage
 from chaingeo.level import Level, content_hash
 
@@ -56,6 +57,7 @@ class ProtocolConfig:
     text_state: bool = False
     candidates: int = 1  # > 1: verifier-based selection among this many per turn
     judge: str = "first"
+    judge_options: Mapping[str, Any] = field(default_factory=dict)
     oneshot_view: str = "iso"
     #: The module providing ``new_state`` and ``observe`` (tests may point at a double).
     env: str = "chaingeo"
@@ -65,7 +67,7 @@ class ProtocolConfig:
             raise ValueError(f"unknown protocol {self.name!r}; use interactive or oneshot")
         if self.candidates < 1 or self.history_window < 0:
             raise ValueError("candidates must be >= 1 and history_window >= 0")
-        make_judge(self.judge)
+        make_judge(self.judge, self.judge_options)
 
     def to_json(self) -> dict[str, Any]:
         out: dict[str, Any] = {"name": self.name, "text_state": self.text_state}
@@ -73,6 +75,9 @@ class ProtocolConfig:
             out.update(
                 history_window=self.history_window, candidates=self.candidates, judge=self.judge
             )
+            opts = {k: v for k, v in sorted(self.judge_options.items()) if k not in TRANSPORT}
+            if opts:
+                out["judge_options"] = opts
         else:
             out["view"] = self.oneshot_view
         if self.env != "chaingeo":
@@ -181,6 +186,7 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
     agent = make_agent(task.agent)
     record["model"] = agent.model
     finished = False
+    judge: Judge | None = None
     status, error = "done", None
     try:
         agent.start(level, seed)
@@ -192,7 +198,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
             return obs
 
         if proto.name == "interactive":
-            judge = make_judge(proto.judge)
+            judge = make_judge(proto.judge, proto.judge_options)
+            judge.start(seed)
             note: str | None = None
             turn = 0
             while not (state.is_success() or state.is_truncated()):
@@ -220,7 +227,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                 chosen = replies[0]
                 if len(replies) > 1:
                     checked = verify(state, replies)
-                    best = judge.rank(state, checked)[0]
+                    spent = judge.usage
+                    best = judge.rank(state, checked, obs)[0]
                     chosen = replies[best]
                     cands = [
                         {
@@ -240,6 +248,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                 if cands:
                     rec["candidates"] = cands
                     rec["usage"] = sum((r.usage for r in replies), Usage()).to_json()
+                    if judge.usage != spent:
+                        rec["judge_usage"] = _spent(judge.usage, spent).to_json()
                 steps.append(rec)
                 note = chosen.note if chosen.action is None else None
                 turn += 1
@@ -275,6 +285,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
         status, error = "error", str(e)
     finally:
         agent.close()
+    if judge is not None and judge.usage.calls:
+        record["judge"] = {"model": judge.model, "usage": judge.usage.to_json()}
     record.update(
         status=status,
         error=error,
@@ -291,6 +303,16 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
         steps=steps,
     )
     return EpisodeResult(record, images.files)
+
+
+def _spent(now: Usage, before: Usage) -> Usage:
+    return Usage(
+        now.input_tokens - before.input_tokens,
+        now.output_tokens - before.output_tokens,
+        now.reasoning_tokens - before.reasoning_tokens,
+        now.cached_tokens - before.cached_tokens,
+        now.calls - before.calls,
+    )
 
 
 def _with_images(obs: ObservationLike, images: Mapping[str, bytes]) -> ObservationLike:

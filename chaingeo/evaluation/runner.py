@@ -40,6 +40,10 @@ class RunConfig:
 
 
 def outcome_of(record: dict[str, Any]) -> Outcome:
+    """The metrics' view of a record; a model judge's tokens count with the agent's."""
+    usage = Usage.from_json(record.get("usage", {}))
+    if record.get("judge"):
+        usage = usage + Usage.from_json(record["judge"]["usage"])
     return Outcome(
         level_id=str(record["level_id"]),
         family=str(record["family"]),
@@ -48,7 +52,7 @@ def outcome_of(record: dict[str, Any]) -> Outcome:
         success=bool(record["success"]),
         steps=int(record["steps_used"]),
         sample=int(record.get("sample", 0)),
-        usage=Usage.from_json(record.get("usage", {})),
+        usage=usage,
         cost_usd=record.get("cost_usd"),
     )
 
@@ -138,12 +142,23 @@ def _execute(tasks: Sequence[EpisodeTask], cfg: RunConfig) -> Iterator[EpisodeRe
                 fut.cancel()
 
 
-def _secrets(agent: AgentSpec) -> list[str]:
-    """Every secret the agent may send anywhere, to be scrubbed from whatever is logged."""
+def _cost(prices: PriceTable, rec: dict[str, Any]) -> float | None:
+    """The agent's tokens at its model's price, plus a model judge's at the judge's."""
+    cost = prices.cost(rec.get("model"), Usage.from_json(rec["usage"]))
+    judge = rec.get("judge")
+    if judge and cost is not None:
+        extra = prices.cost(judge.get("model"), Usage.from_json(judge["usage"]))
+        cost = None if extra is None else cost + extra
+    return cost
+
+
+def _secrets(agent: AgentSpec, protocol: ProtocolConfig) -> list[str]:
+    """Every secret the agent or a model judge may send, to be scrubbed from whatever is logged."""
     out = [v for v in agent.secrets.values() if v]
-    key = os.environ.get(str(agent.options.get("api_key_env", "OPENAI_API_KEY")))
-    if key:
-        out.append(key)
+    for options in (agent.options, protocol.judge_options):
+        key = os.environ.get(str(options.get("api_key_env", "OPENAI_API_KEY")))
+        if key:
+            out.append(key)
     return out
 
 
@@ -177,7 +192,7 @@ def evaluate(
         samples=cfg.samples,
         extra={"label": agent.label, "agent_transport": agent.transport()},
     )
-    log = RunLog.create(run_dir, header, resume=cfg.resume, secrets=_secrets(agent))
+    log = RunLog.create(run_dir, header, resume=cfg.resume, secrets=_secrets(agent, protocol))
     done = log.finished_keys(retry_errors=cfg.retry_errors)
     tasks = [
         EpisodeTask(lv, s, cfg.seed, agent, protocol)
@@ -193,7 +208,7 @@ def evaluate(
         for png in result.images.values():
             log.put_image(png)  # stored under its SHA-256, the name the record uses
         rec = result.record
-        rec["cost_usd"] = prices.cost(rec.get("model"), Usage.from_json(rec["usage"]))
+        rec["cost_usd"] = _cost(prices, rec)
         log.append(rec)
         bar.add(rec)
     bar.show(final=True)

@@ -8,18 +8,23 @@ commits the first one. Built-in judges:
 - ``first``: verified-legal candidates first, otherwise in sampling order (plain verifier);
 - ``vote``: verified-legal first, then the action proposed most often (self-consistency);
 - ``progress``: a reward model without a network: prefers a candidate that solves the level,
-  then one after which the most legal actions remain (keeps options open), then sampling order.
+  then one after which the most legal actions remain (keeps options open), then sampling order;
+- ``model``: a vision-language judge on any OpenAI-compatible server
+  (:mod:`chaingeo.agents.model_judge`; options ``judge_options``: model, base_url, ...).
 
-Register another (an LLM judge, a trained reward model) with :func:`register_judge`.
+Register another (a trained reward model, ...) with :func:`register_judge`: a factory taking
+the judge options. A judge that calls a model adds what it spent to ``usage``.
 """
 
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
-from chaingeo.agents.base import Reply, StateLike, StepResultLike
+from chaingeo.agents.base import ObservationLike, Reply, StateLike, StepResultLike
+from chaingeo.evaluation.usage import Usage
 
 
 @dataclass(frozen=True)
@@ -36,8 +41,18 @@ class Candidate:
 
 class Judge:
     name = "judge"
+    model: str | None = None  # for pricing what it spends
+    usage: Usage = Usage()  # tokens spent so far (judges that call a model add to it)
 
-    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+    def start(self, seed: int) -> None:
+        """A new episode begins."""
+
+    def rank(
+        self,
+        state: StateLike,
+        candidates: Sequence[Candidate],
+        observation: ObservationLike | None = None,
+    ) -> list[int]:
         """Candidate indices, best first (every index exactly once)."""
         raise NotImplementedError
 
@@ -45,14 +60,24 @@ class Judge:
 class FirstLegal(Judge):
     name = "first"
 
-    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+    def rank(
+        self,
+        state: StateLike,
+        candidates: Sequence[Candidate],
+        observation: ObservationLike | None = None,
+    ) -> list[int]:
         return [c.index for c in sorted(candidates, key=lambda c: (not c.legal, c.index))]
 
 
 class Vote(Judge):
     name = "vote"
 
-    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+    def rank(
+        self,
+        state: StateLike,
+        candidates: Sequence[Candidate],
+        observation: ObservationLike | None = None,
+    ) -> list[int]:
         votes = Counter(c.result.action.to_text() for c in candidates if c.legal and c.result)
 
         def key(c: Candidate) -> tuple[bool, int, int]:
@@ -65,7 +90,12 @@ class Vote(Judge):
 class Progress(Judge):
     name = "progress"
 
-    def rank(self, state: StateLike, candidates: Sequence[Candidate]) -> list[int]:
+    def rank(
+        self,
+        state: StateLike,
+        candidates: Sequence[Candidate],
+        observation: ObservationLike | None = None,
+    ) -> list[int]:
         def key(c: Candidate) -> tuple[bool, bool, int, int]:
             if c.after is None:
                 return (True, True, 0, c.index)
@@ -74,22 +104,30 @@ class Progress(Judge):
         return [c.index for c in sorted(candidates, key=key)]
 
 
-JUDGES: dict[str, Callable[[], Judge]] = {
-    "first": FirstLegal,
-    "vote": Vote,
-    "progress": Progress,
+def _model_judge(options: Mapping[str, Any]) -> Judge:
+    from chaingeo.agents.model_judge import ModelJudge
+
+    return ModelJudge(options)
+
+
+JUDGES: dict[str, Callable[[Mapping[str, Any]], Judge]] = {
+    "first": lambda options: FirstLegal(),
+    "vote": lambda options: Vote(),
+    "progress": lambda options: Progress(),
+    "model": _model_judge,
 }
 
 
-def register_judge(name: str, factory: Callable[[], Judge]) -> None:
+def register_judge(name: str, factory: Callable[[Mapping[str, Any]], Judge]) -> None:
     JUDGES[name] = factory
 
 
-def make_judge(name: str) -> Judge:
+def make_judge(name: str, options: Mapping[str, Any] | None = None) -> Judge:
     try:
-        return JUDGES[name]()
+        factory = JUDGES[name]
     except KeyError:
         raise ValueError(f"unknown judge {name!r}; known: {sorted(JUDGES)}") from None
+    return factory(options or {})
 
 
 def verify(state: StateLike, replies: Sequence[Reply]) -> list[Candidate]:
