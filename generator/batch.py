@@ -203,11 +203,11 @@ def dask_workers(address: str) -> int:
 
 
 def _distributed() -> Any:
-    """The ``distributed`` package (the ``dask`` extra), untyped: its annotations are partial."""
+    """The ``distributed`` package (the ``cluster`` extra), untyped: its annotations are partial."""
     try:
         return importlib.import_module("distributed")
     except ImportError:
-        raise GenerationError("--dask needs the dask extra: pip install 'chaingeo[dask]'") from None
+        raise GenerationError("--dask needs the cluster extra: pip install 'chaingeo[cluster]'") from None
 
 
 # ---------------------------------------------------------------------------------------------
