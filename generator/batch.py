@@ -207,7 +207,9 @@ def _distributed() -> Any:
     try:
         return importlib.import_module("distributed")
     except ImportError:
-        raise GenerationError("--dask needs the cluster extra: pip install 'chaingeo[cluster]'") from None
+        raise GenerationError(
+            "--dask needs the cluster extra: pip install 'chaingeo[cluster]'"
+        ) from None
 
 
 # ---------------------------------------------------------------------------------------------
