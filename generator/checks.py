@@ -69,7 +69,16 @@ def level_problems(level: Level, config: StackingConfig) -> list[str]:
         return out
     if nodes < config.min_nodes:
         out.append(f"{nodes} exact-cover nodes, below the config's {config.min_nodes}")
-    recorded = level.stats.get("exact_cover", {}).get("nodes_first")
+    figures = level.stats.get("exact_cover", {})
+    recorded = figures.get("nodes_first")
     if recorded is not None and recorded != nodes:
         out.append(f"stats record {recorded} nodes to the first packing, the engine takes {nodes}")
+    if figures.get("solutions") is not None:
+        budget = 2 * int(figures.get("count_budget") or 0) or None
+        counted = packing.count_packings(shapes, level.box, budget)
+        if counted != (figures["solutions"], figures.get("distinct")):
+            out.append(
+                f"stats record {figures['solutions']} packings ({figures.get('distinct')} "
+                f"distinct), the engine counts {counted}"
+            )
     return out

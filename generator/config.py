@@ -46,7 +46,7 @@ class StackingConfig:
     attempts: int = 400
     repair_moves: int = 64
     easy_packings: int = 64
-    count_limit: int = 2_000_000
+    count_limit: int = 200_000
     support: SupportRule = "contact"
 
     def __post_init__(self) -> None:

@@ -3,9 +3,10 @@
 Two questions are asked of it: how hard is a packing to find (nodes of a plain dancing-links
 search with MRV column choice to the first packing, the CHAIN generator's difficulty proxy;
 the engine is pinned and the pieces are listed in canonical order, so the figure depends only
-on the multiset of pieces and the box) and how many packings exist
-(counted with symmetry reduction, up to a node budget). Easy mode also draws packings of a
-piece multiset in a seeded random order.
+on the multiset of pieces and the box) and how many packings exist (counted by the fastest
+engine with symmetry reduction, up to a node budget; only a finished count is recorded, since
+it alone is the same whatever the engine). Easy mode also draws packings of a piece multiset
+in a seeded random order, on the pinned engine so the draw does not change with the other.
 """
 
 from __future__ import annotations
@@ -34,7 +35,7 @@ class SearchEffort:
     nodes_first: int  # dancing-links nodes to the first packing (no symmetry reduction)
     solutions: int | None  # every packing; None when counting exceeded the node budget
     distinct: int | None  # packings up to the box's rotations (and reflections if they apply)
-    nodes_count: int  # nodes spent counting (with symmetry reduction)
+    count_budget: int  # the node budget the count had (0: not counted)
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -42,7 +43,7 @@ class SearchEffort:
             "nodes_first": self.nodes_first,
             "solutions": self.solutions,
             "distinct": self.distinct,
-            "nodes_count": self.nodes_count,
+            "count_budget": self.count_budget,
         }
 
 
@@ -75,12 +76,23 @@ def search_effort(
     (the count is then None) and 0 skips it."""
     if count_limit <= 0:
         return SearchEffort(nodes_first, None, None, 0)
+    counted = count_packings(shapes, box, count_limit)
+    if counted is None:
+        return SearchEffort(nodes_first, None, None, count_limit)
+    return SearchEffort(nodes_first, counted[0], counted[1], count_limit)
+
+
+def count_packings(
+    shapes: Sequence[Shape], box: Sequence[int], node_limit: int | None
+) -> tuple[int, int | None] | None:
+    """``(packings, distinct packings)``, or None when the count needs more than
+    ``node_limit`` nodes (None: no limit)."""
     dims = tuple(int(v) for v in box)
     try:
-        res = count_solutions(_named(shapes)[0], dims, node_limit=count_limit)
-    except CoverLimitError as e:
-        return SearchEffort(nodes_first, None, None, e.stats.nodes)
-    return SearchEffort(nodes_first, res.solutions, res.distinct, res.stats.nodes)
+        res = count_solutions(_named(shapes)[0], dims, node_limit=node_limit)
+    except CoverLimitError:
+        return None
+    return res.solutions, res.distinct
 
 
 def random_packings(
@@ -91,7 +103,7 @@ def random_packings(
     pieces, names = _named(shapes)
     dims = tuple(int(v) for v in box)
     rng = np.random.default_rng(seed)
-    for n, sol in enumerate(random_solutions(pieces, dims, rng)):
+    for n, sol in enumerate(random_solutions(pieces, dims, rng, engine=EFFORT_ENGINE)):
         if n >= limit:
             return
         placed = dict(sol.placements)

@@ -20,9 +20,10 @@ The stored solution is the carved (or, in easy mode, the engine's) packing; piec
 in a random order (colours carry no hint) and handed to the agent in a random rotation.
 ``Level.stats``: ``mode``, ``min_piece`` (the stage that succeeded), ``pieces``, ``attempts``,
 ``rejected_attempts`` (reason -> count for the failed attempts before), ``repair_moves``,
-``exact_cover`` (``nodes_first``: dancing-links nodes to a first packing, ``solutions`` and
-``distinct`` packings, ``nodes_count``; see :mod:`generator.packing`) and ``linear_assembly``
-(``[piece, direction it slides in]`` in insertion order, or None).
+``exact_cover`` (``nodes_first``: dancing-links nodes to a first packing; ``solutions`` and
+``distinct`` packings when counted within ``count_budget`` nodes, else None; see
+:mod:`generator.packing`) and ``linear_assembly`` (``[piece, direction it slides in]`` in
+insertion order, or None).
 """
 
 from __future__ import annotations
