@@ -45,9 +45,57 @@ def _lowest_bit(x: np.uint64, table: Any) -> int:
 
 
 @njit(cache=True)
+def _popcount(x: np.uint64) -> int:
+    x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+    return int((x * np.uint64(0x0101010101010101)) >> np.uint64(56))
+
+
+@njit(cache=True)
+def _grow(x: np.uint64, nb: Any) -> np.uint64:
+    """``x`` with its face neighbours in the box (``nb``: edge masks and strides)."""
+    return (
+        x
+        | ((x & nb[0]) << np.uint64(1))
+        | ((x & nb[1]) >> np.uint64(1))
+        | ((x & nb[2]) << nb[6])
+        | ((x & nb[3]) >> nb[6])
+        | ((x & nb[4]) << nb[7])
+        | ((x & nb[5]) >> nb[7])
+    )
+
+
+@njit(cache=True)
+def _regions_ok(placed: np.uint64, empty: np.uint64, nb: Any, gcd: int, smallest: int) -> bool:
+    """Can every empty region touching the piece just placed still be filled?
+
+    A region must hold at least ``smallest`` cells and a multiple of ``gcd`` (the gcd of all
+    piece sizes); when ``gcd`` is 1 the fill stops as soon as the region is big enough.
+    """
+    seeds = _grow(placed, nb) & empty
+    while seeds != 0:
+        region = seeds & (~seeds + np.uint64(1))
+        while True:
+            grown = _grow(region, nb) & empty
+            if grown == region:
+                break
+            region = grown
+            if gcd == 1 and _popcount(region) >= smallest:
+                break
+        size = _popcount(region)
+        if size < smallest or size % gcd != 0:
+            return False
+        seeds &= ~region
+    return True
+
+
+@njit(cache=True)
 def bitboard_run(
-    mask: Any, rtype: Any, rid: Any, cand_ptr: Any, cand: Any, primary: np.uint64,
+    mask: Any, rtype: Any, rid: Any, cand_ptr: Any, cand: Any, skip: Any, root: Any,
+    primary: np.uint64,
     lo: Any, hi: Any, cnt: Any, counters: Any, table: Any,
+    nb: Any, region_gcd: int, region_min: int,
     occ: Any, buf: Any, nbuf: Any, pos: Any, base: Any, chosen: Any,
     regs: Any, rng: Any, shuffle: bool,
     out: Any, max_store: int, stop_after: int, node_limit: int,
@@ -63,9 +111,13 @@ def bitboard_run(
     if status == FRESH:
         k = 0
         occ[0] = np.uint64(0)
-        cell = _lowest_bit(primary, table)
-        base[0] = cand_ptr[cell]
-        nbuf[0] = cand_ptr[cell + 1] - cand_ptr[cell]
+        if root[1] > root[0]:  # branch on one piece type first
+            base[0] = root[0]
+            nbuf[0] = root[1] - root[0]
+        else:
+            cell = _lowest_bit(primary, table)
+            base[0] = cand_ptr[cell]
+            nbuf[0] = cand_ptr[cell + 1] - cand_ptr[cell]
         pos[0] = 0
         if shuffle:
             for i in range(nbuf[0]):
@@ -78,23 +130,32 @@ def bitboard_run(
         if pos[k] < nbuf[k]:
             if shuffle:
                 r = buf[k, pos[k]]
+                pos[k] += 1
+                t = rtype[r]
+                if cnt[t] >= hi[t]:
+                    continue
             else:
                 r = cand[base[k] + pos[k]]
-            pos[k] += 1
+                t = rtype[r]
+                if cnt[t] >= hi[t]:
+                    pos[k] = skip[base[k] + pos[k]] - base[k]  # past this type's run
+                    continue
+                pos[k] += 1
             updates += 1
-            t = rtype[r]
-            if cnt[t] >= hi[t] or (mask[r] & occ[k]) != 0:
+            if (mask[r] & occ[k]) != 0:
+                continue
+            o = occ[k] | mask[r]
+            free = primary & ~o
+            if region_min > 0 and free != 0 and not _regions_ok(mask[r], free, nb, region_gcd, region_min):
                 continue
             if nodes >= node_limit:
                 pos[k] -= 1
-                updates -= 1
+                updates -= 1  # the row is tried again on resumption
                 regs[REG_STATUS] = LIMIT
                 break
             nodes += 1
             cnt[t] += 1
             chosen[k] = r
-            o = occ[k] | mask[r]
-            free = primary & ~o
             if free == 0:
                 ok = True
                 for q in counters:
@@ -136,11 +197,21 @@ def bitboard_run(
     return n_out
 
 
+def scan_axes(problem: CoverProblem) -> list[int]:
+    """The axes in scan order, fastest first: the shortest bounding-box axis first."""
+    ext = problem.target.extent
+    axes = sorted(range(3), key=lambda a: (ext[a], a))
+    import os
+    o = os.environ.get("CHAIN_SCAN")
+    if o:
+        axes = [axes[int(c)] for c in o]
+    return axes
+
+
 def scan_order(problem: CoverProblem) -> Int32Array:
-    """``bit[cell]``: cells ranked with the shortest bounding-box axis varying fastest."""
+    """``bit[cell]``: cells ranked in :func:`scan_axes` order."""
     vox = problem.target.voxels - problem.target.min_corner
-    ext = np.asarray(problem.target.extent)
-    axes = sorted(range(3), key=lambda a: (ext[a], a))  # fastest first
+    axes = scan_axes(problem)
     rank = np.lexsort([vox[:, a] for a in axes])  # last key is the primary sort key
     bit = np.empty(len(vox), dtype=np.int32)
     bit[rank] = np.arange(len(vox), dtype=np.int32)
@@ -170,14 +241,34 @@ class BitboardArrays:
         keep = pm != 0  # rows entirely on optional cells are unreachable
         rows, masks, pm = rows[keep], masks[keep], pm[keep]
         low = np.array([_lowest_bit(np.uint64(x), _DEBRUIJN_TABLE) for x in pm], dtype=np.int64)
-        order = np.lexsort((rows, low))  # by lowest mandatory cell, then row id
+        rtype = problem.row_type[rows].astype(np.int64)
+        order = np.lexsort((rows, rtype, low))  # by lowest mandatory cell, type, row id
         self.mask = np.ascontiguousarray(masks[order])
         self.rid = np.ascontiguousarray(rows[order])
-        self.rtype = np.ascontiguousarray(problem.row_type[self.rid]).astype(np.int32)
-        self.cand = np.arange(len(order), dtype=np.int32)
-        counts = np.bincount(low[order], minlength=MAX_CELLS)
+        self.rtype = np.ascontiguousarray(rtype[order]).astype(np.int32)
+        counts = np.bincount(low, minlength=MAX_CELLS)
         self.cand_ptr = np.zeros(MAX_CELLS + 1, dtype=np.int64)
         np.cumsum(counts, out=self.cand_ptr[1:])
+        # Root branching: the exact-once type with fewest rows, if it has at most a quarter as
+        # many as the first cell (a symmetry-reduced anchor, typically).
+        n = len(order)
+        first_cell = _lowest_bit(primary, _DEBRUIJN_TABLE)
+        best, best_n = -1, int(counts[first_cell]) // 4 + 1
+        for t, ty in enumerate(problem.types):
+            nt = int(np.count_nonzero(self.rtype == t))
+            if ty.lo == 1 and ty.hi == 1 and nt < best_n:
+                best, best_n = t, nt
+        root_rows = np.flatnonzero(self.rtype == best).astype(np.int32) if best >= 0 else []
+        self.cand = np.concatenate([np.arange(n), root_rows]).astype(np.int32)
+        self.root = np.array([n, n + len(root_rows)], dtype=np.int64)
+        # skip[i]: end of the run of candidates of one type (in one list) containing position i.
+        key = np.concatenate([low[order] * (len(problem.types) + 1) + self.rtype, np.full(len(root_rows), -1)])
+        self.skip = np.empty(len(self.cand), dtype=np.int64)
+        end = len(self.cand)
+        for i in range(len(self.cand) - 1, -1, -1):
+            if i + 1 < len(self.cand) and (key[i + 1] != key[i] or i + 1 == n):
+                end = i + 1
+            self.skip[i] = end
         self.primary = primary
         T = len(problem.types)
         self.lo = np.array([t.lo for t in problem.types], dtype=np.int32)
@@ -187,3 +278,26 @@ class BitboardArrays:
         self.max_depth = min(n_primary, int(self.hi.sum()))
         self.max_col = int(counts.max()) if len(counts) else 0
         self.table = _DEBRUIJN_TABLE
+        self.nb, self.region_gcd, self.region_min = region_pruning(problem)
+
+
+def region_pruning(problem: CoverProblem) -> tuple[np.ndarray, int, int]:  # type: ignore[type-arg]
+    """Edge masks and strides of a box target in scan order, the gcd and the least of the piece
+    sizes; ``region_min`` is 0 (pruning off) for non-box targets, optional cells, or when no
+    region size could ever be ruled out."""
+    nb = np.zeros(8, dtype=np.uint64)
+    ext = problem.target.extent
+    if problem.optional or problem.n_cells != ext[0] * ext[1] * ext[2]:
+        return nb, 1, 0
+    sizes = [len(t.shape) for t in problem.types]
+    gcd = int(np.gcd.reduce(sizes))
+    smallest = min(sizes)
+    if gcd == 1 and smallest == 1:
+        return nb, 1, 0
+    e0, e1, e2 = (ext[a] for a in scan_axes(problem))
+    i = np.arange(problem.n_cells)
+    i0, i1, i2 = i % e0, (i // e0) % e1, i // (e0 * e1)
+    for slot, sel in enumerate([i0 < e0 - 1, i0 > 0, i1 < e1 - 1, i1 > 0, i2 < e2 - 1, i2 > 0]):
+        nb[slot] = np.uint64(sum(1 << int(b) for b in i[sel]))
+    nb[6], nb[7] = np.uint64(e0), np.uint64(e0 * e1)
+    return nb, gcd, smallest

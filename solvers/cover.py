@@ -128,13 +128,14 @@ class AnchorPlan:
     fixed_orbit: Int32Array  # orbit size of each fixed rep
 
 
-def anchor_plan(problem: CoverProblem) -> AnchorPlan | None:
-    """Pick the anchor giving the fewest orbit representatives (achiral anchors first)."""
+def anchor_plan(problem: CoverProblem, prefer: str | None = None) -> AnchorPlan | None:
+    """Pick the anchor giving the fewest orbit representatives (achiral anchors first), or the
+    piece named ``prefer`` if it can be one."""
     syms, maps = problem.symmetry
     if len(syms) == 1:
         return None
     proper = np.array([round(np.linalg.det(m)) > 0 for m, _ in syms])
-    best: tuple[tuple[int, int, int], AnchorPlan] | None = None
+    best: tuple[tuple[int, int, int, int], AnchorPlan] | None = None
     for t, ty in enumerate(problem.types):
         if not (ty.lo == 1 and ty.hi == 1):
             continue
@@ -151,7 +152,7 @@ def anchor_plan(problem: CoverProblem) -> AnchorPlan | None:
         fixed = reps[stab > 1].astype(np.int32)
         orbit = (len(group) // stab[stab > 1]).astype(np.int32)
         plan = AnchorPlan(t, group, full, free, fixed, orbit)
-        score = (0 if full else 1, len(reps), len(fixed))
+        score = (0 if ty.slots[0] == prefer else 1, 0 if full else 1, len(reps), len(fixed))
         if best is None or score < best[0]:
             best = (score, plan)
     return None if best is None else best[1]
@@ -203,11 +204,12 @@ def count_solutions(
     engine: Engine = "auto",
     node_limit: int | None = None,
     symmetry: bool = True,
+    anchor: str | None = None,
 ) -> CoverResult:
     """Count all solutions and (if asked) the distinct ones up to the target's symmetries."""
     problem = _problem(pieces, target, optional, reflections)
     syms, _ = problem.symmetry
-    plan = anchor_plan(problem) if symmetry else None
+    plan = anchor_plan(problem, anchor) if symmetry else None
     budget = _Budget(node_limit)
     if plan is None:
         search = budget.search(problem, None, engine)
