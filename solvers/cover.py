@@ -41,10 +41,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.geometry import Shape
+from solvers.placements import Int32Array
 from solvers.problem import (
     CoverError,
     CoverProblem,
-    Int32Array,
     PiecesLike,
     PieceSpec,
     TargetLike,
@@ -108,7 +108,9 @@ def make_solution(problem: CoverProblem, rows: Int32Array) -> Solution:
     for t, ty in enumerate(problem.types):
         for slot, r in zip(ty.slots, per_type.get(t, []), strict=False):
             named.append((slot, problem.placed_shape(r)))
-    order = {name: i for i, name in enumerate(dict.fromkeys(n for ty in problem.types for n in ty.slots))}
+    order = {
+        name: i for i, name in enumerate(dict.fromkeys(n for ty in problem.types for n in ty.slots))
+    }
     named.sort(key=lambda p: order[p[0]])
     return Solution(tuple(named), tuple(ids))
 
@@ -183,11 +185,15 @@ def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> in
     if not blocks:
         return 0
     width = max(b.shape[1] for b in blocks)
-    sols = np.concatenate([np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks])
+    sols = np.concatenate(
+        [np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks]
+    )
     return len(np.unique(canonical_forms(problem, sols), axis=0))
 
 
-def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, anchor_rows: Int32Array) -> Int32Array:
+def _restricted_rows(
+    problem: CoverProblem, plan: AnchorPlan, anchor_rows: Int32Array
+) -> Int32Array:
     a, b = int(problem.row_start[plan.type_index]), int(problem.row_start[plan.type_index + 1])
     rows = np.arange(problem.n_rows, dtype=np.int32)
     others = np.concatenate([rows[:a], rows[b:]])
@@ -216,9 +222,9 @@ def count_solutions(
         if not distinct:
             total = budget.count(search)
             return CoverResult(total, None, budget.stats, len(syms), None)
-        blocks = budget.collect(search)
+        every = budget.collect(search)
         return CoverResult(
-            search.found, _count_distinct_forms(problem, blocks), budget.stats, len(syms), None
+            search.found, _count_distinct_forms(problem, every), budget.stats, len(syms), None
         )
     anchor_name = problem.types[plan.type_index].slots[0]
     h = len(plan.group)

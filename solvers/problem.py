@@ -17,7 +17,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from typing import Union
 
 import numpy as np
 import numpy.typing as npt
@@ -48,8 +47,8 @@ class PieceSpec:
     max: int = 1
 
 
-PiecesLike = Union[Mapping[str, Shape], Sequence[Union[Shape, PieceSpec]]]
-TargetLike = Union[Shape, Sequence[int]]
+PiecesLike = Mapping[str, Shape] | Sequence[Shape | PieceSpec]
+TargetLike = Shape | Sequence[int]
 
 
 @dataclass(frozen=True)
@@ -86,13 +85,17 @@ def as_specs(pieces: PiecesLike) -> tuple[PieceSpec, ...]:
         if not isinstance(spec.shape, Shape) or len(spec.shape) == 0:
             raise CoverError(f"pieces[{i}] ({spec.name}): expected a non-empty Shape")
         if not 0 <= spec.min <= spec.max:
-            raise CoverError(f"pieces[{i}] ({spec.name}): need 0 <= min <= max, got {spec.min}, {spec.max}")
+            raise CoverError(
+                f"pieces[{i}] ({spec.name}): need 0 <= min <= max, got {spec.min}, {spec.max}"
+            )
         out.append(spec)
     if not out:
         raise CoverError("pieces: no pieces given")
     names = [s.name for s in out]
     if len(set(names)) != len(names):
-        raise CoverError(f"pieces: duplicate names {sorted({n for n in names if names.count(n) > 1})}")
+        raise CoverError(
+            f"pieces: duplicate names {sorted({n for n in names if names.count(n) > 1})}"
+        )
     return tuple(out)
 
 
@@ -134,7 +137,8 @@ class CoverProblem:
 
     def row_cells(self, row: int) -> Int32Array:
         t = int(self.row_type[row])
-        return self.table[t].cells[row - int(self.row_start[t])]
+        cells: Int32Array = self.table[t].cells[row - int(self.row_start[t])]
+        return cells
 
     @cached_property
     def row_ptr(self) -> IntArray:
@@ -198,9 +202,7 @@ class CoverProblem:
     @cached_property
     def orientation_index(self) -> list[dict[bytes, int]]:
         """Per type: orientation key -> orientation number (see :func:`_orientation_keys`)."""
-        return [
-            {k: i for i, k in enumerate(_orientation_keys(_stacked(p)))} for p in self.table
-        ]
+        return [{k: i for i, k in enumerate(_orientation_keys(_stacked(p)))} for p in self.table]
 
     def _row_map(self, m: IntArray, t: IntArray) -> Int32Array | None:
         origin = target_index(self.target).origin

@@ -2,8 +2,9 @@
 
 Prints one JSON object: ``solutions`` (all packings), ``distinct`` (up to the box's rotations
 and reflections, reflections only when the piece set is mirror-closed), ``seconds`` (wall time
-of the count, JIT loading excluded), ``nodes`` and the search details. Pieces are always free 3D pieces (a flat pentomino may be turned over
-or stood up), so the solid-pentomino counts need no extra flag.
+of the count, JIT loading excluded), ``nodes`` and the search details. Pieces are always free
+3D pieces (a flat pentomino may be turned over or stood up), so the solid-pentomino counts need
+no extra flag.
 """
 
 from __future__ import annotations
@@ -44,7 +45,7 @@ def parse_box(text: str) -> tuple[int, int, int]:
         dims = ()
     if len(dims) != 3 or min(dims) < 1:
         raise CommandError(f"--box: expected AxBxC with positive sizes, got {text!r}")
-    return dims  # type: ignore[return-value]
+    return dims
 
 
 def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | None]:
@@ -66,14 +67,16 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
         raise CommandError(f"--pieces: cannot read {source}: {e}") from None
     if isinstance(data, dict) and "format" in data:
         level = parse_level(data, source)
-        return dict(level.shapes()), level.box
+        return dict(level.shapes), level.box
     items = data.items() if isinstance(data, dict) else enumerate(data, start=1)
     pieces: dict[str, Any] = {}
     for key, voxels in items:
         try:
             shape = Shape(voxels)
         except (TypeError, ValueError) as e:
-            raise CommandError(f"--pieces: piece {key!r} in {source} is not a voxel list: {e}")
+            raise CommandError(
+                f"--pieces: piece {key!r} in {source} is not a voxel list: {e}"
+            ) from None
         if len(shape) == 0:
             raise CommandError(f"--pieces: piece {key!r} in {source} is empty")
         pieces[str(key)] = shape
