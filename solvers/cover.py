@@ -41,10 +41,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.geometry import Shape
+from solvers.placements import Int32Array
 from solvers.problem import (
     CoverError,
     CoverProblem,
-    Int32Array,
     PiecesLike,
     PieceSpec,
     TargetLike,
@@ -108,7 +108,9 @@ def make_solution(problem: CoverProblem, rows: Int32Array) -> Solution:
     for t, ty in enumerate(problem.types):
         for slot, r in zip(ty.slots, per_type.get(t, []), strict=False):
             named.append((slot, problem.placed_shape(r)))
-    order = {name: i for i, name in enumerate(dict.fromkeys(n for ty in problem.types for n in ty.slots))}
+    order = {
+        name: i for i, name in enumerate(dict.fromkeys(n for ty in problem.types for n in ty.slots))
+    }
     named.sort(key=lambda p: order[p[0]])
     return Solution(tuple(named), tuple(ids))
 
@@ -128,13 +130,14 @@ class AnchorPlan:
     fixed_orbit: Int32Array  # orbit size of each fixed rep
 
 
-def anchor_plan(problem: CoverProblem) -> AnchorPlan | None:
-    """Pick the anchor giving the fewest orbit representatives (achiral anchors first)."""
+def anchor_plan(problem: CoverProblem, prefer: str | None = None) -> AnchorPlan | None:
+    """Pick the anchor giving the fewest orbit representatives (achiral anchors first), or the
+    piece named ``prefer`` if it can be one."""
     syms, maps = problem.symmetry
     if len(syms) == 1:
         return None
     proper = np.array([round(np.linalg.det(m)) > 0 for m, _ in syms])
-    best: tuple[tuple[int, int, int], AnchorPlan] | None = None
+    best: tuple[tuple[int, int, int, int], AnchorPlan] | None = None
     for t, ty in enumerate(problem.types):
         if not (ty.lo == 1 and ty.hi == 1):
             continue
@@ -151,7 +154,7 @@ def anchor_plan(problem: CoverProblem) -> AnchorPlan | None:
         fixed = reps[stab > 1].astype(np.int32)
         orbit = (len(group) // stab[stab > 1]).astype(np.int32)
         plan = AnchorPlan(t, group, full, free, fixed, orbit)
-        score = (0 if full else 1, len(reps), len(fixed))
+        score = (0 if ty.slots[0] == prefer else 1, 0 if full else 1, len(reps), len(fixed))
         if best is None or score < best[0]:
             best = (score, plan)
     return None if best is None else best[1]
@@ -182,11 +185,15 @@ def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> in
     if not blocks:
         return 0
     width = max(b.shape[1] for b in blocks)
-    sols = np.concatenate([np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks])
+    sols = np.concatenate(
+        [np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks]
+    )
     return len(np.unique(canonical_forms(problem, sols), axis=0))
 
 
-def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, anchor_rows: Int32Array) -> Int32Array:
+def _restricted_rows(
+    problem: CoverProblem, plan: AnchorPlan, anchor_rows: Int32Array
+) -> Int32Array:
     a, b = int(problem.row_start[plan.type_index]), int(problem.row_start[plan.type_index + 1])
     rows = np.arange(problem.n_rows, dtype=np.int32)
     others = np.concatenate([rows[:a], rows[b:]])
@@ -203,20 +210,21 @@ def count_solutions(
     engine: Engine = "auto",
     node_limit: int | None = None,
     symmetry: bool = True,
+    anchor: str | None = None,
 ) -> CoverResult:
     """Count all solutions and (if asked) the distinct ones up to the target's symmetries."""
     problem = _problem(pieces, target, optional, reflections)
     syms, _ = problem.symmetry
-    plan = anchor_plan(problem) if symmetry else None
+    plan = anchor_plan(problem, anchor) if symmetry else None
     budget = _Budget(node_limit)
     if plan is None:
         search = budget.search(problem, None, engine)
         if not distinct:
             total = budget.count(search)
             return CoverResult(total, None, budget.stats, len(syms), None)
-        blocks = budget.collect(search)
+        every = budget.collect(search)
         return CoverResult(
-            search.found, _count_distinct_forms(problem, blocks), budget.stats, len(syms), None
+            search.found, _count_distinct_forms(problem, every), budget.stats, len(syms), None
         )
     anchor_name = problem.types[plan.type_index].slots[0]
     h = len(plan.group)

@@ -34,7 +34,8 @@ from solvers.kernels import (
     RUNNING,
     shuffle_prefix,
 )
-from solvers.problem import CoverProblem, Int32Array
+from solvers.placements import Int32Array
+from solvers.problem import CoverProblem
 
 PRIMARY, SECONDARY, COUNTER = 0, 1, 2
 
@@ -73,7 +74,9 @@ def _uncover(c: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any) -> None:
 
 
 @njit(cache=True)
-def _select(r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any) -> int:
+def _select(
+    r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any
+) -> int:
     upd = 0
     j = R[r]
     while j != r:
@@ -89,7 +92,9 @@ def _select(r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, h
 
 
 @njit(cache=True)
-def _unselect(r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any) -> None:
+def _unselect(
+    r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any
+) -> None:
     j = L[r]
     while j != r:
         c = C[j]
@@ -290,7 +295,7 @@ class DLXArrays:
         self.max_col = int(S[1:].max()) if n_cols else 0
         self.has_primary = len(prim) > 1
 
-    def fresh(self) -> tuple[np.ndarray, ...]:  # type: ignore[type-arg]
+    def fresh(self) -> tuple[np.ndarray, ...]:
         """Copies of the mutable arrays for one independent search."""
         L, R, U, D, C, RW, S = self.arrays
         return (L.copy(), R.copy(), U.copy(), D.copy(), C, RW, S.copy())

@@ -7,6 +7,8 @@ of solutions (or at a node limit) and a later call continues exactly where it st
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numba import njit
 
@@ -25,12 +27,12 @@ REG_SOLUTIONS = 4
 N_REGS = 5
 
 
-def new_regs() -> np.ndarray:  # type: ignore[type-arg]
+def new_regs() -> np.ndarray:
     return np.zeros(N_REGS, dtype=np.int64)
 
 
 @njit(cache=True)
-def splitmix64(state: np.ndarray) -> np.uint64:  # type: ignore[type-arg]
+def splitmix64(state: np.ndarray) -> Any:
     """Next 64-bit output of SplitMix64; ``state`` is a length-1 uint64 array (advanced)."""
     z = state[0] + np.uint64(0x9E3779B97F4A7C15)
     state[0] = z
@@ -40,7 +42,7 @@ def splitmix64(state: np.ndarray) -> np.uint64:  # type: ignore[type-arg]
 
 
 @njit(cache=True)
-def shuffle_prefix(buf: np.ndarray, n: int, state: np.ndarray) -> None:  # type: ignore[type-arg]
+def shuffle_prefix(buf: np.ndarray, n: int, state: np.ndarray) -> None:
     """Fisher-Yates shuffle of ``buf[:n]`` driven by :func:`splitmix64`."""
     for i in range(n - 1, 0, -1):
         j = np.int64(splitmix64(state) % np.uint64(i + 1))

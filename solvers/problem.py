@@ -17,7 +17,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
-from typing import Union
 
 import numpy as np
 import numpy.typing as npt
@@ -48,8 +47,8 @@ class PieceSpec:
     max: int = 1
 
 
-PiecesLike = Union[Mapping[str, Shape], Sequence[Union[Shape, PieceSpec]]]
-TargetLike = Union[Shape, Sequence[int]]
+PiecesLike = Mapping[str, Shape] | Sequence[Shape | PieceSpec]
+TargetLike = Shape | Sequence[int]
 
 
 @dataclass(frozen=True)
@@ -86,13 +85,17 @@ def as_specs(pieces: PiecesLike) -> tuple[PieceSpec, ...]:
         if not isinstance(spec.shape, Shape) or len(spec.shape) == 0:
             raise CoverError(f"pieces[{i}] ({spec.name}): expected a non-empty Shape")
         if not 0 <= spec.min <= spec.max:
-            raise CoverError(f"pieces[{i}] ({spec.name}): need 0 <= min <= max, got {spec.min}, {spec.max}")
+            raise CoverError(
+                f"pieces[{i}] ({spec.name}): need 0 <= min <= max, got {spec.min}, {spec.max}"
+            )
         out.append(spec)
     if not out:
         raise CoverError("pieces: no pieces given")
     names = [s.name for s in out]
     if len(set(names)) != len(names):
-        raise CoverError(f"pieces: duplicate names {sorted({n for n in names if names.count(n) > 1})}")
+        raise CoverError(
+            f"pieces: duplicate names {sorted({n for n in names if names.count(n) > 1})}"
+        )
     return tuple(out)
 
 
@@ -134,7 +137,8 @@ class CoverProblem:
 
     def row_cells(self, row: int) -> Int32Array:
         t = int(self.row_type[row])
-        return self.table[t].cells[row - int(self.row_start[t])]
+        cells: Int32Array = self.table[t].cells[row - int(self.row_start[t])]
+        return cells
 
     @cached_property
     def row_ptr(self) -> IntArray:
@@ -169,7 +173,6 @@ class CoverProblem:
         """``(symmetries, row_maps)``: the faithful group and ``row_maps[g, r]`` = image row."""
         use_mirrors = self.reflections and self.mirror_invariant
         syms = target_symmetries(self.target, reflections=use_mirrors)
-        by_shape = {t.shape: i for i, t in enumerate(self.types)}
         kept: list[tuple[IntArray, IntArray]] = []
         maps: list[Int32Array] = []
         seen: set[bytes] = set()
@@ -179,7 +182,7 @@ class CoverProblem:
                 np.sort(cell_permutation(self.target, m, t)[opt]), opt
             ):
                 continue  # must map the optional cells onto themselves
-            rmap = self._row_map(m, t, by_shape)
+            rmap = self._row_map(m, t)
             if rmap is None:
                 continue
             key = rmap.tobytes()
@@ -190,25 +193,28 @@ class CoverProblem:
             maps.append(rmap)
         return tuple(kept), np.stack(maps).astype(np.int32)
 
-    def _row_map(self, m: IntArray, t: IntArray, by_shape: dict[Shape, int]) -> Int32Array | None:
+    @cached_property
+    def mirror_types(self) -> list[int]:
+        """The type index of each type's mirror image (-1 if it is not a type)."""
+        by_shape = {t.shape: i for i, t in enumerate(self.types)}
+        return [by_shape.get(t.shape.mirrored().canonical(), -1) for t in self.types]
+
+    @cached_property
+    def orientation_index(self) -> list[dict[bytes, int]]:
+        """Per type: orientation key -> orientation number (see :func:`_orientation_keys`)."""
+        return [{k: i for i, k in enumerate(_orientation_keys(_stacked(p)))} for p in self.table]
+
+    def _row_map(self, m: IntArray, t: IntArray) -> Int32Array | None:
         origin = target_index(self.target).origin
         out = np.empty(self.n_rows, dtype=np.int32)
         for ti, table in enumerate(self.table):
             if len(table) == 0:
                 continue
-            image_type = ti
-            if round(np.linalg.det(m)) < 0:
-                image_type = by_shape.get(table.shape.mirrored().canonical(), -1)
-                if image_type < 0:
-                    return None
+            image_type = ti if round(np.linalg.det(m)) > 0 else self.mirror_types[ti]
+            if image_type < 0:
+                return None
             dest = self.table[image_type]
-            orient_index = {o.cells: i for i, o in enumerate(dest.orientations)}
-            new_o = np.empty(len(table.orientations), dtype=np.int64)
-            shift = np.empty((len(table.orientations), 3), dtype=np.int64)
-            for o, orient in enumerate(table.orientations):
-                img = orient.rotate(m)
-                new_o[o] = orient_index[img.normalized().cells]
-                shift[o] = img.min_corner
+            new_o, shift = _orientation_map(table, self.orientation_index[image_type], m)
             o_of = table.orientation.astype(np.int64)
             corner = table.offset @ np.asarray(m).T + np.asarray(t) + shift[o_of] - origin
             rows = dest.lookup[new_o[o_of], corner[:, 0], corner[:, 1], corner[:, 2]]
@@ -221,6 +227,28 @@ class CoverProblem:
     def cell_permutations(self) -> Int32Array:
         syms, _ = self.symmetry
         return np.stack([cell_permutation(self.target, m, t) for m, t in syms])
+
+
+def _orientation_keys(vox: IntArray) -> list[bytes]:
+    """One key per normalised orientation in ``vox`` (n_orientations, k, 3)."""
+    rel = vox - vox.min(axis=1, keepdims=True)
+    base = int(rel.max()) + 1 if rel.size else 1
+    keys = np.sort((rel[..., 0] * base + rel[..., 1]) * base + rel[..., 2], axis=1)
+    return [bytes([base]) + row.tobytes() for row in keys]
+
+
+def _stacked(p: Placements) -> IntArray:
+    return np.stack([o.voxels for o in p.orientations])
+
+
+def _orientation_map(
+    src: Placements, dest_index: dict[bytes, int], m: IntArray
+) -> tuple[IntArray, IntArray]:
+    """For each orientation of ``src``: the destination orientation its image under ``m`` is,
+    and the min corner of that image (so image = destination orientation + corner)."""
+    img = _stacked(src) @ np.asarray(m).T
+    new_o = np.array([dest_index[key] for key in _orientation_keys(img)], dtype=np.int64)
+    return new_o, img.min(axis=1)
 
 
 def cover_problem(

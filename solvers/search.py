@@ -18,7 +18,8 @@ from chaingeo.kinematics import SearchLimitError
 from solvers import kernels
 from solvers.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
 from solvers.dlx import DLXArrays, dlx_run
-from solvers.problem import CoverError, CoverProblem, Int32Array
+from solvers.placements import Int32Array
+from solvers.problem import CoverError, CoverProblem
 
 Engine = Literal["auto", "dlx", "bitboard"]
 NO_LIMIT = np.iinfo(np.int64).max
@@ -60,7 +61,9 @@ def choose_engine(problem: CoverProblem, engine: Engine) -> Literal["dlx", "bitb
     if engine == "auto":
         return "bitboard" if problem.n_cells <= MAX_CELLS else "dlx"
     if engine == "bitboard" and problem.n_cells > MAX_CELLS:
-        raise CoverError(f"engine: bitboard needs at most {MAX_CELLS} cells, target has {problem.n_cells}")
+        raise CoverError(
+            f"engine: bitboard needs at most {MAX_CELLS} cells, target has {problem.n_cells}"
+        )
     if engine not in ("dlx", "bitboard"):
         raise CoverError(f"engine: expected auto, dlx or bitboard, got {engine!r}")
     return engine
@@ -110,13 +113,14 @@ class CoverSearch:
         self._shuffle = rng is not None
         if rng is not None:
             self._rng[0] = np.uint64(int(rng.integers(0, 2**63)))
-        self._buf = np.zeros((depth, width if self._shuffle or self.engine == "dlx" else 1), np.int32)
+        self._buf = np.zeros((depth, width if self.engine == "dlx" else 1), np.int32)
         self._nbuf = np.zeros(depth, dtype=np.int64)
         self._pos = np.zeros(depth, dtype=np.int64)
         self._aux = np.zeros(depth, dtype=np.int64)  # column (dlx) or candidate base (bitboard)
         self._chosen = np.zeros(depth, dtype=np.int32)
         self._depth = depth
         self._seconds = 0.0
+        self._perm = np.zeros(depth * width if self._shuffle else depth, dtype=np.int32)
         if isinstance(self._arr, DLXArrays):
             self._links = self._arr.fresh()
             self._cnt = np.zeros(len(self._arr.kind), dtype=np.int32)
@@ -145,17 +149,19 @@ class CoverSearch:
         t0 = time.perf_counter()
         a = self._arr
         if isinstance(a, DLXArrays):
+            L, R, U, D, C, RW, S = self._links
             n = dlx_run(
-                *self._links, a.kind, a.lo, a.hi, self._cnt, a.counters,
+                L, R, U, D, C, RW, S, a.kind, a.lo, a.hi, self._cnt, a.counters,
                 self._buf, self._nbuf, self._pos, self._aux, self._chosen,
                 self._regs, self._rng, self._shuffle,
                 out, max_store, stop_after, self.node_limit,
             )  # fmt: skip
         else:
             n = bitboard_run(
-                a.mask, a.rtype, a.rid, a.cand_ptr, a.cand, a.primary,
+                a.mask, a.rtype, a.rid, a.cand_ptr, a.cand, a.skip, a.root, a.primary,
                 a.lo, a.hi, self._cnt, a.counters, a.table,
-                self._occ, self._buf, self._nbuf, self._pos, self._aux, self._chosen,
+                a.nb, a.region_gcd, a.region_min, a.region_cap,
+                self._occ, self._perm, self._nbuf, self._pos, self._aux, self._chosen,
                 self._regs, self._rng, self._shuffle,
                 out, max_store, stop_after, self.node_limit,
             )  # fmt: skip

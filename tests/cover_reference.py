@@ -49,7 +49,9 @@ def solutions(
     mandatory = sorted(target - optional)
     found: list[frozenset[tuple[int, frozenset[Cell]]]] = []
 
-    def rec(filled: frozenset[Cell], used: list[int], chosen: list[tuple[int, frozenset[Cell]]]) -> None:
+    def rec(
+        filled: frozenset[Cell], used: list[int], chosen: list[tuple[int, frozenset[Cell]]]
+    ) -> None:
         empty = [c for c in mandatory if c not in filled]
         if not empty:
             if all(used[i] >= lo for i, (_, lo, _) in enumerate(pieces)):
@@ -88,7 +90,9 @@ def distinct(
 
     kinds = [norm_key(s) for s, _, _ in pieces]
 
-    def as_shapes(sol: frozenset[tuple[int, frozenset[Cell]]]) -> frozenset[tuple[frozenset[Cell], frozenset[Cell]]]:
+    def as_shapes(
+        sol: frozenset[tuple[int, frozenset[Cell]]],
+    ) -> frozenset[tuple[frozenset[Cell], frozenset[Cell]]]:
         return frozenset((kinds[i], cells) for i, cells in sol)
 
     canon = {as_shapes(s) for s in sols}

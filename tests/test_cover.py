@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from chaingeo.geometry import Shape, box_cells, box_symmetries
 from chaingeo.kinematics import SearchLimitError
-from chaingeo.piecesets import PENTOMINOES, SOMA
+from chaingeo.piecesets import BEDLAM, PENTOMINOES, SOMA
 from solvers.cover import (
     CoverError,
     CoverLimitError,
@@ -48,17 +48,31 @@ def test_soma_rotations_only() -> None:
     assert (r.solutions, r.distinct, r.symmetry_order) == (11520, 480, 24)
 
 
-def test_pentominoes_6x10() -> None:
-    r = count_solutions(PENTOMINOES.pieces, (6, 10, 1))
-    assert (r.solutions, r.distinct) == (9356, 2339)
+def _known(box: tuple[int, int, int]) -> tuple[int | None, int]:
+    known = next(p for p in PENTOMINOES.packings if p.box == box)
+    return known.solutions, known.distinct
+
+
+@pytest.mark.parametrize(
+    ("box", "engine"),
+    [((6, 10, 1), "auto"), ((5, 12, 1), "auto"), ((5, 12, 1), "dlx"), ((2, 5, 6), "auto")],
+)
+def test_pentomino_packings(box: tuple[int, int, int], engine: str) -> None:
+    r = count_solutions(PENTOMINOES.pieces, box, engine=engine)  # type: ignore[arg-type]
+    assert (r.solutions, r.distinct) == _known(box)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("box", [(5, 12, 1), (2, 5, 6), (3, 4, 5)])
-def test_pentomino_packings(box: tuple[int, int, int]) -> None:
-    known = next(p for p in PENTOMINOES.packings if p.box == box)
-    r = count_solutions(PENTOMINOES.pieces, box)
-    assert (r.solutions, r.distinct) == (known.solutions, known.distinct)
+def test_solid_pentominoes_3x4x5() -> None:
+    r = count_solutions(PENTOMINOES.pieces, (3, 4, 5))
+    assert (r.solutions, r.distinct) == _known((3, 4, 5))
+
+
+@pytest.mark.slow
+def test_bedlam_cube() -> None:
+    r = count_solutions(BEDLAM.pieces, (4, 4, 4))
+    # No reflection maps the (chiral) Bedlam set to itself: classes have 24 members.
+    assert (r.distinct, r.symmetry_order, r.solutions) == (19186, 24, 19186 * 24)
 
 
 def test_target_symmetries_match_box_symmetries() -> None:
@@ -190,7 +204,9 @@ def test_random_order_is_seeded_and_complete(engine: str) -> None:
     assert len(a) == 36 and sorted(a) == sorted(fixed) and a != fixed
     # On a big instance the first few differ between seeds and repeat for the same seed.
     rng1, rng2 = (np.random.default_rng(np.random.SeedSequence([3, i])) for i in (0, 0))
-    first = [next(random_solutions(SOMA.pieces, (3, 3, 3), r, engine=engine)).rows for r in (rng1, rng2)]  # type: ignore[arg-type]
+    first = [
+        next(random_solutions(SOMA.pieces, (3, 3, 3), r, engine=engine)).rows for r in (rng1, rng2)
+    ]  # type: ignore[arg-type]
     assert first[0] == first[1]
 
 
