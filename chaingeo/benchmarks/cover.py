@@ -1,0 +1,153 @@
+"""``chain bench cover``: our exact-cover engine against the PyPI package ``xcover``.
+
+Each instance is counted three ways in the same process: ``ours`` is ``count_solutions`` as
+``chain cover`` runs it (symmetry reduction, automatic engine, problem built from scratch);
+``raw`` is our engine enumerating every solution without symmetry reduction (the same work
+xcover does); ``xcover`` runs ``xcover.covers`` over the very same rows. JIT compilation is
+excluded: every kernel is warmed up on a tiny instance first. Times are the best of
+``--repeat`` runs (wall clock); the ratios are xcover's time over ours.
+
+Bedlam (4x4x4) is left out unless ``CHAIN_BENCH_COVER_BEDLAM=1``, and then timed for ours only:
+the unreduced runs would list all 460464 packings one by one. ``--quick`` runs Soma and the
+5x12 pentominoes only.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from chaingeo.geometry import Shape
+from chaingeo.piecesets import BEDLAM, PENTOMINOES, SOMA
+
+
+@dataclass(frozen=True)
+class Instance:
+    name: str
+    pieces: dict[str, Shape]
+    box: tuple[int, int, int]
+    solutions: int | None
+    distinct: int
+    compare: bool = True  # also time the unreduced enumeration and xcover
+
+
+INSTANCES = (
+    Instance("soma 3x3x3", SOMA.pieces, (3, 3, 3), 11520, 240),
+    Instance("pentominoes 6x10x1", PENTOMINOES.pieces, (6, 10, 1), 9356, 2339),
+    Instance("pentominoes 5x12x1", PENTOMINOES.pieces, (5, 12, 1), 4040, 1010),
+    Instance("solid pentominoes 2x5x6", PENTOMINOES.pieces, (2, 5, 6), 2112, 264),
+    Instance("solid pentominoes 3x4x5", PENTOMINOES.pieces, (3, 4, 5), 31520, 3940),
+)
+BEDLAM_INSTANCE = Instance("bedlam 4x4x4", BEDLAM.pieces, (4, 4, 4), None, 19186, compare=False)
+QUICK = ("soma 3x3x3", "pentominoes 5x12x1")
+
+
+def _best(fn: Callable[[], int], repeat: int) -> tuple[float, int]:
+    best = float("inf")
+    value = 0
+    for _ in range(max(repeat, 1)):
+        t0 = time.perf_counter()
+        value = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, value
+
+
+def _clear_caches() -> None:
+    from solvers import placements, problem
+
+    problem._cover_problem.cache_clear()
+    placements._placements.cache_clear()
+    placements.target_index.cache_clear()
+
+
+def _warm_up() -> None:
+    """Compile (or load) every kernel on a tiny instance, outside the timed region."""
+    from xcover import covers
+
+    from solvers.cover import count_solutions
+    from solvers.search import CoverSearch
+
+    domino = Shape([(0, 0, 0), (1, 0, 0)])
+    for engine in ("bitboard", "dlx"):
+        count_solutions({"a": domino, "b": domino}, (2, 2, 1), engine=engine)
+        from solvers.problem import cover_problem
+
+        CoverSearch(cover_problem([domino, domino], (2, 2, 1)), engine=engine).count()
+    sum(1 for _ in covers([[0, 1], [2]]))
+
+
+def run(args: argparse.Namespace) -> int:
+    from xcover import covers
+
+    from solvers.cover import count_solutions
+    from solvers.problem import cover_problem
+    from solvers.search import CoverSearch
+
+    instances = list(INSTANCES)
+    if os.environ.get("CHAIN_BENCH_COVER_BEDLAM") == "1":
+        instances.append(BEDLAM_INSTANCE)
+    if args.quick:
+        instances = [i for i in instances if i.name in QUICK]
+    repeat = int(args.repeat)
+    _warm_up()
+    print(f"chain bench cover: best of {repeat}, wall seconds, JIT warm-up excluded")
+    print(
+        f"{'instance':26} {'solutions':>9} {'distinct':>8} {'ours':>8} {'raw':>8} "
+        f"{'xcover':>8} {'x/ours':>7} {'x/raw':>6}"
+    )
+    rows = []
+    for inst in instances:
+
+        def ours(inst: Instance = inst) -> int:
+            _clear_caches()
+            r = count_solutions(inst.pieces, inst.box)
+            if inst.solutions is not None and r.solutions != inst.solutions:
+                raise AssertionError(f"{inst.name}: {r.solutions} solutions")
+            if r.distinct != inst.distinct:
+                raise AssertionError(f"{inst.name}: {r.distinct} distinct")
+            return r.solutions
+
+        problem = cover_problem(inst.pieces, inst.box)
+
+        def raw(problem: object = problem) -> int:
+            return CoverSearch(problem).count()  # type: ignore[arg-type]
+
+        options = [
+            [f"piece{int(problem.row_type[r])}", *problem.row_cells(r).tolist()]
+            for r in range(problem.n_rows)
+        ]
+
+        def reference(options: list[list[object]] = options) -> int:
+            return sum(1 for _ in covers(options))
+
+        t_ours, n = _best(ours, repeat)
+        if not inst.compare:
+            print(f"{inst.name:26} {n:>9} {inst.distinct:>8} {t_ours:>8.3f}      (ours only)")
+            continue
+        t_raw, n_raw = _best(raw, repeat)
+        t_ref, n_ref = _best(reference, repeat)
+        if not n == n_raw == n_ref:
+            raise AssertionError(f"{inst.name}: counts differ: {n}, {n_raw}, {n_ref}")
+        record = {
+            "instance": inst.name,
+            "solutions": n,
+            "distinct": inst.distinct,
+            "ours_s": round(t_ours, 4),
+            "raw_s": round(t_raw, 4),
+            "xcover_s": round(t_ref, 4),
+            "xcover_over_ours": round(t_ref / t_ours, 2),
+            "xcover_over_raw": round(t_ref / t_raw, 2),
+        }
+        rows.append(record)
+        print(
+            f"{inst.name:26} {n:>9} {inst.distinct:>8} {t_ours:>8.3f} {t_raw:>8.3f} "
+            f"{t_ref:>8.3f} {t_ref / t_ours:>7.1f} {t_ref / t_raw:>6.1f}",
+            flush=True,
+        )
+    worst = min(r["xcover_over_ours"] for r in rows)  # type: ignore[type-var]
+    print(json.dumps({"benchmark": "cover", "repeat": repeat, "worst_ratio": worst, "rows": rows}))
+    return 0

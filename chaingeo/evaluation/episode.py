@@ -1,0 +1,324 @@
+"""One episode: an agent plays one level under one protocol; the result is a log record.
+
+This is a pure function of its :class:`EpisodeTask` (level, agent spec, protocol, seeds), so it
+runs the same in this process, a worker process or on a Dask worker. Images never go into the
+record: they come back beside it, keyed by SHA-256, for the writer to store as files.
+
+Protocols:
+
+- ``interactive`` (closed loop): each turn the agent sees the observation (task, colour table,
+  the last ``history_window`` turns, steps left, views) and answers one action; the environment
+  applies it or explains why not (an unparseable, illegal or ambiguous action changes nothing
+  but costs a step) until the level is solved, the agent says ``finish`` or the step budget is
+  spent. With ``candidates > 1`` each turn asks the agent that many times and commits the
+  candidate the judge ranks first after every one was checked in a cloned state.
+- ``oneshot`` (open loop): the agent sees one fixed view once (plus the tray of pieces, or the
+  assembly target, where the level has one: they say what there is to place, not where things
+  are) and writes its whole plan, which
+  is executed action by action with no feedback (a failed action costs its step and the plan
+  goes on) until solved, finished, out of budget or out of actions.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from chaingeo.agents.base import (
+    TRANSPORT,
+    AgentError,
+    AgentSpec,
+    ObservationLike,
+    Reply,
+    StateLike,
+    StepResultLike,
+    Turn,
+)
+from chaingeo.evaluation.logs import episode_key
+from chaingeo.evaluation.selection import Judge, make_judge, verify
+from chaingeo.evaluation.usage import Usage
+from chaingeo.level import Level, content_hash
+
+ProtocolName = Literal["interactive", "oneshot"]
+#: Pictures that show what the pieces or the goal are rather than the scene (kept in one-shot).
+AUXILIARY_VIEWS = ("tray", "target")
+
+
+@dataclass(frozen=True)
+class ProtocolConfig:
+    name: ProtocolName = "interactive"
+    history_window: int = 5
+    text_state: bool = False
+    candidates: int = 1  # > 1: verifier-based selection among this many per turn
+    judge: str = "first"
+    judge_options: Mapping[str, Any] = field(default_factory=dict)
+    oneshot_view: str = "iso"
+    #: The module providing ``new_state`` and ``observe`` (tests may point at a double).
+    env: str = "chaingeo"
+
+    def __post_init__(self) -> None:
+        if self.name not in ("interactive", "oneshot"):
+            raise ValueError(f"unknown protocol {self.name!r}; use interactive or oneshot")
+        if self.candidates < 1 or self.history_window < 0:
+            raise ValueError("candidates must be >= 1 and history_window >= 0")
+        make_judge(self.judge, self.judge_options)
+
+    def to_json(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name, "text_state": self.text_state}
+        if self.name == "interactive":
+            out.update(
+                history_window=self.history_window, candidates=self.candidates, judge=self.judge
+            )
+            opts = {k: v for k, v in sorted(self.judge_options.items()) if k not in TRANSPORT}
+            if opts:
+                out["judge_options"] = opts
+        else:
+            out["view"] = self.oneshot_view
+        if self.env != "chaingeo":
+            out["env"] = self.env
+        return out
+
+
+@dataclass(frozen=True)
+class EpisodeTask:
+    level: Level
+    sample: int
+    seed: int  # the run's seed
+    agent: AgentSpec
+    protocol: ProtocolConfig = field(default_factory=ProtocolConfig)
+
+    @property
+    def key(self) -> str:
+        return episode_key(self.level.id, self.sample)
+
+
+@dataclass
+class EpisodeResult:
+    record: dict[str, Any]
+    images: dict[str, bytes]  # file name (sha256.png) -> PNG bytes
+
+
+def episode_seed(run_seed: int, level: Level, sample: int) -> int:
+    """Seed of one episode, from the run seed, the level's content and the sample number: an
+    episode draws the same randomness whichever other levels share the run."""
+    level_part = int(content_hash(level)[:15], 16)
+    ss = np.random.SeedSequence([run_seed, level_part, sample])
+    return int(ss.generate_state(1, dtype=np.uint64)[0] >> np.uint64(1))
+
+
+def _environment(module: str) -> tuple[Callable[[Level], StateLike], Callable[..., Any]]:
+    if module == "chaingeo":
+        state_mod = importlib.import_module("chaingeo.state")
+        obs_mod = importlib.import_module("chaingeo.observation")
+        return state_mod.new_state, obs_mod.observe
+    mod = importlib.import_module(module)
+    return mod.new_state, mod.observe
+
+
+class _Images:
+    def __init__(self) -> None:
+        self.files: dict[str, bytes] = {}
+
+    def names(self, obs: ObservationLike | None) -> dict[str, str]:
+        out: dict[str, str] = {}
+        if obs is None:
+            return out
+        for view, png in obs.images.items():
+            name = hashlib.sha256(png).hexdigest() + ".png"
+            self.files[name] = png
+            out[view] = name
+        return out
+
+
+def _is_finish(result: StepResultLike) -> bool:
+    return result.action is not None and result.action.to_text() == "finish"
+
+
+def _step_record(turn: int, reply: Reply, sent: str, result: StepResultLike) -> dict[str, Any]:
+    rec: dict[str, Any] = {
+        "turn": turn,
+        "reply": reply.text,
+        "sent": sent,
+        "action": result.action.to_text() if result.action is not None else None,
+        "legal": result.legal,
+        "error": result.error,
+        "feedback": result.feedback,
+        "usage": reply.usage.to_json(),
+    }
+    if reply.note:
+        rec["note"] = reply.note
+    if reply.reasoning:
+        rec["reasoning"] = reply.reasoning
+    return rec
+
+
+def run_episode(task: EpisodeTask) -> EpisodeResult:
+    from chaingeo.agents import make_agent
+
+    level, proto = task.level, task.protocol
+    new_state, observe = _environment(proto.env)
+    seed = episode_seed(task.seed, level, task.sample)
+    started = time.monotonic()
+    images = _Images()
+    steps: list[dict[str, Any]] = []
+    usage = Usage()
+    record: dict[str, Any] = {
+        "key": task.key,
+        "level_id": level.id,
+        "level_hash": content_hash(level),
+        "family": level.family,
+        "difficulty": level.difficulty,
+        "goal": level.goal,
+        "optimal_steps": level.optimal_steps,
+        "max_steps": level.max_steps,
+        "sample": task.sample,
+        "seed": seed,
+        "protocol": proto.name,
+        "agent": task.agent.label,
+    }
+    state = new_state(level)
+    agent = make_agent(task.agent)
+    record["model"] = agent.model
+    finished = False
+    judge: Judge | None = None
+    status, error = "done", None
+    try:
+        agent.start(level, seed)
+
+        def see(window: int) -> ObservationLike:
+            obs: ObservationLike = observe(
+                state, history_window=window, text_state=proto.text_state, images=agent.uses_images
+            )
+            return obs
+
+        if proto.name == "interactive":
+            judge = make_judge(proto.judge, proto.judge_options)
+            judge.start(seed)
+            note: str | None = None
+            turn = 0
+            while not (state.is_success() or state.is_truncated()):
+                if turn >= state.max_steps:
+                    raise RuntimeError(f"{level.id}: the environment stopped counting steps")
+                obs = see(proto.history_window)
+                shown = images.names(obs)
+                replies = [
+                    agent.act(
+                        Turn(
+                            level,
+                            obs,
+                            state.clone() if agent.needs_state else None,
+                            turn,
+                            task.sample,
+                            c,
+                            note,
+                        )
+                    )
+                    for c in range(proto.candidates)
+                ]
+                for r in replies:
+                    usage = usage + r.usage
+                cands: list[dict[str, Any]] = []
+                chosen = replies[0]
+                if len(replies) > 1:
+                    checked = verify(state, replies)
+                    spent = judge.usage
+                    best = judge.rank(state, checked, obs)[0]
+                    chosen = replies[best]
+                    cands = [
+                        {
+                            "reply": c.reply.text,
+                            "action": c.reply.action,
+                            "legal": c.legal,
+                            "error": c.result.error if c.result else None,
+                            "usage": c.reply.usage.to_json(),
+                            "chosen": c.index == best,
+                        }
+                        for c in checked
+                    ]
+                sent = chosen.action if chosen.action is not None else ""
+                result = state.step_text(sent)
+                rec = _step_record(turn, chosen, sent, result)
+                rec["images"] = shown
+                if cands:
+                    rec["candidates"] = cands
+                    rec["usage"] = sum((r.usage for r in replies), Usage()).to_json()
+                    if judge.usage != spent:
+                        rec["judge_usage"] = _spent(judge.usage, spent).to_json()
+                steps.append(rec)
+                note = chosen.note if chosen.action is None else None
+                turn += 1
+                if _is_finish(result):
+                    finished = True
+                    break
+        else:
+            obs = see(0)
+            keep = (proto.oneshot_view, *AUXILIARY_VIEWS)
+            view = {k: v for k, v in obs.images.items() if k in keep}
+            obs = _with_images(obs, view)
+            shown = images.names(obs)
+            plan = agent.plan(
+                Turn(level, obs, state.clone() if agent.needs_state else None, 0, task.sample)
+            )
+            usage = usage + plan.usage
+            record["plan"] = {
+                "reply": plan.text,
+                "actions": list(plan.actions),
+                "note": plan.note,
+                "usage": plan.usage.to_json(),
+                "images": shown,
+            }
+            for i, text in enumerate(plan.actions):
+                if state.is_success() or state.is_truncated():
+                    break
+                result = state.step_text(text)
+                steps.append(_step_record(i, Reply(text, text), text, result))
+                if _is_finish(result):
+                    finished = True
+                    break
+    except AgentError as e:
+        status, error = "error", str(e)
+    finally:
+        agent.close()
+    if judge is not None and judge.usage.calls:
+        record["judge"] = {"model": judge.model, "usage": judge.usage.to_json()}
+    record.update(
+        status=status,
+        error=error,
+        success=bool(state.is_success()),
+        steps_used=int(state.steps_used),
+        invalid=sum(1 for s in steps if not s["legal"]),
+        unparseable=sum(1 for s in steps if s["error"] == "unparseable"),
+        illegal=sum(1 for s in steps if s["error"] == "illegal"),
+        ambiguous=sum(1 for s in steps if s["error"] == "ambiguous"),
+        finished=finished,
+        truncated=bool(state.is_truncated()) and not state.is_success(),
+        usage=usage.to_json(),
+        wall_seconds=round(time.monotonic() - started, 3),
+        steps=steps,
+    )
+    return EpisodeResult(record, images.files)
+
+
+def _spent(now: Usage, before: Usage) -> Usage:
+    return Usage(
+        now.input_tokens - before.input_tokens,
+        now.output_tokens - before.output_tokens,
+        now.reasoning_tokens - before.reasoning_tokens,
+        now.cached_tokens - before.cached_tokens,
+        now.calls - before.calls,
+    )
+
+
+def _with_images(obs: ObservationLike, images: Mapping[str, bytes]) -> ObservationLike:
+    import dataclasses
+
+    if dataclasses.is_dataclass(obs) and not isinstance(obs, type):
+        out: ObservationLike = dataclasses.replace(obs, images=dict(images))
+        return out
+    raise TypeError("observations must be dataclasses with an 'images' field")

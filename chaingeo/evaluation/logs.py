@@ -1,0 +1,262 @@
+"""The run directory: a header, one JSONL record per episode, images by content hash.
+
+Layout of ``RUN/``::
+
+    header.json      what was run: git commit, package versions, level-set hash, agent config,
+                     protocol, seeds (canonical JSON; never a secret)
+    episodes.jsonl   one line per finished episode, appended and fsynced as it finishes
+    images/          PNG files named ``<sha256>.png``; records refer to them by name
+
+A killed run leaves at most one partial line at the end of ``episodes.jsonl``; reading ignores
+it and resuming cuts it off before appending, so no finished episode is lost and none is
+recorded twice. Every line written passes through :meth:`RunLog.redact`, which replaces each
+registered secret (API keys) wherever it appears, so a key echoed back by a server never lands
+in a log either.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import hashlib
+import json
+import os
+import platform
+import subprocess
+from collections.abc import Iterable, Mapping
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Final
+
+from chaingeo import canonical_json
+
+RUN_FORMAT: Final = "chain-run/1"
+HEADER: Final = "header.json"
+EPISODES: Final = "episodes.jsonl"
+IMAGES: Final = "images"
+REDACTED: Final = "[REDACTED]"
+#: Header fields that must match for ``--resume`` to continue a run.
+IDENTITY_FIELDS: Final = ("agent", "protocol", "level_set_hash", "seed", "samples", "levels")
+PACKAGES: Final = (
+    "chaingeo",
+    "numpy",
+    "numba",
+    "pillow",
+    "matplotlib",
+    "trimesh",
+    "manifold3d",
+    "networkx",
+)
+
+
+class RunError(ValueError):
+    """A run directory that cannot be used as asked (exists, differs, unreadable)."""
+
+
+def git_commit(start: Path | None = None) -> dict[str, Any]:
+    """The commit of the checkout holding this package (and whether files were modified)."""
+    root = start or Path(__file__).resolve().parents[2]
+    try:
+        head = subprocess.run(
+            ["git", "-C", str(root), "rev-parse", "HEAD"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return {"commit": None, "dirty": None}
+    return {"commit": head, "dirty": bool(dirty)}
+
+
+def package_versions(names: Iterable[str] = PACKAGES) -> dict[str, str | None]:
+    out: dict[str, str | None] = {"python": platform.python_version()}
+    for name in names:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
+    return out
+
+
+def make_header(
+    *,
+    agent: Mapping[str, Any],
+    protocol: Mapping[str, Any],
+    level_set_hash: str,
+    levels: Iterable[str],
+    seed: int,
+    samples: int,
+    extra: Mapping[str, Any] | None = None,
+) -> dict[str, Any]:
+    return {
+        "format": RUN_FORMAT,
+        "created": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "git": git_commit(),
+        "packages": package_versions(),
+        "platform": platform.platform(),
+        "agent": dict(agent),
+        "protocol": dict(protocol),
+        "level_set_hash": level_set_hash,
+        "levels": sorted(levels),
+        "seed": seed,
+        "samples": samples,
+        **dict(extra or {}),
+    }
+
+
+def episode_key(level_id: str, sample: int) -> str:
+    return f"{level_id}#{sample}"
+
+
+class RunLog:
+    """Writer and reader of one run directory."""
+
+    def __init__(self, path: str | os.PathLike[str], secrets: Iterable[str] = ()) -> None:
+        self.path = Path(path)
+        self._secrets = sorted({s for s in secrets if s}, key=len, reverse=True)
+
+    # -- opening ---------------------------------------------------------------------------
+
+    @staticmethod
+    def create(
+        path: str | os.PathLike[str],
+        header: Mapping[str, Any],
+        *,
+        resume: bool = False,
+        secrets: Iterable[str] = (),
+    ) -> RunLog:
+        """Start a new run, or with ``resume`` continue one whose header agrees."""
+        log = RunLog(path, secrets)
+        head = log.path / HEADER
+        if head.exists():
+            if not resume:
+                raise RunError(f"{log.path}: a run is already there; pass --resume to continue it")
+            old = log.header()
+            for key in IDENTITY_FIELDS:
+                if old.get(key) != header.get(key):
+                    raise RunError(
+                        f"{log.path}: cannot resume: {key} differs from the recorded run "
+                        f"({_short(old.get(key))} there, {_short(header.get(key))} now)"
+                    )
+            log._drop_partial_tail()
+            return log
+        if log.path.exists() and any(log.path.iterdir()):
+            raise RunError(f"{log.path}: exists and is not a run directory")
+        (log.path / IMAGES).mkdir(parents=True, exist_ok=True)
+        _atomic_write(head, log.redact(canonical_json.dumps(dict(header))).encode("utf-8"))
+        (log.path / EPISODES).touch()
+        return log
+
+    def header(self) -> dict[str, Any]:
+        try:
+            data = json.loads((self.path / HEADER).read_text("utf-8"))
+        except (OSError, json.JSONDecodeError) as e:
+            raise RunError(f"{self.path}: no readable {HEADER}: {e}") from None
+        if not isinstance(data, dict) or data.get("format") != RUN_FORMAT:
+            raise RunError(f"{self.path}/{HEADER}: not a {RUN_FORMAT} header")
+        return data
+
+    # -- writing ---------------------------------------------------------------------------
+
+    def redact(self, text: str) -> str:
+        for secret in self._secrets:
+            text = text.replace(secret, REDACTED)
+        return text
+
+    def append(self, record: Mapping[str, Any]) -> None:
+        """One line, written whole, flushed and fsynced before returning."""
+        line = json.dumps(record, sort_keys=True, ensure_ascii=False, allow_nan=False)
+        data = (self.redact(line) + "\n").encode("utf-8")
+        fd = os.open(self.path / EPISODES, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        try:
+            view = memoryview(data)
+            while view:
+                n = os.write(fd, view)
+                view = view[n:]
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+    def put_image(self, png: bytes) -> str:
+        """Store a PNG under its SHA-256 (once) and return the file name records use."""
+        name = hashlib.sha256(png).hexdigest() + ".png"
+        target = self.path / IMAGES / name
+        if not target.exists():
+            target.parent.mkdir(parents=True, exist_ok=True)
+            _atomic_write(target, png)
+        return name
+
+    def _drop_partial_tail(self) -> None:
+        """Cut a last line that a killed writer left unfinished."""
+        file = self.path / EPISODES
+        if not file.exists():
+            file.touch()
+            return
+        data = file.read_bytes()
+        keep = data.rfind(b"\n") + 1
+        if keep != len(data):
+            with open(file, "r+b") as fh:
+                fh.truncate(keep)
+                fh.flush()
+                os.fsync(fh.fileno())
+
+    # -- reading ---------------------------------------------------------------------------
+
+    def records(self) -> list[dict[str, Any]]:
+        """Every complete record, in file order (a partial last line is ignored)."""
+        return read_records(self.path / EPISODES)
+
+    def latest(self) -> dict[str, dict[str, Any]]:
+        """The last record of each episode key (a retried episode replaces its error)."""
+        out: dict[str, dict[str, Any]] = {}
+        for rec in self.records():
+            out[str(rec["key"])] = rec
+        return out
+
+    def finished_keys(self, retry_errors: bool = False) -> set[str]:
+        return {
+            k for k, r in self.latest().items() if not (retry_errors and r.get("status") == "error")
+        }
+
+
+def read_records(file: Path) -> list[dict[str, Any]]:
+    try:
+        data = file.read_bytes()
+    except OSError as e:
+        raise RunError(f"{file}: cannot read: {e.strerror or e}") from None
+    lines = data.split(b"\n")
+    out: list[dict[str, Any]] = []
+    for i, raw in enumerate(lines):
+        if not raw.strip():
+            continue
+        try:
+            rec = json.loads(raw)
+        except json.JSONDecodeError:
+            if i == len(lines) - 1:  # unfinished last line of a killed run
+                break
+            raise RunError(f"{file}: line {i + 1} is not JSON") from None
+        if not isinstance(rec, dict) or "key" not in rec:
+            raise RunError(f"{file}: line {i + 1} is not an episode record")
+        out.append(rec)
+    return out
+
+
+def _atomic_write(target: Path, data: bytes) -> None:
+    tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, target)
+
+
+def _short(value: Any) -> str:
+    text = json.dumps(value, sort_keys=True)
+    return text if len(text) <= 80 else text[:77] + "..."

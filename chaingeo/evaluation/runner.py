@@ -1,0 +1,215 @@
+"""Running an agent over a level suite: episodes in parallel, logged as they finish, resumable.
+
+:func:`evaluate` plans one :class:`~chaingeo.evaluation.episode.EpisodeTask` per (level, sample),
+skips those a resumed run already recorded, runs the rest (in this process, ``jobs`` worker
+processes, or on a Dask cluster) and writes each finished episode (images first, then its
+record, fsynced) from this process only, so records never interleave. Killing the run at any
+moment loses at most the episodes in flight, which ``--resume`` runs again; none is recorded
+twice.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import multiprocessing
+import os
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TextIO
+
+from chaingeo.agents.base import AgentSpec
+from chaingeo.evaluation.episode import EpisodeResult, EpisodeTask, ProtocolConfig, run_episode
+from chaingeo.evaluation.logs import RunLog, make_header
+from chaingeo.evaluation.metrics import Outcome
+from chaingeo.evaluation.usage import PriceTable, Usage
+from chaingeo.level import Level, level_set_hash
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    samples: int = 1
+    seed: int = 0
+    jobs: int = 1
+    dask: str | None = None  # scheduler address, e.g. tcp://host:8786
+    resume: bool = False
+    retry_errors: bool = False
+    progress: bool = True
+
+
+def outcome_of(record: dict[str, Any]) -> Outcome:
+    """The metrics' view of a record; a model judge's tokens count with the agent's."""
+    usage = Usage.from_json(record.get("usage", {}))
+    if record.get("judge"):
+        usage = usage + Usage.from_json(record["judge"]["usage"])
+    return Outcome(
+        level_id=str(record["level_id"]),
+        family=str(record["family"]),
+        difficulty=str(record["difficulty"]),
+        optimal_steps=int(record["optimal_steps"]),
+        success=bool(record["success"]),
+        steps=int(record["steps_used"]),
+        sample=int(record.get("sample", 0)),
+        usage=usage,
+        cost_usd=record.get("cost_usd"),
+    )
+
+
+class ProgressBar:
+    """One status line: episodes done, solved, tokens and dollars so far."""
+
+    def __init__(self, label: str, total: int, stream: TextIO | None, enabled: bool) -> None:
+        self.label, self.total, self.stream = label, total, stream or sys.stderr
+        self.enabled = enabled
+        self.done = self.solved = self.errors = 0
+        self.tokens = 0
+        self.cost: float | None = 0.0
+        self.started = time.monotonic()
+
+    def add(self, record: dict[str, Any]) -> None:
+        self.done += 1
+        self.solved += bool(record.get("success"))
+        self.errors += record.get("status") == "error"
+        self.tokens += Usage.from_json(record.get("usage", {})).total_tokens
+        cost = record.get("cost_usd")
+        self.cost = None if cost is None or self.cost is None else self.cost + cost
+        self.show()
+
+    def line(self) -> str:
+        cost = "$?" if self.cost is None else f"${self.cost:.4f}"
+        err = f" | {self.errors} errors" if self.errors else ""
+        secs = time.monotonic() - self.started
+        return (
+            f"[{self.label}] {self.done}/{self.total} | solved {self.solved} | "
+            f"{_tokens(self.tokens)} tok | {cost}{err} | {secs:.0f}s"
+        )
+
+    def show(self, final: bool = False) -> None:
+        """Redraw in place on a terminal; elsewhere (logs, CI) only the final line."""
+        if not self.enabled:
+            return
+        tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        if tty:
+            self.stream.write("\r" + self.line() + ("\n" if final else ""))
+        elif final:
+            self.stream.write(self.line() + "\n")
+        self.stream.flush()
+
+
+def _tokens(n: int) -> str:
+    if n >= 1_000_000:
+        return f"{n / 1e6:.2f}M"
+    if n >= 1_000:
+        return f"{n / 1e3:.1f}k"
+    return str(n)
+
+
+def _execute(tasks: Sequence[EpisodeTask], cfg: RunConfig) -> Iterator[EpisodeResult]:
+    if not tasks:
+        return
+    if cfg.dask:
+        try:
+            import distributed
+        except ImportError:
+            raise ValueError(
+                "--dask needs the 'distributed' package: pip install 'chaingeo[cluster]'"
+            ) from None
+        client: Any = distributed.Client(cfg.dask)  # type: ignore[no-untyped-call]
+        try:
+            futures = client.map(run_episode, list(tasks), pure=False)
+            completed: Any = distributed.as_completed(futures)  # type: ignore[no-untyped-call]
+            for fut in completed:
+                yield fut.result()
+        finally:
+            client.close()
+        return
+    if cfg.jobs <= 1:
+        for t in tasks:
+            yield run_episode(t)
+        return
+    ctx = multiprocessing.get_context("spawn")
+    with cf.ProcessPoolExecutor(max_workers=cfg.jobs, mp_context=ctx) as pool:
+        pending = {pool.submit(run_episode, t) for t in tasks}
+        try:
+            while pending:
+                finished, pending = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
+                for fut in sorted(finished, key=lambda f: f.result().record["key"]):
+                    yield fut.result()
+        finally:
+            for fut in pending:
+                fut.cancel()
+
+
+def _cost(prices: PriceTable, rec: dict[str, Any]) -> float | None:
+    """The agent's tokens at its model's price, plus a model judge's at the judge's."""
+    cost = prices.cost(rec.get("model"), Usage.from_json(rec["usage"]))
+    judge = rec.get("judge")
+    if judge and cost is not None:
+        extra = prices.cost(judge.get("model"), Usage.from_json(judge["usage"]))
+        cost = None if extra is None else cost + extra
+    return cost
+
+
+def _secrets(agent: AgentSpec, protocol: ProtocolConfig) -> list[str]:
+    """Every secret the agent or a model judge may send, to be scrubbed from whatever is logged."""
+    out = [v for v in agent.secrets.values() if v]
+    for options in (agent.options, protocol.judge_options):
+        key = os.environ.get(str(options.get("api_key_env", "OPENAI_API_KEY")))
+        if key:
+            out.append(key)
+    return out
+
+
+def evaluate(
+    levels: Sequence[Level],
+    agent: AgentSpec,
+    run_dir: str | Path,
+    protocol: ProtocolConfig | None = None,
+    config: RunConfig | None = None,
+    prices: PriceTable | None = None,
+    stream: TextIO | None = None,
+) -> list[Outcome]:
+    """Run (or continue) one agent over ``levels``; returns every recorded episode's outcome."""
+    protocol = protocol or ProtocolConfig()
+    cfg = config or RunConfig()
+    prices = prices or PriceTable.load()
+    if cfg.samples < 1:
+        raise ValueError("samples must be >= 1")
+    from chaingeo.agents import make_agent
+
+    make_agent(agent).close()  # bad options fail here, before anything is written
+    ids = [lv.id for lv in levels]
+    if len(set(ids)) != len(ids):
+        raise ValueError("duplicate level ids in the suite")
+    header = make_header(
+        agent=agent.to_json(),
+        protocol=protocol.to_json(),
+        level_set_hash=level_set_hash(levels),
+        levels=ids,
+        seed=cfg.seed,
+        samples=cfg.samples,
+        extra={"label": agent.label, "agent_transport": agent.transport()},
+    )
+    log = RunLog.create(run_dir, header, resume=cfg.resume, secrets=_secrets(agent, protocol))
+    done = log.finished_keys(retry_errors=cfg.retry_errors)
+    tasks = [
+        EpisodeTask(lv, s, cfg.seed, agent, protocol)
+        for lv in levels
+        for s in range(cfg.samples)
+        if EpisodeTask(lv, s, cfg.seed, agent, protocol).key not in done
+    ]
+    bar = ProgressBar(agent.label, len(levels) * cfg.samples, stream, cfg.progress)
+    for rec in log.latest().values():
+        if rec["key"] in done:
+            bar.add(rec)
+    for result in _execute(tasks, cfg):
+        for png in result.images.values():
+            log.put_image(png)  # stored under its SHA-256, the name the record uses
+        rec = result.record
+        rec["cost_usd"] = _cost(prices, rec)
+        log.append(rec)
+        bar.add(rec)
+    bar.show(final=True)
+    return [outcome_of(r) for r in log.latest().values()]

@@ -1,0 +1,194 @@
+"""Stacking generator settings: one frozen dataclass and a registry of named configurations.
+
+As in reasoning-gym, a configuration is plain data (it pickles to any worker and is written into
+every run summary) and ``make(config, seed, index)`` is the only code that reads it. The named
+configurations carry the per-box limits of the CHAIN generator (most pieces, least search
+effort for hard levels); :func:`stacking_config` builds one for any other box.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from dataclasses import dataclass
+from typing import Any, Final, Literal
+
+from chaingeo.rules import SUPPORT_RULES, SupportRule
+
+Mode = Literal["easy", "mid", "hard"]
+MODES: Final[tuple[str, ...]] = ("easy", "mid", "hard")
+
+#: Largest cuboid piece in easy mode: a 2x2x2 cube is the biggest cuboid with two equal sides
+#: and no filled 2x3 face.
+EASY_MAX_PIECE_CELLS: Final = 8
+
+
+@dataclass(frozen=True)
+class StackingConfig:
+    """How to make one stacking level.
+
+    ``min_piece`` is tried for the first half of ``attempts``; then ``fallback_min_piece``
+    (None: no fallback) for the rest. ``min_nodes`` is the least exact-cover search effort
+    (nodes to the first packing) a level must need. ``planar`` (mid mode) keeps every piece in
+    one plane after repair; without it pieces are only grown in a plane. ``count_limit`` is
+    the node budget for counting every packing (0: do not count).
+    """
+
+    box: tuple[int, int, int]
+    mode: Mode
+    min_piece: int = 4
+    fallback_min_piece: int | None = 3
+    max_piece_cells: int = 5
+    max_pieces: int = 13
+    min_nodes: int = 0
+    linear_assembly: bool = True
+    planar: bool = True
+    attempts: int = 400
+    repair_moves: int = 64
+    easy_packings: int = 64
+    count_limit: int = 200_000
+    support: SupportRule = "contact"
+
+    def __post_init__(self) -> None:
+        box = tuple(int(v) for v in self.box)
+        object.__setattr__(self, "box", box)
+        if len(box) != 3 or min(box) < 1:
+            raise ValueError(f"box must be three positive sizes, got {list(self.box)}")
+        if box[0] * box[1] * box[2] < 2:
+            raise ValueError("the box must hold at least two cells")
+        if self.mode not in MODES:
+            raise ValueError(f"mode {self.mode!r} is not one of {list(MODES)}")
+        if not 1 <= self.min_piece <= self.max_piece_cells:
+            raise ValueError(
+                f"need 1 <= min_piece <= max_piece_cells, got {self.min_piece}, "
+                f"{self.max_piece_cells}"
+            )
+        if self.fallback_min_piece is not None and self.fallback_min_piece < 1:
+            raise ValueError(f"fallback_min_piece must be >= 1, got {self.fallback_min_piece}")
+        if self.max_pieces < 2:
+            raise ValueError(
+                f"max_pieces must be >= 2 (a level has two pieces or more), got {self.max_pieces}"
+            )
+        if self.attempts < 1:
+            raise ValueError(f"attempts must be >= 1, got {self.attempts}")
+        for name in ("min_nodes", "repair_moves", "easy_packings", "count_limit"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"{name} must be >= 0, got {getattr(self, name)}")
+        if self.support not in SUPPORT_RULES:
+            raise ValueError(f"support {self.support!r} is not one of {list(SUPPORT_RULES)}")
+
+    @property
+    def volume(self) -> int:
+        a, b, c = self.box
+        return a * b * c
+
+    @property
+    def stages(self) -> list[tuple[int, int]]:
+        """``(min_piece, attempts)`` per stage: the staged fallback (e.g. 4 then 3)."""
+        if self.fallback_min_piece is None or self.fallback_min_piece == self.min_piece:
+            return [(self.min_piece, self.attempts)]
+        first = (self.attempts + 1) // 2
+        return [(self.min_piece, first), (self.fallback_min_piece, self.attempts - first)]
+
+    def to_json(self) -> dict[str, Any]:
+        out = dataclasses.asdict(self)
+        out["box"] = list(self.box)
+        return out
+
+    def replace(self, **changes: Any) -> StackingConfig:
+        return dataclasses.replace(self, **changes)
+
+
+@dataclass(frozen=True)
+class BoxLimits:
+    """Per-box limits of the CHAIN generator: most pieces, least search effort for hard."""
+
+    max_pieces: int
+    hard_min_nodes: int
+
+
+#: The boxes of the CHAIN stacking split. ``max_pieces`` follows the CHAIN generator;
+#: ``hard_min_nodes`` is about the median, over 40 hard partitions per box, of our engine's
+#: dancing-links nodes to the first packing, so hard levels are the harder half to search.
+BOX_LIMITS: Final[dict[tuple[int, int, int], BoxLimits]] = {
+    (2, 2, 2): BoxLimits(2, 0),
+    (2, 2, 3): BoxLimits(4, 0),
+    (2, 2, 4): BoxLimits(4, 0),
+    (2, 3, 3): BoxLimits(5, 10),
+    (2, 3, 4): BoxLimits(6, 30),
+    (2, 4, 4): BoxLimits(7, 60),
+    (3, 3, 3): BoxLimits(6, 25),
+    (3, 3, 4): BoxLimits(8, 75),
+    (3, 4, 4): BoxLimits(10, 350),
+    (4, 4, 4): BoxLimits(13, 1000),
+}
+
+
+def parse_box(text: str) -> tuple[int, int, int]:
+    """``"3x3x4"`` -> ``(3, 3, 4)``; ``ValueError`` naming the bad text otherwise."""
+    m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+    if not m:
+        raise ValueError(f"box {text!r} is not of the form AxBxC, e.g. 3x3x4")
+    a, b, c = (int(g) for g in m.groups())
+    if min(a, b, c) < 1:
+        raise ValueError(f"box {text!r} has a zero side")
+    return a, b, c
+
+
+def box_text(box: tuple[int, int, int]) -> str:
+    return "x".join(str(v) for v in box)
+
+
+def stacking_config(box: tuple[int, int, int], mode: str, **overrides: Any) -> StackingConfig:
+    """The default configuration for a box and mode (CHAIN limits when the box is known).
+
+    Unknown boxes get as many pieces as the average piece size of 4.5 cells suggests.
+    """
+    if mode not in MODES:
+        raise ValueError(f"mode {mode!r} is not one of {list(MODES)}")
+    a, b, c = sorted(box)
+    limits = BOX_LIMITS.get((a, b, c))
+    volume = box[0] * box[1] * box[2]
+    max_pieces = limits.max_pieces if limits else max(2, round(volume / 4.5))
+    fields: dict[str, Any] = {"box": box, "mode": mode, "max_pieces": max_pieces}
+    if mode == "easy":
+        fields["max_piece_cells"] = EASY_MAX_PIECE_CELLS
+    if mode == "hard" and limits is not None:
+        fields["min_nodes"] = limits.hard_min_nodes
+    if volume <= 12:
+        # With 4-cell pieces a box this small holds too few distinct puzzles (2x2x3: two
+        # easy, two mid), so it starts at 3 cells.
+        fields["min_piece"] = 3
+    if mode == "mid" and volume == 8:
+        # Planar pieces of 3..5 cells fill a 2x2x2 box only as two 2x2 plates (the easy
+        # level); pieces grown in a plane and completed off it give the mid level.
+        fields["planar"] = False
+    fields.update(overrides)
+    return StackingConfig(**fields)
+
+
+_REGISTRY: dict[str, StackingConfig] = {}
+
+
+def register_config(name: str, config: StackingConfig) -> None:
+    if name in _REGISTRY:
+        raise ValueError(f"a stacking config named {name!r} is already registered")
+    _REGISTRY[name] = config
+
+
+def get_config(name: str) -> StackingConfig:
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        raise ValueError(
+            f"no stacking config named {name!r}; known: {', '.join(sorted(_REGISTRY))}"
+        ) from None
+
+
+def config_names() -> list[str]:
+    return sorted(_REGISTRY)
+
+
+for _box in BOX_LIMITS:
+    for _mode in MODES:
+        register_config(f"{box_text(_box)}-{_mode}", stacking_config(_box, _mode))

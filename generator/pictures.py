@@ -1,0 +1,24 @@
+"""Pictures written next to each generated level: the packed assembly and the pieces handed out.
+
+The one place the generator makes pictures; it uses the project renderer
+(:mod:`chaingeo.render`: deterministic PNG bytes, no GUI), so worker processes can call it.
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+from chaingeo.level import Level
+from chaingeo.render import render_level_tray, render_solution_views
+
+PictureSet = dict[str, bytes]
+#: The solved level is drawn from this view.
+ASSEMBLY_VIEW: Final = "iso"
+
+
+def level_pictures(level: Level) -> PictureSet:
+    """``{"assembly": png, "pieces": png}``: the level solved, and its pieces as handed out."""
+    return {
+        "assembly": render_solution_views(level, views=(ASSEMBLY_VIEW,))[ASSEMBLY_VIEW],
+        "pieces": render_level_tray(level),
+    }

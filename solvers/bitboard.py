@@ -1,0 +1,337 @@
+"""Bit-board exact cover for targets of at most 64 cells.
+
+The occupancy is one ``uint64``; every row is a precomputed mask. The search always fills the
+first empty mandatory cell (in a scan order that runs fastest along the target's shortest
+axis), trying only the rows whose lowest mandatory cell is that cell: each solution is found
+exactly once, and the fit test is one AND. Piece types carry count ranges exactly as in
+:mod:`solvers.dlx` (checked against ``hi`` on the way down, against ``lo`` at a full cover).
+
+``nodes`` counts rows placed; ``updates`` counts rows tested (the bit-board's unit of work).
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from solvers.kernels import (
+    DONE,
+    FRESH,
+    LIMIT,
+    REG_DEPTH,
+    REG_NODES,
+    REG_SOLUTIONS,
+    REG_STATUS,
+    REG_UPDATES,
+    RUNNING,
+    shuffle_prefix,
+)
+from solvers.placements import Int32Array
+from solvers.problem import CoverProblem
+
+MAX_CELLS = 64
+
+_DEBRUIJN = np.uint64(0x03F79D71B4CB0A89)
+_DEBRUIJN_TABLE = np.zeros(64, dtype=np.int32)
+for _i in range(64):
+    _DEBRUIJN_TABLE[(((1 << _i) * 0x03F79D71B4CB0A89) & 0xFFFFFFFFFFFFFFFF) >> 58] = _i
+
+
+@njit(cache=True)
+def _lowest_bit(x: np.uint64, table: Any) -> int:
+    low = x & (~x + np.uint64(1))
+    return int(table[(low * np.uint64(0x03F79D71B4CB0A89)) >> np.uint64(58)])
+
+
+@njit(cache=True)
+def _popcount(x: np.uint64) -> int:
+    x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+    return int((x * np.uint64(0x0101010101010101)) >> np.uint64(56))
+
+
+@njit(cache=True)
+def _grow(x: np.uint64, nb: Any) -> Any:
+    """``x`` with its face neighbours in the box (``nb``: edge masks and strides)."""
+    return (
+        x
+        | ((x & nb[0]) << np.uint64(1))
+        | ((x & nb[1]) >> np.uint64(1))
+        | ((x & nb[2]) << nb[6])
+        | ((x & nb[3]) >> nb[6])
+        | ((x & nb[4]) << nb[7])
+        | ((x & nb[5]) >> nb[7])
+    )
+
+
+@njit(cache=True)
+def _regions_ok(
+    placed: np.uint64, empty: np.uint64, nb: Any, gcd: int, smallest: int, cap: int
+) -> bool:
+    """Can every empty region touching the piece just placed still be filled?
+
+    Each region is grown from a seed next to the piece until it closes or holds ``cap`` cells.
+    A closed region must hold at least ``smallest`` cells and a multiple of ``gcd`` (the gcd of
+    all piece sizes). Regions the piece does not touch were checked when they formed.
+    """
+    seeds = _grow(placed, nb) & empty
+    while seeds != 0:
+        region = seeds & (~seeds + np.uint64(1))
+        closed = False
+        while True:
+            grown = _grow(region, nb) & empty
+            if grown == region:
+                closed = True
+                break
+            region = grown
+            if _popcount(region) >= cap:
+                break
+        if closed:
+            size = _popcount(region)
+            if size < smallest or size % gcd != 0:
+                return False
+        seeds &= ~region
+    return True
+
+
+@njit(cache=True)
+def _enter(k: int, lst_start: int, lst_len: int, cand: Any, perm: Any, width: int,
+           base: Any, pos: Any, end: Any, shuffle: bool, rng: Any) -> None:  # fmt: skip
+    """Start level ``k`` on the candidate list ``cand[lst_start : lst_start + lst_len]``
+    (copied into level ``k``'s slice of ``perm`` and shuffled in random mode)."""
+    if shuffle:
+        off = k * width
+        for i in range(lst_len):
+            perm[off + i] = cand[lst_start + i]
+        shuffle_prefix(perm[off : off + lst_len], lst_len, rng)
+        base[k] = off
+    else:
+        base[k] = lst_start
+    pos[k] = base[k]
+    end[k] = base[k] + lst_len
+
+
+@njit(cache=True)
+def bitboard_run(
+    mask: Any, rtype: Any, rid: Any, cand_ptr: Any, cand: Any, skip: Any, root: Any,
+    primary: np.uint64,
+    lo: Any, hi: Any, cnt: Any, counters: Any, table: Any,
+    nb: Any, region_gcd: int, region_min: int, region_cap: int,
+    occ: Any, perm: Any, end: Any, pos: Any, base: Any, chosen: Any,
+    regs: Any, rng: Any, shuffle: bool,
+    out: Any, max_store: int, stop_after: int, node_limit: int,
+) -> int:  # fmt: skip
+    """Run (or resume) the search; same contract as :func:`solvers.dlx.dlx_run`.
+
+    ``pos[k]``/``end[k]`` index ``cand`` (fixed order) or level ``k``'s slice of ``perm``
+    (random order, ``width`` entries per level).
+    """
+    status = regs[REG_STATUS]
+    if status == DONE:
+        return 0
+    width = len(perm) // len(pos)
+    nodes = regs[REG_NODES]
+    updates = regs[REG_UPDATES]
+    found = 0
+    n_out = 0
+    if status == FRESH:
+        k = 0
+        occ[0] = np.uint64(0)
+        if root[1] > root[0]:  # branch on one piece type first
+            _enter(0, root[0], root[1] - root[0], cand, perm, width, base, pos, end, shuffle, rng)
+        else:
+            c = _lowest_bit(primary, table)
+            n = cand_ptr[c + 1] - cand_ptr[c]
+            _enter(0, cand_ptr[c], n, cand, perm, width, base, pos, end, shuffle, rng)
+    else:
+        k = regs[REG_DEPTH]
+    regs[REG_STATUS] = RUNNING
+    src = perm if shuffle else cand
+    stop = False
+    while not stop:
+        # Find the next row that fits at level k.
+        p = pos[k]
+        e = end[k]
+        here = occ[k]
+        row = -1
+        free = np.uint64(0)
+        while p < e:
+            r = src[p]
+            t = rtype[r]
+            if cnt[t] >= hi[t]:
+                p = p + 1 if shuffle else skip[p]  # past this type's run
+                continue
+            p += 1
+            updates += 1
+            m = mask[r]
+            if (m & here) != 0:
+                continue
+            free = primary & ~(here | m)
+            if (
+                region_min > 0
+                and free != 0
+                and not _regions_ok(m, free, nb, region_gcd, region_min, region_cap)
+            ):
+                continue
+            row = r
+            break
+        if row >= 0 and nodes >= node_limit:
+            pos[k] = p - 1
+            updates -= 1  # the row is tried again on resumption
+            regs[REG_STATUS] = LIMIT
+            break
+        pos[k] = p
+        if row < 0:  # level exhausted: backtrack
+            if k == 0:
+                regs[REG_STATUS] = DONE
+                break
+            k -= 1
+            cnt[rtype[chosen[k]]] -= 1
+            continue
+        nodes += 1
+        t = rtype[row]
+        chosen[k] = row
+        if free == 0:  # every mandatory cell covered
+            ok = True
+            for q in counters:
+                if cnt[q] + (1 if q == t else 0) < lo[q]:
+                    ok = False
+                    break
+            if ok:
+                found += 1
+                if max_store > 0:
+                    for d in range(k + 1):
+                        out[n_out, d] = rid[chosen[d]]
+                    for d in range(k + 1, out.shape[1]):
+                        out[n_out, d] = -1
+                    n_out += 1
+                if (max_store > 0 and n_out == max_store) or found == stop_after:
+                    stop = True
+            continue
+        cnt[t] += 1
+        k += 1
+        occ[k] = here | mask[row]
+        c = _lowest_bit(free, table)
+        n = cand_ptr[c + 1] - cand_ptr[c]
+        _enter(k, cand_ptr[c], n, cand, perm, width, base, pos, end, shuffle, rng)
+    regs[REG_DEPTH] = k
+    regs[REG_NODES] = nodes
+    regs[REG_UPDATES] = updates
+    regs[REG_SOLUTIONS] += found
+    return n_out
+
+
+def scan_axes(problem: CoverProblem) -> list[int]:
+    """The axes in scan order, fastest first: the shortest bounding-box axis first."""
+    ext = problem.target.extent
+    axes = sorted(range(3), key=lambda a: (ext[a], a))
+    import os
+
+    o = os.environ.get("CHAIN_SCAN")
+    if o:
+        axes = [axes[int(c)] for c in o]
+    return axes
+
+
+def scan_order(problem: CoverProblem) -> Int32Array:
+    """``bit[cell]``: cells ranked in :func:`scan_axes` order."""
+    vox = problem.target.voxels - problem.target.min_corner
+    axes = scan_axes(problem)
+    rank = np.lexsort([vox[:, a] for a in axes])  # last key is the primary sort key
+    bit = np.empty(len(vox), dtype=np.int32)
+    bit[rank] = np.arange(len(vox), dtype=np.int32)
+    return bit
+
+
+class BitboardArrays:
+    """Row masks and per-cell candidate lists of a problem restricted to a subset of rows."""
+
+    def __init__(self, problem: CoverProblem, rows: Int32Array) -> None:
+        if problem.n_cells > MAX_CELLS:
+            raise ValueError(f"bit-board needs at most {MAX_CELLS} cells, got {problem.n_cells}")
+        bit = scan_order(problem)
+        primary = np.uint64(0)
+        for c in range(problem.n_cells):
+            if c not in problem.optional:
+                primary |= np.uint64(1) << np.uint64(bit[c])
+        rows = np.asarray(rows, dtype=np.int32)
+        ptr, flat = problem.row_ptr, problem.flat_cells
+        masks = np.zeros(len(rows), dtype=np.uint64)
+        for i, r in enumerate(rows):
+            m = np.uint64(0)
+            for c in bit[flat[ptr[r] : ptr[r + 1]]]:
+                m |= np.uint64(1) << np.uint64(c)
+            masks[i] = m
+        pm = masks & primary
+        keep = pm != 0  # rows entirely on optional cells are unreachable
+        rows, masks, pm = rows[keep], masks[keep], pm[keep]
+        low = np.array([_lowest_bit(np.uint64(x), _DEBRUIJN_TABLE) for x in pm], dtype=np.int64)
+        rtype = problem.row_type[rows].astype(np.int64)
+        order = np.lexsort((rows, rtype, low))  # by lowest mandatory cell, type, row id
+        self.mask = np.ascontiguousarray(masks[order])
+        self.rid = np.ascontiguousarray(rows[order])
+        self.rtype = np.ascontiguousarray(rtype[order]).astype(np.int32)
+        counts = np.bincount(low, minlength=MAX_CELLS)
+        self.cand_ptr = np.zeros(MAX_CELLS + 1, dtype=np.int64)
+        np.cumsum(counts, out=self.cand_ptr[1:])
+        # Root branching: the exact-once type with fewest rows, if it has at most a quarter as
+        # many as the first cell (a symmetry-reduced anchor, typically).
+        n = len(order)
+        first_cell = _lowest_bit(primary, _DEBRUIJN_TABLE)
+        best, best_n = -1, int(counts[first_cell]) // 4 + 1
+        for t, ty in enumerate(problem.types):
+            nt = int(np.count_nonzero(self.rtype == t))
+            if ty.lo == 1 and ty.hi == 1 and nt < best_n:
+                best, best_n = t, nt
+        root_rows: Int32Array = np.flatnonzero(self.rtype == best).astype(np.int32)
+        if best < 0:
+            root_rows = root_rows[:0]
+        self.cand = np.concatenate([np.arange(n), root_rows]).astype(np.int32)
+        self.root = np.array([n, n + len(root_rows)], dtype=np.int64)
+        # skip[i]: end of the run of candidates of one type (in one list) containing position i.
+        key = np.concatenate(
+            [low[order] * (len(problem.types) + 1) + self.rtype, np.full(len(root_rows), -1)]
+        )
+        self.skip = np.empty(len(self.cand), dtype=np.int64)
+        end = len(self.cand)
+        for i in range(len(self.cand) - 1, -1, -1):
+            if i + 1 < len(self.cand) and (key[i + 1] != key[i] or i + 1 == n):
+                end = i + 1
+            self.skip[i] = end
+        self.primary = primary
+        T = len(problem.types)
+        self.lo = np.array([t.lo for t in problem.types], dtype=np.int32)
+        self.hi = np.array([t.hi for t in problem.types], dtype=np.int32)
+        self.counters = np.array([t for t in range(T) if self.lo[t] > 0], dtype=np.int32)
+        n_primary = problem.n_cells - len(problem.optional)
+        self.max_depth = min(n_primary, int(self.hi.sum()))
+        self.max_col = int(counts.max()) if len(counts) else 0
+        self.table = _DEBRUIJN_TABLE
+        self.nb, self.region_gcd, self.region_min = region_pruning(problem)
+        self.region_cap = int(os.environ.get("CHAIN_CAP", "64"))
+
+
+def region_pruning(problem: CoverProblem) -> tuple[np.ndarray, int, int]:
+    """Edge masks and strides of a box target in scan order, the gcd and the least of the piece
+    sizes; ``region_min`` is 0 (pruning off) for non-box targets, optional cells, or when no
+    region size could ever be ruled out."""
+    nb = np.zeros(8, dtype=np.uint64)
+    ext = problem.target.extent
+    if problem.optional or problem.n_cells != ext[0] * ext[1] * ext[2]:
+        return nb, 1, 0
+    sizes = [len(t.shape) for t in problem.types]
+    gcd = int(np.gcd.reduce(sizes))
+    smallest = min(sizes)
+    if gcd == 1 and smallest == 1:
+        return nb, 1, 0
+    e0, e1, e2 = (ext[a] for a in scan_axes(problem))
+    i = np.arange(problem.n_cells)
+    i0, i1, i2 = i % e0, (i // e0) % e1, i // (e0 * e1)
+    for slot, sel in enumerate([i0 < e0 - 1, i0 > 0, i1 < e1 - 1, i1 > 0, i2 < e2 - 1, i2 > 0]):
+        nb[slot] = np.uint64(sum(1 << int(b) for b in i[sel]))
+    nb[6], nb[7] = np.uint64(e0), np.uint64(e0 * e1)
+    return nb, gcd, smallest

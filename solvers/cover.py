@@ -1,0 +1,373 @@
+"""Exact cover for polycube packing: count, enumerate, first, seeded-random solutions.
+
+Public API (pieces: a ``{name: Shape}`` mapping, a list of :class:`Shape`, or a list of
+:class:`PieceSpec` with ``min``/``max`` copies; target: any :class:`Shape` or box sizes
+``(a, b, c)``; ``optional``: target cells that may stay empty)::
+
+    count_solutions(pieces, target, *, distinct=True, reflections=True, optional=None,
+                    engine="auto", node_limit=None, symmetry=True) -> CoverResult
+    iter_solutions(pieces, target, *, distinct=False, ...) -> Iterator[Solution]
+    first_solution(pieces, target, ...) -> Solution | None
+    random_solutions(pieces, target, rng, ...) -> Iterator[Solution]
+    cover_problem(pieces, target, ...) -> CoverProblem   # compiled + cached, reusable
+    CoverSearch(problem, rows=None, engine=..., rng=..., node_limit=...)  # low level
+
+*Solutions* are sets of placed shapes: identical pieces (same shape up to rotation) are
+interchangeable, so they are never counted twice in different orders. ``distinct`` counts
+solutions up to the target's own symmetries: its rotations, plus its reflections when
+``reflections=True`` and the piece multiset is mirror-invariant (a reflection turns each
+piece into its mirror image, so the count only makes sense if those are pieces too; BurrTools
+style "rotations only" is ``reflections=False``).
+
+*Symmetry reduction* (``symmetry=True``): one anchor piece type used exactly once is restricted
+to one placement per orbit of the symmetry group (an achiral anchor is preferred, so the whole
+group applies). Then ``solutions = sum(orbit size x solutions with the anchor there)`` exactly;
+``distinct`` is the number of free-orbit solutions plus the distinct canonical forms of the few
+solutions whose anchor placement is itself symmetric. Without a usable anchor every solution
+is enumerated and canonicalised.
+
+*Engines*: ``"bitboard"`` (targets of at most 64 cells) or ``"dlx"`` (dancing links, MRV);
+``"auto"`` takes the bit-board whenever it applies (it is the faster one there). ``nodes`` in
+:class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates`` the engine's
+unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a ``SearchLimitError``) is
+raised carrying the solutions found so far and the stats; iterators first yield what they found.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+from chaingeo.geometry import Shape
+from solvers.placements import Int32Array
+from solvers.problem import (
+    CoverError,
+    CoverProblem,
+    PiecesLike,
+    PieceSpec,
+    TargetLike,
+    cover_problem,
+)
+from solvers.search import CoverLimitError, CoverSearch, CoverStats, Engine
+
+__all__ = [
+    "AnchorPlan",
+    "CoverError",
+    "CoverLimitError",
+    "CoverProblem",
+    "CoverResult",
+    "CoverSearch",
+    "CoverStats",
+    "PieceSpec",
+    "Solution",
+    "anchor_plan",
+    "canonical_forms",
+    "count_solutions",
+    "cover_problem",
+    "first_solution",
+    "iter_solutions",
+    "random_solutions",
+]
+
+
+@dataclass(frozen=True)
+class CoverResult:
+    solutions: int  # every solution
+    distinct: int | None  # up to the symmetry group (None when not asked for)
+    stats: CoverStats
+    symmetry_order: int  # size of the (faithful) group ``distinct`` is taken under
+    anchor: str | None  # the anchor piece used for symmetry reduction, if any
+
+
+@dataclass(frozen=True)
+class Solution:
+    """One packing: ``placements`` are ``(piece name, placed shape)`` in the pieces' order."""
+
+    placements: tuple[tuple[str, Shape], ...]
+    rows: tuple[int, ...]  # the problem's row ids, sorted
+
+    @property
+    def shapes(self) -> list[Shape]:
+        return [s for _, s in self.placements]
+
+    def by_piece(self) -> dict[str, list[Shape]]:
+        out: dict[str, list[Shape]] = {}
+        for name, s in self.placements:
+            out.setdefault(name, []).append(s)
+        return out
+
+
+def make_solution(problem: CoverProblem, rows: Int32Array) -> Solution:
+    ids = sorted(int(r) for r in rows if r >= 0)
+    per_type: dict[int, list[int]] = {}
+    for r in ids:
+        per_type.setdefault(int(problem.row_type[r]), []).append(r)
+    named: list[tuple[str, Shape]] = []
+    for t, ty in enumerate(problem.types):
+        for slot, r in zip(ty.slots, per_type.get(t, []), strict=False):
+            named.append((slot, problem.placed_shape(r)))
+    order = {
+        name: i for i, name in enumerate(dict.fromkeys(n for ty in problem.types for n in ty.slots))
+    }
+    named.sort(key=lambda p: order[p[0]])
+    return Solution(tuple(named), tuple(ids))
+
+
+# -- symmetry -----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class AnchorPlan:
+    """Anchor type, the subgroup ``group`` that fixes it, and its placement orbit reps."""
+
+    type_index: int
+    group: Int32Array  # indices into the problem's row maps
+    full: bool  # the subgroup is the whole symmetry group
+    free_reps: Int32Array  # reps whose stabiliser is trivial (orbit size len(group))
+    fixed_reps: Int32Array  # reps with a non-trivial stabiliser
+    fixed_orbit: Int32Array  # orbit size of each fixed rep
+
+
+def anchor_plan(problem: CoverProblem, prefer: str | None = None) -> AnchorPlan | None:
+    """Pick the anchor giving the fewest orbit representatives (achiral anchors first), or the
+    piece named ``prefer`` if it can be one."""
+    syms, maps = problem.symmetry
+    if len(syms) == 1:
+        return None
+    proper = np.array([round(np.linalg.det(m)) > 0 for m, _ in syms])
+    best: tuple[tuple[int, int, int, int], AnchorPlan] | None = None
+    for t, ty in enumerate(problem.types):
+        if not (ty.lo == 1 and ty.hi == 1):
+            continue
+        full = not ty.chiral or bool(proper.all())
+        group = np.flatnonzero(np.ones(len(syms), bool) if full else proper).astype(np.int32)
+        a, b = int(problem.row_start[t]), int(problem.row_start[t + 1])
+        if b == a:
+            continue
+        images = maps[group][:, a:b]  # (|H|, n) images of this type's rows
+        rep_of = images.min(axis=0)
+        reps = np.unique(rep_of)
+        stab = (maps[group][:, reps] == reps[None, :]).sum(axis=0)
+        free = reps[stab == 1].astype(np.int32)
+        fixed = reps[stab > 1].astype(np.int32)
+        orbit = (len(group) // stab[stab > 1]).astype(np.int32)
+        plan = AnchorPlan(t, group, full, free, fixed, orbit)
+        score = (0 if ty.slots[0] == prefer else 1, 0 if full else 1, len(reps), len(fixed))
+        if best is None or score < best[0]:
+            best = (score, plan)
+    return None if best is None else best[1]
+
+
+def canonical_forms(problem: CoverProblem, solutions: Int32Array, chunk: int = 4096) -> Int32Array:
+    """Lexicographically least sorted row set of each solution over the symmetry group.
+
+    ``solutions`` is ``(n, k)`` row ids, ``-1`` padded; the result is ``(n, k)`` (padding last).
+    """
+    _, maps = problem.symmetry
+    big = np.int32(np.iinfo(np.int32).max)
+    out = np.empty(solutions.shape, dtype=np.int32)
+    for s in range(0, len(solutions), chunk):
+        sol = solutions[s : s + chunk]
+        imgs = np.where(sol[None] >= 0, maps[:, np.maximum(sol, 0)], big)  # (G, n, k)
+        imgs.sort(axis=2)
+        alive = np.ones(imgs.shape[:2], dtype=bool)
+        for p in range(imgs.shape[2]):
+            col = np.where(alive, imgs[:, :, p], big)
+            m = col.min(axis=0)
+            alive &= imgs[:, :, p] == m[None, :]
+            out[s : s + chunk, p] = m
+    return np.where(out == big, -1, out)
+
+
+def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> int:
+    if not blocks:
+        return 0
+    width = max(b.shape[1] for b in blocks)
+    sols = np.concatenate(
+        [np.pad(b, ((0, 0), (0, width - b.shape[1])), constant_values=-1) for b in blocks]
+    )
+    return len(np.unique(canonical_forms(problem, sols), axis=0))
+
+
+def _restricted_rows(
+    problem: CoverProblem, plan: AnchorPlan, anchor_rows: Int32Array
+) -> Int32Array:
+    a, b = int(problem.row_start[plan.type_index]), int(problem.row_start[plan.type_index + 1])
+    rows = np.arange(problem.n_rows, dtype=np.int32)
+    others = np.concatenate([rows[:a], rows[b:]])
+    return np.sort(np.concatenate([others, anchor_rows])).astype(np.int32)
+
+
+def count_solutions(
+    pieces: PiecesLike | CoverProblem,
+    target: TargetLike | None = None,
+    *,
+    distinct: bool = True,
+    reflections: bool = True,
+    optional: Shape | None = None,
+    engine: Engine = "auto",
+    node_limit: int | None = None,
+    symmetry: bool = True,
+    anchor: str | None = None,
+) -> CoverResult:
+    """Count all solutions and (if asked) the distinct ones up to the target's symmetries."""
+    problem = _problem(pieces, target, optional, reflections)
+    syms, _ = problem.symmetry
+    plan = anchor_plan(problem, anchor) if symmetry else None
+    budget = _Budget(node_limit)
+    if plan is None:
+        search = budget.search(problem, None, engine)
+        if not distinct:
+            total = budget.count(search)
+            return CoverResult(total, None, budget.stats, len(syms), None)
+        every = budget.collect(search)
+        return CoverResult(
+            search.found, _count_distinct_forms(problem, every), budget.stats, len(syms), None
+        )
+    anchor_name = problem.types[plan.type_index].slots[0]
+    h = len(plan.group)
+    total = 0
+    n_distinct = 0
+    blocks: list[Int32Array] = []
+    if len(plan.free_reps):
+        search = budget.search(problem, _restricted_rows(problem, plan, plan.free_reps), engine)
+        if distinct and not plan.full:
+            found = budget.collect(search)
+            blocks.extend(found)
+            total += h * sum(len(b) for b in found)
+        else:
+            n = budget.count(search)
+            total += h * n
+            n_distinct += n
+    if len(plan.fixed_reps):
+        search = budget.search(problem, _restricted_rows(problem, plan, plan.fixed_reps), engine)
+        found = budget.collect(search)
+        blocks.extend(found)
+        orbit_of = dict(zip(plan.fixed_reps.tolist(), plan.fixed_orbit.tolist(), strict=True))
+        anchor_rows = set(orbit_of)
+        for block in found:
+            for sol in block:
+                r = next(int(x) for x in sol if int(x) in anchor_rows)
+                total += orbit_of[r]
+    if distinct:
+        n_distinct += _count_distinct_forms(problem, blocks)
+    return CoverResult(
+        total, n_distinct if distinct else None, budget.stats, len(syms), anchor_name
+    )
+
+
+class _Budget:
+    """Shares one node limit across the several searches of a count."""
+
+    def __init__(self, node_limit: int | None) -> None:
+        if node_limit is not None and node_limit < 0:
+            raise CoverError(f"node_limit: must be >= 0, got {node_limit}")
+        self.limit = node_limit
+        self.stats = CoverStats()
+        self.found = 0
+
+    def search(self, problem: CoverProblem, rows: Int32Array | None, engine: Engine) -> CoverSearch:
+        left = None if self.limit is None else max(self.limit - self.stats.nodes, 0)
+        return CoverSearch(problem, rows, engine=engine, node_limit=left)
+
+    def _run(self, search: CoverSearch, collect: bool) -> list[Int32Array]:
+        blocks: list[Int32Array] = []
+        try:
+            if collect:
+                blocks.extend(search.batches(4096))
+            else:
+                search.count()
+        except CoverLimitError:
+            self.stats += search.stats
+            raise CoverLimitError(self.limit or 0, self.found + search.found, self.stats) from None
+        self.stats += search.stats
+        self.found += search.found
+        return blocks
+
+    def count(self, search: CoverSearch) -> int:
+        self._run(search, False)
+        return search.found
+
+    def collect(self, search: CoverSearch) -> list[Int32Array]:
+        return self._run(search, True)
+
+
+def _problem(
+    pieces: PiecesLike | CoverProblem,
+    target: TargetLike | None,
+    optional: Shape | None,
+    reflections: bool,
+) -> CoverProblem:
+    if isinstance(pieces, CoverProblem):
+        return pieces
+    if target is None:
+        raise CoverError("target: required unless a compiled CoverProblem is given")
+    return cover_problem(pieces, target, optional=optional, reflections=reflections)
+
+
+def iter_solutions(
+    pieces: PiecesLike | CoverProblem,
+    target: TargetLike | None = None,
+    *,
+    distinct: bool = False,
+    reflections: bool = True,
+    optional: Shape | None = None,
+    engine: Engine = "auto",
+    node_limit: int | None = None,
+) -> Iterator[Solution]:
+    """Every solution, lazily, in a fixed order; ``distinct=True`` yields one per symmetry class
+    (the first met), at the cost of remembering the canonical form of each class."""
+    problem = _problem(pieces, target, optional, reflections)
+    search = CoverSearch(problem, engine=engine, node_limit=node_limit)
+    seen: set[bytes] = set()
+    for block in search.batches(64):
+        forms = canonical_forms(problem, block) if distinct else block
+        for sol, form in zip(block, forms, strict=True):
+            if distinct:
+                key = form.tobytes()
+                if key in seen:
+                    continue
+                seen.add(key)
+            yield make_solution(problem, sol)
+
+
+def first_solution(
+    pieces: PiecesLike | CoverProblem,
+    target: TargetLike | None = None,
+    *,
+    reflections: bool = True,
+    optional: Shape | None = None,
+    engine: Engine = "auto",
+    node_limit: int | None = None,
+) -> Solution | None:
+    """The first solution in the engine's fixed order, or ``None`` if there is none."""
+    problem = _problem(pieces, target, optional, reflections)
+    search = CoverSearch(problem, engine=engine, node_limit=node_limit)
+    for block in search.batches(1):
+        return make_solution(problem, block[0])
+    return None
+
+
+def random_solutions(
+    pieces: PiecesLike | CoverProblem,
+    target: TargetLike | None = None,
+    rng: np.random.Generator | None = None,
+    *,
+    reflections: bool = True,
+    optional: Shape | None = None,
+    engine: Engine = "auto",
+    node_limit: int | None = None,
+) -> Iterator[Solution]:
+    """All solutions, each once, in an order shuffled at every search node by ``rng``.
+
+    The same generator state gives the same sequence on any machine (the kernel runs its own
+    SplitMix64 seeded from one draw of ``rng``).
+    """
+    if rng is None:
+        raise CoverError("rng: random_solutions needs a numpy.random.Generator")
+    problem = _problem(pieces, target, optional, reflections)
+    search = CoverSearch(problem, engine=engine, rng=rng, node_limit=node_limit)
+    for block in search.batches(1):
+        yield make_solution(problem, block[0])

@@ -1,0 +1,301 @@
+"""Dancing-links Algorithm X on flat int32 arrays (any target size).
+
+Columns (items): one per piece type, then one per target cell. Kinds:
+
+- *primary* (covered exactly once): mandatory cells and types used exactly once;
+- *secondary* (at most once): optional cells and types used 0..1 times;
+- *counter*: types with any other range ``[lo, hi]``; choosing a row increments the count, the
+  column is covered (its remaining rows removed) when the count reaches ``hi``, and a full cover
+  is a solution only if every count is at least ``lo``. Counters are never branched on, so each
+  solution (a set of rows) is still found exactly once.
+
+The search branches on the primary column with fewest rows (MRV, first in column order on
+ties; type columns come first). ``nodes`` counts rows chosen, ``updates`` counts link removals
+(Knuth's measure). Rows whose cells are all optional are dropped (they cannot be reached by
+branching on mandatory cells).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from solvers.kernels import (
+    DONE,
+    FRESH,
+    LIMIT,
+    REG_DEPTH,
+    REG_NODES,
+    REG_SOLUTIONS,
+    REG_STATUS,
+    REG_UPDATES,
+    RUNNING,
+    shuffle_prefix,
+)
+from solvers.placements import Int32Array
+from solvers.problem import CoverProblem
+
+PRIMARY, SECONDARY, COUNTER = 0, 1, 2
+
+
+@njit(cache=True)
+def _cover(c: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any) -> int:
+    L[R[c]] = L[c]
+    R[L[c]] = R[c]
+    upd = 0
+    i = D[c]
+    while i != c:
+        j = R[i]
+        while j != i:
+            U[D[j]] = U[j]
+            D[U[j]] = D[j]
+            S[C[j]] -= 1
+            upd += 1
+            j = R[j]
+        i = D[i]
+    return upd
+
+
+@njit(cache=True)
+def _uncover(c: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any) -> None:
+    i = U[c]
+    while i != c:
+        j = L[i]
+        while j != i:
+            S[C[j]] += 1
+            U[D[j]] = j
+            D[U[j]] = j
+            j = L[j]
+        i = U[i]
+    L[R[c]] = c
+    R[L[c]] = c
+
+
+@njit(cache=True)
+def _select(
+    r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any
+) -> int:
+    upd = 0
+    j = R[r]
+    while j != r:
+        c = C[j]
+        if kind[c] == COUNTER:
+            cnt[c] += 1
+            if cnt[c] == hi[c]:
+                upd += _cover(c, L, R, U, D, C, S)
+        else:
+            upd += _cover(c, L, R, U, D, C, S)
+        j = R[j]
+    return upd
+
+
+@njit(cache=True)
+def _unselect(
+    r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any
+) -> None:
+    j = L[r]
+    while j != r:
+        c = C[j]
+        if kind[c] == COUNTER:
+            if cnt[c] == hi[c]:
+                _uncover(c, L, R, U, D, C, S)
+            cnt[c] -= 1
+        else:
+            _uncover(c, L, R, U, D, C, S)
+        j = L[j]
+
+
+@njit(cache=True)
+def _choose(R: Any, S: Any) -> int:
+    best = 0
+    best_size = 1 << 30
+    c = R[0]
+    while c != 0:
+        if S[c] < best_size:
+            best = c
+            best_size = S[c]
+            if best_size <= 1:
+                break
+        c = R[c]
+    return best
+
+
+@njit(cache=True)
+def dlx_run(
+    L: Any, R: Any, U: Any, D: Any, C: Any, RW: Any, S: Any,
+    kind: Any, lo: Any, hi: Any, cnt: Any, counters: Any,
+    buf: Any, nbuf: Any, pos: Any, lcol: Any, chosen: Any,
+    regs: Any, rng: Any, shuffle: bool,
+    out: Any, max_store: int, stop_after: int, node_limit: int,
+) -> int:  # fmt: skip
+    """Run (or resume) the search; returns how many solutions were written to ``out``.
+
+    Stops when ``max_store`` solutions are stored (if > 0), ``stop_after`` solutions were found
+    in this call (if > 0), the tree is exhausted (status DONE) or ``node_limit`` total nodes were
+    spent (status LIMIT). ``out[i, :depth]`` holds the chosen row ids, -1 padded.
+    """
+    status = regs[REG_STATUS]
+    if status == DONE:
+        return 0
+    nodes = regs[REG_NODES]
+    updates = regs[REG_UPDATES]
+    found = 0
+    n_out = 0
+    if status == FRESH:
+        c = _choose(R, S)
+        updates += _cover(c, L, R, U, D, C, S)
+        k = 0
+        n = 0
+        i = D[c]
+        while i != c:
+            buf[0, n] = i
+            n += 1
+            i = D[i]
+        if shuffle:
+            shuffle_prefix(buf[0], n, rng)
+        nbuf[0] = n
+        pos[0] = 0
+        lcol[0] = c
+    else:
+        k = regs[REG_DEPTH]
+    regs[REG_STATUS] = RUNNING
+    while True:
+        if pos[k] < nbuf[k]:
+            if nodes >= node_limit:
+                regs[REG_STATUS] = LIMIT
+                break
+            r = buf[k, pos[k]]
+            pos[k] += 1
+            nodes += 1
+            updates += _select(r, L, R, U, D, C, S, kind, hi, cnt)
+            chosen[k] = r
+            c = _choose(R, S)
+            if c == 0:
+                ok = True
+                for q in counters:
+                    if cnt[q] < lo[q]:
+                        ok = False
+                        break
+                if ok:
+                    found += 1
+                    if max_store > 0:
+                        for d in range(k + 1):
+                            out[n_out, d] = RW[chosen[d]]
+                        for d in range(k + 1, out.shape[1]):
+                            out[n_out, d] = -1
+                        n_out += 1
+                _unselect(r, L, R, U, D, C, S, kind, hi, cnt)
+                if ok and ((max_store > 0 and n_out == max_store) or found == stop_after):
+                    break
+                continue
+            if S[c] == 0:
+                _unselect(r, L, R, U, D, C, S, kind, hi, cnt)
+                continue
+            k += 1
+            updates += _cover(c, L, R, U, D, C, S)
+            n = 0
+            i = D[c]
+            while i != c:
+                buf[k, n] = i
+                n += 1
+                i = D[i]
+            if shuffle:
+                shuffle_prefix(buf[k], n, rng)
+            nbuf[k] = n
+            pos[k] = 0
+            lcol[k] = c
+        else:
+            _uncover(lcol[k], L, R, U, D, C, S)
+            if k == 0:
+                regs[REG_STATUS] = DONE
+                break
+            k -= 1
+            _unselect(chosen[k], L, R, U, D, C, S, kind, hi, cnt)
+    regs[REG_DEPTH] = k
+    regs[REG_NODES] = nodes
+    regs[REG_UPDATES] = updates
+    regs[REG_SOLUTIONS] += found
+    return n_out
+
+
+class DLXArrays:
+    """The linked-list matrix of a problem restricted to a subset of its rows."""
+
+    def __init__(self, problem: CoverProblem, rows: Int32Array) -> None:
+        T = len(problem.types)
+        n_cells = problem.n_cells
+        n_cols = T + n_cells
+        kind = np.zeros(n_cols + 1, dtype=np.int32)
+        lo = np.zeros(n_cols + 1, dtype=np.int32)
+        hi = np.zeros(n_cols + 1, dtype=np.int32)
+        for t, ty in enumerate(problem.types):
+            h = t + 1
+            lo[h], hi[h] = ty.lo, ty.hi
+            if ty.lo == 1 and ty.hi == 1:
+                kind[h] = PRIMARY
+            elif ty.lo == 0 and ty.hi == 1:
+                kind[h] = SECONDARY
+            else:
+                kind[h] = COUNTER
+        optional = np.zeros(n_cells, dtype=bool)
+        if problem.optional:
+            optional[sorted(problem.optional)] = True
+        kind[T + 1 :][optional] = SECONDARY
+        kind[0] = -1
+        # Drop rows lying entirely on optional cells.
+        rows = np.asarray(rows, dtype=np.int32)
+        ptr, flat = problem.row_ptr, problem.flat_cells
+        if optional.any():
+            keep = [not optional[flat[ptr[r] : ptr[r + 1]]].all() for r in rows]
+            rows = rows[np.asarray(keep, dtype=bool)]
+        sizes = (ptr[rows + 1] - ptr[rows]).astype(np.int64) + 1
+        n_nodes = 1 + n_cols + int(sizes.sum())
+        first = np.zeros(len(rows) + 1, dtype=np.int64)
+        np.cumsum(sizes, out=first[1:])
+        first += 1 + n_cols
+        C = np.zeros(n_nodes, dtype=np.int32)
+        RW = np.full(n_nodes, -1, dtype=np.int32)
+        L = np.arange(n_nodes, dtype=np.int32)
+        R = np.arange(n_nodes, dtype=np.int32)
+        for i, r in enumerate(rows):
+            a, b = int(first[i]), int(first[i + 1])
+            C[a] = problem.row_type[r] + 1
+            C[a + 1 : b] = flat[ptr[r] : ptr[r + 1]] + T + 1
+            RW[a:b] = r
+            idx = np.arange(a, b, dtype=np.int32)
+            R[a:b] = np.roll(idx, -1)
+            L[a:b] = np.roll(idx, 1)
+        C[: n_cols + 1] = np.arange(n_cols + 1, dtype=np.int32)
+        # Vertical lists: every column is header, then its nodes in row order, circular.
+        U = np.arange(n_nodes, dtype=np.int32)
+        D = np.arange(n_nodes, dtype=np.int32)
+        data = np.arange(n_cols + 1, n_nodes, dtype=np.int32)
+        order = data[np.argsort(C[data], kind="stable")]
+        col_sorted = C[order]
+        S = np.bincount(C[data], minlength=n_cols + 1).astype(np.int32)
+        starts = np.searchsorted(col_sorted, np.arange(1, n_cols + 1))
+        for h in range(1, n_cols + 1):
+            seq = order[starts[h - 1] : starts[h - 1] + S[h]]
+            chain = np.concatenate(([h], seq)).astype(np.int32)
+            D[chain] = np.roll(chain, -1)
+            U[chain] = np.roll(chain, 1)
+        # Header list: primary columns only, in column order.
+        prim = [0] + [h for h in range(1, n_cols + 1) if kind[h] == PRIMARY]
+        pa = np.asarray(prim, dtype=np.int32)
+        R[pa] = np.roll(pa, -1)
+        L[pa] = np.roll(pa, 1)
+        self.arrays = (L, R, U, D, C, RW, S)
+        self.kind, self.lo, self.hi = kind, lo, hi
+        self.counters = np.asarray(
+            [h for h in range(1, n_cols + 1) if kind[h] == COUNTER and lo[h] > 0], dtype=np.int32
+        )
+        self.max_depth = min(int(np.count_nonzero(kind == PRIMARY)), int(hi[1 : T + 1].sum()))
+        self.max_col = int(S[1:].max()) if n_cols else 0
+        self.has_primary = len(prim) > 1
+
+    def fresh(self) -> tuple[np.ndarray, ...]:
+        """Copies of the mutable arrays for one independent search."""
+        L, R, U, D, C, RW, S = self.arrays
+        return (L.copy(), R.copy(), U.copy(), D.copy(), C, RW, S.copy())

@@ -1,0 +1,51 @@
+"""Shared pieces of the numba search kernels: status codes, register layout, a seeded PRNG.
+
+Both engines (:mod:`solvers.dlx`, :mod:`solvers.bitboard`) run a resumable depth-first search:
+all search state lives in arrays owned by the Python wrapper, so a call can stop after a batch
+of solutions (or at a node limit) and a later call continues exactly where it stopped.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+# Status codes (REG_STATUS).
+FRESH = 0
+RUNNING = 1
+DONE = 2
+LIMIT = 3
+
+# Register layout of the int64 ``regs`` array shared with Python.
+REG_STATUS = 0
+REG_DEPTH = 1
+REG_NODES = 2
+REG_UPDATES = 3
+REG_SOLUTIONS = 4
+N_REGS = 5
+
+
+def new_regs() -> np.ndarray:
+    return np.zeros(N_REGS, dtype=np.int64)
+
+
+@njit(cache=True)
+def splitmix64(state: np.ndarray) -> Any:
+    """Next 64-bit output of SplitMix64; ``state`` is a length-1 uint64 array (advanced)."""
+    z = state[0] + np.uint64(0x9E3779B97F4A7C15)
+    state[0] = z
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True)
+def shuffle_prefix(buf: np.ndarray, n: int, state: np.ndarray) -> None:
+    """Fisher-Yates shuffle of ``buf[:n]`` driven by :func:`splitmix64`."""
+    for i in range(n - 1, 0, -1):
+        j = np.int64(splitmix64(state) % np.uint64(i + 1))
+        tmp = buf[i]
+        buf[i] = buf[j]
+        buf[j] = tmp

@@ -1,0 +1,167 @@
+"""Every placement of a piece inside a target voxel set, as flat cell-index arrays.
+
+**Cell indexing.** A target's cells are numbered by their rank in ``target.voxels`` (sorted by
+x, then y, then z). For an ``a x b x c`` box with its corner at the origin that is
+``index = (x * b + y) * c + z``.
+
+A placement is one distinct orientation (of :meth:`Shape.orientations`) times one translation
+that keeps every voxel inside the target. Placements are computed once per
+``(canonical shape, target)`` and cached: rotated copies of a piece share one table.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import numpy.typing as npt
+
+from chaingeo.geometry import SYMMETRIES, Shape
+
+IntArray = npt.NDArray[np.int64]
+Int32Array = npt.NDArray[np.int32]
+
+
+@dataclass(frozen=True, eq=False)
+class TargetIndex:
+    """A target voxel set with its cell numbering and a dense lookup grid."""
+
+    target: Shape
+    origin: IntArray  # min corner of the target
+    dims: tuple[int, int, int]  # bounding-box extent
+    grid: Int32Array  # cell index at [x, y, z] - origin, or -1 outside the target
+
+    @property
+    def n_cells(self) -> int:
+        return len(self.target)
+
+    def index_of(self, cells: npt.ArrayLike) -> Int32Array:
+        """Cell indices of absolute voxels (``-1`` for voxels outside the target)."""
+        v = np.asarray(cells, dtype=np.int64).reshape(-1, 3) - self.origin
+        inside = np.all((v >= 0) & (v < np.asarray(self.dims)), axis=1)
+        out = np.full(len(v), -1, dtype=np.int32)
+        w = v[inside]
+        out[inside] = self.grid[w[:, 0], w[:, 1], w[:, 2]]
+        return out
+
+
+@lru_cache(maxsize=256)
+def target_index(target: Shape) -> TargetIndex:
+    if len(target) == 0:
+        raise ValueError("the target voxel set is empty")
+    origin = target.min_corner
+    dims = target.extent
+    grid = np.full(dims, -1, dtype=np.int32)
+    rel = target.voxels - origin
+    grid[rel[:, 0], rel[:, 1], rel[:, 2]] = np.arange(len(target), dtype=np.int32)
+    grid.setflags(write=False)
+    return TargetIndex(target, origin, dims, grid)
+
+
+@dataclass(frozen=True, eq=False)
+class Placements:
+    """All placements of one piece (given by its canonical form) inside one target.
+
+    ``cells[i]`` are the sorted cell indices of placement ``i``; it is orientation
+    ``orientation[i]`` (an index into ``orientations``) translated by ``offset[i]``.
+    ``lookup[o, tx, ty, tz]`` inverts that: the placement of orientation ``o`` whose min corner
+    is ``origin + (tx, ty, tz)``, or -1.
+    """
+
+    shape: Shape
+    orientations: tuple[Shape, ...]
+    cells: Int32Array  # (n, len(shape))
+    orientation: Int32Array  # (n,)
+    offset: IntArray  # (n, 3)
+    lookup: Int32Array  # (n_orientations, *dims)
+    origin: IntArray  # the target's min corner: lookup translations are relative to it
+
+    def __len__(self) -> int:
+        return len(self.cells)
+
+    def find(self, placed: Shape) -> int:
+        """Index of the placement whose voxels are exactly ``placed``, or -1."""
+        key = placed.normalized().cells
+        for o, orient in enumerate(self.orientations):
+            if orient.cells == key:
+                t = placed.min_corner - self.origin
+                if np.any(t < 0) or np.any(t >= np.asarray(self.lookup.shape[1:])):
+                    return -1
+                return int(self.lookup[o, t[0], t[1], t[2]])
+        return -1
+
+
+def placements(shape: Shape, target: Shape) -> Placements:
+    """Every placement of ``shape`` (any rotation, any translation) inside ``target``."""
+    return _placements(shape.canonical(), target)
+
+
+@lru_cache(maxsize=4096)
+def _placements(canon: Shape, target: Shape) -> Placements:
+    idx = target_index(target)
+    dims = np.asarray(idx.dims)
+    occ = idx.grid >= 0
+    orients = canon.orientations()
+    lookup = np.full((len(orients), *idx.dims), -1, dtype=np.int32)
+    all_cells: list[Int32Array] = []
+    all_orient: list[Int32Array] = []
+    all_offset: list[IntArray] = []
+    count = 0
+    for o, orient in enumerate(orients):
+        ext = np.asarray(orient.extent)
+        span = dims - ext + 1
+        if np.any(span <= 0):
+            continue
+        acc = np.ones(tuple(int(s) for s in span), dtype=bool)
+        for x, y, z in orient.cells:
+            acc &= occ[x : x + span[0], y : y + span[1], z : z + span[2]]
+        rel = np.argwhere(acc).astype(np.int64)  # lexicographic translation order
+        if len(rel) == 0:
+            continue
+        vox = orient.voxels[None, :, :] + rel[:, None, :]
+        cells = np.sort(idx.grid[vox[..., 0], vox[..., 1], vox[..., 2]], axis=1)
+        lookup[o, rel[:, 0], rel[:, 1], rel[:, 2]] = np.arange(count, count + len(rel))
+        count += len(rel)
+        all_cells.append(cells.astype(np.int32))
+        all_orient.append(np.full(len(rel), o, dtype=np.int32))
+        all_offset.append(rel + idx.origin)
+    k = len(canon)
+    result = Placements(
+        shape=canon,
+        orientations=orients,
+        cells=np.concatenate(all_cells) if all_cells else np.zeros((0, k), dtype=np.int32),
+        orientation=np.concatenate(all_orient) if all_orient else np.zeros(0, dtype=np.int32),
+        offset=np.concatenate(all_offset) if all_offset else np.zeros((0, 3), dtype=np.int64),
+        lookup=lookup,
+        origin=idx.origin,
+    )
+    for arr in (result.cells, result.orientation, result.offset, result.lookup):
+        arr.setflags(write=False)
+    return result
+
+
+def target_symmetries(target: Shape, reflections: bool = True) -> list[tuple[IntArray, IntArray]]:
+    """The lattice symmetries ``v -> M v + t`` mapping ``target`` onto itself, identity first.
+
+    Same order as :data:`SYMMETRIES` (rotations first); for a box at the origin this is exactly
+    :func:`chaingeo.geometry.box_symmetries`. ``reflections=False`` keeps the rotations only.
+    """
+    mats = SYMMETRIES if reflections else SYMMETRIES[:24]
+    lo = target.min_corner
+    out: list[tuple[IntArray, IntArray]] = []
+    for m in mats:
+        image = target.rotate(m)
+        t = lo - image.min_corner
+        if image.translate(t) == target:
+            out.append((m, t.astype(np.int64)))
+    return out
+
+
+def cell_permutation(target: Shape, m: IntArray, t: IntArray) -> Int32Array:
+    """``perm[i]`` = index of the image of cell ``i`` under the symmetry ``v -> m v + t``."""
+    idx = target_index(target)
+    perm = idx.index_of(target.voxels @ np.asarray(m).T + np.asarray(t))
+    if np.any(perm < 0):
+        raise ValueError("not a symmetry of the target")
+    return perm

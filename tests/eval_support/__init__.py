@@ -1,0 +1,1 @@
+"""Test doubles for the evaluation harness: a fake environment and a fake OpenAI server."""
