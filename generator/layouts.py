@@ -3,15 +3,15 @@
 A layout is a list of slots (voxel sets) that overlap; a *design* says, for every cell shared by
 two or more slots, which slot owns it (or that it stays empty). Piece ``k`` is its slot's own
 cells plus the shared cells it owns, so any design is a non-overlapping assembly of the target:
-burrs (sticks crossing in the middle), plate burrs and burrs made of several burr units. Cube
+six-piece burrs and towers of stacked burr units (12 pieces and up). Cube
 layouts instead partition an ``n x n x n`` cube (:func:`cube_cells`), handled by the generator.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, partial
 
 from chaingeo.geometry import Cell, Shape
 from chaingeo.piecesets.burrs import SLOTS, slot_cells
@@ -37,9 +37,7 @@ class Layout:
         if len(design) != len(shared):
             raise ValueError(f"a design has {len(shared)} entries, got {len(design)}")
         shared_set = set(shared)
-        out: list[list[Cell]] = [
-            [c for c in s.cells if c not in shared_set] for s in self.slots
-        ]
+        out: list[list[Cell]] = [[c for c in s.cells if c not in shared_set] for s in self.slots]
         for cell, owner in zip(shared, design, strict=True):
             if owner >= 0:
                 out[owner].append(cell)
@@ -55,23 +53,6 @@ def _shared(slots: tuple[Shape, ...]) -> tuple[Cell, ...]:
     return tuple(sorted(c for c, k in count.items() if k > 1))
 
 
-def _box(lo: Cell, size: Cell) -> Shape:
-    return Shape(
-        [
-            (lo[0] + i, lo[1] + j, lo[2] + k)
-            for i in range(size[0])
-            for j in range(size[1])
-            for k in range(size[2])
-        ]
-    )
-
-
-def _stick(axis: int, corner: Cell, length: int) -> Shape:
-    size = [2, 2, 2]
-    size[axis] = length
-    return _box(corner, (size[0], size[1], size[2]))
-
-
 def burr6() -> Layout:
     return Layout(
         "burr6",
@@ -80,48 +61,27 @@ def burr6() -> Layout:
     )
 
 
-def burr3() -> Layout:
-    """Three 2x2x6 sticks through one central 2x2x2 cube, one per axis."""
+def burr_tower(units: int) -> Layout:
+    """``units`` six-piece burr units stacked along z: the z-sticks of neighbouring units meet
+    end to end, so the units block one another; ``6 * units`` pieces."""
+    slots = [
+        slot_cells(axis, (corner[0], corner[1], corner[2] + 6 * u))
+        for u in range(units)
+        for axis, corner in SLOTS
+    ]
     return Layout(
-        "burr3",
-        (_stick(0, (0, 2, 2), 6), _stick(1, (2, 0, 2), 6), _stick(2, (2, 2, 0), 6)),
-        "three-piece burr: three 2x2x6 sticks crossing in one 2x2x2 core",
-    )
-
-
-def plate3() -> Layout:
-    """Three 2-thick 6x6 plates, one per axis, crossing in the middle."""
-    return Layout(
-        "plate3",
-        (_box((2, 0, 0), (2, 6, 6)), _box((0, 2, 0), (6, 2, 6)), _box((0, 0, 2), (6, 6, 2))),
-        "three-plate burr: three 6x6 plates, 2 thick, crossing in the middle",
-    )
-
-
-def burr_chain(units: int) -> Layout:
-    """``units`` six-piece burr units in a row along x, sharing two long x-sticks: the y- and
-    z-sticks of each unit are its own, so there are ``2 + 4 * units`` pieces."""
-    slots: list[Shape] = [_stick(0, (0, 2, 1), 6 * units), _stick(0, (0, 2, 3), 6 * units)]
-    for u in range(units):
-        for axis, corner in SLOTS:
-            if axis == 0:
-                continue
-            slots.append(slot_cells(axis, (corner[0] + 6 * u, corner[1], corner[2])))
-    return Layout(
-        f"burr{2 + 4 * units}",
+        f"burr{6 * units}",
         tuple(slots),
-        f"larger burr: {units} burr units along two shared {6 * units}-long sticks",
+        f"larger burr: a tower of {units} six-piece burr units stacked along z",
     )
 
 
-LAYOUTS = {
+LAYOUTS: dict[str, Callable[[], Layout]] = {
     "burr6": burr6,
-    "burr3": burr3,
-    "plate3": plate3,
-    "burr10": lambda: burr_chain(2),
-    "burr14": lambda: burr_chain(3),
-    "burr18": lambda: burr_chain(4),
-    "burr34": lambda: burr_chain(8),
+    "burr12": partial(burr_tower, 2),
+    "burr18": partial(burr_tower, 3),
+    "burr24": partial(burr_tower, 4),
+    "burr36": partial(burr_tower, 6),
 }
 
 

@@ -31,6 +31,7 @@ from chaingeo.level import (
 )
 from chaingeo.rules import PuzzleRules
 from generator.layouts import cube_cells, get_layout
+from generator.result import Rejection
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
 
@@ -50,17 +51,13 @@ class PuzzleConfig:
     hill_steps: int = 300
     goal: Literal["disassemble", "assemble"] = "disassemble"
     max_group: int | None = None
-    seconds: float = 60.0  # time limit of the final optimal-plan search
+    seconds: float | None = None  # optional time limit of each search (machine-dependent!)
     max_states: int = 500_000  # state cap per part in the final search
+    max_total_states: int = 3_000_000  # state cap of the whole optimal-plan search
     probe_states: int = 20_000  # state cap of each evaluation while climbing (over: rejected)
 
     def to_json(self) -> dict[str, object]:
         return asdict(self)
-
-
-@dataclass(frozen=True)
-class Rejected:
-    reason: str
 
 
 Score = tuple[int, int]
@@ -84,7 +81,11 @@ def _evaluate(shapes: Sequence[Shape], config: PuzzleConfig) -> Analysis | None:
     if any(len(s) == 0 or not s.is_connected() for s in shapes):
         return None
     named = {f"p{i:02d}": s for i, s in enumerate(shapes)}
-    limits = SearchLimits(max_states=config.probe_states, seconds=config.seconds)
+    limits = SearchLimits(
+        max_states=config.probe_states,
+        seconds=config.seconds,
+        max_total_states=10 * config.probe_states,
+    )
     try:
         result = analyze(named, max_group=config.max_group, limits=limits, optimal=False)
     except SearchLimitError:
@@ -198,10 +199,11 @@ def _cube_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Can
 
 
 def difficulty_of(first_level: int, optimal_steps: int, pieces: int) -> Difficulty:
-    """The suite's thresholds (README, 'Puzzle suite'): hard when the first part needs 5 or more
-    moves or the optimal plan 20 or more; easy when it needs at most 2 and the plan at most 8;
-    mid otherwise."""
-    if first_level >= 5 or optimal_steps >= 20:
+    """The suite's thresholds (README, 'Puzzle suite'): *hard* when the first part needs 4 or
+    more moves, or the optimal plan 14 or more, or there are 12 or more pieces; *easy* when the
+    first part needs at most 2 moves, the plan at most 8 and there are at most 6 pieces; *mid*
+    otherwise."""
+    if first_level >= 4 or optimal_steps >= 14 or pieces >= 12:
         return "hard"
     if first_level <= 2 and optimal_steps <= 8 and pieces <= 6:
         return "easy"
@@ -262,7 +264,7 @@ def puzzle_level(
     return revalidate(level)
 
 
-def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejected:
+def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
     if config.shape.startswith("cube"):
@@ -274,10 +276,14 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejected:
     else:
         best = _layout_search(config, rng)
     if best is None:
-        return Rejected("no design that comes apart")
+        return Rejection("no design that comes apart", seed, index)
     if best.score[0] < config.min_level:
-        return Rejected(f"level {best.score[0]} below {config.min_level}")
-    limits = SearchLimits(max_states=config.max_states, seconds=config.seconds)
+        return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)
+    limits = SearchLimits(
+        max_states=config.max_states,
+        seconds=config.seconds,
+        max_total_states=config.max_total_states,
+    )
     level_id = f"puzzle-{config.shape}-s{seed}-i{index}"
     try:
         return puzzle_level(
@@ -291,4 +297,4 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejected:
             extra_stats={"shape": config.shape},
         )
     except SearchLimitError as e:
-        return Rejected(f"optimal plan not found within limits: {e}")
+        return Rejection(f"optimal plan not found within limits: {e}", seed, index)

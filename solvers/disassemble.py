@@ -118,6 +118,12 @@ class _Solver:
         return members, rel.astype(np.int16).tobytes()
 
     def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch:
+        cap = self.limits.max_total_states
+        if cap is not None and self.states > cap:
+            raise SearchLimitError(
+                f"total state cap of {cap} reached over all searches; "
+                "raise SearchLimits(max_total_states=...)"
+            )
         return PartSearch(
             self.table,
             members,

@@ -26,12 +26,14 @@ class SearchLimits:
     """Caps that turn an endless search into a :class:`SearchLimitError` with a clear message.
 
     ``max_states`` caps one part's breadth-first search; ``seconds`` the whole analysis;
-    ``group_limit`` the movable groups per direction in one state.
+    ``group_limit`` the movable groups per direction in one state; ``max_total_states`` the
+    states of all searches of one analysis together (unlike time, the same on every machine).
     """
 
     max_states: int = 2_000_000
     seconds: float | None = 120.0
     group_limit: int = 4096
+    max_total_states: int | None = None  # over every search of one analysis (deterministic)
 
 
 class Deadline:
@@ -144,7 +146,7 @@ class PartSearch:
         self.states = np.zeros((cap, 3 * n), dtype=np.int16)
         self.parent = np.full(cap, -1, dtype=np.int64)
         self.move = np.zeros((cap, 3), dtype=np.int64)
-        self.hash = np.full(4 * cap, -1, dtype=np.int64)
+        self.hash = np.full(1 << (4 * cap - 1).bit_length(), -1, dtype=np.int64)
         self.seps = np.zeros((256, 3), dtype=np.int64)
         self.moves_buf = np.zeros((256, 4), dtype=np.int64)
         self.groups_buf = np.zeros(min(limits.group_limit, 1 << 16) + 1, dtype=np.uint64)
@@ -179,7 +181,8 @@ class PartSearch:
             self.parent = np.concatenate([self.parent, np.full(cap, -1, dtype=np.int64)])[:new_cap]
             self.move = np.concatenate([self.move, np.zeros_like(self.move)])[:new_cap]
         if self.hash.shape[0] < 4 * self.states.shape[0]:
-            self.hash = np.full(4 * self.states.shape[0], -1, dtype=np.int64)
+            size = 1 << (4 * self.states.shape[0] - 1).bit_length()  # a power of two
+            self.hash = np.full(size, -1, dtype=np.int64)
             mv.rebuild_table(self.states, self.n_states, self.hash)
 
     def expand_layer(self) -> list[Removal]:
