@@ -108,3 +108,17 @@ def count_solutions(
             if len(kept) < keep:
                 kept.append(asm)
     return AssemblyReport(n_asm, n_sol, first, time.perf_counter() - start, tuple(kept))
+
+
+def solid_burr_codes() -> tuple[int, ...]:
+    """Recompute the burr catalogue: the codes of the notchable pieces used by any assembly
+    of the whole notchable family (each 0..6 times) into the Solid Knot."""
+    from chaingeo.piecesets.burrs import notchable_family, solid_knot
+
+    family = notchable_family()
+    code_of = {s.canonical(): c for c, s in family.items()}
+    pieces = [PieceCount(f"b{c:04x}", s, 0, 6) for c, s in family.items()]
+    used: set[int] = set()
+    for asm in iter_assemblies(pieces, solid_knot()):
+        used.update(code_of[s.canonical()] for s in asm.values())
+    return tuple(sorted(used))

@@ -7,9 +7,11 @@ other stick can reach in an assembled six-piece burr. A piece is named by the 12
 the cubes it lacks (bit ``i`` = :data:`REMOVABLE` ``[i]``). Up to rotation the connected codes
 give Cutler's 837 distinct pieces.
 
-Six such sticks in the standard arrangement fill the *Solid Knot* (104 cubes) when no cube is
-left empty. :data:`SOLID_BURR_CODES` lists the pieces that occur in some solid assembly: the
-catalogue the test suite recomputes with the assembler (``tests/test_burr_catalogue.py``).
+*Notchable* pieces are those a saw can make: the removed cubes are a union of full-width unit
+notches (:data:`NOTCHES`); there are 59 (Cutler). Six sticks in the standard arrangement fill
+the *Solid Knot* (104 cubes) when no cube is left empty; :data:`SOLID_BURR_CODES` lists the
+25 notchable pieces that occur in such solid assemblies (the burr catalogue; with 0..6 copies
+each they make 1063 assemblies, 314 of which come apart: Cutler's solid six-piece burrs).
 """
 
 from __future__ import annotations
@@ -42,6 +44,39 @@ def six_piece_family() -> dict[int, Shape]:
     """The distinct connected pieces (up to rotation), each under its smallest code."""
     seen: dict[Shape, int] = {}
     for code in range(1 << len(REMOVABLE)):
+        piece = burr_piece(code)
+        if piece.is_connected():
+            seen.setdefault(piece.canonical(), code)
+    return {code: burr_piece(code) for code in sorted(seen.values())}
+
+
+def _notches() -> tuple[frozenset[Cell], ...]:
+    """Unit notches: the two cubes at one x across the full width of one face of the stick
+    (top at x = 1..4; bottom and both sides at x = 2..3, where cubes may go at all)."""
+    out = [frozenset({(x, 0, 1), (x, 1, 1)}) for x in range(1, 5)]
+    for x in (2, 3):
+        out += [
+            frozenset({(x, 0, 0), (x, 1, 0)}),
+            frozenset({(x, 0, 0), (x, 0, 1)}),
+            frozenset({(x, 1, 0), (x, 1, 1)}),
+        ]
+    return tuple(out)
+
+
+NOTCHES: Final[tuple[frozenset[Cell], ...]] = _notches()
+
+
+@cache
+def notchable_family() -> dict[int, Shape]:
+    """Pieces a saw can make: the removed cubes are a union of :data:`NOTCHES` (Cutler's
+    notchable pieces; 59 distinct up to rotation), each under its smallest code."""
+    bit = {c: i for i, c in enumerate(REMOVABLE)}
+    codes: set[int] = set()
+    for choice in range(1 << len(NOTCHES)):
+        cells = {c for k, n in enumerate(NOTCHES) if choice >> k & 1 for c in n}
+        codes.add(sum(1 << bit[c] for c in cells))
+    seen: dict[Shape, int] = {}
+    for code in sorted(codes):
         piece = burr_piece(code)
         if piece.is_connected():
             seen.setdefault(piece.canonical(), code)
@@ -82,7 +117,15 @@ def solid_knot() -> Shape:
     return Shape(sorted(cells))
 
 
-#: Codes (see :func:`burr_piece`) of the pieces that occur in a solid six-piece burr, computed
-#: by assembling the whole family into the Solid Knot (``solvers.burrs.solid_burr_codes``;
-#: a slow test recomputes this list).
-SOLID_BURR_CODES: Final[tuple[int, ...]] = ()
+#: Codes (see :func:`burr_piece`) of the 25 notchable pieces that occur in a solid six-piece
+#: burr: every assembly of the notchable family (each piece 0..6 times) into the Solid Knot uses
+#: only these. Computed by :func:`solvers.assemble.solid_burr_codes` (a slow test recomputes it).
+SOLID_BURR_CODES: Final[tuple[int, ...]] = (
+    0, 3, 12, 15, 51, 60, 63, 195, 207, 255, 316, 572, 1303,
+    1311, 1335, 1340, 1343, 1492, 1495, 1500, 1503, 1524, 1527, 1532, 1535,
+)  # fmt: skip
+
+
+def solid_burr_pieces() -> dict[str, Shape]:
+    """The catalogue: ``{"b0000": shape, ...}`` named by hex code."""
+    return {f"b{code:04x}": burr_piece(code) for code in SOLID_BURR_CODES}
