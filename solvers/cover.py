@@ -137,7 +137,7 @@ def anchor_plan(problem: CoverProblem, prefer: str | None = None) -> AnchorPlan 
     if len(syms) == 1:
         return None
     proper = np.array([round(np.linalg.det(m)) > 0 for m, _ in syms])
-    best: tuple[tuple[int, int, int, int], AnchorPlan] | None = None
+    best: tuple[tuple[int, int, int, float, int], AnchorPlan] | None = None
     for t, ty in enumerate(problem.types):
         if not (ty.lo == 1 and ty.hi == 1):
             continue
@@ -154,7 +154,14 @@ def anchor_plan(problem: CoverProblem, prefer: str | None = None) -> AnchorPlan 
         fixed = reps[stab > 1].astype(np.int32)
         orbit = (len(group) // stab[stab > 1]).astype(np.int32)
         plan = AnchorPlan(t, group, full, free, fixed, orbit)
-        score = (0 if ty.slots[0] == prefer else 1, 0 if full else 1, len(reps), len(fixed))
+        n_orient = len(problem.table[t].orientations)
+        score = (
+            0 if ty.slots[0] == prefer else 1,
+            0 if full else 1,
+            n_orient,
+            len(reps) / (b - a),
+            len(reps),
+        )
         if best is None or score < best[0]:
             best = (score, plan)
     return None if best is None else best[1]
