@@ -65,7 +65,6 @@ def test_pentomino_packings(box: tuple[int, int, int], engine: str) -> None:
     assert (r.solutions, r.distinct) == _known(box)
 
 
-@pytest.mark.slow
 def test_solid_pentominoes_3x4x5() -> None:
     r = count_solutions(PENTOMINOES.pieces, (3, 4, 5))
     assert (r.solutions, r.distinct) == _known((3, 4, 5))
