@@ -6,7 +6,7 @@ Public API (pieces: a ``{name: Shape}`` mapping, a list of :class:`Shape`, or a 
 
     count_solutions(pieces, target, *, distinct=True, reflections=True, optional=None,
                     engine="auto", node_limit=None, symmetry=True) -> CoverResult
-    iter_solutions(pieces, target, *, distinct=False, ...) -> Iterator[Solution]
+    iter_solutions(pieces, target, *, distinct=False, symmetry=False, ...) -> Iterator[Solution]
     first_solution(pieces, target, ...) -> Solution | None
     random_solutions(pieces, target, rng, ...) -> Iterator[Solution]
     cover_problem(pieces, target, ...) -> CoverProblem   # compiled + cached, reusable
@@ -19,17 +19,20 @@ solutions up to the target's own symmetries: its rotations, plus its reflections
 piece into its mirror image, so the count only makes sense if those are pieces too; BurrTools
 style "rotations only" is ``reflections=False``).
 
-*Symmetry reduction* (``symmetry=True``): one anchor piece type used exactly once is restricted
-to one placement per orbit of the symmetry group (an achiral anchor is preferred, so the whole
-group applies). Then ``solutions = sum(orbit size x solutions with the anchor there)`` exactly;
-``distinct`` is the number of free-orbit solutions plus the distinct canonical forms of the few
-solutions whose anchor placement is itself symmetric. Without a usable anchor every solution
-is enumerated and canonicalised.
+*Symmetry reduction* (``symmetry=True``): the anchored rows (those of a piece used exactly
+once, else those through a mandatory cell, under the subgroup fixing that cell) are cut to one
+per orbit of the group. Then ``solutions = sum(orbit size x solutions with that anchor row)``
+exactly. With an achiral unique piece under the whole group, ``distinct`` is the number of
+free-orbit solutions plus the distinct canonical forms of the few solutions whose anchor
+placement is itself symmetric; otherwise the reduced solutions are enumerated and
+canonicalised (:func:`canonical_forms`). ``iter_solutions(distinct=True, symmetry=True)``
+lists one solution per class from the reduced search (the default keeps the plain order).
 
 *Engines*: ``"bitboard"`` (targets of at most 64 cells) or ``"dlx"`` (dancing links, MRV);
-``"auto"`` takes the bit-board whenever it applies (it is the faster one there). ``nodes`` in
-:class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates`` the engine's
-unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a ``SearchLimitError``) is
+``"auto"`` takes the bit-board whenever it applies (it is the faster one there). Every function
+also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``target``).
+``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
+the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a ``SearchLimitError``) is
 raised carrying the solutions found so far and the stats; iterators first yield what they found.
 """
 

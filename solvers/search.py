@@ -35,12 +35,11 @@ class CoverStats:
     engine: str = ""
 
     def __add__(self, other: CoverStats) -> CoverStats:
-        engine = self.engine if self.engine == other.engine or not other.engine else other.engine
         return CoverStats(
             self.nodes + other.nodes,
             self.updates + other.updates,
             self.seconds + other.seconds,
-            engine or other.engine,
+            self.engine or other.engine,
         )
 
 
