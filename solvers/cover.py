@@ -32,8 +32,9 @@ lists one solution per class from the reduced search (the default keeps the plai
 ``"auto"`` takes the bit-board whenever it applies (it is the faster one there). Every function
 also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``target``).
 ``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
-the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a ``SearchLimitError``) is
-raised carrying the solutions found so far and the stats; iterators first yield what they found.
+the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a
+``SearchLimitError``) is raised carrying the solutions found so far and the stats; iterators
+first yield what they found.
 """
 
 from __future__ import annotations
