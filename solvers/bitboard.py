@@ -1,17 +1,21 @@
 """Bit-board exact cover for targets of at most 64 cells.
 
-The occupancy is one ``uint64``; every row is a precomputed mask. The search always fills the
-first empty mandatory cell (in a scan order that runs fastest along the target's shortest
-axis), trying only the rows whose lowest mandatory cell is that cell: each solution is found
-exactly once, and the fit test is one AND. Piece types carry count ranges exactly as in
-:mod:`solvers.dlx` (checked against ``hi`` on the way down, against ``lo`` at a full cover).
+The occupancy is one ``uint64``; every row is a precomputed mask. The search fills the first
+empty mandatory cell (in a scan order that runs fastest along the target's shortest axis),
+trying only the rows whose lowest mandatory cell is that cell: each solution is found exactly
+once, and the fit test is one AND. Near the root (:data:`MRV_DEPTH` levels) it branches instead
+on an unused exact-once piece when that piece has fewer fitting placements than the cell, which
+puts a symmetry-reduced anchor first and awkward pieces early. A placement is rejected when it
+cuts off an empty region that no set of pieces could fill (smaller than the smallest piece or
+not a multiple of the gcd of the piece sizes; box targets without optional cells). Piece types
+carry count ranges exactly as in :mod:`solvers.dlx` (checked against ``hi`` on the way down,
+against ``lo`` at a full cover).
 
 ``nodes`` counts rows placed; ``updates`` counts rows tested (the bit-board's unit of work).
 """
 
 from __future__ import annotations
 
-import os
 from typing import Any
 
 import numpy as np
@@ -33,6 +37,9 @@ from solvers.placements import Int32Array
 from solvers.problem import CoverProblem
 
 MAX_CELLS = 64
+#: Levels (from the root) at which the search branches on whichever of the first empty cell and
+#: the unused exact-once pieces has the fewest fitting rows, rather than on the cell alone.
+MRV_DEPTH = 2
 
 _DEBRUIJN = np.uint64(0x03F79D71B4CB0A89)
 _DEBRUIJN_TABLE = np.zeros(64, dtype=np.int32)
@@ -69,31 +76,27 @@ def _grow(x: np.uint64, nb: Any) -> Any:
 
 
 @njit(cache=True)
-def _regions_ok(
-    placed: np.uint64, empty: np.uint64, nb: Any, gcd: int, smallest: int, cap: int
-) -> bool:
+def _regions_ok(placed: np.uint64, empty: np.uint64, nb: Any, gcd: int, smallest: int) -> bool:
     """Can every empty region touching the piece just placed still be filled?
 
-    Each region is grown from a seed next to the piece until it closes or holds ``cap`` cells.
-    A closed region must hold at least ``smallest`` cells and a multiple of ``gcd`` (the gcd of
-    all piece sizes). Regions the piece does not touch were checked when they formed.
+    Each region is grown from a seed next to the piece; it must hold at least ``smallest``
+    cells and a multiple of ``gcd`` (the gcd of all piece sizes). With ``gcd`` 1 the growth
+    stops once the region is big enough. Regions the piece does not touch were checked when
+    they formed.
     """
     seeds = _grow(placed, nb) & empty
     while seeds != 0:
         region = seeds & (~seeds + np.uint64(1))
-        closed = False
         while True:
             grown = _grow(region, nb) & empty
             if grown == region:
-                closed = True
                 break
             region = grown
-            if _popcount(region) >= cap:
+            if gcd == 1 and _popcount(region) >= smallest:
                 break
-        if closed:
-            size = _popcount(region)
-            if size < smallest or size % gcd != 0:
-                return False
+        size = _popcount(region)
+        if size < smallest or size % gcd != 0:
+            return False
         seeds &= ~region
     return True
 
@@ -116,11 +119,48 @@ def _enter(k: int, lst_start: int, lst_len: int, cand: Any, perm: Any, width: in
 
 
 @njit(cache=True)
+def _count_fits(cand: Any, start: int, n: int, mask: Any, rtype: Any, cnt: Any, hi: Any,
+                here: np.uint64) -> int:  # fmt: skip
+    """How many rows of ``cand[start : start + n]`` are still available and fit."""
+    fits = 0
+    for i in range(start, start + n):
+        r = cand[i]
+        t = rtype[r]
+        if cnt[t] < hi[t] and (mask[r] & here) == 0:
+            fits += 1
+    return fits
+
+
+@njit(cache=True)
+def _fewest_fits(
+    c: int, cand_ptr: Any, cand: Any, type_ptr: Any, exact1: Any, mask: Any,
+    rtype: Any, cnt: Any, hi: Any, here: np.uint64,
+) -> tuple[int, int, int, int]:  # fmt: skip
+    """The list to branch on: cell ``c``'s or an unused exact-once piece's, whichever has the
+    fewest rows that fit; returns ``(start, length, fits, rows examined)``."""
+    a = cand_ptr[c]
+    n = cand_ptr[c + 1] - a
+    best = _count_fits(cand, a, n, mask, rtype, cnt, hi, here)
+    work = n
+    for t in exact1:
+        if best == 0:
+            break
+        if cnt[t] == 0:
+            ta = type_ptr[t]
+            tn = type_ptr[t + 1] - ta
+            work += tn
+            fits = _count_fits(cand, ta, tn, mask, rtype, cnt, hi, here)
+            if fits < best:
+                best, a, n = fits, ta, tn
+    return a, n, best, work
+
+
+@njit(cache=True)
 def bitboard_run(
-    mask: Any, rtype: Any, rid: Any, cand_ptr: Any, cand: Any, skip: Any, root: Any,
-    primary: np.uint64,
+    mask: Any, rtype: Any, rid: Any, cand_ptr: Any, cand: Any, skip: Any,
+    type_ptr: Any, exact1: Any, mrv_depth: int, primary: np.uint64,
     lo: Any, hi: Any, cnt: Any, counters: Any, table: Any,
-    nb: Any, region_gcd: int, region_min: int, region_cap: int,
+    nb: Any, region_gcd: int, region_min: int,
     occ: Any, perm: Any, end: Any, pos: Any, base: Any, chosen: Any,
     regs: Any, rng: Any, shuffle: bool,
     out: Any, max_store: int, stop_after: int, node_limit: int,
@@ -141,12 +181,15 @@ def bitboard_run(
     if status == FRESH:
         k = 0
         occ[0] = np.uint64(0)
-        if root[1] > root[0]:  # branch on one piece type first
-            _enter(0, root[0], root[1] - root[0], cand, perm, width, base, pos, end, shuffle, rng)
-        else:
-            c = _lowest_bit(primary, table)
-            n = cand_ptr[c + 1] - cand_ptr[c]
-            _enter(0, cand_ptr[c], n, cand, perm, width, base, pos, end, shuffle, rng)
+        c = _lowest_bit(primary, table)
+        a = cand_ptr[c]
+        n = cand_ptr[c + 1] - a
+        if mrv_depth > 0:
+            a, n, fits, work = _fewest_fits(
+                c, cand_ptr, cand, type_ptr, exact1, mask, rtype, cnt, hi, np.uint64(0)
+            )
+            updates += work
+        _enter(0, a, n, cand, perm, width, base, pos, end, shuffle, rng)
     else:
         k = regs[REG_DEPTH]
     regs[REG_STATUS] = RUNNING
@@ -174,7 +217,7 @@ def bitboard_run(
             if (
                 region_min > 0
                 and free != 0
-                and not _regions_ok(m, free, nb, region_gcd, region_min, region_cap)
+                and not _regions_ok(m, free, nb, region_gcd, region_min)
             ):
                 continue
             row = r
@@ -216,8 +259,16 @@ def bitboard_run(
         k += 1
         occ[k] = here | mask[row]
         c = _lowest_bit(free, table)
-        n = cand_ptr[c + 1] - cand_ptr[c]
-        _enter(k, cand_ptr[c], n, cand, perm, width, base, pos, end, shuffle, rng)
+        a = cand_ptr[c]
+        n = cand_ptr[c + 1] - a
+        if k < mrv_depth:  # near the root: branch on the cell or piece with fewest fits
+            a, n, fits, work = _fewest_fits(
+                c, cand_ptr, cand, type_ptr, exact1, mask, rtype, cnt, hi, occ[k]
+            )
+            updates += work
+            if fits == 0:
+                n = 0
+        _enter(k, a, n, cand, perm, width, base, pos, end, shuffle, rng)
     regs[REG_DEPTH] = k
     regs[REG_NODES] = nodes
     regs[REG_UPDATES] = updates
@@ -229,11 +280,6 @@ def scan_axes(problem: CoverProblem) -> list[int]:
     """The axes in scan order, fastest first: the shortest bounding-box axis first."""
     ext = problem.target.extent
     axes = sorted(range(3), key=lambda a: (ext[a], a))
-    import os
-
-    o = os.environ.get("CHAIN_SCAN")
-    if o:
-        axes = [axes[int(c)] for c in o]
     return axes
 
 
@@ -278,41 +324,35 @@ class BitboardArrays:
         counts = np.bincount(low, minlength=MAX_CELLS)
         self.cand_ptr = np.zeros(MAX_CELLS + 1, dtype=np.int64)
         np.cumsum(counts, out=self.cand_ptr[1:])
-        # Root branching: the exact-once type with fewest rows, if it has at most a quarter as
-        # many as the first cell (a symmetry-reduced anchor, typically).
+        # Every row again, grouped by type: lists for branching on a piece.
         n = len(order)
-        first_cell = _lowest_bit(primary, _DEBRUIJN_TABLE)
-        best, best_n = -1, int(counts[first_cell]) // 4 + 1
-        for t, ty in enumerate(problem.types):
-            nt = int(np.count_nonzero(self.rtype == t))
-            if ty.lo == 1 and ty.hi == 1 and nt < best_n:
-                best, best_n = t, nt
-        root_rows: Int32Array = np.flatnonzero(self.rtype == best).astype(np.int32)
-        if best < 0:
-            root_rows = root_rows[:0]
-        self.cand = np.concatenate([np.arange(n), root_rows]).astype(np.int32)
-        self.root = np.array([n, n + len(root_rows)], dtype=np.int64)
-        # skip[i]: end of the run of candidates of one type (in one list) containing position i.
-        key = np.concatenate(
-            [low[order] * (len(problem.types) + 1) + self.rtype, np.full(len(root_rows), -1)]
+        T = len(problem.types)
+        by_type = np.argsort(self.rtype, kind="stable").astype(np.int32)
+        self.type_ptr = np.zeros(T + 1, dtype=np.int64)
+        np.cumsum(np.bincount(self.rtype, minlength=T), out=self.type_ptr[1:])
+        self.type_ptr += n
+        self.cand = np.concatenate([np.arange(n), by_type]).astype(np.int32)
+        self.exact1 = np.array(
+            [t for t, ty in enumerate(problem.types) if ty.lo == 1 and ty.hi == 1], dtype=np.int32
         )
+        self.mrv_depth = MRV_DEPTH
+        # skip[i]: end of the run of candidates of one type (in one list) containing position i.
+        key = np.concatenate([low[order] * (T + 1) + self.rtype, -2 - self.rtype[by_type]])
         self.skip = np.empty(len(self.cand), dtype=np.int64)
         end = len(self.cand)
         for i in range(len(self.cand) - 1, -1, -1):
-            if i + 1 < len(self.cand) and (key[i + 1] != key[i] or i + 1 == n):
+            if i + 1 < len(self.cand) and key[i + 1] != key[i]:
                 end = i + 1
             self.skip[i] = end
         self.primary = primary
-        T = len(problem.types)
         self.lo = np.array([t.lo for t in problem.types], dtype=np.int32)
         self.hi = np.array([t.hi for t in problem.types], dtype=np.int32)
         self.counters = np.array([t for t in range(T) if self.lo[t] > 0], dtype=np.int32)
         n_primary = problem.n_cells - len(problem.optional)
         self.max_depth = min(n_primary, int(self.hi.sum()))
-        self.max_col = int(counts.max()) if len(counts) else 0
+        self.max_col = max(int(counts.max()), int(np.diff(self.type_ptr).max(initial=0)))
         self.table = _DEBRUIJN_TABLE
         self.nb, self.region_gcd, self.region_min = region_pruning(problem)
-        self.region_cap = int(os.environ.get("CHAIN_CAP", "64"))
 
 
 def region_pruning(problem: CoverProblem) -> tuple[np.ndarray, int, int]:

@@ -6,7 +6,7 @@ Public API (pieces: a ``{name: Shape}`` mapping, a list of :class:`Shape`, or a 
 
     count_solutions(pieces, target, *, distinct=True, reflections=True, optional=None,
                     engine="auto", node_limit=None, symmetry=True) -> CoverResult
-    iter_solutions(pieces, target, *, distinct=False, ...) -> Iterator[Solution]
+    iter_solutions(pieces, target, *, distinct=False, symmetry=False, ...) -> Iterator[Solution]
     first_solution(pieces, target, ...) -> Solution | None
     random_solutions(pieces, target, rng, ...) -> Iterator[Solution]
     cover_problem(pieces, target, ...) -> CoverProblem   # compiled + cached, reusable
@@ -19,18 +19,22 @@ solutions up to the target's own symmetries: its rotations, plus its reflections
 piece into its mirror image, so the count only makes sense if those are pieces too; BurrTools
 style "rotations only" is ``reflections=False``).
 
-*Symmetry reduction* (``symmetry=True``): one anchor piece type used exactly once is restricted
-to one placement per orbit of the symmetry group (an achiral anchor is preferred, so the whole
-group applies). Then ``solutions = sum(orbit size x solutions with the anchor there)`` exactly;
-``distinct`` is the number of free-orbit solutions plus the distinct canonical forms of the few
-solutions whose anchor placement is itself symmetric. Without a usable anchor every solution
-is enumerated and canonicalised.
+*Symmetry reduction* (``symmetry=True``): the anchored rows (those of a piece used exactly
+once, else those through a mandatory cell, under the subgroup fixing that cell) are cut to one
+per orbit of the group. Then ``solutions = sum(orbit size x solutions with that anchor row)``
+exactly. With an achiral unique piece under the whole group, ``distinct`` is the number of
+free-orbit solutions plus the distinct canonical forms of the few solutions whose anchor
+placement is itself symmetric; otherwise the reduced solutions are enumerated and
+canonicalised (:func:`canonical_forms`). ``iter_solutions(distinct=True, symmetry=True)``
+lists one solution per class from the reduced search (the default keeps the plain order).
 
 *Engines*: ``"bitboard"`` (targets of at most 64 cells) or ``"dlx"`` (dancing links, MRV);
-``"auto"`` takes the bit-board whenever it applies (it is the faster one there). ``nodes`` in
-:class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates`` the engine's
-unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a ``SearchLimitError``) is
-raised carrying the solutions found so far and the stats; iterators first yield what they found.
+``"auto"`` takes the bit-board whenever it applies (it is the faster one there). Every function
+also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``target``).
+``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
+the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a
+``SearchLimitError``) is raised carrying the solutions found so far and the stats; iterators
+first yield what they found.
 """
 
 from __future__ import annotations
@@ -120,43 +124,91 @@ def make_solution(problem: CoverProblem, rows: Int32Array) -> Solution:
 
 @dataclass(frozen=True)
 class AnchorPlan:
-    """Anchor type, the subgroup ``group`` that fixes it, and its placement orbit reps."""
+    """Symmetry reduction: the anchored ``rows`` are cut to one per orbit of ``group``.
 
-    type_index: int
-    group: Int32Array  # indices into the problem's row maps
-    full: bool  # the subgroup is the whole symmetry group
+    The anchor is a piece used exactly once (its rows) or, failing that, a mandatory cell (the
+    rows through it, under the subgroup fixing the cell). Every solution has exactly one
+    anchored row, so restricting them to orbit representatives loses no symmetry class.
+    """
+
+    label: str  # the anchor piece's name, or "cell [x, y, z]"
+    rows: Int32Array  # every anchored row
+    group: Int32Array  # the subgroup used (indices into the problem's row maps)
+    exact: bool  # a unique piece under the whole group: free-rep solutions are all distinct
     free_reps: Int32Array  # reps whose stabiliser is trivial (orbit size len(group))
     fixed_reps: Int32Array  # reps with a non-trivial stabiliser
     fixed_orbit: Int32Array  # orbit size of each fixed rep
 
 
+def _orbits(
+    maps: Int32Array, group: Int32Array, rows: Int32Array
+) -> tuple[Int32Array, Int32Array, Int32Array]:
+    """Orbit representatives of ``rows`` under ``group``: free, fixed, and fixed orbit sizes."""
+    sub = maps[group]
+    reps = np.unique(sub[:, rows].min(axis=0))
+    stab = (sub[:, reps] == reps[None, :]).sum(axis=0)
+    free = reps[stab == 1].astype(np.int32)
+    fixed = reps[stab > 1].astype(np.int32)
+    return free, fixed, (len(group) // stab[stab > 1]).astype(np.int32)
+
+
 def anchor_plan(problem: CoverProblem, prefer: str | None = None) -> AnchorPlan | None:
-    """Pick the anchor giving the fewest orbit representatives (achiral anchors first), or the
-    piece named ``prefer`` if it can be one."""
+    """The anchor for symmetry reduction (None when the problem has no symmetry).
+
+    A piece used exactly once is preferred: the named one if given, else an achiral one (the
+    whole group applies) with the fewest orientations (the most symmetric piece goes first,
+    as in Knuth's pentomino runs), then the fewest representatives per placement. Without such
+    a piece, a mandatory cell with the largest stabiliser anchors instead.
+    """
     syms, maps = problem.symmetry
     if len(syms) == 1:
         return None
     proper = np.array([round(np.linalg.det(m)) > 0 for m, _ in syms])
-    best: tuple[tuple[int, int, int, int], AnchorPlan] | None = None
+    best: tuple[tuple[int, int, int, float, int], AnchorPlan] | None = None
     for t, ty in enumerate(problem.types):
-        if not (ty.lo == 1 and ty.hi == 1):
+        a, b = int(problem.row_start[t]), int(problem.row_start[t + 1])
+        if not (ty.lo == 1 and ty.hi == 1) or b == a:
             continue
         full = not ty.chiral or bool(proper.all())
         group = np.flatnonzero(np.ones(len(syms), bool) if full else proper).astype(np.int32)
-        a, b = int(problem.row_start[t]), int(problem.row_start[t + 1])
-        if b == a:
-            continue
-        images = maps[group][:, a:b]  # (|H|, n) images of this type's rows
-        rep_of = images.min(axis=0)
-        reps = np.unique(rep_of)
-        stab = (maps[group][:, reps] == reps[None, :]).sum(axis=0)
-        free = reps[stab == 1].astype(np.int32)
-        fixed = reps[stab > 1].astype(np.int32)
-        orbit = (len(group) // stab[stab > 1]).astype(np.int32)
-        plan = AnchorPlan(t, group, full, free, fixed, orbit)
-        score = (0 if ty.slots[0] == prefer else 1, 0 if full else 1, len(reps), len(fixed))
+        rows = np.arange(a, b, dtype=np.int32)
+        free, fixed, orbit = _orbits(maps, group, rows)
+        plan = AnchorPlan(ty.slots[0], rows, group, full, free, fixed, orbit)
+        n_reps = len(free) + len(fixed)
+        score = (
+            0 if ty.slots[0] == prefer else 1,
+            0 if full else 1,
+            len(problem.table[t].orientations),
+            n_reps / (b - a),
+            n_reps,
+        )
         if best is None or score < best[0]:
             best = (score, plan)
+    return best[1] if best is not None else _cell_anchor(problem)
+
+
+def _cell_anchor(problem: CoverProblem) -> AnchorPlan | None:
+    _, maps = problem.symmetry
+    perms = problem.cell_permutations()
+    stab = (perms == np.arange(problem.n_cells)[None, :]).sum(axis=0)
+    mandatory = np.ones(problem.n_cells, dtype=bool)
+    mandatory[sorted(problem.optional)] = False
+    stab[~mandatory] = 0
+    if stab.max() <= 1:
+        return None
+    ptr = problem.row_ptr
+    owner = np.repeat(np.arange(problem.n_rows, dtype=np.int32), np.diff(ptr))
+    best: tuple[int, AnchorPlan] | None = None
+    for c in np.flatnonzero(stab == stab.max()):
+        group = np.flatnonzero(perms[:, c] == c).astype(np.int32)
+        rows = np.unique(owner[problem.flat_cells == c]).astype(np.int32)
+        if len(rows) == 0:
+            continue
+        free, fixed, orbit = _orbits(maps, group, rows)
+        label = f"cell {problem.target.cells[int(c)]}"
+        plan = AnchorPlan(label, rows, group, False, free, fixed, orbit)
+        if best is None or len(free) + len(fixed) < best[0]:
+            best = (len(free) + len(fixed), plan)
     return None if best is None else best[1]
 
 
@@ -191,13 +243,11 @@ def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> in
     return len(np.unique(canonical_forms(problem, sols), axis=0))
 
 
-def _restricted_rows(
-    problem: CoverProblem, plan: AnchorPlan, anchor_rows: Int32Array
-) -> Int32Array:
-    a, b = int(problem.row_start[plan.type_index]), int(problem.row_start[plan.type_index + 1])
-    rows = np.arange(problem.n_rows, dtype=np.int32)
-    others = np.concatenate([rows[:a], rows[b:]])
-    return np.sort(np.concatenate([others, anchor_rows])).astype(np.int32)
+def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, reps: Int32Array) -> Int32Array:
+    keep = np.ones(problem.n_rows, dtype=bool)
+    keep[plan.rows] = False
+    keep[reps] = True
+    return np.flatnonzero(keep).astype(np.int32)
 
 
 def count_solutions(
@@ -226,14 +276,13 @@ def count_solutions(
         return CoverResult(
             search.found, _count_distinct_forms(problem, every), budget.stats, len(syms), None
         )
-    anchor_name = problem.types[plan.type_index].slots[0]
     h = len(plan.group)
     total = 0
     n_distinct = 0
     blocks: list[Int32Array] = []
     if len(plan.free_reps):
         search = budget.search(problem, _restricted_rows(problem, plan, plan.free_reps), engine)
-        if distinct and not plan.full:
+        if distinct and not plan.exact:
             found = budget.collect(search)
             blocks.extend(found)
             total += h * sum(len(b) for b in found)
@@ -253,9 +302,7 @@ def count_solutions(
                 total += orbit_of[r]
     if distinct:
         n_distinct += _count_distinct_forms(problem, blocks)
-    return CoverResult(
-        total, n_distinct if distinct else None, budget.stats, len(syms), anchor_name
-    )
+    return CoverResult(total, n_distinct if distinct else None, budget.stats, len(syms), plan.label)
 
 
 class _Budget:
@@ -316,11 +363,21 @@ def iter_solutions(
     optional: Shape | None = None,
     engine: Engine = "auto",
     node_limit: int | None = None,
+    symmetry: bool = False,
 ) -> Iterator[Solution]:
-    """Every solution, lazily, in a fixed order; ``distinct=True`` yields one per symmetry class
-    (the first met), at the cost of remembering the canonical form of each class."""
+    """Every solution, lazily, in the engine's fixed order; ``distinct=True`` yields one per
+    symmetry class (the first met), remembering the canonical form of each class.
+
+    ``symmetry=True`` (with ``distinct``) searches the anchor-reduced problem instead, up to
+    the group's order faster; the classes then come in a different order and each is
+    represented by a solution with its anchor at an orbit representative.
+    """
     problem = _problem(pieces, target, optional, reflections)
-    search = CoverSearch(problem, engine=engine, node_limit=node_limit)
+    plan = anchor_plan(problem) if distinct and symmetry else None
+    rows = None
+    if plan is not None:
+        rows = _restricted_rows(problem, plan, np.concatenate([plan.free_reps, plan.fixed_reps]))
+    search = CoverSearch(problem, rows, engine=engine, node_limit=node_limit)
     seen: set[bytes] = set()
     for block in search.batches(64):
         forms = canonical_forms(problem, block) if distinct else block

@@ -35,12 +35,11 @@ class CoverStats:
     engine: str = ""
 
     def __add__(self, other: CoverStats) -> CoverStats:
-        engine = self.engine if self.engine == other.engine or not other.engine else other.engine
         return CoverStats(
             self.nodes + other.nodes,
             self.updates + other.updates,
             self.seconds + other.seconds,
-            engine or other.engine,
+            self.engine or other.engine,
         )
 
 
@@ -158,9 +157,10 @@ class CoverSearch:
             )  # fmt: skip
         else:
             n = bitboard_run(
-                a.mask, a.rtype, a.rid, a.cand_ptr, a.cand, a.skip, a.root, a.primary,
+                a.mask, a.rtype, a.rid, a.cand_ptr, a.cand, a.skip,
+                a.type_ptr, a.exact1, a.mrv_depth, a.primary,
                 a.lo, a.hi, self._cnt, a.counters, a.table,
-                a.nb, a.region_gcd, a.region_min, a.region_cap,
+                a.nb, a.region_gcd, a.region_min,
                 self._occ, self._perm, self._nbuf, self._pos, self._aux, self._chosen,
                 self._regs, self._rng, self._shuffle,
                 out, max_store, stop_after, self.node_limit,

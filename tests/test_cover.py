@@ -14,6 +14,9 @@ from solvers.cover import (
     CoverError,
     CoverLimitError,
     PieceSpec,
+    Solution,
+    anchor_plan,
+    canonical_forms,
     count_solutions,
     cover_problem,
     first_solution,
@@ -62,7 +65,6 @@ def test_pentomino_packings(box: tuple[int, int, int], engine: str) -> None:
     assert (r.solutions, r.distinct) == _known(box)
 
 
-@pytest.mark.slow
 def test_solid_pentominoes_3x4x5() -> None:
     r = count_solutions(PENTOMINOES.pieces, (3, 4, 5))
     assert (r.solutions, r.distinct) == _known((3, 4, 5))
@@ -264,3 +266,38 @@ def test_engines_agree_with_naive_oracle(
         for symmetry in (True, False):
             r = count_solutions(problem, engine=engine, symmetry=symmetry)  # type: ignore[arg-type]
             assert (r.solutions, r.distinct) == (len(sols), expected_distinct), (engine, symmetry)
+
+
+def test_distinct_iteration_with_symmetry_reduction() -> None:
+    plain = list(iter_solutions(SOMA.pieces, (3, 3, 3), distinct=True))
+    reduced = list(iter_solutions(SOMA.pieces, (3, 3, 3), distinct=True, symmetry=True))
+    problem = cover_problem(SOMA.pieces, (3, 3, 3))
+
+    def forms(sols: list[Solution]) -> set[bytes]:
+        rows = np.array([s.rows for s in sols], dtype=np.int32)
+        return {f.tobytes() for f in canonical_forms(problem, rows)}
+
+    assert len(reduced) == len(plain) == 240
+    assert forms(reduced) == forms(plain)
+
+
+def _burr_like_problem() -> tuple[list[PieceSpec], Shape]:
+    # Bars of 1x1x2 and 1x1x3 (any number of each) filling a 3x3x2 box: no piece is unique,
+    # so the symmetry reduction anchors a cell instead.
+    bar2 = Shape([(0, 0, 0), (1, 0, 0)])
+    bar3 = Shape([(0, 0, 0), (1, 0, 0), (2, 0, 0)])
+    return [PieceSpec(bar2, "b2", 0, 9), PieceSpec(bar3, "b3", 0, 6)], box_cells((3, 3, 2))
+
+
+@pytest.mark.parametrize("reflections", [True, False])
+def test_cell_anchor_matches_plain_count(reflections: bool) -> None:
+    specs, target = _burr_like_problem()
+    problem = cover_problem(specs, target, reflections=reflections)
+    plan = anchor_plan(problem)
+    assert plan is not None and plan.label.startswith("cell")
+    reduced = count_solutions(problem)
+    plain = count_solutions(problem, symmetry=False)
+    assert (reduced.solutions, reduced.distinct) == (plain.solutions, plain.distinct)
+    assert reduced.stats.nodes < plain.stats.nodes
+    sols = list(iter_solutions(problem, distinct=True, symmetry=True))
+    assert len(sols) == plain.distinct
