@@ -289,3 +289,71 @@ def replay_disassembly(shapes: Mapping[str, Shape], moves: Sequence[Move]) -> As
 def disassembly_of_assembly_plan(moves: Sequence[Move]) -> list[Move]:
     """An assembly plan is a disassembly played backwards: reverse it and invert each move."""
     return [m.inverse() for m in reversed(moves)]
+
+
+# ---------------------------------------------------------------------------------------------
+# Reference searches (pure Python): the oracle the numba search is tested and timed against
+# ---------------------------------------------------------------------------------------------
+
+
+def state_key(state: Assembly) -> tuple[tuple[tuple[str, ...], tuple[Cell, ...]], ...]:
+    """Hashable identity of a state: each part with its offsets relative to its first piece
+    (positions are relative: moving a group one way equals moving the rest the other way)."""
+    out = []
+    for part in state.parts:
+        names = sorted(part)
+        bx, by, bz = state.offsets[names[0]]
+        rel = tuple((x - bx, y - by, z - bz) for x, y, z in (state.offsets[n] for n in names))
+        out.append((tuple(names), rel))
+    return tuple(sorted(out))
+
+
+def blocking_matrix(state: Assembly, direction: str) -> dict[tuple[str, str], int | None]:
+    """``(i, j) -> how far i alone can travel along direction with j fixed`` (None: never
+    meets it), for every ordered pair of pieces in the same part: Cutler's movement matrix."""
+    d = DIRECTIONS[direction]
+    out: dict[tuple[str, str], int | None] = {}
+    for part in state.parts:
+        for i in sorted(part):
+            for j in sorted(part):
+                if i != j:
+                    out[(i, j)] = _max_free_run(state.cells_of(i), state.cells_of(j), d)
+    return out
+
+
+def reference_optimal_disassembly(
+    shapes: Mapping[str, Shape], max_group: int | None = None, max_states: int = 200_000
+) -> list[Move] | None:
+    """Fewest moves taking every piece apart, by plain breadth-first search over whole states
+    (all parts at once); None if impossible. Exponential: for small puzzles and tests only."""
+    start = Assembly.assembled(shapes)
+    if start.is_separated():
+        return []
+    seen: dict[object, tuple[object, Move | None]] = {state_key(start): (None, None)}
+    frontier = [start]
+    while frontier:
+        nxt: list[Assembly] = []
+        for state in frontier:
+            for move in legal_moves(state, max_group):
+                child = state.apply(move)
+                key = state_key(child)
+                if key in seen:
+                    continue
+                seen[key] = (state_key(state), move)
+                if child.is_separated():
+                    plan: list[Move] = []
+                    k: object = key
+                    while True:
+                        prev, m = seen[k]
+                        if m is None:
+                            break
+                        plan.append(m)
+                        k = prev
+                    return plan[::-1]
+                if len(seen) > max_states:
+                    raise SearchLimitError(
+                        f"reference search passed {max_states} states; raise max_states"
+                    )
+                nxt.append(child)
+        frontier = nxt
+    return None

@@ -19,6 +19,8 @@ def register(sub: Any) -> None:
     fam = p.add_subparsers(dest="family", metavar="FAMILY", required=True)
     _register_stacking(fam)
     _register_suite(fam)
+    _register_puzzle(fam)
+    _register_puzzle_suite(fam)
 
 
 def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
@@ -144,4 +146,61 @@ def _run_suite(args: argparse.Namespace) -> int:
     for s in summaries:
         print(json.dumps(s.to_json() | {"levels": len(s.accepted)}, sort_keys=True))
     print(json.dumps({"suite": str(args.out), "levels": sum(len(s.accepted) for s in summaries)}))
+    return 0
+
+
+# -- puzzles -------------------------------------------------------------------------------------
+
+
+def _register_puzzle(fam: Any) -> None:
+    p = fam.add_parser("puzzle", help="interlocking puzzles (burrs, plate burrs, cubes)")
+    p.add_argument(
+        "--shape",
+        default="burr6",
+        help="burr6, burr12, burr18, burr24, burr36 or cubeN (default burr6)",
+    )
+    p.add_argument("--min-level", type=int, default=1, help="least moves to free the first part")
+    p.add_argument("--pieces", type=int, default=0, help="pieces of a cubeN partition")
+    p.add_argument("--hole-rate", type=float, help="chance a shared cell starts empty")
+    p.add_argument("--hill-steps", type=int, help="single-voxel improvement steps")
+    p.add_argument("--goal", choices=("disassemble", "assemble"), default="disassemble")
+    p.add_argument("--max-group", type=int, help="most pieces one move may carry")
+    p.add_argument("--seconds", type=float, help="time limit of the optimal-plan search")
+    add_run_options(p)
+    p.set_defaults(func=_run_puzzle)
+
+
+def _run_puzzle(args: argparse.Namespace) -> int:
+    from generator.puzzle import PuzzleConfig, make
+
+    fields: dict[str, Any] = {
+        "shape": args.shape,
+        "min_level": args.min_level,
+        "pieces": args.pieces,
+        "goal": args.goal,
+        "max_group": args.max_group,
+    }
+    for opt in ("hole_rate", "hill_steps", "seconds"):
+        if getattr(args, opt) is not None:
+            fields[opt] = getattr(args, opt)
+    return run_job(args, "puzzle", make, PuzzleConfig(**fields))
+
+
+def _register_puzzle_suite(fam: Any) -> None:
+    p = fam.add_parser("puzzle-suite", help="rebuild the shipped 32-level puzzle suite")
+    p.add_argument("--out", type=Path, default=Path("levels") / "puzzle", help="target folder")
+    p.set_defaults(func=_run_puzzle_suite)
+
+
+def _run_puzzle_suite(args: argparse.Namespace) -> int:
+    import sys
+
+    from chaingeo.cli import CommandError
+    from generator.puzzle_suite import build_puzzle_suite
+
+    try:
+        levels = build_puzzle_suite(args.out, log=lambda s: print(s, file=sys.stderr, flush=True))
+    except RuntimeError as e:
+        raise CommandError(str(e)) from None
+    print(json.dumps({"suite": str(args.out), "levels": len(levels)}))
     return 0

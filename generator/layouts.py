@@ -1,0 +1,98 @@
+"""Target shapes for generated interlocking puzzles, as *layouts* of overlapping piece slots.
+
+A layout is a list of slots (voxel sets) that overlap; a *design* says, for every cell shared by
+two or more slots, which slot owns it (or that it stays empty). Piece ``k`` is its slot's own
+cells plus the shared cells it owns, so any design is a non-overlapping assembly of the target:
+six-piece burrs and towers of stacked burr units (12 pieces and up). Cube
+layouts instead partition an ``n x n x n`` cube (:func:`cube_cells`), handled by the generator.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import cache, partial
+
+from chaingeo.geometry import Cell, Shape
+from chaingeo.piecesets.burrs import SLOTS, slot_cells
+
+
+@dataclass(frozen=True)
+class Layout:
+    name: str
+    slots: tuple[Shape, ...]
+    description: str
+
+    @property
+    def shared(self) -> tuple[Cell, ...]:
+        """Cells in two or more slots, sorted."""
+        return _shared(self.slots)
+
+    def owners(self, cell: Cell) -> tuple[int, ...]:
+        return tuple(i for i, s in enumerate(self.slots) if cell in s.cell_set)
+
+    def pieces(self, design: Sequence[int]) -> list[Shape]:
+        """The pieces of ``design`` (owner slot per shared cell, -1 for empty)."""
+        shared = self.shared
+        if len(design) != len(shared):
+            raise ValueError(f"a design has {len(shared)} entries, got {len(design)}")
+        shared_set = set(shared)
+        out: list[list[Cell]] = [[c for c in s.cells if c not in shared_set] for s in self.slots]
+        for cell, owner in zip(shared, design, strict=True):
+            if owner >= 0:
+                out[owner].append(cell)
+        return [Shape(cells) for cells in out]
+
+
+@cache
+def _shared(slots: tuple[Shape, ...]) -> tuple[Cell, ...]:
+    count: dict[Cell, int] = {}
+    for s in slots:
+        for c in s.cells:
+            count[c] = count.get(c, 0) + 1
+    return tuple(sorted(c for c, k in count.items() if k > 1))
+
+
+def burr6() -> Layout:
+    return Layout(
+        "burr6",
+        tuple(slot_cells(a, c) for a, c in SLOTS),
+        "six-piece burr (Kongming / Lu Ban lock): six 2x2x6 sticks, three pairs crossing",
+    )
+
+
+def burr_tower(units: int) -> Layout:
+    """``units`` six-piece burr units stacked along z: the z-sticks of neighbouring units meet
+    end to end, so the units block one another; ``6 * units`` pieces."""
+    slots = [
+        slot_cells(axis, (corner[0], corner[1], corner[2] + 6 * u))
+        for u in range(units)
+        for axis, corner in SLOTS
+    ]
+    return Layout(
+        f"burr{6 * units}",
+        tuple(slots),
+        f"larger burr: a tower of {units} six-piece burr units stacked along z",
+    )
+
+
+LAYOUTS: dict[str, Callable[[], Layout]] = {
+    "burr6": burr6,
+    "burr12": partial(burr_tower, 2),
+    "burr18": partial(burr_tower, 3),
+    "burr24": partial(burr_tower, 4),
+    "burr36": partial(burr_tower, 6),
+}
+
+
+def get_layout(name: str) -> Layout:
+    try:
+        return LAYOUTS[name]()
+    except KeyError:
+        raise ValueError(
+            f"unknown puzzle shape {name!r}; known: {sorted(LAYOUTS)} and cubeN (e.g. cube3)"
+        ) from None
+
+
+def cube_cells(n: int) -> list[Cell]:
+    return [(x, y, z) for x in range(n) for y in range(n) for z in range(n)]

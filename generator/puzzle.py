@@ -1,0 +1,300 @@
+"""Interlocking-puzzle generator: one pure function ``make(config, seed, index)``.
+
+A candidate is a random design of a layout (:mod:`generator.layouts`: who owns each shared
+cell of a burr, a plate burr or a chain of burr units) or a random partition of an n x n x n
+cube into face-connected pieces. It is then improved by hill climbing on single voxels (give one
+shared cell to another slot, or move one cube voxel to a neighbouring piece), keeping a change
+when the puzzle still comes apart and its (level, total moves) does not drop. The result is
+accepted when it reaches ``min_level``; its optimal plan (o_i) is then computed exactly and the
+level file is built and verified. Everything random comes from ``SeedSequence([seed, index])``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from typing import Literal
+
+import numpy as np
+
+from chaingeo.colors import assign_colors
+from chaingeo.geometry import NEIGHBOURS, Cell, Shape, puzzle_signature
+from chaingeo.kinematics import SearchLimitError
+from chaingeo.level import (
+    Difficulty,
+    Level,
+    Piece,
+    Provenance,
+    PuzzleSolution,
+    default_step_budget,
+    revalidate,
+)
+from chaingeo.rules import PuzzleRules
+from generator.layouts import cube_cells, get_layout
+from generator.result import Rejection
+from solvers.disassemble import Analysis, analyze
+from solvers.partsearch import SearchLimits
+
+GENERATOR = "chaingeo.generator.puzzle"
+VERSION = "1"
+
+
+@dataclass(frozen=True)
+class PuzzleConfig:
+    """What to make. ``shape``: a layout name (burr6, burr3, plate3, burr10, burr14, burr18,
+    burr34) or ``cubeN`` with ``pieces``; ``min_level``: moves until the first part comes free."""
+
+    shape: str = "burr6"
+    min_level: int = 1
+    pieces: int = 0  # cube partitions only
+    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs)
+    hill_steps: int = 300
+    goal: Literal["disassemble", "assemble"] = "disassemble"
+    max_group: int | None = None
+    seconds: float | None = None  # optional time limit of each search (machine-dependent!)
+    max_states: int = 500_000  # state cap per part in the final search
+    max_total_states: int = 3_000_000  # state cap of the whole optimal-plan search
+    probe_states: int = 20_000  # state cap of each evaluation while climbing (over: rejected)
+
+    def to_json(self) -> dict[str, object]:
+        return asdict(self)
+
+
+Score = tuple[int, int]
+
+
+class _Candidate:
+    """One puzzle being improved: its pieces and how well it scores."""
+
+    def __init__(self, shapes: list[Shape], analysis: Analysis) -> None:
+        self.shapes = shapes
+        self.analysis = analysis
+
+    @property
+    def score(self) -> Score:
+        a = self.analysis
+        return (a.first_level or 0, a.moves or 0)
+
+
+def _evaluate(shapes: Sequence[Shape], config: PuzzleConfig) -> Analysis | None:
+    """The BurrTools-style analysis, or None if a piece is broken or the puzzle is stuck."""
+    if any(len(s) == 0 or not s.is_connected() for s in shapes):
+        return None
+    named = {f"p{i:02d}": s for i, s in enumerate(shapes)}
+    limits = SearchLimits(
+        max_states=config.probe_states,
+        seconds=config.seconds,
+        max_total_states=10 * config.probe_states,
+    )
+    try:
+        result = analyze(named, max_group=config.max_group, limits=limits, optimal=False)
+    except SearchLimitError:
+        return None
+    return result if result.disassemblable else None
+
+
+def _broken(shapes: Sequence[Shape]) -> int:
+    return sum(1 for s in shapes if len(s) == 0 or not s.is_connected())
+
+
+def _mutate(owners: Sequence[int], current: int, hole_rate: float, rng: np.random.Generator) -> int:
+    """Another owner for one shared cell (or empty, when holes are allowed)."""
+    choices = [o for o in (*owners, -1) if o != current and (o >= 0 or hole_rate > 0)]
+    return int(choices[int(rng.integers(len(choices)))]) if choices else current
+
+
+def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate | None:
+    layout = get_layout(config.shape)
+    shared = layout.shared
+    options = [layout.owners(c) for c in shared]
+    design = [
+        -1 if rng.random() < config.hole_rate else int(opts[rng.integers(len(opts))])
+        for opts in options
+    ]
+    best: _Candidate | None = None
+    for _ in range(40):  # repair towards connected pieces, then look for one that comes apart
+        for _ in range(400):
+            broken = _broken(layout.pieces(design))
+            if broken == 0:
+                break
+            i = int(rng.integers(len(design)))
+            old = design[i]
+            design[i] = _mutate(options[i], old, config.hole_rate, rng)
+            if _broken(layout.pieces(design)) > broken:
+                design[i] = old
+        shapes = layout.pieces(design)
+        result = _evaluate(shapes, config)
+        if result is not None:
+            best = _Candidate(shapes, result)
+            break
+        for _ in range(3):  # shake and retry
+            i = int(rng.integers(len(design)))
+            design[i] = _mutate(options[i], design[i], config.hole_rate, rng)
+    if best is None:
+        return None
+    for _ in range(config.hill_steps):
+        i = int(rng.integers(len(design)))
+        old = design[i]
+        design[i] = _mutate(options[i], old, config.hole_rate, rng)
+        shapes = layout.pieces(design)
+        result = _evaluate(shapes, config)
+        if result is not None and _Candidate(shapes, result).score >= best.score:
+            best = _Candidate(shapes, result)
+        else:
+            design[i] = old
+    return best
+
+
+def _cube_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Candidate | None:
+    cells = cube_cells(n)
+    k = config.pieces or max(3, n)
+    if not 2 <= k <= len(cells):
+        raise ValueError(f"a {n}x{n}x{n} cube cannot be cut into {k} pieces")
+    owner: dict[Cell, int] = {}
+    for i, j in enumerate(rng.permutation(len(cells))[:k]):
+        owner[cells[int(j)]] = i
+    while len(owner) < len(cells):
+        frontier = sorted(
+            {
+                (nb, owner[c])
+                for c in owner
+                for d in NEIGHBOURS
+                if (nb := (c[0] + d[0], c[1] + d[1], c[2] + d[2])) not in owner
+                and all(0 <= v < n for v in nb)
+            }
+        )
+        cell, who = frontier[int(rng.integers(len(frontier)))]
+        owner[cell] = who
+
+    def shapes_of(own: dict[Cell, int]) -> list[Shape]:
+        groups: list[list[Cell]] = [[] for _ in range(k)]
+        for c, w in sorted(own.items()):
+            groups[w].append(c)
+        return [Shape(g) for g in groups]
+
+    shapes = shapes_of(owner)
+    result = _evaluate(shapes, config)
+    best = _Candidate(shapes, result) if result is not None else None
+    for _ in range(config.hill_steps):
+        c = cells[int(rng.integers(len(cells)))]
+        near = sorted(
+            {
+                owner[nb]
+                for d in NEIGHBOURS
+                if (nb := (c[0] + d[0], c[1] + d[1], c[2] + d[2])) in owner
+                and owner[nb] != owner[c]
+            }
+        )
+        if not near:
+            continue
+        old = owner[c]
+        owner[c] = near[int(rng.integers(len(near)))]
+        shapes = shapes_of(owner)
+        result = _evaluate(shapes, config) if len(shapes[old]) >= 2 else None
+        if result is not None and (best is None or _Candidate(shapes, result).score >= best.score):
+            best = _Candidate(shapes, result)
+        else:
+            owner[c] = old
+    return best
+
+
+def difficulty_of(first_level: int, optimal_steps: int, pieces: int) -> Difficulty:
+    """The suite's thresholds (README, 'Puzzle suite'): *hard* when the first part needs 4 or
+    more moves, or the optimal plan 14 or more, or there are 12 or more pieces; *easy* when the
+    first part needs at most 2 moves, the plan at most 8 and there are at most 6 pieces; *mid*
+    otherwise."""
+    if first_level >= 4 or optimal_steps >= 14 or pieces >= 12:
+        return "hard"
+    if first_level <= 2 and optimal_steps <= 8 and pieces <= 6:
+        return "easy"
+    return "mid"
+
+
+def puzzle_level(
+    level_id: str,
+    shapes: Sequence[Shape],
+    *,
+    goal: Literal["disassemble", "assemble"],
+    max_group: int | None,
+    limits: SearchLimits,
+    seed: int | None = None,
+    index: int | None = None,
+    difficulty: Difficulty | None = None,
+    extra_stats: dict[str, object] | None = None,
+) -> Level:
+    """Build and verify a puzzle level: palette names, the exact optimal plan (o_i) and stats.
+
+    For 'assemble' the stored plan is the optimal disassembly reversed with each move inverted
+    (the assembly optimum equals the disassembly optimum: the two state graphs are mirror
+    images). Raises :class:`SearchLimitError` when o_i cannot be computed within ``limits``.
+    """
+    base = np.min(np.concatenate([s.voxels for s in shapes]), axis=0)
+    placed = [s.translate(-base) for s in shapes]
+    colors = assign_colors(len(placed))
+    named = {c.name: s for c, s in zip(colors, placed, strict=True)}
+    result = analyze(named, max_group=max_group, limits=limits, optimal=True)
+    if not result.disassemblable or result.optimal_steps is None:
+        raise ValueError(f"{level_id}: the puzzle does not come apart")
+    plan = list(result.plan)
+    moves = plan if goal == "disassemble" else [m.inverse() for m in reversed(plan)]
+    first = result.first_level or 0
+    stats: dict[str, object] = {
+        "level": result.level,
+        "first_level": first,
+        "moves": result.moves,
+        "pieces": len(placed),
+        "voxels": int(sum(len(s) for s in placed)),
+        "states": result.states,
+    }
+    stats.update(extra_stats or {})
+    level = Level(
+        id=level_id,
+        family="puzzle",
+        difficulty=difficulty or difficulty_of(first, result.optimal_steps, len(placed)),
+        goal=goal,
+        box=None,
+        pieces=tuple(Piece(c.name, c.hex, s) for c, s in zip(colors, placed, strict=True)),
+        solution=PuzzleSolution(tuple(moves)),
+        optimal_steps=result.optimal_steps,
+        max_steps=default_step_budget(result.optimal_steps),
+        rules=PuzzleRules(max_group=max_group),
+        provenance=Provenance(GENERATOR, VERSION, seed, index, puzzle_signature(placed)),
+        stats=stats,
+    )
+    return revalidate(level)
+
+
+def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
+    """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
+    rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
+    if config.shape.startswith("cube"):
+        try:
+            n = int(config.shape[4:])
+        except ValueError:
+            raise ValueError(f"cube shapes are cube2..cube5, got {config.shape!r}") from None
+        best = _cube_search(config, n, rng)
+    else:
+        best = _layout_search(config, rng)
+    if best is None:
+        return Rejection("no design that comes apart", seed, index)
+    if best.score[0] < config.min_level:
+        return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)
+    limits = SearchLimits(
+        max_states=config.max_states,
+        seconds=config.seconds,
+        max_total_states=config.max_total_states,
+    )
+    level_id = f"puzzle-{config.shape}-s{seed}-i{index}"
+    try:
+        return puzzle_level(
+            level_id,
+            best.shapes,
+            goal=config.goal,
+            max_group=config.max_group,
+            limits=limits,
+            seed=seed,
+            index=index,
+            extra_stats={"shape": config.shape},
+        )
+    except SearchLimitError as e:
+        return Rejection(f"optimal plan not found within limits: {e}", seed, index)

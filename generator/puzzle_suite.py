@@ -1,0 +1,97 @@
+"""The shipped 32-level puzzle suite (``levels/puzzle``), rebuilt byte for byte from fixed seeds.
+
+``chain generate puzzle-suite [--out levels/puzzle]`` walks :data:`SUITE` in order: for each
+entry it tries items ``0, 1, 2, ...`` of the entry's seed with :func:`generator.puzzle.make`
+and keeps the first ones whose difficulty (computed from the solver's figures, see
+:func:`generator.puzzle.difficulty_of`) is the entry's and whose signature is new. Every search
+is bounded by state caps only, never by time, so every machine makes the same files.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from chaingeo.level import Difficulty, Level, revalidate, save_level
+from generator.puzzle import PuzzleConfig, make
+from generator.result import Rejection
+
+
+@dataclass(frozen=True)
+class SuiteEntry:
+    difficulty: Difficulty
+    config: PuzzleConfig
+    seed: int
+    count: int
+    goals: tuple[str, ...]  # goal of each of the ``count`` levels, in order
+
+
+_EASY6 = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=0)
+_HOLEY = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=300, min_level=3)
+_HARD6 = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=400, min_level=4)
+_CUBE3 = PuzzleConfig(shape="cube3", pieces=4, hill_steps=80)
+_CUBE3B = PuzzleConfig(shape="cube3", pieces=5, hill_steps=80)
+_CUBE4 = PuzzleConfig(shape="cube4", pieces=8, hill_steps=100)
+_CUBE4H = PuzzleConfig(shape="cube4", pieces=12, hill_steps=60)
+_TOWER = PuzzleConfig(shape="burr12", hole_rate=0.1, hill_steps=100)
+
+D, A = "disassemble", "assemble"
+
+#: 10 easy, 12 mid, 10 hard.
+SUITE: tuple[SuiteEntry, ...] = (
+    SuiteEntry("easy", _EASY6, 101, 4, (D, D, A, A)),
+    SuiteEntry("easy", _CUBE3, 102, 3, (D, A, D)),
+    SuiteEntry("easy", _CUBE3B, 103, 3, (D, D, A)),
+    SuiteEntry("mid", _HOLEY, 201, 8, (D, D, D, D, D, A, A, A)),
+    SuiteEntry("mid", _CUBE4, 202, 4, (D, D, A, D)),
+    SuiteEntry("hard", _HARD6, 301, 4, (D, D, A, D)),
+    SuiteEntry("hard", _TOWER, 303, 3, (D, D, A)),
+    SuiteEntry("hard", _CUBE4H, 302, 3, (D, A, D)),
+)
+
+
+def build_puzzle_suite(
+    out: Path,
+    *,
+    max_items: int = 400,
+    log: Callable[[str], None] | None = None,
+) -> list[Level]:
+    """Generate every entry of :data:`SUITE` into ``out`` (old ``puzzle-*.json`` removed)."""
+    out.mkdir(parents=True, exist_ok=True)
+    for old in sorted(out.glob("puzzle-*.json")):
+        old.unlink()
+    seen: set[str] = set()
+    made: list[Level] = []
+    number = {"easy": 0, "mid": 0, "hard": 0}
+    for entry in SUITE:
+        got = 0
+        for index in range(max_items):
+            if got == entry.count:
+                break
+            goal = entry.goals[got]
+            item = make(dataclasses.replace(entry.config, goal=goal), entry.seed, index)  # type: ignore[arg-type]
+            if isinstance(item, Rejection):
+                continue
+            if item.difficulty != entry.difficulty or item.provenance.signature in seen:
+                continue
+            seen.add(item.provenance.signature)
+            number[entry.difficulty] += 1
+            level_id = (
+                f"puzzle-{entry.difficulty}-{number[entry.difficulty]:02d}-{entry.config.shape}"
+            )
+            level = revalidate(dataclasses.replace(item, id=level_id))
+            save_level(level, out / f"{level_id}.json")
+            made.append(level)
+            got += 1
+            if log is not None:
+                log(
+                    f"{level_id}: optimal_steps {level.optimal_steps}, level {level.stats['level']}"
+                )
+        if got < entry.count:
+            raise RuntimeError(
+                f"only {got} of {entry.count} {entry.difficulty} {entry.config.shape} levels "
+                f"from seed {entry.seed} in {max_items} items"
+            )
+    return made

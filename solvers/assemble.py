@@ -1,0 +1,124 @@
+"""The assembler: every assembly of a piece multiset into a target shape, then the disassembler
+decides which of them can actually be taken apart ('assemblies' and 'solutions' as BurrTools
+counts them).
+
+Assemblies come from the exact-cover engine (:mod:`solvers.cover`) with every rotation of every
+piece, one per class of the target's rotations (symmetric duplicates removed; mirror images are
+kept apart, BurrTools' default). A *solution* is an assembly the disassembler can take apart
+completely under the reference kinematics.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from chaingeo.geometry import Shape
+from solvers.disassemble import Analysis, analyze
+from solvers.partsearch import SearchLimits
+
+
+@dataclass(frozen=True)
+class PieceCount:
+    """A piece shape used between ``min`` and ``max`` times."""
+
+    name: str
+    shape: Shape
+    min: int = 1
+    max: int = 1
+
+
+@dataclass(frozen=True)
+class AssemblyReport:
+    assemblies: int
+    solutions: int
+    first_solution: dict[str, Shape] | None
+    seconds: float
+    solution_list: tuple[dict[str, Shape], ...] = ()
+
+
+def _cover() -> Any:
+    try:
+        return importlib.import_module("solvers.cover")
+    except ImportError as e:  # pragma: no cover - only before the engine lands
+        raise RuntimeError(
+            "the exact-cover engine (solvers.cover) is not available in this installation"
+        ) from e
+
+
+def iter_assemblies(
+    pieces: Sequence[PieceCount],
+    target: Shape,
+    *,
+    optional: Shape | None = None,
+    mirror_distinct: bool = True,
+    node_limit: int | None = None,
+) -> Iterator[dict[str, Shape]]:
+    """Every assembly, one per symmetry class of the target (rotations; reflections too when
+    ``mirror_distinct`` is False), as ``{piece name: placed voxels}``. Copies of one piece are
+    named ``name``, ``name_2``, ... in placement order."""
+    cover = _cover()
+    specs = [cover.PieceSpec(p.shape, p.name, p.min, p.max) for p in pieces]
+    solutions = cover.iter_solutions(
+        specs,
+        target,
+        distinct=True,
+        reflections=not mirror_distinct,
+        optional=optional,
+        node_limit=node_limit,
+    )
+    base_of = {p.name: p.name for p in pieces}
+    for sol in solutions:
+        out: dict[str, Shape] = {}
+        counts: dict[str, int] = {}
+        for slot, placed in sol.placements:
+            base = base_of.get(slot, slot.split("#")[0])
+            counts[base] = counts.get(base, 0) + 1
+            name = base if counts[base] == 1 else f"{base}_{counts[base]}"
+            out[name] = placed
+        yield out
+
+
+def count_solutions(
+    pieces: Sequence[PieceCount],
+    target: Shape,
+    *,
+    optional: Shape | None = None,
+    mirror_distinct: bool = True,
+    max_group: int | None = None,
+    limits: SearchLimits | None = None,
+    keep: int = 0,
+) -> AssemblyReport:
+    """Count assemblies and those that come apart; keep the first ``keep`` solutions."""
+    start = time.perf_counter()
+    n_asm = 0
+    n_sol = 0
+    first: dict[str, Shape] | None = None
+    kept: list[dict[str, Shape]] = []
+    for asm in iter_assemblies(pieces, target, optional=optional, mirror_distinct=mirror_distinct):
+        n_asm += 1
+        result: Analysis = analyze(asm, max_group=max_group, limits=limits, optimal=False)
+        if result.disassemblable:
+            n_sol += 1
+            if first is None:
+                first = asm
+            if len(kept) < keep:
+                kept.append(asm)
+    return AssemblyReport(n_asm, n_sol, first, time.perf_counter() - start, tuple(kept))
+
+
+def solid_burr_codes() -> tuple[int, ...]:
+    """Recompute the burr catalogue: the codes of the notchable pieces used by any assembly
+    of the whole notchable family (each 0..6 times) into the Solid Knot."""
+    from chaingeo.piecesets.burrs import notchable_family, solid_knot
+
+    family = notchable_family()
+    code_of = {s.canonical(): c for c, s in family.items()}
+    pieces = [PieceCount(f"b{c:04x}", s, 0, 6) for c, s in family.items()]
+    used: set[int] = set()
+    for asm in iter_assemblies(pieces, solid_knot()):
+        used.update(code_of[s.canonical()] for s in asm.values())
+    return tuple(sorted(used))

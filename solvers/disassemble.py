@@ -1,0 +1,300 @@
+"""Disassembly search: the BurrTools level, and the optimal full disassembly o_i.
+
+Semantics are those of :mod:`chaingeo.kinematics` (the reference); the search itself runs on
+:mod:`solvers.movement` (numba). Two questions are answered:
+
+* **Level** (BurrTools' notation, e.g. ``"4.9.3"``): breadth first to the first removal whose two
+  parts can both be taken apart in turn, then the same in each part. The first number is the
+  fewest moves until something comes free; the text lists the moves of each separation, the
+  part left behind before the part removed, omitting sub-trees made only of one-move
+  separations (BurrTools' rule). ``moves`` is the total of the whole tree.
+* **Optimal plan**: the fewest moves that take *every* piece apart, over all ways of doing it.
+  Parts never interact after a removal, so ``f(part) = min over reachable states s and removals
+  r at s of dist(s) + 1 + f(removed) + f(left)``; a part of ``m`` pieces needs at least
+  ``m - 1`` removals, which bounds the search (branch and bound, memoised per part state).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from chaingeo.geometry import Shape
+from chaingeo.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
+from solvers import movement as mv
+from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
+
+__all__ = [
+    "Analysis",
+    "SearchLimitError",
+    "SearchLimits",
+    "Separation",
+    "analyze",
+    "fast_legal_moves",
+]
+
+_UNSOLVABLE = 1 << 30
+
+
+@dataclass(frozen=True)
+class Separation:
+    """One node of a disassembly tree: ``moves`` (ending with the removal) split a part into
+    ``removed`` and ``left`` (None where that side is a single piece)."""
+
+    moves: tuple[Move, ...]
+    removed: Separation | None = None
+    left: Separation | None = None
+
+    def total_moves(self) -> int:
+        return (
+            len(self.moves)
+            + (self.removed.total_moves() if self.removed else 0)
+            + (self.left.total_moves() if self.left else 0)
+        )
+
+    def has_multi_moves(self) -> bool:
+        return (
+            len(self.moves) > 1
+            or (self.left is not None and self.left.has_multi_moves())
+            or (self.removed is not None and self.removed.has_multi_moves())
+        )
+
+    def level_text(self) -> str:
+        """BurrTools' notation: this separation's moves, then the left and removed sub-trees
+        that contain a separation of more than one move."""
+        text = str(len(self.moves))
+        for sub in (self.left, self.removed):
+            if sub is not None and sub.has_multi_moves():
+                text += "." + sub.level_text()
+        return text
+
+    def all_moves(self) -> list[Move]:
+        """The whole tree as one move sequence: this part, then the left part, then the
+        removed one (parts are independent, so any interleaving is as good)."""
+        out = list(self.moves)
+        if self.left is not None:
+            out.extend(self.left.all_moves())
+        if self.removed is not None:
+            out.extend(self.removed.all_moves())
+        return out
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """What the disassembler found for one assembled puzzle."""
+
+    disassemblable: bool
+    level: str | None  # BurrTools notation, None when it cannot be taken apart
+    moves: int | None  # total moves of that (BurrTools-style) disassembly
+    optimal_steps: int | None  # o_i, the fewest moves of any full disassembly
+    plan: tuple[Move, ...] = ()  # one optimal full disassembly
+    tree: Separation | None = None
+    states: int = 0  # states visited, over every search
+    first_level: int | None = field(default=None)  # moves until the first part comes free
+
+
+PartKey = tuple[tuple[int, ...], bytes]
+
+
+class _Solver:
+    """Searches of one puzzle, sharing the piece table, the caps, the deadline and memos."""
+
+    def __init__(
+        self, shapes: Mapping[str, Shape], max_group: int | None, limits: SearchLimits
+    ) -> None:
+        self.table = PieceTable(shapes)
+        self.max_group = max_group
+        self.limits = limits
+        self.deadline = Deadline(limits.seconds)
+        self.greedy_memo: dict[PartKey, Separation | None] = {}
+        self.opt_memo: dict[PartKey, tuple[int, bool, list[Move]]] = {}
+        self.states = 0
+
+    @staticmethod
+    def key(members: tuple[int, ...], offsets: np.ndarray) -> PartKey:
+        rel = np.asarray(offsets, dtype=np.int64) - np.asarray(offsets[0], dtype=np.int64)
+        return members, rel.astype(np.int16).tobytes()
+
+    def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch:
+        cap = self.limits.max_total_states
+        if cap is not None and self.states > cap:
+            raise SearchLimitError(
+                f"total state cap of {cap} reached over all searches; "
+                "raise SearchLimits(max_total_states=...)"
+            )
+        return PartSearch(
+            self.table,
+            members,
+            offsets,
+            max_group=self.max_group,
+            limits=self.limits,
+            deadline=self.deadline,
+        )
+
+    # -- BurrTools-style tree ------------------------------------------------------------------
+    def greedy(self, members: tuple[int, ...], offsets: np.ndarray) -> Separation | None:
+        """Shortest way to a removal whose parts both come apart, recursively (None: stuck)."""
+        k = self.key(members, offsets)
+        if k in self.greedy_memo:
+            return self.greedy_memo[k]
+        s = self.search(members, offsets)
+        result: Separation | None = None
+        while result is None and not s.exhausted:
+            # Like BurrTools, prefer taking out single pieces (then smaller groups) first.
+            found = sorted(s.expand_layer(), key=lambda r: (r.mask.bit_count(), r.node))
+            for sp in s.unique_splits(found):
+                rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
+                removed = self.greedy(rm, roff) if len(rm) > 1 else None
+                if len(rm) > 1 and removed is None:
+                    continue
+                left = self.greedy(lm, loff) if len(lm) > 1 else None
+                if len(lm) > 1 and left is None:
+                    continue
+                r = sp.removal
+                moves = (*s.path_to(r.node), s.local_move(r.mask, r.direction, None))
+                result = Separation(moves, removed, left)
+                break
+        self.states += s.n_states
+        self.greedy_memo[k] = result
+        return result
+
+    # -- optimal full disassembly --------------------------------------------------------------
+    def optimal(
+        self, members: tuple[int, ...], offsets: np.ndarray, budget: int
+    ) -> tuple[int, list[Move] | None]:
+        """``(f, plan)`` with ``f`` the fewest moves to take the part apart if that is below
+        ``budget``; otherwise ``(lower bound >= budget, None)``."""
+        n = len(members)
+        if n == 1:
+            return 0, []
+        if n - 1 >= budget:
+            return n - 1, None
+        k = self.key(members, offsets)
+        memo = self.opt_memo.get(k)
+        if memo is not None:
+            value, exact, plan = memo
+            if exact:
+                return (value, plan) if value < budget else (value, None)
+            if value >= budget:
+                return value, None
+        s = self.search(members, offsets)
+        best, best_plan = budget, None
+        while not s.exhausted and s.depth + 1 + (n - 2) < best:
+            for sp in s.unique_splits(s.expand_layer()):
+                r = sp.removal
+                rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
+                base = r.depth + 1
+                if base + (len(rm) - 1) + (len(lm) - 1) >= best:
+                    continue
+                fa, pa = self.optimal(rm, roff, best - base - (len(lm) - 1))
+                if pa is None:
+                    continue
+                fb, pb = self.optimal(lm, loff, best - base - fa)
+                if pb is None:
+                    continue
+                best = base + fa + fb
+                best_plan = [
+                    *s.path_to(r.node),
+                    s.local_move(r.mask, r.direction, None),
+                    *pb,
+                    *pa,
+                ]
+        self.states += s.n_states
+        if best_plan is not None:
+            self.opt_memo[k] = (best, True, best_plan)
+            return best, best_plan
+        if s.exhausted and budget >= _UNSOLVABLE:
+            self.opt_memo[k] = (_UNSOLVABLE, True, [])  # every state seen: it never comes apart
+            return _UNSOLVABLE, None
+        self.opt_memo[k] = (budget, False, [])
+        return budget, None
+
+
+def analyze(
+    shapes: Mapping[str, Shape],
+    *,
+    max_group: int | None = None,
+    limits: SearchLimits | None = None,
+    optimal: bool = True,
+) -> Analysis:
+    """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
+    state (every piece at offset zero, one part)."""
+    solver = _Solver(shapes, max_group, limits or SearchLimits())
+    n = len(solver.table.names)
+    members = tuple(range(n))
+    offsets = np.zeros((n, 3), dtype=np.int64)
+    if n == 1:
+        return Analysis(True, "0", 0, 0)
+    tree = solver.greedy(members, offsets)
+    if tree is None:
+        return Analysis(False, None, None, None, states=solver.states)
+    total = tree.total_moves()
+    plan = tree.all_moves()
+    steps: int | None = None
+    if optimal:
+        found, better = solver.optimal(members, offsets, total)
+        steps, plan = (found, better) if better is not None else (total, plan)
+    return Analysis(
+        disassemblable=True,
+        level=tree.level_text(),
+        moves=total,
+        optimal_steps=steps,
+        plan=tuple(plan),
+        tree=tree,
+        states=solver.states,
+        first_level=len(tree.moves),
+    )
+
+
+def can_disassemble(
+    shapes: Mapping[str, Shape],
+    *,
+    max_group: int | None = None,
+    limits: SearchLimits | None = None,
+) -> bool:
+    """Can the assembled puzzle be taken completely apart?"""
+    return analyze(shapes, max_group=max_group, limits=limits, optimal=False).disassemblable
+
+
+# -------------------------------------------------------------------------------------------
+# Per-state helpers (for environments and for the conformance tests against the reference)
+# -------------------------------------------------------------------------------------------
+
+
+def fast_legal_moves(
+    state: Assembly, max_group: int | None = None, group_limit: int = 4096
+) -> list[Move]:
+    """Every legal move of ``state``, as :func:`chaingeo.kinematics.legal_moves` lists them,
+    computed by the numba movement analysis."""
+    table = PieceTable(state.shapes)
+    names = table.names
+    moves: list[Move] = []
+    for part in state.parts:
+        if len(part) < 2:
+            continue
+        members = tuple(table.index(p) for p in sorted(part))
+        vox, starts, lo, hi = table.part_arrays(members)
+        off = np.array([state.offsets[names[m]] for m in members], dtype=np.int64)
+        n = len(members)
+        gaps = np.empty((3, n, n), dtype=np.int64)
+        groups = np.zeros(group_limit + 1, dtype=np.uint64)
+        buf = np.zeros((1024, 4), dtype=np.int64)
+        while True:
+            rows = mv.node_moves(
+                vox, starts, lo, hi, off, -1 if max_group is None else max_group,
+                group_limit, True, gaps, groups, buf,
+            )  # fmt: skip
+            if rows != -1:
+                break
+            buf = np.zeros((2 * buf.shape[0], 4), dtype=np.int64)
+        if rows == -2:
+            raise SearchLimitError(f"more than {group_limit} movable groups along one direction")
+        dirs = list(DIRECTIONS)
+        for mask, d, kmax, removable in buf[:rows].tolist():
+            pieces = tuple(names[members[i]] for i in range(n) if mask >> i & 1)
+            moves.extend(Move(pieces, dirs[d], k) for k in range(1, kmax + 1))
+            if removable:
+                moves.append(Move(pieces, dirs[d], None))
+    return sorted(moves, key=lambda m: (m.pieces, m.direction, m.distance is None, m.distance or 0))

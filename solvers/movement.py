@@ -1,0 +1,392 @@
+"""Movement analysis on flat integer arrays (numba): who blocks whom, which groups move, how far.
+
+Cutler's / BurrTools' method: for each axis ``a`` and each ordered pair of pieces ``(i, j)`` the
+gap ``g[a, i, j]`` is how far ``i`` can travel along ``+a`` while ``j`` stays put (``INF``: never
+meets it). A group ``G`` can travel ``min g[a, i, j]`` over ``i in G, j not in G``, so every
+legal move follows from these matrices: the groups that can step at all are the sets closed
+under "is blocked by" (``g == 0``), enumerated here one by one without trying every subset.
+Moving ``G`` along ``+a`` and moving the rest along ``-a`` give the same relative state.
+
+Pieces are the voxels of one *part* (a sub-puzzle) in their assembled position; a state is one
+``int16`` row of ``3 n`` offsets, piece 0 always at the origin. Directions are indexed as in
+:data:`chaingeo.kinematics.DIRECTIONS`: ``2 a`` is ``+a`` and ``2 a + 1`` is ``-a``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+
+I64 = npt.NDArray[np.int64]
+I16 = npt.NDArray[np.int16]
+U64 = npt.NDArray[np.uint64]
+
+#: "Never meets": larger than any real gap.
+INF = 1 << 40
+#: Status codes returned by :func:`expand`.
+DONE, NEED_STATES, NEED_SEPS, TOO_MANY_GROUPS, NEED_MOVES = 0, 1, 2, 3, 4
+#: Most pieces one part may hold (groups are 64-bit masks).
+MAX_PIECES = 63
+
+
+@njit(cache=True)
+def pair_gaps(vox: I64, starts: I64, lo: I64, hi: I64, off: I64, out: I64) -> None:
+    """Fill ``out[a, i, j]``: how far piece ``i`` can move along ``+a`` with ``j`` fixed.
+
+    ``vox[a]`` holds every piece's voxels sorted by (the two other axes, then ``a``), piece
+    ``p`` in rows ``starts[p]:starts[p + 1]``; ``lo``/``hi`` are bounding boxes, ``off`` the
+    offsets. One merge per pair and axis finds the nearest voxel of the other piece ahead.
+    """
+    n = starts.shape[0] - 1
+    for a in range(3):
+        u = (a + 1) % 3
+        v = (a + 2) % 3
+        for i in range(n):
+            out[a, i, i] = INF
+        for i in range(n):
+            for j in range(i + 1, n):
+                ru = off[j, u] - off[i, u]
+                rv = off[j, v] - off[i, v]
+                ra = off[j, a] - off[i, a]
+                gij = INF
+                gji = INF
+                if not (
+                    lo[j, u] + ru > hi[i, u]
+                    or hi[j, u] + ru < lo[i, u]
+                    or lo[j, v] + rv > hi[i, v]
+                    or hi[j, v] + rv < lo[i, v]
+                ):
+                    p = starts[i]
+                    pe = starts[i + 1]
+                    q = starts[j]
+                    qe = starts[j + 1]
+                    while p < pe and q < qe:
+                        iu = vox[a, p, u]
+                        iv = vox[a, p, v]
+                        ju = vox[a, q, u] + ru
+                        jv = vox[a, q, v] + rv
+                        if iu < ju or (iu == ju and iv < jv):
+                            p += 1
+                            continue
+                        if iu > ju or (iu == ju and iv > jv):
+                            q += 1
+                            continue
+                        # The same line: walk both runs in order; an i-voxel followed by a
+                        # j-voxel is a gap for i moving +a, and the other way round for j.
+                        last_owner = -1
+                        last_val = 0
+                        while True:
+                            p_in = p < pe and vox[a, p, u] == iu and vox[a, p, v] == iv
+                            q_in = q < qe and vox[a, q, u] + ru == iu and vox[a, q, v] + rv == iv
+                            if not p_in and not q_in:
+                                break
+                            if p_in and (not q_in or vox[a, p, a] < vox[a, q, a] + ra):
+                                val = vox[a, p, a]
+                                owner = 0
+                                p += 1
+                            else:
+                                val = vox[a, q, a] + ra
+                                owner = 1
+                                q += 1
+                            if last_owner == 0 and owner == 1:
+                                gij = min(gij, val - last_val - 1)
+                            elif last_owner == 1 and owner == 0:
+                                gji = min(gji, val - last_val - 1)
+                            last_owner = owner
+                            last_val = val
+                out[a, i, j] = gij
+                out[a, j, i] = gji
+
+
+@njit(cache=True)
+def closures(gaps: I64, a: int, n: int) -> U64:
+    """``c[i]``: the pieces that must come along when ``i`` steps along ``+a`` (with ``i``)."""
+    c = np.zeros(n, dtype=np.uint64)
+    for i in range(n):
+        m = np.uint64(1) << np.uint64(i)
+        for j in range(n):
+            if j != i and gaps[a, i, j] == 0:
+                m |= np.uint64(1) << np.uint64(j)
+        c[i] = m
+    for k in range(n):  # Warshall on bit rows
+        bk = np.uint64(1) << np.uint64(k)
+        for i in range(n):
+            if c[i] & bk:
+                c[i] |= c[k]
+    return c
+
+
+@njit(cache=True)
+def closed_groups(c: U64, n: int, limit: int, out: U64) -> int:
+    """Write every proper, non-empty set closed under ``c`` into ``out``; return the count, or
+    -1 if there are more than ``limit`` (or more than ``out`` holds).
+
+    Depth first over pieces in index order: piece ``i`` is in (forced if a chosen closure
+    holds it, allowed if its closure avoids every excluded piece) or out (if not forced), so
+    each closed set is produced exactly once.
+    """
+    full = (np.uint64(1) << np.uint64(n)) - np.uint64(1)
+    stack_i = np.empty(n + 2, dtype=np.int64)
+    stack_s = np.empty(n + 2, dtype=np.uint64)
+    stack_x = np.empty(n + 2, dtype=np.uint64)
+    stack_b = np.empty(n + 2, dtype=np.int64)  # 0: try "in" next, 1: try "out" next, 2: done
+    count = 0
+    top = 0
+    stack_i[0] = 0
+    stack_s[0] = np.uint64(0)
+    stack_x[0] = np.uint64(0)
+    stack_b[0] = 0
+    while top >= 0:
+        i = stack_i[top]
+        s = stack_s[top]
+        x = stack_x[top]
+        if i == n:
+            if s != np.uint64(0) and s != full:
+                if count >= limit or count >= out.shape[0]:
+                    return -1
+                out[count] = s
+                count += 1
+            top -= 1
+            continue
+        bit = np.uint64(1) << np.uint64(i)
+        b = stack_b[top]
+        if b == 0:
+            stack_b[top] = 1
+            if s & bit:  # forced in: only one branch
+                stack_b[top] = 2
+                top += 1
+                stack_i[top] = i + 1
+                stack_s[top] = s
+                stack_x[top] = x
+                stack_b[top] = 0
+            elif (c[i] & x) == np.uint64(0):
+                top += 1
+                stack_i[top] = i + 1
+                stack_s[top] = s | c[i]
+                stack_x[top] = x
+                stack_b[top] = 0
+        elif b == 1:
+            stack_b[top] = 2
+            top += 1
+            stack_i[top] = i + 1
+            stack_s[top] = s
+            stack_x[top] = x | bit
+            stack_b[top] = 0
+        else:
+            top -= 1
+    return count
+
+
+@njit(cache=True)
+def _popcount(m: np.uint64) -> int:
+    k = 0
+    while m:
+        m &= m - np.uint64(1)
+        k += 1
+    return k
+
+
+@njit(cache=True)
+def node_moves(
+    vox: I64,
+    starts: I64,
+    lo: I64,
+    hi: I64,
+    off: I64,
+    max_group: int,
+    group_limit: int,
+    both: bool,
+    gaps: I64,
+    groups: U64,
+    out: I64,
+) -> int:
+    """List the legal moves of one state into ``out`` rows ``(mask, dir, kmax, removable)``.
+
+    ``kmax`` is the longest finite move (``k = 1..kmax`` are all legal); ``removable`` = 1 when
+    the group can also leave for good. With ``both`` every move is listed (a group along ``+a``
+    and the rest along ``-a``); otherwise one of each such pair, the smaller group (ties: the
+    group moving along ``+a``), which reaches the same relative state. Returns the row count,
+    -1 if ``out`` is too small, -2 if some direction has more than ``group_limit`` groups.
+    """
+    n = starts.shape[0] - 1
+    full = (np.uint64(1) << np.uint64(n)) - np.uint64(1)
+    pair_gaps(vox, starts, lo, hi, off, gaps)
+    rows = 0
+    for a in range(3):
+        c = closures(gaps, a, n)
+        ng = closed_groups(c, n, group_limit, groups)
+        if ng < 0:
+            return -2
+        for gi in range(ng):
+            g = groups[gi]
+            rest = full & ~g
+            f = INF
+            gmin = INF
+            rmax = -INF
+            for i in range(n):
+                if g & (np.uint64(1) << np.uint64(i)):
+                    gmin = min(gmin, lo[i, a] + off[i, a])
+                    for j in range(n):
+                        if not (g & (np.uint64(1) << np.uint64(j))):
+                            f = min(f, gaps[a, i, j])
+                else:
+                    rmax = max(rmax, hi[i, a] + off[i, a])
+            removable = 1 if f >= INF else 0
+            kmax = rmax - gmin if removable else f  # clearance - 1 when it can leave
+            if kmax < 0:
+                kmax = 0
+            size_g = _popcount(g)
+            ok_g = max_group < 0 or size_g <= max_group
+            ok_r = max_group < 0 or n - size_g <= max_group
+            for side in range(2):
+                if side == 0:
+                    if not ok_g:
+                        continue
+                    if not both and ok_r and n - size_g < size_g:
+                        continue
+                    mask = g
+                    d = 2 * a
+                else:
+                    if not ok_r:
+                        continue
+                    if not both and ok_g and size_g <= n - size_g:
+                        continue
+                    mask = rest
+                    d = 2 * a + 1
+                if kmax == 0 and removable == 0:
+                    continue
+                if rows >= out.shape[0]:
+                    return -1
+                out[rows, 0] = np.int64(mask)
+                out[rows, 1] = d
+                out[rows, 2] = kmax
+                out[rows, 3] = removable
+                rows += 1
+    return rows
+
+
+@njit(cache=True)
+def hash_row(row: I16) -> np.uint64:
+    h = np.uint64(14695981039346656037)
+    for v in row:
+        h ^= np.uint64(np.int64(v) & 0xFFFF)
+        h *= np.uint64(1099511628211)
+    return h
+
+
+@njit(cache=True)
+def find_or_insert(states: I16, n_states: int, table: I64, row: I16) -> int:
+    """Index of ``row`` in ``states`` (via the open-addressing ``table``); if absent, store it
+    at ``n_states`` and return ``-1 - n_states``."""
+    mask = np.uint64(table.shape[0] - 1)
+    h = hash_row(row) & mask
+    w = row.shape[0]
+    while True:
+        idx = int(table[h])
+        if idx < 0:
+            table[h] = n_states
+            for t in range(w):
+                states[n_states, t] = row[t]
+            return -1 - n_states
+        same = True
+        for t in range(w):
+            if states[idx, t] != row[t]:
+                same = False
+                break
+        if same:
+            return idx
+        h = (h + np.uint64(1)) & mask
+
+
+@njit(cache=True)
+def rebuild_table(states: I16, n_states: int, table: I64) -> None:
+    table[:] = -1
+    mask = np.uint64(table.shape[0] - 1)
+    for s in range(n_states):
+        h = hash_row(states[s]) & mask
+        while table[h] >= 0:
+            h = (h + np.uint64(1)) & mask
+        table[h] = s
+
+
+@njit(cache=True)
+def expand(
+    states: I16,
+    n_states: int,
+    parent: I64,
+    move: I64,
+    table: I64,
+    node_start: int,
+    node_end: int,
+    vox: I64,
+    starts: I64,
+    lo: I64,
+    hi: I64,
+    max_group: int,
+    group_limit: int,
+    seps: I64,
+    n_seps: int,
+    moves_buf: I64,
+    groups_buf: U64,
+) -> tuple[int, int, int, int]:
+    """Expand nodes ``node_start..node_end-1`` of a breadth-first search.
+
+    New states are appended with their parent and the move that made them (``move`` rows:
+    mask, direction, distance); every removal seen is appended to ``seps`` as
+    ``(node, mask, direction)``. Returns ``(status, next node, n_states, n_seps)``; on a
+    status other than DONE the caller grows the named buffer and calls again from ``next``
+    (a node is expanded again from scratch, so its removals are dropped first).
+    """
+    n = starts.shape[0] - 1
+    w = 3 * n
+    gaps = np.empty((3, n, n), dtype=np.int64)
+    off = np.empty((n, 3), dtype=np.int64)
+    child = np.empty(w, dtype=np.int16)
+    while n_seps > 0 and seps[n_seps - 1, 0] >= node_start:
+        n_seps -= 1
+    for node in range(node_start, node_end):
+        for p in range(n):
+            for t in range(3):
+                off[p, t] = states[node, 3 * p + t]
+        rows = node_moves(
+            vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
+        )
+        if rows == -2:
+            return TOO_MANY_GROUPS, node, n_states, n_seps
+        if rows == -1:
+            return NEED_MOVES, node, n_states, n_seps
+        for r in range(rows):
+            mask = np.uint64(moves_buf[r, 0])
+            d = moves_buf[r, 1]
+            kmax = moves_buf[r, 2]
+            if moves_buf[r, 3]:
+                if n_seps >= seps.shape[0]:
+                    return NEED_SEPS, node, n_states, n_seps
+                seps[n_seps, 0] = node
+                seps[n_seps, 1] = np.int64(mask)
+                seps[n_seps, 2] = d
+                n_seps += 1
+            a = d // 2
+            sign = 1 if d % 2 == 0 else -1
+            anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
+            for k in range(1, kmax + 1):
+                if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
+                    return NEED_STATES, node, n_states, n_seps
+                for t in range(w):
+                    child[t] = states[node, t]
+                for p in range(n):
+                    inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
+                    if anchor_moves:  # keep piece 0 still: move everyone else back instead
+                        if not inside:
+                            child[3 * p + a] -= sign * k
+                    elif inside:
+                        child[3 * p + a] += sign * k
+                got = find_or_insert(states, n_states, table, child)
+                if got < 0:
+                    parent[n_states] = node
+                    move[n_states, 0] = np.int64(mask)
+                    move[n_states, 1] = d
+                    move[n_states, 2] = k
+                    n_states += 1
+    return DONE, node_end, n_states, n_seps

@@ -1,0 +1,285 @@
+"""Breadth-first search over the configurations of one part, with caps and a deadline.
+
+A *part* is a set of pieces still to be taken apart; its states are the pieces' offsets relative
+to its first piece. :class:`PartSearch` grows the search one depth layer at a time (numba does
+the expansion, :mod:`solvers.movement`), remembers each state's parent and the move that made
+it, and collects every removal (a move that splits the part) seen on the way.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from chaingeo.geometry import Shape
+from chaingeo.kinematics import DIRECTIONS, Move, SearchLimitError
+from solvers import movement as mv
+
+DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
+
+
+@dataclass(frozen=True)
+class SearchLimits:
+    """Caps that turn an endless search into a :class:`SearchLimitError` with a clear message.
+
+    ``max_states`` caps one part's breadth-first search; ``seconds`` the whole analysis;
+    ``group_limit`` the movable groups per direction in one state; ``max_total_states`` the
+    states of all searches of one analysis together (unlike time, the same on every machine).
+    """
+
+    max_states: int = 2_000_000
+    seconds: float | None = 120.0
+    group_limit: int = 4096
+    max_total_states: int | None = None  # over every search of one analysis (deterministic)
+
+
+class Deadline:
+    """The wall-clock budget shared by every search of one analysis."""
+
+    def __init__(self, seconds: float | None) -> None:
+        self.seconds = seconds
+        self.end = None if seconds is None else time.monotonic() + seconds
+
+    def check(self) -> None:
+        if self.end is not None and time.monotonic() > self.end:
+            raise SearchLimitError(
+                f"time limit of {self.seconds:g} s reached; pass a larger limit "
+                "(SearchLimits(seconds=...) or --seconds)"
+            )
+
+
+class PieceTable:
+    """Every piece's voxels (assembled position), pre-sorted per axis for the gap kernel."""
+
+    def __init__(self, shapes: Mapping[str, Shape]) -> None:
+        self.names: tuple[str, ...] = tuple(sorted(shapes))
+        if not self.names:
+            raise ValueError("a puzzle needs at least one piece")
+        self.voxels = [np.ascontiguousarray(shapes[n].voxels, dtype=np.int64) for n in self.names]
+        if any(len(v) == 0 for v in self.voxels):
+            raise ValueError("every piece needs at least one voxel")
+        self.sorted_axes: list[list[np.ndarray]] = []
+        for v in self.voxels:
+            per_axis = []
+            for a in range(3):
+                u, w = (a + 1) % 3, (a + 2) % 3
+                per_axis.append(v[np.lexsort((v[:, a], v[:, w], v[:, u]))])
+            self.sorted_axes.append(per_axis)
+        self.lo = np.array([v.min(axis=0) for v in self.voxels], dtype=np.int64)
+        self.hi = np.array([v.max(axis=0) for v in self.voxels], dtype=np.int64)
+        # Relative offsets stay within the sum of the extents plus the assembled span.
+        bound = int((self.hi - self.lo + 1).sum(axis=0).max()) + int(
+            (self.hi.max(axis=0) - self.lo.min(axis=0)).max()
+        )
+        if bound > 30000:
+            raise ValueError(f"puzzle too large for 16-bit offsets (bound {bound})")
+
+    def index(self, name: str) -> int:
+        return self.names.index(name)
+
+    def part_arrays(
+        self, members: Sequence[int]
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """``(vox, starts, lo, hi)`` for the pieces ``members`` (global indices), in order."""
+        sizes = [len(self.voxels[m]) for m in members]
+        starts = np.zeros(len(members) + 1, dtype=np.int64)
+        starts[1:] = np.cumsum(sizes)
+        vox = np.empty((3, int(starts[-1]), 3), dtype=np.int64)
+        for a in range(3):
+            vox[a] = np.concatenate([self.sorted_axes[m][a] for m in members])
+        return vox, starts, self.lo[list(members)].copy(), self.hi[list(members)].copy()
+
+
+@dataclass(frozen=True)
+class Removal:
+    """A removal seen while expanding ``node`` at ``depth``: ``mask`` (local bits) leaves along
+    ``direction``."""
+
+    node: int
+    depth: int
+    mask: int
+    direction: int
+
+
+@dataclass(frozen=True)
+class Split:
+    """A removal and the two parts it leaves: members (global indices) and their offsets."""
+
+    removal: Removal
+    removed: tuple[int, ...]
+    removed_offsets: np.ndarray
+    left: tuple[int, ...]
+    left_offsets: np.ndarray
+
+
+class PartSearch:
+    """Layered breadth-first search of one part from one configuration."""
+
+    def __init__(
+        self,
+        table: PieceTable,
+        members: Sequence[int],
+        offsets: np.ndarray,
+        *,
+        max_group: int | None,
+        limits: SearchLimits,
+        deadline: Deadline,
+        chunk: int = 20000,
+    ) -> None:
+        n = len(members)
+        if n < 2:
+            raise ValueError("a part to search needs at least two pieces")
+        if n > mv.MAX_PIECES:
+            raise ValueError(f"at most {mv.MAX_PIECES} pieces per part, got {n}")
+        self.table = table
+        self.members = tuple(members)
+        self.n = n
+        self.max_group = -1 if max_group is None else int(max_group)
+        self.limits = limits
+        self.deadline = deadline
+        self.chunk = chunk
+        self.vox, self.starts, self.lo, self.hi = table.part_arrays(self.members)
+        cap = max(2, min(1024, limits.max_states))
+        self.states = np.zeros((cap, 3 * n), dtype=np.int16)
+        self.parent = np.full(cap, -1, dtype=np.int64)
+        self.move = np.zeros((cap, 3), dtype=np.int64)
+        self.hash = np.full(1 << (4 * cap - 1).bit_length(), -1, dtype=np.int64)
+        self.seps = np.zeros((256, 3), dtype=np.int64)
+        self.moves_buf = np.zeros((256, 4), dtype=np.int64)
+        self.groups_buf = np.zeros(min(limits.group_limit, 1 << 16) + 1, dtype=np.uint64)
+        start = np.asarray(offsets, dtype=np.int64).reshape(n, 3)
+        start = start - start[0]
+        row = start.reshape(-1).astype(np.int16)
+        mv.find_or_insert(self.states, 0, self.hash, row)
+        self.n_states = 1
+        self.n_seps = 0
+        self.layers: list[int] = [0, 1]  # layer d holds nodes layers[d]:layers[d+1]
+
+    @property
+    def depth(self) -> int:
+        """Depth of the deepest layer found so far."""
+        return len(self.layers) - 2
+
+    def offsets_of(self, node: int) -> np.ndarray:
+        out: np.ndarray = self.states[node].astype(np.int64).reshape(self.n, 3)
+        return out
+
+    def _grow_states(self) -> None:
+        need = self.n_states + 1
+        cap = self.states.shape[0]
+        if need >= cap:
+            if cap >= self.limits.max_states:
+                raise SearchLimitError(
+                    f"state cap of {self.limits.max_states} reached in a {self.n}-piece part; "
+                    "raise SearchLimits(max_states=...) or --max-states"
+                )
+            new_cap = min(2 * cap, self.limits.max_states)
+            self.states = np.concatenate([self.states, np.zeros_like(self.states)])[:new_cap]
+            self.parent = np.concatenate([self.parent, np.full(cap, -1, dtype=np.int64)])[:new_cap]
+            self.move = np.concatenate([self.move, np.zeros_like(self.move)])[:new_cap]
+        if self.hash.shape[0] < 4 * self.states.shape[0]:
+            size = 1 << (4 * self.states.shape[0] - 1).bit_length()  # a power of two
+            self.hash = np.full(size, -1, dtype=np.int64)
+            mv.rebuild_table(self.states, self.n_states, self.hash)
+
+    def expand_layer(self) -> list[Removal]:
+        """Expand the deepest layer; return the removals found there (in search order)."""
+        d = self.depth
+        lo, hi = self.layers[d], self.layers[d + 1]
+        first_sep = self.n_seps
+        node = lo
+        while node < hi:
+            self.deadline.check()
+            end = min(hi, node + self.chunk)
+            status, node, self.n_states, self.n_seps = mv.expand(
+                self.states,
+                self.n_states,
+                self.parent,
+                self.move,
+                self.hash,
+                node,
+                end,
+                self.vox,
+                self.starts,
+                self.lo,
+                self.hi,
+                self.max_group,
+                self.limits.group_limit,
+                self.seps,
+                self.n_seps,
+                self.moves_buf,
+                self.groups_buf,
+            )
+            if status == mv.NEED_STATES:
+                self._grow_states()
+            elif status == mv.NEED_MOVES:
+                self.moves_buf = np.zeros((2 * self.moves_buf.shape[0], 4), dtype=np.int64)
+            elif status == mv.NEED_SEPS:
+                self.seps = np.concatenate([self.seps, np.zeros_like(self.seps)])
+            elif status == mv.TOO_MANY_GROUPS:
+                raise SearchLimitError(
+                    f"more than {self.limits.group_limit} movable groups along one direction "
+                    "in one state; raise SearchLimits(group_limit=...)"
+                )
+        self.layers.append(self.n_states)
+        return [
+            Removal(int(s[0]), d, int(s[1]), int(s[2])) for s in self.seps[first_sep : self.n_seps]
+        ]
+
+    @property
+    def exhausted(self) -> bool:
+        """True when the deepest layer is empty: every reachable state has been expanded."""
+        return self.layers[-1] == self.layers[-2]
+
+    def local_move(self, mask: int, direction: int, distance: int | None) -> Move:
+        names = self.table.names
+        pieces = tuple(names[self.members[i]] for i in range(self.n) if mask >> i & 1)
+        return Move(pieces, DIRECTION_NAMES[direction], distance)
+
+    def path_to(self, node: int) -> list[Move]:
+        """The moves from the start state to ``node`` (shortest, as found)."""
+        out: list[Move] = []
+        while node > 0:
+            m = self.move[node]
+            out.append(self.local_move(int(m[0]), int(m[1]), int(m[2])))
+            node = int(self.parent[node])
+        return out[::-1]
+
+    def unique_splits(self, removals: Sequence[Removal]) -> list[Split]:
+        """The removals that lead to different sub-problems (which pieces go, and the
+        configurations of both sides), first occurrence kept, in the given order."""
+        if not removals:
+            return []
+        n = self.n
+        full = (1 << n) - 1
+        nodes = np.array([r.node for r in removals], dtype=np.int64)
+        canon = np.array([min(r.mask, full ^ r.mask) for r in removals], dtype=np.int64)
+        keep: list[int] = []
+        for c in dict.fromkeys(canon.tolist()):
+            idx = np.nonzero(canon == c)[0]
+            inside = [i for i in range(n) if c >> i & 1]
+            outside = [i for i in range(n) if not c >> i & 1]
+            offs = self.states[nodes[idx]].astype(np.int64).reshape(len(idx), n, 3)
+            a = offs[:, inside] - offs[:, inside[:1]]
+            b = offs[:, outside] - offs[:, outside[:1]]
+            rows = np.concatenate([a.reshape(len(idx), -1), b.reshape(len(idx), -1)], axis=1)
+            _, first = np.unique(rows, axis=0, return_index=True)
+            keep.extend(int(idx[j]) for j in first)
+        return [Split(removals[i], *self.split(removals[i])) for i in sorted(keep)]
+
+    def split(
+        self, removal: Removal
+    ) -> tuple[tuple[int, ...], np.ndarray, tuple[int, ...], np.ndarray]:
+        """``(removed members, their offsets, left members, their offsets)`` at the removal."""
+        off = self.offsets_of(removal.node)
+        inside = [i for i in range(self.n) if removal.mask >> i & 1]
+        outside = [i for i in range(self.n) if not removal.mask >> i & 1]
+        return (
+            tuple(self.members[i] for i in inside),
+            off[inside],
+            tuple(self.members[i] for i in outside),
+            off[outside],
+        )

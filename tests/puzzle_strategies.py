@@ -1,0 +1,39 @@
+"""Hypothesis strategies for small interlocking scenes (random partitions of a small box)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import strategies as st
+
+from chaingeo.geometry import NEIGHBOURS, Shape
+
+
+def random_partition(dims: tuple[int, int, int], k: int, seed: int) -> dict[str, Shape]:
+    """Split the box into ``k`` face-connected pieces grown from random seeds."""
+    rng = np.random.default_rng(seed)
+    cells = [(x, y, z) for x in range(dims[0]) for y in range(dims[1]) for z in range(dims[2])]
+    order = rng.permutation(len(cells))
+    owner: dict[tuple[int, int, int], int] = {}
+    for i in range(k):
+        owner[cells[int(order[i])]] = i
+    while len(owner) < len(cells):
+        frontier = sorted(
+            (c, owner[o])
+            for o in owner
+            for d in NEIGHBOURS
+            if (c := (o[0] + d[0], o[1] + d[1], o[2] + d[2])) in set(cells) and c not in owner
+        )
+        c, who = frontier[int(rng.integers(len(frontier)))]
+        owner.setdefault(c, who)
+    pieces: dict[int, list[tuple[int, int, int]]] = {}
+    for c, who in sorted(owner.items()):
+        pieces.setdefault(who, []).append(c)
+    names = ["red", "green", "blue", "yellow", "orange", "purple"]
+    return {names[i]: Shape(v) for i, v in sorted(pieces.items())}
+
+
+@st.composite
+def small_scenes(draw: st.DrawFn, max_pieces: int = 4) -> dict[str, Shape]:
+    dims = (draw(st.integers(2, 3)), draw(st.integers(2, 3)), draw(st.integers(1, 2)))
+    k = draw(st.integers(2, min(max_pieces, dims[0] * dims[1] * dims[2])))
+    return random_partition(dims, k, draw(st.integers(0, 2**32 - 1)))

@@ -1,0 +1,39 @@
+"""The assembler (exact-cover engine) plus the disassembler: BurrTools' 'assemblies' and
+'solutions', checked against the figures of BurrTools' own example file."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from chaingeo.cli import main
+from chaingeo.geometry import Shape
+from solvers.assemble import PieceCount, count_solutions, iter_assemblies
+from tests.test_burrtools import BT, needs_files
+
+
+def test_small_assemblies_and_solutions() -> None:
+    # Two L-trominoes and a domino fill a 2x2x2 cube in many ways; all of them come apart.
+    ell = Shape([(0, 0, 0), (1, 0, 0), (0, 1, 0)])
+    pieces = [PieceCount("ell", ell, 2, 2), PieceCount("bar", Shape([(0, 0, 0), (1, 0, 0)]))]
+    target = Shape([(x, y, z) for x in range(2) for y in range(2) for z in range(2)])
+    asms = list(iter_assemblies(pieces, target))
+    assert asms and all(sorted(a) == ["bar", "ell", "ell_2"] for a in asms)
+    for a in asms:
+        cells = [c for s in a.values() for c in s.cells]
+        assert sorted(cells) == sorted(target.cells)
+    report = count_solutions(pieces, target)
+    assert report.assemblies == len(asms) and report.solutions == len(asms)
+
+
+@needs_files
+def test_solid_six_piece_burrs_1063_assemblies_314_solutions(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Cutler's 314 solid six-piece burrs: BurrTools reports 1063 assemblies, 314 solutions."""
+    assert BT is not None
+    assert main(["analyze", str(BT / "SolidSixPieceBurrs.xmpuzzle"), "--no-optimal"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["assemblies"] == 1063 and out["solutions"] == 314
+    assert out["level"] == "1"

@@ -1,0 +1,138 @@
+"""The numba disassembly search agrees with the reference kinematics (the specification)."""
+
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from chaingeo.geometry import Shape
+from chaingeo.kinematics import (
+    Assembly,
+    Move,
+    SearchLimitError,
+    legal_moves,
+    reference_optimal_disassembly,
+    replay_disassembly,
+    state_key,
+)
+from solvers.disassemble import Separation, analyze, fast_legal_moves
+from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
+from tests.puzzle_strategies import small_scenes
+
+SCENE = {
+    "red": Shape([(0, 0, 0), (1, 0, 0), (2, 0, 0)]),
+    "blue": Shape([(0, 1, 0), (1, 1, 0), (2, 1, 0), (3, 1, 0), (3, 0, 0)]),
+    "green": Shape([(0, 0, 1), (1, 0, 1), (2, 0, 1), (3, 0, 1)]),
+}
+
+
+def random_walk(shapes: dict[str, Shape], seed: int, steps: int) -> Assembly:
+    """A state reached by random legal moves of the reference (removals included)."""
+    rng = random.Random(seed)
+    state = Assembly.assembled(shapes)
+    for _ in range(steps):
+        moves = legal_moves(state)
+        if not moves:
+            break
+        state = state.apply(rng.choice(moves))
+    return state
+
+
+def test_scene_moves_match_reference() -> None:
+    a = Assembly.assembled(SCENE)
+    assert fast_legal_moves(a) == legal_moves(a)
+    assert fast_legal_moves(a, max_group=1) == legal_moves(a, max_group=1)
+
+
+@settings(max_examples=60)
+@given(small_scenes(), st.integers(0, 10**6), st.integers(0, 6), st.sampled_from([None, 1, 2]))
+def test_legal_moves_match_reference(
+    shapes: dict[str, Shape], seed: int, steps: int, max_group: int | None
+) -> None:
+    state = random_walk(shapes, seed, steps)
+    assert fast_legal_moves(state, max_group) == legal_moves(state, max_group)
+
+
+@settings(max_examples=40)
+@given(small_scenes(), st.integers(0, 10**6), st.integers(0, 4))
+def test_successor_states_match_reference(shapes: dict[str, Shape], seed: int, steps: int) -> None:
+    """One expansion of the numba search yields exactly the reference's successor states."""
+    state = random_walk(shapes, seed, steps)
+    part = max(state.parts, key=lambda p: (len(p), sorted(p)))
+    if len(part) < 2:
+        return
+    sub = Assembly({n: state.shapes[n] for n in part}, {n: state.offsets[n] for n in part},
+                   (part,))  # fmt: skip
+    table = PieceTable(sub.shapes)
+    members = tuple(range(len(table.names)))
+    offsets = np.array([sub.offsets[n] for n in table.names])
+    search = PartSearch(table, members, offsets, max_group=None, limits=SearchLimits(),
+                        deadline=Deadline(None))  # fmt: skip
+    removals = search.expand_layer()
+    fast_children = set()
+    for node in range(1, search.n_states):
+        rel = search.offsets_of(node)
+        fast_children.add(tuple(tuple(int(v) for v in row) for row in rel))
+    ref_children = set()
+    ref_splits = set()
+    start = state_key(sub)
+    for m in legal_moves(sub):
+        child = sub.apply(m)
+        if len(child.parts) > 1:
+            ref_splits.add(frozenset(frozenset(p) for p in child.parts))
+            continue
+        ((_, rel),) = state_key(child)
+        if state_key(child) != start:
+            ref_children.add(rel)
+    assert fast_children == ref_children
+    fast_splits = set()
+    for r in removals:
+        rm, _, lm, _ = search.split(r)
+        fast_splits.add(
+            frozenset(
+                [frozenset(table.names[i] for i in rm), frozenset(table.names[i] for i in lm)]
+            )
+        )
+    assert fast_splits == ref_splits
+
+
+@settings(max_examples=40)
+@given(small_scenes(max_pieces=4), st.sampled_from([None, 1]))
+def test_optimal_steps_match_reference_bfs(shapes: dict[str, Shape], max_group: int | None) -> None:
+    ref = reference_optimal_disassembly(shapes, max_group)
+    got = analyze(shapes, max_group=max_group)
+    if ref is None:
+        assert not got.disassemblable and got.optimal_steps is None
+        return
+    assert got.disassemblable
+    assert got.optimal_steps == len(ref)
+    assert replay_disassembly(shapes, got.plan).is_separated()
+    assert got.moves is not None and got.moves >= len(ref)
+    assert got.tree is not None and replay_disassembly(shapes, got.tree.all_moves()).is_separated()
+    if max_group is not None:
+        assert all(len(m.pieces) <= max_group for m in got.plan)
+
+
+def test_level_notation_follows_burrtools() -> None:
+    m = Move(("red",), "+x", None)
+    one = Separation((m,))
+    three = Separation((m, m, m))
+    tree = Separation((m,) * 4, removed=one, left=Separation((m,) * 9, left=three, removed=one))
+    assert tree.level_text() == "4.9.3"
+    assert tree.total_moves() == 4 + 1 + 9 + 3 + 1
+    assert Separation((m,), left=one, removed=one).level_text() == "1"
+
+
+def test_limits_raise_clear_errors() -> None:
+    shapes = {
+        "red": Shape([(0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0)]),
+        "blue": Shape([(0, 1, 0)]),
+    }
+    with pytest.raises(SearchLimitError, match="time limit"):
+        analyze(shapes, limits=SearchLimits(seconds=0.0))
+    with pytest.raises(SearchLimitError, match="state cap"):
+        analyze(SCENE | {"yellow": Shape([(5, 5, 5)])}, limits=SearchLimits(max_states=4))

@@ -1,0 +1,69 @@
+"""The shipped puzzle suite: the split, goals, unique puzzles, and exact optimal plans."""
+
+from __future__ import annotations
+
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+from chaingeo.kinematics import disassembly_of_assembly_plan, replay_disassembly
+from chaingeo.level import Level, PuzzleSolution, level_bytes, load_levels
+from chaingeo.rules import PuzzleRules
+from generator.puzzle import difficulty_of
+from solvers.disassemble import analyze
+from solvers.partsearch import SearchLimits
+
+SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
+LEVELS = load_levels(SUITE) if any(SUITE.glob("*.json")) else []
+SMALL = [lv for lv in LEVELS if len(lv.pieces) <= 8]
+LARGE = [lv for lv in LEVELS if len(lv.pieces) > 8]
+
+
+def test_the_split_and_the_goals() -> None:
+    assert len(LEVELS) == 32
+    assert Counter(lv.difficulty for lv in LEVELS) == {"easy": 10, "mid": 12, "hard": 10}
+    assert {lv.goal for lv in LEVELS} == {"disassemble", "assemble"}
+    assert len({lv.provenance.signature for lv in LEVELS}) == 32
+    shapes = {str(lv.stats["shape"]) for lv in LEVELS}
+    assert {"burr6", "burr12", "cube3", "cube4"} <= shapes
+    assert max(len(lv.pieces) for lv in LEVELS) >= 12
+
+
+@pytest.mark.parametrize("level", LEVELS, ids=lambda lv: lv.id)
+def test_stored_plan_replays_and_matches_the_stats(level: Level) -> None:
+    assert isinstance(level.solution, PuzzleSolution)
+    moves = list(level.solution.moves)
+    plan = moves if level.goal == "disassemble" else disassembly_of_assembly_plan(moves)
+    assert replay_disassembly(level.shapes, plan).is_separated()
+    assert len(moves) == level.optimal_steps
+    first = int(level.stats["first_level"])
+    assert level.difficulty == difficulty_of(first, level.optimal_steps, len(level.pieces))
+
+
+def _recheck(level: Level) -> None:
+    mg = level.rules.max_group if isinstance(level.rules, PuzzleRules) else None
+    limits = SearchLimits(seconds=None, max_total_states=5_000_000)
+    result = analyze(level.shapes, max_group=mg, limits=limits)
+    assert result.optimal_steps == level.optimal_steps
+    assert result.level == level.stats["level"] and result.moves == level.stats["moves"]
+
+
+@pytest.mark.parametrize("level", SMALL, ids=lambda lv: lv.id)
+def test_optimal_steps_are_optimal(level: Level) -> None:
+    _recheck(level)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("level", LARGE, ids=lambda lv: lv.id)
+def test_optimal_steps_are_optimal_large(level: Level) -> None:
+    _recheck(level)
+
+
+@pytest.mark.slow
+def test_suite_rebuilds_byte_for_byte(tmp_path: Path) -> None:
+    from generator.puzzle_suite import build_puzzle_suite
+
+    build_puzzle_suite(tmp_path)
+    for lv in LEVELS:
+        assert (tmp_path / f"{lv.id}.json").read_bytes() == level_bytes(lv)
