@@ -140,9 +140,7 @@ def test_limits_raise_clear_errors() -> None:
 
 @settings(max_examples=40)
 @given(small_scenes(), st.integers(0, 10**6), st.integers(0, 4))
-def test_movement_matrix_matches_reference(
-    shapes: dict[str, Shape], seed: int, steps: int
-) -> None:
+def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, steps: int) -> None:
     """Cutler's pairwise matrix from the numba kernel equals the reference blocking_matrix."""
     from chaingeo.kinematics import DIRECTIONS, blocking_matrix
     from solvers import movement
