@@ -5,8 +5,9 @@ on the spot with the highest level the generator reaches from fixed seeds (goal:
 the level actually reached is printed). For each instance, ``ours`` is the full analysis
 (BurrTools-style level and the exact optimal plan) and ``states_per_s`` the states it visited
 per second; ``reference`` is a breadth-first search with the pure-Python reference kinematics
-(:mod:`chaingeo.kinematics`) on the same puzzle, stopped after expanding ``CHAIN_BENCH_REF_STATES``
-states (default 2000) or 5 seconds, giving its states per second. ``speedup`` is the ratio of the two rates.
+(:mod:`chaingeo.kinematics`) on the same puzzle, stopped after expanding
+``CHAIN_BENCH_REF_STATES`` states (default 2000) or 5 seconds, giving its states per second.
+``speedup`` is the ratio of the two rates.
 JIT compilation is excluded (a warm-up analysis runs first). ``--quick``: three suite levels and
 one small generated puzzle. Set ``CHAIN_BENCH_GENERATED=N`` for N generated puzzles (default 2).
 """
