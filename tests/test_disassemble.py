@@ -136,3 +136,29 @@ def test_limits_raise_clear_errors() -> None:
         analyze(shapes, limits=SearchLimits(seconds=0.0))
     with pytest.raises(SearchLimitError, match="state cap"):
         analyze(SCENE | {"yellow": Shape([(5, 5, 5)])}, limits=SearchLimits(max_states=4))
+
+
+@settings(max_examples=40)
+@given(small_scenes(), st.integers(0, 10**6), st.integers(0, 4))
+def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, steps: int) -> None:
+    """Cutler's pairwise matrix from the numba kernel equals the reference blocking_matrix."""
+    from chaingeo.kinematics import DIRECTIONS, blocking_matrix
+    from solvers import movement
+
+    state = random_walk(shapes, seed, steps)
+    table = PieceTable(state.shapes)
+    members = tuple(range(len(table.names)))
+    vox, starts, lo, hi = table.part_arrays(members)
+    off = np.array([state.offsets[n] for n in table.names], dtype=np.int64)
+    n = len(members)
+    gaps = np.empty((3, n, n), dtype=np.int64)
+    movement.pair_gaps(vox, starts, lo, hi, off, gaps)
+    for d, name in enumerate(DIRECTIONS):
+        ref = blocking_matrix(state, name)
+        axis, sign = d // 2, 1 if d % 2 == 0 else -1
+        for (a, b), free in ref.items():
+            if state.part_of(a) != state.part_of(b):
+                continue
+            i, j = table.index(a), table.index(b)
+            got = int(gaps[axis, i, j] if sign > 0 else gaps[axis, j, i])
+            assert (None if got >= movement.INF else got) == free

@@ -16,8 +16,6 @@ from solvers.partsearch import SearchLimits
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
 LEVELS = load_levels(SUITE) if any(SUITE.glob("*.json")) else []
-SMALL = [lv for lv in LEVELS if len(lv.pieces) <= 8]
-LARGE = [lv for lv in LEVELS if len(lv.pieces) > 8]
 
 
 def test_the_split_and_the_goals() -> None:
@@ -41,23 +39,14 @@ def test_stored_plan_replays_and_matches_the_stats(level: Level) -> None:
     assert level.difficulty == difficulty_of(first, level.optimal_steps, len(level.pieces))
 
 
-def _recheck(level: Level) -> None:
+@pytest.mark.parametrize("level", LEVELS, ids=lambda lv: lv.id)
+def test_optimal_steps_are_optimal(level: Level) -> None:
+    """Every level is small enough to search again in the default run (about 15 s in all)."""
     mg = level.rules.max_group if isinstance(level.rules, PuzzleRules) else None
     limits = SearchLimits(seconds=None, max_total_states=5_000_000)
     result = analyze(level.shapes, max_group=mg, limits=limits)
     assert result.optimal_steps == level.optimal_steps
     assert result.level == level.stats["level"] and result.moves == level.stats["moves"]
-
-
-@pytest.mark.parametrize("level", SMALL, ids=lambda lv: lv.id)
-def test_optimal_steps_are_optimal(level: Level) -> None:
-    _recheck(level)
-
-
-@pytest.mark.slow
-@pytest.mark.parametrize("level", LARGE, ids=lambda lv: lv.id)
-def test_optimal_steps_are_optimal_large(level: Level) -> None:
-    _recheck(level)
 
 
 @pytest.mark.slow

@@ -5,8 +5,9 @@ on the spot with the highest level the generator reaches from fixed seeds (goal:
 the level actually reached is printed). For each instance, ``ours`` is the full analysis
 (BurrTools-style level and the exact optimal plan) and ``states_per_s`` the states it visited
 per second; ``reference`` is a breadth-first search with the pure-Python reference kinematics
-(:mod:`chaingeo.kinematics`) on the same puzzle, stopped after ``CHAIN_BENCH_REF_STATES``
-states (default 2000), giving its states per second. ``speedup`` is the ratio of the two rates.
+(:mod:`chaingeo.kinematics`) on the same puzzle, stopped after expanding
+``CHAIN_BENCH_REF_STATES`` states (default 2000) or 5 seconds, giving its states per second.
+``speedup`` is the ratio of the two rates.
 JIT compilation is excluded (a warm-up analysis runs first). ``--quick``: three suite levels and
 one small generated puzzle. Set ``CHAIN_BENCH_GENERATED=N`` for N generated puzzles (default 2).
 """
@@ -24,7 +25,9 @@ from chaingeo.geometry import Shape
 from chaingeo.kinematics import Assembly, legal_moves, state_key
 
 
-def reference_rate(shapes: Mapping[str, Shape], max_states: int) -> tuple[int, float]:
+def reference_rate(
+    shapes: Mapping[str, Shape], max_states: int, max_seconds: float = 5.0
+) -> tuple[int, float]:
     """States found by the reference breadth-first search (it stops after expanding
     ``max_states``) and the seconds it took: the same unit as the states our search stores."""
     start = Assembly.assembled(shapes)
@@ -32,7 +35,7 @@ def reference_rate(shapes: Mapping[str, Shape], max_states: int) -> tuple[int, f
     frontier = [start]
     t0 = time.perf_counter()
     expanded = 0
-    while frontier and expanded < max_states:
+    while frontier and expanded < max_states and time.perf_counter() - t0 < max_seconds:
         nxt = []
         for state in frontier:
             expanded += 1
@@ -42,7 +45,7 @@ def reference_rate(shapes: Mapping[str, Shape], max_states: int) -> tuple[int, f
                 if k not in seen:
                     seen.add(k)
                     nxt.append(child)
-            if expanded >= max_states:
+            if expanded >= max_states or time.perf_counter() - t0 >= max_seconds:
                 break
         frontier = nxt
     return len(seen), time.perf_counter() - t0
