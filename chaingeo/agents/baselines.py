@@ -144,6 +144,9 @@ class GreedyAgent(_Seeded):
     def __init__(self, options: Mapping[str, Any]) -> None:
         super().__init__(options)
         self.lookahead = int(options.get("lookahead", 48))
+        # Assembly states can offer tens of thousands of insertions: look at a seeded sample of
+        # them, and skip the costly options-left tie-break, so an episode stays seconds long.
+        self.max_candidates = int(options.get("max_candidates", 512))
         self._seen: set[Hashable] = set()
 
     def start(self, level: Level, seed: int) -> None:
@@ -155,6 +158,11 @@ class GreedyAgent(_Seeded):
         actions = [a for a in state.legal_actions() if not _is_finish(a)]
         if not actions:
             return "finish"
+        lookahead = self.lookahead
+        if len(actions) > self.max_candidates:
+            keep = self._rng.choice(len(actions), size=self.max_candidates, replace=False)
+            actions = [actions[i] for i in sorted(int(k) for k in keep)]
+            lookahead = 0
         scored: list[tuple[int, int, float, Any, StateLike]] = []
         for a in actions:
             after = state.clone()
@@ -165,7 +173,9 @@ class GreedyAgent(_Seeded):
             scored.append((_progress(state, a, after), novel, float(self._rng.random()), a, after))
         scored.sort(key=lambda t: (t[0], t[1], t[2]), reverse=True)
         # Options left is the costly part: only for the best few by progress and novelty.
-        top = _best_prefix(scored, self.lookahead)
+        top = _best_prefix(scored, lookahead)
+        if lookahead == 0:
+            return str(top[0][3].to_text())
         best = max(top, key=lambda t: (t[0], t[1], _options_left(t[4]), t[2]))
         return str(best[3].to_text())
 
