@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import warnings
 
 import gymnasium
@@ -13,8 +12,6 @@ from gymnasium.utils.env_checker import check_env
 from chaingeo.actions import MoveAction, PlaceAction
 from chaingeo.gym import CHARSET, PuzzleEnv, StackingEnv
 from tests.env_levels import drop_level, puzzle_levels, soma_level, tiny_level
-
-HAVE_RENDER = importlib.util.find_spec("chaingeo.render") is not None
 
 
 def stacking_env(**kw: object) -> StackingEnv:
@@ -34,7 +31,6 @@ def test_check_env_passes(make: object) -> None:
         check_env(env, skip_render_check=True)
 
 
-@pytest.mark.skipif(not HAVE_RENDER, reason="chaingeo.render not merged yet")
 @pytest.mark.parametrize("env_id", ["chaingeo/Stacking-v0", "chaingeo/Puzzle-v0"])
 def test_check_env_with_images_through_make(env_id: str) -> None:
     levels = [tiny_level()] if "Stacking" in env_id else [puzzle_levels()[0], puzzle_levels()[1]]

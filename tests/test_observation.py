@@ -2,17 +2,11 @@
 
 from __future__ import annotations
 
-import importlib.util
-
-import pytest
-
 from chaingeo.actions import MoveAction
 from chaingeo.kinematics import Move
 from chaingeo.observation import observe, scene, state_text
 from chaingeo.state import new_state
 from tests.env_levels import drop_level, puzzle_levels, soma_level
-
-HAVE_RENDER = importlib.util.find_spec("chaingeo.render") is not None
 
 
 def puzzle(level_id: str):  # type: ignore[no-untyped-def]
@@ -67,7 +61,6 @@ def test_puzzle_scene_lays_separate_parts_out_without_overlap() -> None:
     assert pieces["red"][0].cells == state.cells_of("red")
 
 
-@pytest.mark.skipif(not HAVE_RENDER, reason="chaingeo.render not merged yet")
 def test_images_are_png_per_view() -> None:
     obs = observe(new_state(soma_level()), image_size=128)
     assert sorted(obs.images) == ["front", "iso", "side", "top", "tray"]

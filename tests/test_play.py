@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import io
 from pathlib import Path
 
@@ -11,8 +10,6 @@ import pytest
 from chaingeo.cli import main
 from chaingeo.level import save_level
 from tests.env_levels import tiny_level
-
-HAVE_RENDER = importlib.util.find_spec("chaingeo.render") is not None
 
 
 def run_play(
@@ -64,7 +61,6 @@ def test_play_by_id_quit_and_errors(
     assert code == 2 and "no level file or level id 'nope'" in out
 
 
-@pytest.mark.skipif(not HAVE_RENDER, reason="chaingeo.render not merged yet")
 def test_play_writes_fresh_views(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
