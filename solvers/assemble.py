@@ -10,25 +10,15 @@ completely under the reference kinematics.
 
 from __future__ import annotations
 
-import importlib
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 from chaingeo.geometry import Shape
+from solvers.cover import iter_solutions
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
-
-
-@dataclass(frozen=True)
-class PieceCount:
-    """A piece shape used between ``min`` and ``max`` times."""
-
-    name: str
-    shape: Shape
-    min: int = 1
-    max: int = 1
+from solvers.problem import PieceSpec
 
 
 @dataclass(frozen=True)
@@ -40,17 +30,8 @@ class AssemblyReport:
     solution_list: tuple[dict[str, Shape], ...] = ()
 
 
-def _cover() -> Any:
-    try:
-        return importlib.import_module("solvers.cover")
-    except ImportError as e:  # pragma: no cover - only before the engine lands
-        raise RuntimeError(
-            "the exact-cover engine (solvers.cover) is not available in this installation"
-        ) from e
-
-
 def iter_assemblies(
-    pieces: Sequence[PieceCount],
+    pieces: Sequence[PieceSpec],
     target: Shape,
     *,
     optional: Shape | None = None,
@@ -60,10 +41,8 @@ def iter_assemblies(
     """Every assembly, one per symmetry class of the target (rotations; reflections too when
     ``mirror_distinct`` is False), as ``{piece name: placed voxels}``. Copies of one piece are
     named ``name``, ``name_2``, ... in placement order."""
-    cover = _cover()
-    specs = [cover.PieceSpec(p.shape, p.name, p.min, p.max) for p in pieces]
-    solutions = cover.iter_solutions(
-        specs,
+    solutions = iter_solutions(
+        list(pieces),
         target,
         distinct=True,
         reflections=not mirror_distinct,
@@ -83,7 +62,7 @@ def iter_assemblies(
 
 
 def count_solutions(
-    pieces: Sequence[PieceCount],
+    pieces: Sequence[PieceSpec],
     target: Shape,
     *,
     optional: Shape | None = None,
@@ -117,7 +96,7 @@ def solid_burr_codes() -> tuple[int, ...]:
 
     family = notchable_family()
     code_of = {s.canonical(): c for c, s in family.items()}
-    pieces = [PieceCount(f"b{c:04x}", s, 0, 6) for c, s in family.items()]
+    pieces = [PieceSpec(s, f"b{c:04x}", 0, 6) for c, s in family.items()]
     used: set[int] = set()
     for asm in iter_assemblies(pieces, solid_knot()):
         used.update(code_of[s.canonical()] for s in asm.values())

@@ -9,9 +9,10 @@ from typing import Any
 from chaingeo.geometry import Shape
 from chaingeo.kinematics import SearchLimitError
 from chaingeo.rules import PuzzleRules
-from solvers.assemble import PieceCount, count_solutions
+from solvers.assemble import count_solutions
 from solvers.disassemble import analyze
 from solvers.partsearch import SearchLimits
+from solvers.problem import PieceSpec
 
 
 def disassembly_figures(
@@ -49,7 +50,7 @@ def analyze_level_file(
     if assemble:
         target = Shape([c for p in level.pieces for c in p.shape.cells])
         rep = count_solutions(
-            [PieceCount(p.name, p.shape.normalized()) for p in level.pieces],
+            [PieceSpec(p.shape.normalized(), p.name) for p in level.pieces],
             target,
             max_group=max_group,
             limits=limits,
@@ -73,7 +74,7 @@ def analyze_xmpuzzle(
     if assemble:
         result = puzzle.shapes[prob.result]
         pieces = [
-            PieceCount(f"s{sid}", puzzle.shapes[sid].filled, lo, hi) for sid, lo, hi in prob.pieces
+            PieceSpec(puzzle.shapes[sid].filled, f"s{sid}", lo, hi) for sid, lo, hi in prob.pieces
         ]
         rep = count_solutions(pieces, result.cells, optional=result.variable, limits=limits)
         out.update(assemblies=rep.assemblies, solutions=rep.solutions)

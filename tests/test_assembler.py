@@ -9,14 +9,15 @@ import pytest
 
 from chaingeo.cli import main
 from chaingeo.geometry import Shape
-from solvers.assemble import PieceCount, count_solutions, iter_assemblies
+from solvers.assemble import count_solutions, iter_assemblies
+from solvers.problem import PieceSpec
 from tests.test_burrtools import BT, needs_files
 
 
 def test_small_assemblies_and_solutions() -> None:
     # Two L-trominoes and a domino fill a 2x2x2 cube in many ways; all of them come apart.
     ell = Shape([(0, 0, 0), (1, 0, 0), (0, 1, 0)])
-    pieces = [PieceCount("ell", ell, 2, 2), PieceCount("bar", Shape([(0, 0, 0), (1, 0, 0)]))]
+    pieces = [PieceSpec(ell, "ell", 2, 2), PieceSpec(Shape([(0, 0, 0), (1, 0, 0)]), "bar")]
     target = Shape([(x, y, z) for x in range(2) for y in range(2) for z in range(2)])
     asms = list(iter_assemblies(pieces, target))
     assert asms and all(sorted(a) == ["bar", "ell", "ell_2"] for a in asms)

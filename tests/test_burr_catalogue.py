@@ -12,7 +12,8 @@ from chaingeo.piecesets.burrs import (
     solid_burr_pieces,
     solid_knot,
 )
-from solvers.assemble import PieceCount, count_solutions, solid_burr_codes
+from solvers.assemble import count_solutions, solid_burr_codes
+from solvers.problem import PieceSpec
 from tests.test_burrtools import BT, needs_files
 
 
@@ -24,7 +25,7 @@ def test_family_sizes() -> None:
 
 
 def test_314_solid_six_piece_burrs() -> None:
-    pieces = [PieceCount(n, s, 0, 6) for n, s in solid_burr_pieces().items()]
+    pieces = [PieceSpec(s, n, 0, 6) for n, s in solid_burr_pieces().items()]
     report = count_solutions(pieces, solid_knot())
     assert (report.assemblies, report.solutions) == (1063, 314)
 
