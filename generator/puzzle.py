@@ -41,8 +41,8 @@ VERSION = "1"
 
 @dataclass(frozen=True)
 class PuzzleConfig:
-    """What to make. ``shape``: a layout name (burr6, burr3, plate3, burr10, burr14, burr18,
-    burr34) or ``cubeN`` with ``pieces``; ``min_level``: moves until the first part comes free."""
+    """What to make. ``shape``: a layout name (burr3, plate3, burr6, burr12, burr18, burr24,
+    burr36) or ``cubeN`` with ``pieces``; ``min_level``: moves until the first part comes free."""
 
     shape: str = "burr6"
     min_level: int = 1
