@@ -72,6 +72,10 @@ from chaingeo.rules import PuzzleRules
 from chaingeo.state import BaseState
 from solvers.partsearch import PieceTable
 
+#: a position (kept alive so its id stays its own), its moves by (group, direction), its actions
+_Listed = tuple[Assembly, dict[tuple[tuple[str, ...], str], MoveRange], ActionList]
+_CACHED_POSITIONS = 8
+
 PartKey = tuple[tuple[str, Cell], ...]
 PositionKey = tuple[PartKey, ...]
 
@@ -151,10 +155,9 @@ class PuzzleState(BaseState):
             )
         else:
             self._asm = Assembly.assembled(self.tables.shapes)
-        #: the legal actions of one position (assembly), reused while the position stands
-        self._legal_cache: (
-            tuple[Assembly, dict[tuple[tuple[str, ...], str], MoveRange], ActionList] | None
-        ) = None
+        #: legal actions of recent positions by id(assembly), shared with clones (an agent's
+        #: clone and the state it came from look at the same position)
+        self._legal_cache: dict[int, _Listed] = {}
 
     # -- position -----------------------------------------------------------------------------
     @property
@@ -193,7 +196,7 @@ class PuzzleState(BaseState):
     def _actions(self) -> tuple[dict[tuple[tuple[str, ...], str], MoveRange], ActionList]:
         """(the moves of groups within a part by (group, direction), every legal action) of
         this position, computed once per position. Disassembling, the first are every move."""
-        cached = self._legal_cache
+        cached = self._legal_cache.get(id(self._asm))
         if cached is not None and cached[0] is self._asm:
             return cached[1], cached[2]
         table, mg = self.tables.piece_table, self.tables.max_group
@@ -203,7 +206,9 @@ class PuzzleState(BaseState):
         else:
             ranges, actions = assembly_actions(self._asm, mg, table)
         by_group = {(r.pieces, r.direction): r for r in ranges}
-        self._legal_cache = (self._asm, by_group, actions)
+        if len(self._legal_cache) >= _CACHED_POSITIONS:
+            del self._legal_cache[next(iter(self._legal_cache))]
+        self._legal_cache[id(self._asm)] = (self._asm, by_group, actions)
         return by_group, actions
 
     def _slides(self, pieces: Sequence[str], direction: str) -> list[Action]:

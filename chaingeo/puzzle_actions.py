@@ -24,7 +24,7 @@ from numba import njit
 from chaingeo.action_list import ActionList
 from chaingeo.actions import MoveAction
 from chaingeo.geometry import Cell, Shape
-from chaingeo.kinematics import DIRECTIONS, OPPOSITE, Assembly, Move
+from chaingeo.kinematics import DIRECTIONS, Assembly, Move
 from solvers.disassemble import move_rows
 from solvers.partsearch import PieceTable
 
@@ -110,17 +110,14 @@ class MoveRange(Sequence[MoveAction]):
     """The moves of ``pieces`` along ``direction``: distances ``1..kmax``, then ``inf`` when
     ``removable``, in the order of the actions' sort keys."""
 
-    __slots__ = ("direction", "kmax", "pieces", "removable")
+    __slots__ = ("direction", "key", "kmax", "pieces", "removable")
 
     def __init__(self, pieces: tuple[str, ...], direction: str, kmax: int, removable: bool):
         self.pieces = pieces
         self.direction = direction
         self.kmax = kmax
         self.removable = removable
-
-    @property
-    def key(self) -> tuple[object, ...]:
-        return (self.pieces, self.direction, False, ())
+        self.key: tuple[object, ...] = (pieces, direction, False, ())
 
     def __len__(self) -> int:
         return self.kmax + (1 if self.removable else 0)
@@ -250,43 +247,61 @@ def _ranges(
     return move_rows(asm, max_group, GROUP_LIMIT, table)
 
 
+def _groups(names: tuple[str, ...], masks: np.ndarray) -> dict[int, tuple[str, ...]]:
+    """The pieces of each group mask (bit ``i``: ``names[i]``), built once per mask."""
+    return {
+        m: tuple(names[i] for i in range(len(names)) if m >> i & 1)
+        for m in sorted(set(masks.tolist()))
+    }
+
+
 def disassembly_actions(asm: Assembly, max_group: int | None, table: PieceTable) -> list[MoveRange]:
     """The moves of :func:`chaingeo.kinematics.legal_moves`, sorted, as lazy ranges."""
-    chunks = [
-        MoveRange(tuple(names[i] for i in range(len(names)) if m >> i & 1), _DIRS[d], k, bool(r))
-        for names, rows in _ranges(asm, max_group, table)
-        for m, d, k, r in rows.tolist()
-    ]
+    chunks: list[MoveRange] = []
+    for names, rows in _ranges(asm, max_group, table):
+        groups = _groups(names, rows[:, 0])
+        chunks.extend(MoveRange(groups[m], _DIRS[d], k, bool(r)) for m, d, k, r in rows.tolist())
     return sorted(chunks, key=lambda c: c.key)
 
 
+def _slide_rows(rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Which move rows of one part are assembly slides: some finite distance, and not a
+    group lying clear of the rest on the side it moves away from while free to leave that
+    way (the move it would undo is a removal). ``lo``/``hi``: each piece's bounding box now.
+    """
+    masks, dirs, kmax, leaves = rows.T
+    keep: np.ndarray = kmax > 0
+    back = dirs ^ 1  # DIRECTIONS pairs each axis as (+a, -a) at (2a, 2a + 1)
+    can_leave = set(zip(dirs[leaves == 1].tolist(), masks[leaves == 1].tolist(), strict=True))
+    cand = np.flatnonzero(keep)
+    hit = [
+        (b, m) in can_leave for b, m in zip(back[cand].tolist(), masks[cand].tolist(), strict=True)
+    ]
+    idx = cand[np.array(hit, dtype=bool)] if cand.size else cand
+    if idx.size:
+        n = lo.shape[0]
+        member = ((masks[idx, None].astype(np.uint64) >> np.arange(n, dtype=np.uint64)) & 1) == 1
+        axis = dirs[idx] // 2
+        lo_ax, hi_ax = lo.T[axis], hi.T[axis]  # (rows, pieces) along each row's axis
+        big = np.iinfo(np.int64).max // 4
+        g_lo = np.where(member, lo_ax, big).min(axis=1)
+        g_hi = np.where(member, hi_ax, -big).max(axis=1)
+        r_lo = np.where(member, big, lo_ax).min(axis=1)
+        r_hi = np.where(member, -big, hi_ax).max(axis=1)
+        clearance = np.where(back[idx] % 2 == 0, r_hi - g_lo + 1, g_hi - r_lo + 1)
+        keep[idx[clearance <= 0]] = False
+    return keep
+
+
 def assembly_slides(asm: Assembly, max_group: int | None, table: PieceTable) -> list[MoveRange]:
-    """The finite moves of a group within its part while assembling: the disassembly moves
-    short of clearing the rest, except for a group that lies clear of the rest on the side it
-    moves away from and is free to leave that way (the move it would undo is a removal)."""
+    """The finite moves of a group within its part while assembling (see :func:`_slide_rows`)."""
     out: list[MoveRange] = []
     for names, rows in _ranges(asm, max_group, table):
-        n = len(names)
         lo = np.array([asm.shapes[p].voxels.min(axis=0) + asm.offsets[p] for p in names])
         hi = np.array([asm.shapes[p].voxels.max(axis=0) + asm.offsets[p] for p in names])
-        inside = ((rows[:, :1].astype(np.uint64) >> np.arange(n, dtype=np.uint64)) & 1) == 1
-        big = np.iinfo(np.int64).max // 4
-        leaving = {(d, m) for m, d, _, r in rows.tolist() if r}
-        for i, (m, d, k, _) in enumerate(rows.tolist()):
-            if k == 0:
-                continue
-            back = _DIRS.index(OPPOSITE[_DIRS[d]])
-            if (back, m) in leaving:
-                axis, member = back // 2, inside[i]
-                g_lo = np.where(member, lo[:, axis], big).min()
-                g_hi = np.where(member, hi[:, axis], -big).max()
-                r_lo = np.where(member, big, lo[:, axis]).min()
-                r_hi = np.where(member, -big, hi[:, axis]).max()
-                clearance = r_hi - g_lo + 1 if back % 2 == 0 else g_hi - r_lo + 1
-                if clearance <= 0:
-                    continue
-            pieces = tuple(names[j] for j in range(n) if m >> j & 1)
-            out.append(MoveRange(pieces, _DIRS[d], k, False))
+        kept = rows[_slide_rows(rows, lo, hi)]
+        groups = _groups(names, kept[:, 0])
+        out.extend(MoveRange(groups[m], _DIRS[d], k, False) for m, d, k, _ in kept.tolist())
     return sorted(out, key=lambda c: c.key)
 
 
