@@ -3,7 +3,9 @@ items, checked against the reference kinematics (pure Python) rather than the nu
 
 from __future__ import annotations
 
+import collections
 import dataclasses
+import itertools
 import json
 from pathlib import Path
 
@@ -14,6 +16,7 @@ from hypothesis import strategies as st
 from chaingeo.cli import main
 from chaingeo.kinematics import (
     Assembly,
+    SearchLimitError,
     disassembly_of_assembly_plan,
     legal_moves,
     reference_optimal_disassembly,
@@ -21,9 +24,10 @@ from chaingeo.kinematics import (
     state_key,
 )
 from chaingeo.level import Level, level_bytes, load_level
-from generator.layouts import get_layout
+from generator.layouts import Layout, get_layout, three_crossing
 from generator.puzzle import PuzzleConfig, difficulty_of, make
 from solvers.disassemble import analyze
+from solvers.partsearch import SearchLimits
 
 #: (config, seed, index) of one quick item per layout that the generator accepts (found by the
 #: histograms in the README: burr3 item 8 of seed 1 is a level-4 burr, plate3 item 27 level 3).
@@ -138,3 +142,44 @@ def test_chain_generate_puzzle_plate3(tmp_path: Path, capsys: pytest.CaptureFixt
     config, seed, index = ITEMS["plate3"]
     assert level_bytes(level) == level_bytes(make(config, seed, index))
     assert json.loads(capsys.readouterr().out.strip().splitlines()[-1])["accepted"] == 1
+
+
+#: Per design; a few plate3 designs move a long way without coming apart (over the cap).
+CENSUS_LIMITS = SearchLimits(max_states=20_000, seconds=None)
+
+
+def _level_census(layout: Layout) -> dict[object, int]:
+    """Every design of ``layout``, one by one: broken (a piece empty or in bits), locked, or
+    the number of moves until the first part comes free."""
+    census: collections.Counter[object] = collections.Counter()
+    choices = [(*layout.owners(c), -1) for c in layout.shared]
+    for design in itertools.product(*choices):
+        pieces = layout.pieces(design)
+        if any(len(p) == 0 or not p.is_connected() for p in pieces):
+            census["broken"] += 1
+            continue
+        named = {f"p{i}": p for i, p in enumerate(pieces)}
+        try:
+            result = analyze(named, optimal=False, limits=CENSUS_LIMITS)
+        except SearchLimitError:
+            census["over cap"] += 1
+            continue
+        census[result.first_level if result.disassemblable else "locked"] += 1
+    return dict(census)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("layout", "expected"),
+    [
+        # the README's figures: plate3 never goes beyond level 3 ...
+        (get_layout("plate3"), {"broken": 53120, "locked": 24793, 2: 795, 3: 24}),
+        # ... and 2x2x6 sticks offset by one unit never beyond 2 (why burr3 has 3x3 sticks)
+        (
+            three_crossing("b2", 6, (2, 2), (2, 1), "2x2x6 sticks"),
+            {"broken": 11664, "locked": 6611, 1: 55944, 2: 4513},
+        ),
+    ],
+)
+def test_every_design_of_a_small_layout(layout: Layout, expected: dict[object, int]) -> None:
+    assert _level_census(layout) == expected
