@@ -26,8 +26,9 @@ import numpy.typing as npt
 from numba import njit
 
 from chaingeo.geometry import NEIGHBOURS, Shape
-from chaingeo.kinematics import SearchLimitError
+from chaingeo.kinematics import Assembly, SearchLimitError
 from generator.candidate import Candidate, evaluate, piece_names, probe_limits
+from solvers.disassemble import fast_legal_moves
 from solvers.partsearch import Deadline, PartSearch, PieceTable, Removal
 
 if TYPE_CHECKING:  # the config lives with make(); only its type is needed here
@@ -41,9 +42,10 @@ Progress = tuple[int, int]
 _WORST: Progress = (1 << 20, 0)
 #: Owner code of an empty cell.
 VOID = -1
-#: Single-voxel transfers per walk before starting again from a new random cut, and walks.
-STEER_STEPS = 400
-RESTARTS = 12
+#: Changes per annealing walk before starting again from a new random cut; walks; temperature.
+STEER_STEPS = 8000
+RESTARTS = 3
+TEMPERATURE = 1.0
 
 
 def interlocking_target(min_level: int) -> int:
@@ -103,16 +105,29 @@ def _neighbours(c: tuple[int, ...], n: int) -> list[tuple[int, int, int]]:
     return [nb for nb in out if all(0 <= v < n for v in nb)]
 
 
+def void_sites(n: int) -> list[tuple[int, int, int]]:
+    """Cells that may be left empty: the interior, and for a 3-cube (whose interior is one
+    cell) the face centres too; edges and corners always stay, so the outline is a cube."""
+    inner = [
+        (x, y, z)
+        for x in range(n)
+        for y in range(n)
+        for z in range(n)
+        if sum(0 < v < n - 1 for v in (x, y, z)) >= (3 if n > 3 else 2)
+    ]
+    return inner
+
+
 def void_count(n: int, hole_rate: float) -> int:
-    """Empty interior cells of an ``n``-cube: ``hole_rate`` of the ``(n - 2)^3`` interior,
-    at least one (a hole-free cube is always level 1, see the module docstring)."""
-    interior = max(0, n - 2) ** 3
-    if interior == 0:
+    """Empty cells of an ``n``-cube: ``hole_rate`` of its :func:`void_sites`, at least one (a
+    cube without an empty cell always has a piece that lifts straight off)."""
+    sites = len(void_sites(n))
+    if sites == 0:
         raise ValueError(
-            f"a {n}x{n}x{n} cube has no interior cell to leave empty, and a cube without an "
+            f"a {n}x{n}x{n} cube has no inner cell to leave empty, and a cube without an "
             "empty cell always has a piece that lifts straight off: use cube3 or larger"
         )
-    return min(interior, max(1, round(hole_rate * interior)))
+    return min(sites, max(1, round(hole_rate * sites)))
 
 
 def random_partition(
@@ -126,8 +141,9 @@ def random_partition(
         raise ValueError(f"a {n}x{n}x{n} cube cannot be cut into {pieces} pieces")
     free = -2
     owner = np.full((n, n, n), free, dtype=np.int64)
-    inner = owner[1:-1, 1:-1, 1:-1]
-    inner.flat[rng.permutation(inner.size)[:voids]] = VOID
+    sites = void_sites(n)
+    for i in rng.permutation(len(sites))[:voids]:
+        owner[sites[int(i)]] = VOID
     cells = np.flatnonzero(owner == free)
     for i, flat in enumerate(rng.permutation(cells)[:pieces]):
         owner.flat[int(flat)] = i
@@ -181,7 +197,8 @@ def shift_void(owner: I64, min_size: int, rng: np.random.Generator) -> I64 | Non
     n = owner.shape[0]
     voids = np.argwhere(owner == VOID)
     v = tuple(int(x) for x in voids[int(rng.integers(len(voids)))])
-    inner = [c for c in _neighbours(v, n) if owner[c] >= 0 and all(0 < x < n - 1 for x in c)]
+    sites = set(void_sites(n))
+    inner = [c for c in _neighbours(v, n) if owner[c] >= 0 and c in sites]
     if not inner:
         return None
     c = inner[int(rng.integers(len(inner)))]
@@ -196,14 +213,15 @@ def shift_void(owner: I64, min_size: int, rng: np.random.Generator) -> I64 | Non
 
 
 def mutate(owner: I64, min_size: int, rng: np.random.Generator) -> I64 | None:
-    """One random change: mostly a cell transfer, sometimes (cubes of more than one interior
-    cell) a void shift."""
-    if owner.shape[0] > 3 and rng.random() < 0.2:
+    """One random change: mostly a cell transfer, sometimes a void shift."""
+    if rng.random() < 0.2:
         return shift_void(owner, min_size, rng)
     return transfer(owner, min_size, rng)
 
 
-def progress(shapes: Sequence[Shape], target: int, config: PuzzleConfig) -> tuple[Progress, Candidate | None]:
+def progress(
+    shapes: Sequence[Shape], target: int, config: PuzzleConfig
+) -> tuple[Progress, Candidate | None]:
     """How far the design is from coming apart at level ``>= target``; the candidate when
     it does.
 
@@ -230,7 +248,8 @@ def progress(shapes: Sequence[Shape], target: int, config: PuzzleConfig) -> tupl
         for depth in range(target):
             removals = search.expand_layer()
             if removals and depth + 1 < target:
-                return (target - 1 - depth, _pieces_with_a_way_out(removals)), None
+                stuck = 0 if _can_slide(named, config.max_group) else 6 * k
+                return (target - 1 - depth, stuck + _pieces_with_a_way_out(removals)), None
             if removals or search.exhausted:
                 break
     except SearchLimitError:
@@ -242,6 +261,15 @@ def progress(shapes: Sequence[Shape], target: int, config: PuzzleConfig) -> tupl
     starts = np.zeros(k + 1, dtype=np.int64)
     starts[1:] = np.cumsum([len(v) for v in table.voxels])
     return (0, 1 + nearest_to_leaving(vox, starts, search.states, search.n_states)), None
+
+
+def _can_slide(named: dict[str, Shape], max_group: int | None) -> bool:
+    """Can some group move at the start without being able to leave that way? (In a cube
+    only into an empty interior cell; without such a slide nothing opens once the ways
+    out are closed.)"""
+    moves = fast_legal_moves(Assembly.assembled(named), max_group)
+    leaving = {(m.pieces, m.direction) for m in moves if m.distance is None}
+    return any((m.pieces, m.direction) not in leaving for m in moves)
 
 
 def _pieces_with_a_way_out(removals: Sequence[Removal]) -> int:
@@ -256,8 +284,10 @@ def _pieces_with_a_way_out(removals: Sequence[Removal]) -> int:
 def _steer(
     owner: I64, target: int, config: PuzzleConfig, min_size: int, rng: np.random.Generator
 ) -> tuple[I64, Candidate] | None:
-    """Walk from ``owner`` by transfers that keep or improve the progress, up to
-    :data:`STEER_STEPS`; the partition and candidate once it comes apart at ``>= target``."""
+    """Anneal from ``owner`` for up to :data:`STEER_STEPS` changes: a change that misses more
+    levels is refused, one that misses fewer is kept, and within the same level a change that
+    opens ``w`` more ways is kept with probability ``exp(-w / TEMPERATURE)``. Returns the
+    partition and candidate once it comes apart at level ``>= target``."""
     k = int(owner.max()) + 1
     current, found = progress(shapes_of(owner, k), target, config)
     for _ in range(STEER_STEPS):
@@ -267,7 +297,10 @@ def _steer(
         if nxt is None:
             continue
         score, cand = progress(shapes_of(nxt, k), target, config)
-        if score <= current:
+        if score[0] > current[0]:
+            continue
+        worse = score[1] - current[1] if score[0] == current[0] else 0
+        if worse <= 0 or rng.random() < np.exp(-worse / TEMPERATURE):
             owner, current, found = nxt, score, cand
     return (owner, found) if found is not None else None
 
@@ -282,7 +315,9 @@ def cube_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> Candi
     min_size = min_piece_size(n, k)
     reached: tuple[I64, Candidate] | None = None
     for _ in range(RESTARTS):
-        reached = _steer(random_partition(n, k, voids, min_size, rng), target, config, min_size, rng)
+        reached = _steer(
+            random_partition(n, k, voids, min_size, rng), target, config, min_size, rng
+        )
         if reached is not None:
             break
     if reached is None:
