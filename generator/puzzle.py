@@ -31,7 +31,7 @@ from chaingeo.level import (
 )
 from chaingeo.rules import PuzzleRules
 from generator.candidate import Candidate, evaluate
-from generator.cubes import cube_search
+from generator.cubes import cube_search, interlocking_target
 from generator.layouts import get_layout
 from generator.result import Rejection
 from solvers.disassemble import analyze
@@ -192,6 +192,9 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     else:
         best = _layout_search(config, rng)
     if best is None:
+        if config.shape.startswith("cube"):
+            target = interlocking_target(config.min_level)
+            return Rejection(f"no cube design comes apart at level {target} or more", seed, index)
         return Rejection("no design that comes apart", seed, index)
     if best.score[0] < config.min_level:
         return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)
