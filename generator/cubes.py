@@ -1,16 +1,23 @@
 """Interlocking n x n x n cubes: random partitions steered until no piece can leave at once.
 
-A random cut of a cube into face-connected pieces nearly always has a piece (or a group) that
-lifts straight off: level 1, not an interlocking cube. Climbing on (level, total moves) alone
-does not get past that, because locking the last free piece usually jams the whole cube. So the
-search steers by a finer measure, the *progress* towards a target level ``L`` (see
-:func:`progress`): while something comes free within fewer than ``L`` moves, fewer ways out
-are better; once nothing does, the candidate either comes apart at level ``>= L`` (done) or is
-stuck, and then the state where a single piece is nearest to leaving (fewest voxels of other
-pieces ahead of it) is the gradient towards a slide that opens the cube. Single-voxel transfers
-that do not lower the progress are kept; a walk that does not get there in its budget restarts
-from a new random cut. Once there, climbing on (level, total moves) goes on as for the burrs,
-only ever keeping designs that come apart at level ``>= L``.
+**A full cube is never interlocking.** If a group can take one unit step along ``+x`` in a
+cube without empty cells, every voxel of the group has its ``+x`` neighbour in the group or
+outside the cube, so on each line the group runs up to the face and nothing lies ahead of it:
+it can leave for good. Every legal first move is then a removal (level 1), which is why the old
+suite's cubes all came out at level 1. So a few cells are left empty (:func:`void_sites`: the
+interior, and for a 3-cube also the face centres; edges and corners stay, the outline is a
+cube): the first move slides a group into the empty cells, and only later can a part leave.
+
+Random cuts still nearly always have a piece that lifts straight off, and closing the last
+way out usually jams the cube. So the search steers by the *progress* towards a target level
+``L`` (:func:`progress`): while some group comes free within fewer than ``L`` moves, fewer
+pieces with a way out are better (and a start with no slide at all is worse); once nothing
+does, the design either comes apart at level ``>= L`` (done) or is stuck, and then the state
+where one piece is nearest to leaving (fewest voxels of other pieces ahead of it) is the
+gradient towards a slide that opens the cube. Single-voxel changes (a cell to a neighbouring
+piece, or an empty cell moved) that do not lower the progress are kept (worse ones now and
+then: annealing); a walk that does not get there in its budget restarts from a new random cut.
+Once there, the same steering aims one level higher at a time, for ``hill_steps`` changes.
 
 Everything random comes from the caller's generator (``SeedSequence([seed, index])``); every
 search is capped by states, never by time, so the same (seed, index) gives the same cube.
@@ -282,17 +289,22 @@ def _pieces_with_a_way_out(removals: Sequence[Removal]) -> int:
 
 
 def _steer(
-    owner: I64, target: int, config: PuzzleConfig, min_size: int, rng: np.random.Generator
-) -> tuple[I64, Candidate] | None:
-    """Anneal from ``owner`` for up to :data:`STEER_STEPS` changes: a change that misses more
-    levels is refused, one that misses fewer is kept, and within the same level a change that
-    opens ``w`` more ways is kept with probability ``exp(-w / TEMPERATURE)``. Returns the
-    partition and candidate once it comes apart at level ``>= target``."""
+    owner: I64,
+    target: int,
+    config: PuzzleConfig,
+    min_size: int,
+    rng: np.random.Generator,
+    steps: int = STEER_STEPS,
+) -> tuple[tuple[I64, Candidate] | None, int]:
+    """Anneal from ``owner`` for up to ``steps`` changes: a change that misses more levels is
+    refused, one that misses fewer is kept, and within the same level a change that opens
+    ``w`` more ways is kept with probability ``exp(-w / TEMPERATURE)``. Returns the partition
+    and candidate once it comes apart at level ``>= target`` (or None), and the steps used."""
     k = int(owner.max()) + 1
     current, found = progress(shapes_of(owner, k), target, config)
-    for _ in range(STEER_STEPS):
+    for step in range(steps):
         if found is not None:
-            return owner, found
+            return (owner, found), step
         nxt = mutate(owner, min_size, rng)
         if nxt is None:
             continue
@@ -302,33 +314,32 @@ def _steer(
         worse = score[1] - current[1] if score[0] == current[0] else 0
         if worse <= 0 or rng.random() < np.exp(-worse / TEMPERATURE):
             owner, current, found = nxt, score, cand
-    return (owner, found) if found is not None else None
+    return ((owner, found) if found is not None else None), steps
 
 
 def cube_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> Candidate | None:
     """An interlocking partition of the n x n x n cube: steered to level
-    :func:`interlocking_target`, then climbed on (level, total moves) for ``hill_steps``
-    transfers. None when no walk reached the target level."""
+    :func:`interlocking_target` (up to :data:`RESTARTS` walks), then steered one level deeper
+    at a time while ``hill_steps`` changes last. None when no walk reached the target."""
     k = config.pieces or max(3, n)
-    target = interlocking_target(config.min_level)
     voids = void_count(n, config.hole_rate)
     min_size = min_piece_size(n, k)
     reached: tuple[I64, Candidate] | None = None
     for _ in range(RESTARTS):
-        reached = _steer(
-            random_partition(n, k, voids, min_size, rng), target, config, min_size, rng
-        )
+        start = random_partition(n, k, voids, min_size, rng)
+        reached, _used = _steer(start, interlocking_target(config.min_level), config, min_size, rng)
         if reached is not None:
             break
     if reached is None:
         return None
     owner, best = reached
-    for _ in range(config.hill_steps):
-        nxt = mutate(owner, min_size, rng)
-        if nxt is None:
-            continue
-        shapes = shapes_of(nxt, k)
-        result = evaluate(shapes, config)
-        if result is not None and Candidate(shapes, result).score >= best.score:
-            owner, best = nxt, Candidate(shapes, result)
+    left = config.hill_steps
+    while left > 0:
+        deeper, used = _steer(
+            owner, (best.analysis.first_level or 0) + 1, config, min_size, rng, left
+        )
+        left -= used
+        if deeper is None:
+            break
+        owner, best = deeper
     return best
