@@ -163,7 +163,7 @@ def random_partition(
                 if owner[nb] == free
             }
         )
-        if not frontier:  # cells walled off by voids: start them as their own seeds' prey
+        if not frontier:  # a cell walled in by voids (a 3-cube with all face centres empty)
             raise ValueError("voids cut the cube apart")
         sizes = np.bincount(owner[owner >= 0], minlength=pieces)
         small = [f for f in frontier if sizes[f[1]] < min_size]
