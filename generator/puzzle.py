@@ -49,8 +49,9 @@ class PuzzleConfig:
     shape: str = "burr6"
     min_level: int = 1
     pieces: int = 0  # cube partitions only
-    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs)
-    hill_steps: int = 300
+    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs); cubes:
+    # the share of inner cells left empty (at least one, see generator.cubes)
+    hill_steps: int = 300  # improvement steps (cubes: steering one level deeper at a time)
     goal: Literal["disassemble", "assemble"] = "disassemble"
     max_group: int | None = None
     seconds: float | None = None  # optional time limit of each search (machine-dependent!)
