@@ -22,9 +22,17 @@ import numpy as np
 from numba import njit
 
 from chaingeo.action_list import ActionList
-from chaingeo.actions import MoveAction
+from chaingeo.actions import Action, FinishAction, MoveAction
 from chaingeo.geometry import Cell, Shape
-from chaingeo.kinematics import DIRECTIONS, Assembly, Move
+from chaingeo.kinematics import (
+    DIRECTIONS,
+    OPPOSITE,
+    Assembly,
+    Move,
+    insertion_shifts,
+    legal_moves,
+    movable_groups,
+)
 from solvers.disassemble import move_rows
 from solvers.partsearch import PieceTable
 
@@ -313,3 +321,40 @@ def assembly_actions(
     blocks: list[MoveRange | InsertionBlock] = [*slides, *insertion_blocks(asm, max_group)]
     blocks.sort(key=lambda c: c.key)
     return slides, ActionList(blocks)
+
+
+def reference_actions(asm: Assembly, mode: str, max_group: int | None) -> list[Action]:
+    """Every legal action, built one by one from the pure-Python reference kinematics
+    (:mod:`chaingeo.kinematics`): what the fast lazy lists must equal, in the same order. Slow;
+    for tests and ``chain bench actions``."""
+    if mode == "disassemble":
+        return [*(MoveAction(m) for m in legal_moves(asm, max_group)), FinishAction()]
+    out: list[Action] = []
+    for d in DIRECTIONS:
+        for group in movable_groups(asm, d):
+            if max_group is not None and len(group) > max_group:
+                continue
+            back = OPPOSITE[d]
+            if asm.clearance(group, back) <= 0 and asm.free_distance(group, back) is None:
+                continue
+            free = asm.free_distance(group, d)
+            top = asm.clearance(group, d) - 1 if free is None else free
+            out.extend(MoveAction(Move(group, d, k)) for k in range(1, top + 1))
+    for a in asm.parts:
+        if max_group is not None and len(a) > max_group:
+            continue
+        for b in asm.parts:
+            if a == b:
+                continue
+            oa, ob = asm.offsets[min(a)], asm.offsets[min(b)]
+            acells = [c for n in sorted(a) for c in asm.cells_of(n)]
+            bcells = [c for n in sorted(b) for c in asm.cells_of(n)]
+            for d in DIRECTIONS:
+                for t in insertion_shifts(acells, bcells, d):
+                    offset = (oa[0] + t[0] - ob[0], oa[1] + t[1] - ob[1], oa[2] + t[2] - ob[2])
+                    out.append(
+                        MoveAction(
+                            Move(tuple(sorted(a)), d, None), into=tuple(sorted(b)), offset=offset
+                        )
+                    )
+    return [*sorted(out), FinishAction()]

@@ -1,10 +1,10 @@
 """Interlocking-puzzle generator: one pure function ``make(config, seed, index)``.
 
 A candidate is a random design of a layout (:mod:`generator.layouts`: who owns each shared
-cell of a burr, a plate burr or a chain of burr units) or a random partition of an n x n x n
-cube into face-connected pieces. It is then improved by hill climbing on single voxels (give one
-shared cell to another slot, or move one cube voxel to a neighbouring piece), keeping a change
-when the puzzle still comes apart and its (level, total moves) does not drop. The result is
+cell of a burr, a plate burr or a chain of burr units), improved by hill climbing on single
+voxels (give one shared cell to another slot), keeping a change when the puzzle still comes
+apart and its (level, total moves) does not drop; or an interlocking partition of an n x n x n
+cube (:mod:`generator.cubes`). The result is
 accepted when it reaches ``min_level``; its optimal plan (o_i) is then computed exactly and the
 level file is built and verified. Everything random comes from ``SeedSequence([seed, index])``.
 """
@@ -18,7 +18,7 @@ from typing import Literal
 import numpy as np
 
 from chaingeo.colors import assign_colors
-from chaingeo.geometry import NEIGHBOURS, Cell, Shape, puzzle_signature
+from chaingeo.geometry import Shape, puzzle_signature
 from chaingeo.kinematics import SearchLimitError
 from chaingeo.level import (
     Difficulty,
@@ -30,9 +30,11 @@ from chaingeo.level import (
     revalidate,
 )
 from chaingeo.rules import PuzzleRules
-from generator.layouts import cube_cells, get_layout
+from generator.candidate import Candidate, evaluate
+from generator.cubes import cube_search, interlocking_target
+from generator.layouts import get_layout
 from generator.result import Rejection
-from solvers.disassemble import Analysis, analyze
+from solvers.disassemble import analyze
 from solvers.partsearch import SearchLimits
 
 GENERATOR = "chaingeo.generator.puzzle"
@@ -47,8 +49,9 @@ class PuzzleConfig:
     shape: str = "burr6"
     min_level: int = 1
     pieces: int = 0  # cube partitions only
-    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs)
-    hill_steps: int = 300
+    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs); cubes:
+    # the share of inner cells left empty (at least one, see generator.cubes)
+    hill_steps: int = 300  # improvement steps (cubes: steering one level deeper at a time)
     goal: Literal["disassemble", "assemble"] = "disassemble"
     max_group: int | None = None
     seconds: float | None = None  # optional time limit of each search (machine-dependent!)
@@ -58,39 +61,6 @@ class PuzzleConfig:
 
     def to_json(self) -> dict[str, object]:
         return asdict(self)
-
-
-Score = tuple[int, int]
-
-
-class _Candidate:
-    """One puzzle being improved: its pieces and how well it scores."""
-
-    def __init__(self, shapes: list[Shape], analysis: Analysis) -> None:
-        self.shapes = shapes
-        self.analysis = analysis
-
-    @property
-    def score(self) -> Score:
-        a = self.analysis
-        return (a.first_level or 0, a.moves or 0)
-
-
-def _evaluate(shapes: Sequence[Shape], config: PuzzleConfig) -> Analysis | None:
-    """The BurrTools-style analysis, or None if a piece is broken or the puzzle is stuck."""
-    if any(len(s) == 0 or not s.is_connected() for s in shapes):
-        return None
-    named = {f"p{i:02d}": s for i, s in enumerate(shapes)}
-    limits = SearchLimits(
-        max_states=config.probe_states,
-        seconds=config.seconds,
-        max_total_states=10 * config.probe_states,
-    )
-    try:
-        result = analyze(named, max_group=config.max_group, limits=limits, optimal=False)
-    except SearchLimitError:
-        return None
-    return result if result.disassemblable else None
 
 
 def _broken(shapes: Sequence[Shape]) -> int:
@@ -103,7 +73,7 @@ def _mutate(owners: Sequence[int], current: int, hole_rate: float, rng: np.rando
     return int(choices[int(rng.integers(len(choices)))]) if choices else current
 
 
-def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate | None:
+def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> Candidate | None:
     layout = get_layout(config.shape)
     shared = layout.shared
     options = [layout.owners(c) for c in shared]
@@ -111,7 +81,7 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate
         -1 if rng.random() < config.hole_rate else int(opts[rng.integers(len(opts))])
         for opts in options
     ]
-    best: _Candidate | None = None
+    best: Candidate | None = None
     for _ in range(40):  # repair towards connected pieces, then look for one that comes apart
         for _ in range(400):
             broken = _broken(layout.pieces(design))
@@ -123,9 +93,9 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate
             if _broken(layout.pieces(design)) > broken:
                 design[i] = old
         shapes = layout.pieces(design)
-        result = _evaluate(shapes, config)
+        result = evaluate(shapes, config)
         if result is not None:
-            best = _Candidate(shapes, result)
+            best = Candidate(shapes, result)
             break
         for _ in range(3):  # shake and retry
             i = int(rng.integers(len(design)))
@@ -137,64 +107,11 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate
         old = design[i]
         design[i] = _mutate(options[i], old, config.hole_rate, rng)
         shapes = layout.pieces(design)
-        result = _evaluate(shapes, config)
-        if result is not None and _Candidate(shapes, result).score >= best.score:
-            best = _Candidate(shapes, result)
+        result = evaluate(shapes, config)
+        if result is not None and Candidate(shapes, result).score >= best.score:
+            best = Candidate(shapes, result)
         else:
             design[i] = old
-    return best
-
-
-def _cube_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Candidate | None:
-    cells = cube_cells(n)
-    k = config.pieces or max(3, n)
-    if not 2 <= k <= len(cells):
-        raise ValueError(f"a {n}x{n}x{n} cube cannot be cut into {k} pieces")
-    owner: dict[Cell, int] = {}
-    for i, j in enumerate(rng.permutation(len(cells))[:k]):
-        owner[cells[int(j)]] = i
-    while len(owner) < len(cells):
-        frontier = sorted(
-            {
-                (nb, owner[c])
-                for c in owner
-                for d in NEIGHBOURS
-                if (nb := (c[0] + d[0], c[1] + d[1], c[2] + d[2])) not in owner
-                and all(0 <= v < n for v in nb)
-            }
-        )
-        cell, who = frontier[int(rng.integers(len(frontier)))]
-        owner[cell] = who
-
-    def shapes_of(own: dict[Cell, int]) -> list[Shape]:
-        groups: list[list[Cell]] = [[] for _ in range(k)]
-        for c, w in sorted(own.items()):
-            groups[w].append(c)
-        return [Shape(g) for g in groups]
-
-    shapes = shapes_of(owner)
-    result = _evaluate(shapes, config)
-    best = _Candidate(shapes, result) if result is not None else None
-    for _ in range(config.hill_steps):
-        c = cells[int(rng.integers(len(cells)))]
-        near = sorted(
-            {
-                owner[nb]
-                for d in NEIGHBOURS
-                if (nb := (c[0] + d[0], c[1] + d[1], c[2] + d[2])) in owner
-                and owner[nb] != owner[c]
-            }
-        )
-        if not near:
-            continue
-        old = owner[c]
-        owner[c] = near[int(rng.integers(len(near)))]
-        shapes = shapes_of(owner)
-        result = _evaluate(shapes, config) if len(shapes[old]) >= 2 else None
-        if result is not None and (best is None or _Candidate(shapes, result).score >= best.score):
-            best = _Candidate(shapes, result)
-        else:
-            owner[c] = old
     return best
 
 
@@ -271,11 +188,14 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
         try:
             n = int(config.shape[4:])
         except ValueError:
-            raise ValueError(f"cube shapes are cube2..cube5, got {config.shape!r}") from None
-        best = _cube_search(config, n, rng)
+            raise ValueError(f"cube shapes are cube3..cube5, got {config.shape!r}") from None
+        best = cube_search(config, n, rng)
     else:
         best = _layout_search(config, rng)
     if best is None:
+        if config.shape.startswith("cube"):
+            target = interlocking_target(config.min_level)
+            return Rejection(f"no cube design comes apart at level {target} or more", seed, index)
         return Rejection("no design that comes apart", seed, index)
     if best.score[0] < config.min_level:
         return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)

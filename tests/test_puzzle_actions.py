@@ -2,26 +2,24 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from chaingeo.action_list import ActionList
-from chaingeo.actions import Action, FinishAction, MoveAction
+from chaingeo.actions import FinishAction, MoveAction
 from chaingeo.geometry import Shape
 from chaingeo.kinematics import (
     DIRECTIONS,
-    OPPOSITE,
-    Assembly,
     Move,
     insertion_shifts,
-    legal_moves,
-    movable_groups,
 )
 from chaingeo.level import Level, load_level
 from chaingeo.puzzle import PuzzleState
-from chaingeo.puzzle_actions import shifts
+from chaingeo.puzzle_actions import reference_actions, shifts
 from tests.env_levels import puzzle_levels
 from tests.strategies import polycubes
 
@@ -44,47 +42,6 @@ def test_insertion_kernel_is_the_reference(
     assert [tuple(int(v) for v in row) for row in got] == want
 
 
-def reference_assembly_actions(asm: Assembly, max_group: int | None) -> list[Action]:
-    """Assembly actions by the module docstring of chaingeo.puzzle, from the pure-Python
-    reference kinematics: slides, then insertions, sorted, finish last."""
-    out: list[Action] = []
-    for d in DIRECTIONS:
-        for group in movable_groups(asm, d):
-            if max_group is not None and len(group) > max_group:
-                continue
-            back = OPPOSITE[d]
-            if asm.clearance(group, back) <= 0 and asm.free_distance(group, back) is None:
-                continue
-            free = asm.free_distance(group, d)
-            top = asm.clearance(group, d) - 1 if free is None else free
-            out.extend(MoveAction(Move(group, d, k)) for k in range(1, top + 1))
-    for a in asm.parts:
-        if max_group is not None and len(a) > max_group:
-            continue
-        for b in asm.parts:
-            if a == b:
-                continue
-            oa, ob = asm.offsets[min(a)], asm.offsets[min(b)]
-            acells = [c for n in sorted(a) for c in asm.cells_of(n)]
-            bcells = [c for n in sorted(b) for c in asm.cells_of(n)]
-            for d in DIRECTIONS:
-                for t in insertion_shifts(acells, bcells, d):
-                    offset = (oa[0] + t[0] - ob[0], oa[1] + t[1] - ob[1], oa[2] + t[2] - ob[2])
-                    out.append(
-                        MoveAction(
-                            Move(tuple(sorted(a)), d, None), into=tuple(sorted(b)), offset=offset
-                        )
-                    )
-    return [*sorted(out), FinishAction()]
-
-
-def reference_actions(state: PuzzleState) -> list[Action]:
-    mg = state.tables.max_group
-    if state.mode == "disassemble":
-        return [*(MoveAction(m) for m in legal_moves(state.assembly, mg)), FinishAction()]
-    return reference_assembly_actions(state.assembly, mg)
-
-
 def small_levels() -> list[Level]:
     shipped = [
         load_level(f"{SUITE}/{name}.json")
@@ -104,7 +61,7 @@ def test_legal_actions_are_the_reference_along_random_walks(lv: Level) -> None:
     state = PuzzleState(lv)
     for _ in range(6):
         legal = state.legal_actions()
-        assert legal == reference_actions(state)
+        assert legal == reference_actions(state.assembly, state.mode, state.tables.max_group)
         moves = len(legal) - 1
         if moves == 0 or state.is_success():
             break
@@ -142,3 +99,15 @@ def test_action_list_behaves_like_the_list_it_stands_for() -> None:
     with pytest.raises(IndexError):
         lst[4]
     assert ActionList([]) == [] and len(ActionList([])) == 0
+
+
+@pytest.mark.slow
+def test_bench_actions_quick_agrees_with_the_reference(capsys: pytest.CaptureFixture[str]) -> None:
+    import argparse
+
+    from chaingeo.benchmarks import actions
+
+    assert actions.run(argparse.Namespace(quick=True, repeat=1)) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert rows[-1]["speedup_overall"] > 1
+    assert rows[0]["actions_max"] > 50_000
