@@ -33,23 +33,32 @@ class SuiteEntry:
 _EASY6 = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=0)
 _HOLEY = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=300, min_level=3)
 _HARD6 = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=400, min_level=4)
-_CUBE3 = PuzzleConfig(shape="cube3", pieces=4, hill_steps=80)
-_CUBE3B = PuzzleConfig(shape="cube3", pieces=5, hill_steps=80)
-_CUBE4 = PuzzleConfig(shape="cube4", pieces=8, hill_steps=100)
-_CUBE4H = PuzzleConfig(shape="cube4", pieces=12, hill_steps=60)
+_BURR3E = PuzzleConfig(shape="burr3", hole_rate=0.8, hill_steps=20, min_level=2)
+_BURR3M = PuzzleConfig(shape="burr3", hole_rate=0.8, hill_steps=100, min_level=3)
+_BURR3H = PuzzleConfig(shape="burr3", hole_rate=0.8, hill_steps=150, min_level=4)
+_PLATE3E = PuzzleConfig(shape="plate3", hole_rate=0.4, hill_steps=20, min_level=2)
+_PLATE3M = PuzzleConfig(shape="plate3", hole_rate=0.4, hill_steps=100, min_level=3)
+_CUBE3 = PuzzleConfig(shape="cube3", pieces=3, min_level=2, hole_rate=0.3, hill_steps=0)
+_CUBE4 = PuzzleConfig(shape="cube4", pieces=6, min_level=3, hole_rate=0.5, hill_steps=0)
+_CUBE4H = PuzzleConfig(shape="cube4", pieces=6, min_level=3, hole_rate=0.5, hill_steps=20000)
 _TOWER = PuzzleConfig(shape="burr12", hole_rate=0.1, hill_steps=100)
 
 D, A = "disassemble", "assemble"
 
-#: 10 easy, 12 mid, 10 hard.
+#: 10 easy, 12 mid, 10 hard: six-piece burrs, three-piece and three-plate burrs, larger burrs
+#: (12 pieces and up) and interlocking cubes, both goals in every family.
 SUITE: tuple[SuiteEntry, ...] = (
-    SuiteEntry("easy", _EASY6, 101, 4, (D, D, A, A)),
+    SuiteEntry("easy", _EASY6, 101, 3, (D, D, A)),
+    SuiteEntry("easy", _BURR3E, 401, 2, (D, A)),
+    SuiteEntry("easy", _PLATE3E, 411, 2, (D, A)),
     SuiteEntry("easy", _CUBE3, 102, 3, (D, A, D)),
-    SuiteEntry("easy", _CUBE3B, 103, 3, (D, D, A)),
-    SuiteEntry("mid", _HOLEY, 201, 8, (D, D, D, D, D, A, A, A)),
+    SuiteEntry("mid", _HOLEY, 201, 4, (D, D, A, A)),
+    SuiteEntry("mid", _BURR3M, 402, 2, (D, A)),
+    SuiteEntry("mid", _PLATE3M, 412, 2, (D, A)),
     SuiteEntry("mid", _CUBE4, 202, 4, (D, D, A, D)),
-    SuiteEntry("hard", _HARD6, 301, 4, (D, D, A, D)),
-    SuiteEntry("hard", _TOWER, 303, 3, (D, D, A)),
+    SuiteEntry("hard", _HARD6, 301, 3, (D, A, D)),
+    SuiteEntry("hard", _BURR3H, 403, 2, (D, A)),
+    SuiteEntry("hard", _TOWER, 303, 2, (D, A)),
     SuiteEntry("hard", _CUBE4H, 302, 3, (D, A, D)),
 )
 
