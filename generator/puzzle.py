@@ -31,6 +31,7 @@ from chaingeo.level import (
 )
 from chaingeo.rules import PuzzleRules
 from generator.layouts import cube_cells, get_layout
+from generator.maze import maze_search, parse_maze_shape, runs, with_exit
 from generator.result import Rejection
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
@@ -42,7 +43,8 @@ VERSION = "1"
 @dataclass(frozen=True)
 class PuzzleConfig:
     """What to make. ``shape``: a layout name (burr6, burr3, plate3, burr10, burr14, burr18,
-    burr34) or ``cubeN`` with ``pieces``; ``min_level``: moves until the first part comes free."""
+    burr34), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
+    of ``hill_steps`` walks); ``min_level``: moves until the first part comes free."""
 
     shape: str = "burr6"
     min_level: int = 1
@@ -198,6 +200,19 @@ def _cube_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Can
     return best
 
 
+def _maze_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Candidate | None:
+    """A maze burr (:mod:`generator.maze`): ``hill_steps`` random walks, the one with the most
+    straight runs kept; its level is measured by the solver and must equal the runs."""
+    found = maze_search(n, config.min_level, config.hill_steps, rng)
+    if found is None:
+        return None
+    path, plate, pin = found
+    result = _evaluate([plate, pin], config)
+    if result is None or result.first_level != runs(with_exit(path, n)):
+        raise RuntimeError(f"maze construction broken: runs {runs(with_exit(path, n))}, {result}")
+    return _Candidate([plate, pin], result)
+
+
 def difficulty_of(first_level: int, optimal_steps: int, pieces: int) -> Difficulty:
     """The suite's thresholds (README, 'Puzzle suite'): *hard* when the first part needs 4 or
     more moves, or the optimal plan 14 or more, or there are 12 or more pieces; *easy* when the
@@ -273,6 +288,8 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
         except ValueError:
             raise ValueError(f"cube shapes are cube2..cube5, got {config.shape!r}") from None
         best = _cube_search(config, n, rng)
+    elif config.shape.startswith("maze"):
+        best = _maze_search(config, parse_maze_shape(config.shape), rng)
     else:
         best = _layout_search(config, rng)
     if best is None:
