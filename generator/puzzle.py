@@ -12,7 +12,7 @@ level file is built and verified. Everything random comes from ``SeedSequence([s
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -33,10 +33,14 @@ from chaingeo.rules import PuzzleRules
 from generator.layouts import cube_cells, get_layout
 from generator.maze import maze_search, parse_maze_shape, runs, with_exit
 from generator.result import Rejection
+from solvers.blockbound import analyze_by_blocks
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
 
 GENERATOR = "chaingeo.generator.puzzle"
+#: Towers of burr units; with single-piece moves (max_group=1) they are built unit by unit and
+#: their o_i is proven with the block bound (:mod:`solvers.blockbound`), one block per unit.
+TOWERS = {"burr12": 2, "burr18": 3, "burr24": 4, "burr36": 6}
 VERSION = "1"
 
 
@@ -213,6 +217,33 @@ def _maze_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Can
     return _Candidate([plate, pin], result)
 
 
+def _tower_search(config: PuzzleConfig, units: int, rng: np.random.Generator) -> _Candidate | None:
+    """A tower of ``units`` burr units (layout ``burr{6*units}``), each unit designed and
+    climbed on its own as a six-piece burr (the units share no cells), then stacked. A unit is
+    kept when its optimal plan never moves down, so that the tower can be taken apart unit by
+    unit from the top in the block bound's number of moves (:mod:`solvers.blockbound`)."""
+    unit_config = replace(config, shape="burr6", min_level=1)
+    shapes: list[Shape] = []
+    for u in range(units):
+        for _ in range(20):  # a unit whose optimal plan lets it leave the top of the stack
+            unit = _layout_search(unit_config, rng)
+            if unit is None:
+                continue
+            named = {f"p{i}": s for i, s in enumerate(unit.shapes)}
+            try:
+                plan = analyze(named, max_group=1, optimal=True).plan
+            except SearchLimitError:
+                continue
+            if any(m.direction == "-z" for m in plan):
+                continue
+            shapes.extend(s.translate((0, 0, 6 * u)) for s in unit.shapes)
+            break
+        else:
+            return None
+    result = _evaluate(shapes, replace(config, probe_states=config.max_states))
+    return None if result is None else _Candidate(shapes, result)
+
+
 def difficulty_of(first_level: int, optimal_steps: int, pieces: int) -> Difficulty:
     """The suite's thresholds (README, 'Puzzle suite'): *hard* when the first part needs 4 or
     more moves, or the optimal plan 14 or more, or there are 12 or more pieces; *easy* when the
@@ -236,18 +267,33 @@ def puzzle_level(
     index: int | None = None,
     difficulty: Difficulty | None = None,
     extra_stats: dict[str, object] | None = None,
+    blocks: Sequence[Sequence[int]] | None = None,
 ) -> Level:
     """Build and verify a puzzle level: palette names, the exact optimal plan (o_i) and stats.
 
     For 'assemble' the stored plan is the optimal disassembly reversed with each move inverted
     (the assembly optimum equals the disassembly optimum: the two state graphs are mirror
     images). Raises :class:`SearchLimitError` when o_i cannot be computed within ``limits``.
+    ``blocks`` (indices into ``shapes``; single-piece moves only) proves o_i with the block
+    bound of :mod:`solvers.blockbound`.
     """
     base = np.min(np.concatenate([s.voxels for s in shapes]), axis=0)
     placed = [s.translate(-base) for s in shapes]
     colors = assign_colors(len(placed))
     named = {c.name: s for c, s in zip(colors, placed, strict=True)}
-    result = analyze(named, max_group=max_group, limits=limits, optimal=True)
+    if blocks is None:
+        result = analyze(named, max_group=max_group, limits=limits, optimal=True)
+    else:
+        if max_group != 1:
+            raise ValueError("blocks prove o_i for single-piece moves (max_group=1) only")
+        names = [c.name for c in colors]
+        result = analyze_by_blocks(
+            named,
+            [[names[i] for i in b] for b in blocks],
+            limits=limits,
+            stacked=True,
+            search=False,
+        )
     if not result.disassemblable or result.optimal_steps is None:
         raise ValueError(f"{level_id}: the puzzle does not come apart")
     plan = list(result.plan)
@@ -271,7 +317,8 @@ def puzzle_level(
         pieces=tuple(Piece(c.name, c.hex, s) for c, s in zip(colors, placed, strict=True)),
         solution=PuzzleSolution(tuple(moves)),
         optimal_steps=result.optimal_steps,
-        max_steps=default_step_budget(result.optimal_steps),
+        # Past 30 moves the benchmark's 60-step cap would leave no room: twice the optimum.
+        max_steps=max(default_step_budget(result.optimal_steps), 2 * result.optimal_steps),
         rules=PuzzleRules(max_group=max_group),
         provenance=Provenance(GENERATOR, VERSION, seed, index, puzzle_signature(placed)),
         stats=stats,
@@ -282,6 +329,7 @@ def puzzle_level(
 def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
+    blocks: list[list[int]] | None = None
     if config.shape.startswith("cube"):
         try:
             n = int(config.shape[4:])
@@ -290,6 +338,10 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
         best = _cube_search(config, n, rng)
     elif config.shape.startswith("maze"):
         best = _maze_search(config, parse_maze_shape(config.shape), rng)
+    elif config.max_group == 1 and config.shape in TOWERS:
+        units = TOWERS[config.shape]
+        best = _tower_search(config, units, rng)
+        blocks = [list(range(6 * u, 6 * u + 6)) for u in range(units)]
     else:
         best = _layout_search(config, rng)
     if best is None:
@@ -312,6 +364,7 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
             seed=seed,
             index=index,
             extra_stats={"shape": config.shape},
+            blocks=blocks,
         )
     except SearchLimitError as e:
         return Rejection(f"optimal plan not found within limits: {e}", seed, index)
