@@ -18,10 +18,11 @@ original parts intersected with ``B``, so a restricted move meets a subset of th
 original met and is legal (a removal stays a removal: ``p`` clears its part for good, so it
 clears the restricted one; a non-removal may become one); the original parts end as single
 pieces, so the restricted ones do: the restricted plan takes ``B`` apart and has at least
-``f(B)`` moves, ``|B| - 1`` of them removals. Each restricted non-removal comes from a non-removal of ``P`` moving a piece of
-``B`` (the image of a removal is a removal or nothing). So the non-removals of ``P`` that move
-pieces of ``B`` number at least ``f(B) - (|B| - 1)``; each non-removal moves one piece, of one
-block; summing over blocks, ``m - (n - 1) >= sum_j (f(B_j) - (|B_j| - 1))``. QED.
+``f(B)`` moves, ``|B| - 1`` of them removals. Each restricted non-removal comes from a
+non-removal of ``P`` moving a piece of ``B`` (the image of a removal is a removal or nothing).
+So the non-removals of ``P`` that move pieces of ``B`` number at least ``f(B) - (|B| - 1)``;
+each non-removal moves one piece, of one block; summing over blocks,
+``m - (n - 1) >= sum_j (f(B_j) - (|B_j| - 1))``. QED.
 
 With moves of several pieces the claim fails (one move can advance two blocks at once), so
 :func:`block_lower_bound` refuses any other ``max_group``.
@@ -35,9 +36,8 @@ then taken out in one move (:func:`end_first_plan`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-
 import dataclasses
+from collections.abc import Mapping, Sequence
 
 from chaingeo.geometry import Shape
 from chaingeo.kinematics import Assembly, Move, MoveError, SearchLimitError
@@ -103,9 +103,10 @@ def end_first_plan(
     out: list[Move] = []
     lo, hi = 0, len(blocks) - 1
     while lo <= hi:
-        for i, up, down in ((hi, f"+{axis}", f"-{axis}"), (lo, f"-{axis}", f"+{axis}")):
-            if all(m.direction != down for m in plans[i]):
-                break
+        if all(m.direction != f"-{axis}" for m in plans[hi]):
+            i, up = hi, f"+{axis}"
+        elif all(m.direction != f"+{axis}" for m in plans[lo]):
+            i, up = lo, f"-{axis}"
         else:
             return None
         try:
