@@ -326,6 +326,19 @@ def puzzle_level(
     return revalidate(level)
 
 
+def analyze_level(level: Level, limits: SearchLimits | None = None) -> Analysis:
+    """Analyse a puzzle level again as :func:`puzzle_level` did: towers made with single-piece
+    moves (``stats['shape']`` in :data:`TOWERS`, ``max_group=1``) with the block bound, one
+    block per unit of six pieces in file order; every other level with the plain search."""
+    mg = level.rules.max_group if isinstance(level.rules, PuzzleRules) else None
+    shapes = level.shapes
+    if mg == 1 and level.stats.get("shape") in TOWERS:
+        names = [p.name for p in level.pieces]
+        blocks = [names[i : i + 6] for i in range(0, len(names), 6)]
+        return analyze_by_blocks(shapes, blocks, limits=limits, stacked=True, search=False)
+    return analyze(shapes, max_group=mg, limits=limits, optimal=True)
+
+
 def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))

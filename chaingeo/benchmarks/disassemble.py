@@ -23,6 +23,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from chaingeo.geometry import Shape
+from chaingeo.level import Level
 from chaingeo.kinematics import Assembly, legal_moves, state_key
 
 
@@ -53,12 +54,18 @@ def reference_rate(
 
 
 def _ours(
-    shapes: Mapping[str, Shape], max_group: int | None
+    shapes: Mapping[str, Shape], max_group: int | None, level: Level | None = None
 ) -> tuple[float, int, dict[str, object]]:
+    """Our full analysis; a suite level is analysed as it was made (towers with single-piece
+    moves by the block bound, :func:`generator.puzzle.analyze_level`)."""
+    from generator.puzzle import analyze_level
     from solvers.disassemble import analyze
 
     t0 = time.perf_counter()
-    result = analyze(shapes, max_group=max_group)
+    if level is not None:
+        result = analyze_level(level)
+    else:
+        result = analyze(shapes, max_group=max_group)
     seconds = time.perf_counter() - t0
     info: dict[str, object] = {
         "level": result.level,
@@ -68,7 +75,7 @@ def _ours(
     return seconds, result.states, info
 
 
-Instance = tuple[str, dict[str, Shape], int | None, dict[str, object]]
+Instance = tuple[str, dict[str, Shape], int | None, dict[str, object], Level | None]
 
 #: Generated deep puzzles: maze burrs (:mod:`generator.maze`) of level >= 10 from seed 10.
 DEEP_CONFIG = {"shape": "maze8", "min_level": 10, "hill_steps": 300}
@@ -84,7 +91,7 @@ def _instances(quick: bool) -> list[Instance]:
     levels = load_levels(suite) if suite.is_dir() else []
     for lv in levels[:3] if quick else levels:
         mg = lv.rules.max_group if isinstance(lv.rules, PuzzleRules) else None
-        out.append((lv.id, lv.shapes, mg, {}))
+        out.append((lv.id, lv.shapes, mg, {}, lv))
     n_gen = 1 if quick else int(os.environ.get("CHAIN_BENCH_GENERATED", "2"))
     burr6 = PuzzleConfig(shape="burr6", min_level=1, hill_steps=60 if quick else 600)
     deep = PuzzleConfig(**DEEP_CONFIG)  # type: ignore[arg-type]
@@ -95,7 +102,7 @@ def _instances(quick: bool) -> list[Instance]:
             extra: dict[str, object] = {"generate_seconds": round(time.perf_counter() - t0, 3)}
             if hasattr(item, "pieces"):
                 name = f"generated-{config.shape}-s10-i{i}"
-                out.append((name, item.shapes, None, extra))  # type: ignore[union-attr]
+                out.append((name, item.shapes, None, extra, None))  # type: ignore[union-attr]
     return out
 
 
@@ -104,12 +111,12 @@ def run(args: argparse.Namespace) -> int:
     warm = {"a": Shape([(0, 0, 0), (1, 0, 0)]), "b": Shape([(0, 1, 0), (1, 1, 0)])}
     _ours(warm, None)  # JIT warm-up, not timed
     rows = []
-    for name, shapes, max_group, extra in _instances(args.quick):
+    for name, shapes, max_group, extra, level in _instances(args.quick):
         best = float("inf")
         states = 0
         info: dict[str, object] = {}
         for _ in range(max(1, args.repeat)):
-            seconds, states, info = _ours(shapes, max_group)
+            seconds, states, info = _ours(shapes, max_group, level)
             best = min(best, seconds)
         ours_rate = states / best if best > 0 else float("inf")
         n_ref, ref_seconds = reference_rate(shapes, ref_states)
