@@ -23,8 +23,8 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from chaingeo.geometry import Shape
-from chaingeo.level import Level
 from chaingeo.kinematics import Assembly, legal_moves, state_key
+from chaingeo.level import Level
 
 
 def reference_rate(
