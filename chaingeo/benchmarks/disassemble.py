@@ -62,10 +62,7 @@ def _ours(
     from solvers.disassemble import analyze
 
     t0 = time.perf_counter()
-    if level is not None:
-        result = analyze_level(level)
-    else:
-        result = analyze(shapes, max_group=max_group)
+    result = analyze_level(level) if level is not None else analyze(shapes, max_group=max_group)
     seconds = time.perf_counter() - t0
     info: dict[str, object] = {
         "level": result.level,
