@@ -291,6 +291,38 @@ def disassembly_of_assembly_plan(moves: Sequence[Move]) -> list[Move]:
     return [m.inverse() for m in reversed(moves)]
 
 
+def insertion_shifts(moving: Iterable[Cell], fixed: Iterable[Cell], direction: str) -> list[Cell]:
+    """Every translation ``t`` (lexicographic order) by which the cells ``moving`` can come in
+    along ``direction`` from infinitely far and land next to ``fixed``: nothing overlaps, the
+    way in is free, and the two bounding boxes touch or overlap on every axis (the bound that
+    keeps an assembly's action set finite). The reference for the numba kernel of
+    :mod:`chaingeo.insertions`."""
+    acells, bcells = list(moving), list(fixed)
+    d = DIRECTIONS[direction]
+    axis = next(i for i in range(3) if d[i])
+    sign = d[axis]
+    lat = [i for i in range(3) if i != axis]
+    # lines[lateral] = axis values v of the shifts that overlap b (t in D iff a + t meets b)
+    lines: dict[tuple[int, int], list[int]] = {}
+    for a in acells:
+        for b in bcells:
+            v = (b[0] - a[0], b[1] - a[1], b[2] - a[2])
+            lines.setdefault((v[lat[0]], v[lat[1]]), []).append(v[axis])
+    bound = {k: (min(vs), max(vs)) for k, vs in lines.items()}
+    lo = [min(c[i] for c in bcells) - 1 - max(c[i] for c in acells) for i in range(3)]
+    hi = [max(c[i] for c in bcells) + 1 - min(c[i] for c in acells) for i in range(3)]
+    out: list[Cell] = []
+    for t0 in range(lo[0], hi[0] + 1):
+        for t1 in range(lo[1], hi[1] + 1):
+            for t2 in range(lo[2], hi[2] + 1):
+                t = (t0, t1, t2)
+                line = bound.get((t[lat[0]], t[lat[1]]))
+                if line is not None and (t[axis] >= line[0] if sign > 0 else t[axis] <= line[1]):
+                    continue  # the way back out along -direction meets b
+                out.append(t)
+    return out
+
+
 # ---------------------------------------------------------------------------------------------
 # Reference searches (pure Python): the oracle the numba search is tested and timed against
 # ---------------------------------------------------------------------------------------------

@@ -40,6 +40,9 @@ from collections.abc import Hashable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
+from chaingeo.action_list import ActionList
 from chaingeo.actions import (
     Action,
     AmbiguousActionError,
@@ -56,12 +59,22 @@ from chaingeo.kinematics import (
     Assembly,
     Move,
     disassembly_of_assembly_plan,
-    legal_moves,
-    movable_groups,
 )
 from chaingeo.level import Level, PuzzleSolution
+from chaingeo.puzzle_actions import (
+    MoveRange,
+    assembly_actions,
+    disassembly_actions,
+    part_cells,
+    shifts,
+)
 from chaingeo.rules import PuzzleRules
 from chaingeo.state import BaseState
+from solvers.partsearch import PieceTable
+
+#: a position (kept alive so its id stays its own), its moves by (group, direction), its actions
+_Listed = tuple[Assembly, dict[tuple[tuple[str, ...], str], MoveRange], ActionList]
+_CACHED_POSITIONS = 8
 
 PartKey = tuple[tuple[str, Cell], ...]
 PositionKey = tuple[PartKey, ...]
@@ -105,6 +118,7 @@ class PuzzleTables:
         self.names: tuple[str, ...] = tuple(sorted(self.shapes))
         self.max_group: int | None = level.rules.max_group
         self.target_key: PositionKey = normal_key(Assembly.assembled(self.shapes))
+        self.piece_table = PieceTable(self.shapes)
         #: assembly only: normalised states on the recorded plan -> how far along they are.
         self.path: dict[PositionKey, int] = {}
         if self.mode == "assemble":
@@ -141,6 +155,9 @@ class PuzzleState(BaseState):
             )
         else:
             self._asm = Assembly.assembled(self.tables.shapes)
+        #: legal actions of recent positions by id(assembly), shared with clones (an agent's
+        #: clone and the state it came from look at the same position)
+        self._legal_cache: dict[int, _Listed] = {}
 
     # -- position -----------------------------------------------------------------------------
     @property
@@ -173,32 +190,31 @@ class PuzzleState(BaseState):
         return normal_key(self._asm) == self.tables.target_key
 
     # -- legal actions ------------------------------------------------------------------------
-    def _legal_moves(self) -> list[Action]:
-        if self.mode == "disassemble":
-            return [MoveAction(m) for m in legal_moves(self._asm, self.tables.max_group)]
-        out: list[Action] = [MoveAction(m) for m in self._slides()]
-        for ins in self._insertions():
-            out.append(self._insertion_action(ins))
-        return sorted(out)
+    def _legal_moves(self) -> Sequence[Action]:
+        return self._actions()[1]
 
-    def _slides(
-        self, pieces: Sequence[str] | None = None, direction: str | None = None
-    ) -> list[Move]:
-        """Assembly slides (finite moves within a part), optionally of one group/direction."""
-        asm = self._asm
-        out: list[Move] = []
-        for d in DIRECTIONS if direction is None else (direction,):
-            for group in movable_groups(asm, d):
-                if pieces is not None and tuple(sorted(pieces)) != group:
-                    continue
-                if self.tables.max_group is not None and len(group) > self.tables.max_group:
-                    continue
-                if self._undoes_removal(group, d):
-                    continue
-                free = asm.free_distance(group, d)
-                top = asm.clearance(group, d) - 1 if free is None else free
-                out.extend(Move(group, d, k) for k in range(1, top + 1))
-        return out
+    def _actions(self) -> tuple[dict[tuple[tuple[str, ...], str], MoveRange], ActionList]:
+        """(the moves of groups within a part by (group, direction), every legal action) of
+        this position, computed once per position. Disassembling, the first are every move."""
+        cached = self._legal_cache.get(id(self._asm))
+        if cached is not None and cached[0] is self._asm:
+            return cached[1], cached[2]
+        table, mg = self.tables.piece_table, self.tables.max_group
+        if self.mode == "disassemble":
+            ranges = disassembly_actions(self._asm, mg, table)
+            actions = ActionList(ranges)
+        else:
+            ranges, actions = assembly_actions(self._asm, mg, table)
+        by_group = {(r.pieces, r.direction): r for r in ranges}
+        if len(self._legal_cache) >= _CACHED_POSITIONS:
+            del self._legal_cache[next(iter(self._legal_cache))]
+        self._legal_cache[id(self._asm)] = (self._asm, by_group, actions)
+        return by_group, actions
+
+    def _slides(self, pieces: Sequence[str], direction: str) -> list[Action]:
+        """The moves of one group along one direction (assembling: its slides)."""
+        moves = self._actions()[0].get((tuple(sorted(pieces)), direction))
+        return [] if moves is None else list(moves)
 
     def _undoes_removal(self, group: Sequence[str], direction: str) -> bool:
         """Clear of the rest on the side it moves away from, and free to leave that way."""
@@ -243,32 +259,9 @@ class PuzzleState(BaseState):
 
     def _shifts(self, a: frozenset[str], b: frozenset[str], direction: str) -> list[Cell]:
         """Every translation of part ``a`` that makes it come in along ``direction`` and join
-        ``b``: free path in from infinity, no overlap, bounding boxes touching or overlapping."""
-        acells = [c for n in sorted(a) for c in self._asm.cells_of(n)]
-        bcells = [c for n in sorted(b) for c in self._asm.cells_of(n)]
-        axis, sign = _axis(direction)
-        lat = [i for i in range(3) if i != axis]
-        # lines[lateral] = axis values v of the shifts that overlap b (t in D iff a + t meets b)
-        lines: dict[tuple[int, int], list[int]] = {}
-        for ax, ay, az in acells:
-            for bx, by, bz in bcells:
-                v = (bx - ax, by - ay, bz - az)
-                lines.setdefault((v[lat[0]], v[lat[1]]), []).append(v[axis])
-        bound = {k: (min(vs), max(vs)) for k, vs in lines.items()}
-        lo = [min(c[i] for c in bcells) - 1 - max(c[i] for c in acells) for i in range(3)]
-        hi = [max(c[i] for c in bcells) + 1 - min(c[i] for c in acells) for i in range(3)]
-        out: list[Cell] = []
-        for t0 in range(lo[0], hi[0] + 1):
-            for t1 in range(lo[1], hi[1] + 1):
-                for t2 in range(lo[2], hi[2] + 1):
-                    t = (t0, t1, t2)
-                    line = bound.get((t[lat[0]], t[lat[1]]))
-                    if line is not None and (
-                        t[axis] >= line[0] if sign > 0 else t[axis] <= line[1]
-                    ):
-                        continue  # the way back out along -direction meets b
-                    out.append(t)
-        return out
+        ``b`` (:func:`chaingeo.kinematics.insertion_shifts`, computed by the fast kernel)."""
+        rows = shifts(part_cells(self._asm, a), part_cells(self._asm, b), direction)
+        return [(int(x), int(y), int(z)) for x, y, z in rows]
 
     def _insertion_action(self, ins: Insertion) -> MoveAction:
         return MoveAction(
@@ -310,11 +303,7 @@ class PuzzleState(BaseState):
                 )
             if req.distance_given:
                 return MoveAction(Move(req.pieces, req.direction, req.distance))
-            cands: list[Action] = [
-                MoveAction(m)
-                for m in legal_moves(self._asm, self.tables.max_group)
-                if m.pieces == req.pieces and m.direction == req.direction
-            ]
+            cands = self._slides(req.pieces, req.direction)
             return self._one_of(cands, Move(req.pieces, req.direction, 1), text)
         part = self._part_of_group(req.pieces, text)
         if part == frozenset(req.pieces):  # a whole part: an insertion
@@ -335,7 +324,7 @@ class PuzzleState(BaseState):
             )
         if req.distance_given:
             return MoveAction(Move(req.pieces, req.direction, req.distance))
-        slides: list[Action] = [MoveAction(m) for m in self._slides(req.pieces, req.direction)]
+        slides = self._slides(req.pieces, req.direction)
         return self._one_of(slides, Move(req.pieces, req.direction, 1), text)
 
     def _one_of(self, cands: list[Action], probe: Move, text: str) -> Action:
@@ -414,6 +403,10 @@ class PuzzleState(BaseState):
         if not isinstance(action, MoveAction):
             return "this is a puzzle level: use move or finish"
         move = action.move
+        if action.into is None and action.offset is None:  # fast path: a listed move is legal
+            listed = self._actions()[0].get((move.pieces, move.direction))
+            if listed is not None and action in listed:
+                return None
         unknown = sorted(set(move.pieces) - set(self.tables.names))
         if unknown:
             return f"unknown piece {unknown[0]!r}"
@@ -495,7 +488,8 @@ class PuzzleState(BaseState):
         if move.distance is not None:
             return "an insertion comes in from infinity: its distance is inf"
         shift = self._shift_of(part, into, action.offset)
-        if shift in self._shifts(part, into, move.direction):
+        rows = shifts(part_cells(self._asm, part), part_cells(self._asm, into), move.direction)
+        if bool(np.any(np.all(rows == np.asarray(shift, dtype=np.int64), axis=1))):
             return None
         return self._why_no_insertion(part, into, move.direction, shift)
 

@@ -15,10 +15,11 @@ the steps used, not the history), so searches can use it for transpositions.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Hashable
+from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar, runtime_checkable
 
+from chaingeo.action_list import ActionList
 from chaingeo.actions import (
     Action,
     ActionError,
@@ -69,7 +70,7 @@ class GameState(Protocol):
     def finished(self) -> bool: ...
     @property
     def history(self) -> list[Turn]: ...
-    def legal_actions(self) -> list[Action]: ...
+    def legal_actions(self) -> Sequence[Action]: ...
     def resolve(self, action: Action | MoveRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
     def apply(self, action: Action) -> None: ...
@@ -113,7 +114,7 @@ class BaseState(ABC):
     def _position_key(self) -> Hashable: ...
 
     @abstractmethod
-    def _legal_moves(self) -> list[Action]:
+    def _legal_moves(self) -> Sequence[Action]:
         """Every legal action except ``finish`` (sorted)."""
 
     @abstractmethod
@@ -165,10 +166,12 @@ class BaseState(ABC):
     def key(self) -> Hashable:
         return (self._position_key(), self._finished)
 
-    def legal_actions(self) -> list[Action]:
+    def legal_actions(self) -> Sequence[Action]:
+        """Every legal action, sorted, ``finish`` last. A read-only sequence whose members
+        may be built on demand (see :mod:`chaingeo.action_list`): index it, don't copy it."""
         if self._finished:
             return []
-        return [*self._legal_moves(), FinishAction()]
+        return ActionList([self._legal_moves(), [FinishAction()]])
 
     def problem(self, action: Action) -> str | None:
         if self._finished:

@@ -1,10 +1,12 @@
 """The shipped 32-level puzzle suite (``levels/puzzle``), rebuilt byte for byte from fixed seeds.
 
-``chain generate puzzle-suite [--out levels/puzzle]`` walks :data:`SUITE` in order: for each
-entry it tries items ``0, 1, 2, ...`` of the entry's seed with :func:`generator.puzzle.make`
-and keeps the first ones whose difficulty (computed from the solver's figures, see
-:func:`generator.puzzle.difficulty_of`) is the entry's and whose signature is new. Every search
-is bounded by state caps only, never by time, so every machine makes the same files.
+``chain generate puzzle-suite [--out levels/puzzle] [--jobs N]``: for each entry of
+:data:`SUITE` it tries items ``0, 1, 2, ...`` of the entry's seed with
+:func:`generator.puzzle.make` and keeps the first ones whose difficulty (computed from the
+solver's figures, see :func:`generator.puzzle.difficulty_of`) is the entry's and whose signature
+is new within the entry; a puzzle made by two entries stops the build (change a seed). Entries
+are independent, so they run in parallel; ids are then given in :data:`SUITE` order. Every
+search is bounded by state caps only, never by time, so every machine makes the same files.
 """
 
 from __future__ import annotations
@@ -52,31 +54,59 @@ SUITE: tuple[SuiteEntry, ...] = (
 )
 
 
+def entry_items(entry: SuiteEntry, max_items: int = 400) -> list[Level]:
+    """The first ``entry.count`` items of the entry's seed with its difficulty and distinct
+    signatures (ids not yet given). Entries are independent, so they can run in parallel."""
+    seen: set[str] = set()
+    made: list[Level] = []
+    for index in range(max_items):
+        if len(made) == entry.count:
+            break
+        goal = entry.goals[len(made)]
+        item = make(dataclasses.replace(entry.config, goal=goal), entry.seed, index)  # type: ignore[arg-type]
+        if isinstance(item, Rejection):
+            continue
+        if item.difficulty != entry.difficulty or item.provenance.signature in seen:
+            continue
+        seen.add(item.provenance.signature)
+        made.append(item)
+    if len(made) < entry.count:
+        raise RuntimeError(
+            f"only {len(made)} of {entry.count} {entry.difficulty} {entry.config.shape} levels "
+            f"from seed {entry.seed} in {max_items} items"
+        )
+    return made
+
+
 def build_puzzle_suite(
     out: Path,
     *,
     max_items: int = 400,
+    jobs: int = 1,
     log: Callable[[str], None] | None = None,
 ) -> list[Level]:
-    """Generate every entry of :data:`SUITE` into ``out`` (old ``puzzle-*.json`` removed)."""
+    """Generate every entry of :data:`SUITE` into ``out`` (old ``puzzle-*.json`` removed);
+    ``jobs`` entries at a time (joblib processes), the same bytes for any ``jobs``."""
+    if jobs > 1:
+        from joblib import Parallel, delayed
+
+        per_entry = Parallel(n_jobs=jobs)(delayed(entry_items)(e, max_items) for e in SUITE)
+    else:
+        per_entry = [entry_items(e, max_items) for e in SUITE]
+    owner: dict[str, str] = {}
+    for entry, items in zip(SUITE, per_entry, strict=True):
+        for item in items:
+            where = f"{entry.config.shape} seed {entry.seed}"
+            first = owner.setdefault(item.provenance.signature, where)
+            if first != where:
+                raise RuntimeError(f"the same puzzle comes from {first} and {where}: change a seed")
     out.mkdir(parents=True, exist_ok=True)
     for old in sorted(out.glob("puzzle-*.json")):
         old.unlink()
-    seen: set[str] = set()
     made: list[Level] = []
     number = {"easy": 0, "mid": 0, "hard": 0}
-    for entry in SUITE:
-        got = 0
-        for index in range(max_items):
-            if got == entry.count:
-                break
-            goal = entry.goals[got]
-            item = make(dataclasses.replace(entry.config, goal=goal), entry.seed, index)  # type: ignore[arg-type]
-            if isinstance(item, Rejection):
-                continue
-            if item.difficulty != entry.difficulty or item.provenance.signature in seen:
-                continue
-            seen.add(item.provenance.signature)
+    for entry, items in zip(SUITE, per_entry, strict=True):
+        for item in items:
             number[entry.difficulty] += 1
             level_id = (
                 f"puzzle-{entry.difficulty}-{number[entry.difficulty]:02d}-{entry.config.shape}"
@@ -84,14 +114,8 @@ def build_puzzle_suite(
             level = revalidate(dataclasses.replace(item, id=level_id))
             save_level(level, out / f"{level_id}.json")
             made.append(level)
-            got += 1
             if log is not None:
                 log(
                     f"{level_id}: optimal_steps {level.optimal_steps}, level {level.stats['level']}"
                 )
-        if got < entry.count:
-            raise RuntimeError(
-                f"only {got} of {entry.count} {entry.difficulty} {entry.config.shape} levels "
-                f"from seed {entry.seed} in {max_items} items"
-            )
     return made

@@ -62,6 +62,14 @@ def _is_finish(action: Any) -> bool:
     return bool(action.to_text() == "finish")
 
 
+def _move_count(actions: Sequence[Any]) -> int:
+    """How many of ``actions`` are not ``finish``: a state lists finish last, so the moves are
+    ``actions[:n]``. Counted without building the actions (an assembly state can offer a
+    hundred thousand insertions, built only when indexed)."""
+    n = len(actions)
+    return n - 1 if n and _is_finish(actions[n - 1]) else n
+
+
 class _Seeded(Agent):
     needs_state = True
     uses_images = False
@@ -101,10 +109,11 @@ class RandomAgent(_Seeded):
     name = "random"
 
     def choose(self, state: StateLike, turn: Turn) -> str:
-        actions = [a for a in state.legal_actions() if not _is_finish(a)]
-        if not actions:
+        actions = state.legal_actions()
+        n = _move_count(actions)
+        if n == 0:
             return "finish"
-        return str(actions[int(self._rng.integers(len(actions)))].to_text())
+        return str(actions[int(self._rng.integers(n))].to_text())
 
 
 def _step_kind(action: Any) -> int:
@@ -135,7 +144,12 @@ def _progress(before: StateLike, action: Any, after: StateLike) -> int:
 
 
 def _options_left(state: StateLike) -> int:
-    return sum(1 for a in state.legal_actions() if _step_kind(a) >= 0 and not _is_finish(a))
+    """Legal moves that are not a step back (pickups); a puzzle has none, so its count needs
+    no action built."""
+    actions = state.legal_actions()
+    if getattr(state, "placed", None) is None:
+        return _move_count(actions)
+    return sum(1 for a in actions if _step_kind(a) >= 0 and not _is_finish(a))
 
 
 class GreedyAgent(_Seeded):
@@ -155,16 +169,19 @@ class GreedyAgent(_Seeded):
 
     def choose(self, state: StateLike, turn: Turn) -> str:
         self._seen.add(state.key())
-        actions = [a for a in state.legal_actions() if not _is_finish(a)]
-        if not actions:
+        legal = state.legal_actions()
+        n = _move_count(legal)
+        if n == 0:
             return "finish"
         lookahead = self.lookahead
-        if len(actions) > self.max_candidates:
-            keep = self._rng.choice(len(actions), size=self.max_candidates, replace=False)
-            actions = [actions[i] for i in sorted(int(k) for k in keep)]
+        indices: Sequence[int] = range(n)
+        if n > self.max_candidates:
+            keep = self._rng.choice(n, size=self.max_candidates, replace=False)
+            indices = sorted(int(k) for k in keep)
             lookahead = 0
         scored: list[tuple[int, int, float, Any, StateLike]] = []
-        for a in actions:
+        for i in indices:
+            a = legal[i]
             after = state.clone()
             after.apply(a)
             if after.is_success():

@@ -193,6 +193,7 @@ def _run_puzzle(args: argparse.Namespace) -> int:
 def _register_puzzle_suite(fam: Any) -> None:
     p = fam.add_parser("puzzle-suite", help="rebuild the shipped 32-level puzzle suite")
     p.add_argument("--out", type=Path, default=Path("levels") / "puzzle", help="target folder")
+    p.add_argument("--jobs", type=int, default=1, help="suite entries built in parallel")
     p.set_defaults(func=_run_puzzle_suite)
 
 
@@ -203,7 +204,9 @@ def _run_puzzle_suite(args: argparse.Namespace) -> int:
     from generator.puzzle_suite import build_puzzle_suite
 
     try:
-        levels = build_puzzle_suite(args.out, log=lambda s: print(s, file=sys.stderr, flush=True))
+        levels = build_puzzle_suite(
+            args.out, jobs=args.jobs, log=lambda s: print(s, file=sys.stderr, flush=True)
+        )
     except RuntimeError as e:
         raise CommandError(str(e)) from None
     print(json.dumps({"suite": str(args.out), "levels": len(levels)}))
