@@ -19,7 +19,7 @@ import numpy as np
 
 from chaingeo.colors import assign_colors
 from chaingeo.geometry import NEIGHBOURS, Cell, Shape, puzzle_signature
-from chaingeo.kinematics import SearchLimitError
+from chaingeo.kinematics import Move, SearchLimitError
 from chaingeo.level import (
     Difficulty,
     Level,
@@ -217,15 +217,25 @@ def _maze_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Can
     return _Candidate([plate, pin], result)
 
 
+def _last_piece(plan: Sequence[Move], n: int) -> str | None:
+    """The piece a full single-piece plan never takes out (it is left alone at the end), if
+    it never moves either."""
+    moved = {p for m in plan for p in m.pieces}
+    left = [f"p{i}" for i in range(n) if f"p{i}" not in moved]
+    return left[0] if len(left) == 1 else None
+
+
 def _tower_search(config: PuzzleConfig, units: int, rng: np.random.Generator) -> _Candidate | None:
     """A tower of ``units`` burr units (layout ``burr{6*units}``), each unit designed and
     climbed on its own as a six-piece burr (the units share no cells), then stacked. A unit is
-    kept when its optimal plan never moves down, so that the tower can be taken apart unit by
-    unit from the top in the block bound's number of moves (:mod:`solvers.blockbound`)."""
+    kept when its optimal plan never moves down and leaves one of its z-sticks (slots 4, 5)
+    unmoved to the end, so that the tower can be taken apart unit by unit from the top in the
+    block bound's number of moves, each unit's last piece touching the unit below as it leaves
+    (:mod:`solvers.blockbound`)."""
     unit_config = replace(config, shape="burr6", min_level=1)
     shapes: list[Shape] = []
     for u in range(units):
-        for _ in range(20):  # a unit whose optimal plan lets it leave the top of the stack
+        for _ in range(60):  # a unit whose optimal plan lets it leave the top of the stack
             unit = _layout_search(unit_config, rng)
             if unit is None:
                 continue
@@ -234,7 +244,10 @@ def _tower_search(config: PuzzleConfig, units: int, rng: np.random.Generator) ->
                 plan = analyze(named, max_group=1, optimal=True).plan
             except SearchLimitError:
                 continue
-            if any(m.direction == "-z" for m in plan):
+            if any(m.direction == "-z" for m in plan) or _last_piece(plan, len(named)) not in (
+                "p4",
+                "p5",
+            ):
                 continue
             shapes.extend(s.translate((0, 0, 6 * u)) for s in unit.shapes)
             break

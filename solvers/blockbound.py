@@ -84,6 +84,32 @@ def _block_plans(
     return plans
 
 
+def _boxes_touch(state: Assembly, *names: str) -> bool:
+    """Do the bounding boxes of ``names`` and the rest of their part touch or overlap on every
+    axis? (Played backwards, the removal is an insertion, which the assemble game allows only
+    then: :mod:`chaingeo.puzzle`.)"""
+    mine = [c for n in names for c in state.cells_of(n)]
+    others = sorted(state.part_of(names[0]) - set(names))
+    rest = [c for n in others for c in state.cells_of(n)]
+    for a in range(3):
+        lo, hi = min(c[a] for c in mine), max(c[a] for c in mine)
+        rlo, rhi = min(c[a] for c in rest), max(c[a] for c in rest)
+        if lo > rhi + 1 or rlo > hi + 1:
+            return False
+    return True
+
+
+def removals_touch(shapes: Mapping[str, Shape], plan: Sequence[Move]) -> bool:
+    """Does every removal of ``plan`` take out a group whose bounding box touches the rest of
+    its part (:func:`_boxes_touch`, for groups)?"""
+    state = Assembly.assembled(shapes)
+    for move in plan:
+        if state.removes(move) and not _boxes_touch(state, *move.pieces):
+            return False
+        state = state.apply(move)
+    return True
+
+
 def end_first_plan(
     shapes: Mapping[str, Shape],
     blocks: Sequence[Sequence[str]],
@@ -97,7 +123,8 @@ def end_first_plan(
     ``-axis``: its pieces stay at or above their own layers, so the blocks below never meet
     them, and its last piece then leaves along ``+axis``. Otherwise the block at the bottom
     when its plan never moves along ``+axis`` (mirrored). Every move is checked with the
-    reference kinematics.
+    reference kinematics, and a last piece must touch the rest of its part when it leaves (so
+    the plan played backwards stays within the assemble game's insertions).
     """
     state = Assembly.assembled(shapes)
     out: list[Move] = []
@@ -115,6 +142,8 @@ def end_first_plan(
                 out.append(move)
             for name in sorted(blocks[i]):
                 if len(state.part_of(name)) > 1:
+                    if not _boxes_touch(state, name):
+                        return None
                     move = Move((name,), up, None)
                     state = state.apply(move)
                     out.append(move)
@@ -146,11 +175,13 @@ def analyze_by_blocks(
         raise ValueError("the blocks must split the pieces: every name in exactly one block")
     bound = len(names) - 1 + sum(len(p) - (len(b) - 1) for p, b in zip(plans, blocks, strict=True))
     quick = analyze(shapes, max_group=1, limits=limits, optimal=False)
-    if not quick.disassemblable or quick.moves == bound:
+    if not quick.disassemblable:
+        return quick
+    if quick.moves == bound and (not stacked or removals_touch(shapes, quick.plan)):
         return dataclasses.replace(quick, optimal_steps=quick.moves)
     if stacked:
         plan = end_first_plan(shapes, blocks, plans)
-        if plan is not None and len(plan) == bound:
+        if plan is not None and len(plan) == bound and removals_touch(shapes, plan):
             return dataclasses.replace(quick, optimal_steps=bound, plan=tuple(plan))
     if not search:
         raise SearchLimitError(f"no quick plan meets the block bound {bound} (best {quick.moves})")
