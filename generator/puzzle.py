@@ -1,10 +1,10 @@
 """Interlocking-puzzle generator: one pure function ``make(config, seed, index)``.
 
 A candidate is a random design of a layout (:mod:`generator.layouts`: who owns each shared
-cell of a burr, a plate burr or a chain of burr units) or a random partition of an n x n x n
-cube into face-connected pieces. It is then improved by hill climbing on single voxels (give one
-shared cell to another slot, or move one cube voxel to a neighbouring piece), keeping a change
-when the puzzle still comes apart and its (level, total moves) does not drop. The result is
+cell of a burr, a plate burr or a chain of burr units), improved by hill climbing on single
+voxels (give one shared cell to another slot), keeping a change when the puzzle still comes
+apart and its (level, total moves) does not drop; or an interlocking partition of an n x n x n
+cube (:mod:`generator.cubes`). The result is
 accepted when it reaches ``min_level``; its optimal plan (o_i) is then computed exactly and the
 level file is built and verified. Everything random comes from ``SeedSequence([seed, index])``.
 """
@@ -12,14 +12,14 @@ level file is built and verified. Everything random comes from ``SeedSequence([s
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from typing import Literal
 
 import numpy as np
 
 from chaingeo.colors import assign_colors
-from chaingeo.geometry import NEIGHBOURS, Cell, Shape, puzzle_signature
-from chaingeo.kinematics import Move, SearchLimitError
+from chaingeo.geometry import Shape, puzzle_signature
+from chaingeo.kinematics import SearchLimitError
 from chaingeo.level import (
     Difficulty,
     Level,
@@ -30,17 +30,17 @@ from chaingeo.level import (
     revalidate,
 )
 from chaingeo.rules import PuzzleRules
-from generator.layouts import cube_cells, get_layout
-from generator.maze import maze_search, parse_maze_shape, runs, with_exit
+from generator.candidate import Candidate, evaluate
+from generator.cubes import cube_search, interlocking_target
+from generator.deep import TOWERS, maze_candidate, tower_candidate
+from generator.layouts import get_layout
+from generator.maze import parse_maze_shape
 from generator.result import Rejection
 from solvers.blockbound import analyze_by_blocks
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
 
 GENERATOR = "chaingeo.generator.puzzle"
-#: Towers of burr units; with single-piece moves (max_group=1) they are built unit by unit and
-#: their o_i is proven with the block bound (:mod:`solvers.blockbound`), one block per unit.
-TOWERS = {"burr12": 2, "burr18": 3, "burr24": 4, "burr36": 6}
 VERSION = "1"
 
 
@@ -48,13 +48,15 @@ VERSION = "1"
 class PuzzleConfig:
     """What to make. ``shape``: a layout name (burr6, burr3, plate3, burr10, burr14, burr18,
     burr34), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
-    of ``hill_steps`` walks); ``min_level``: moves until the first part comes free."""
+    of ``hill_steps`` walks); ``min_level``: moves until the first part comes free. Towers
+    (burr12..burr36) with ``max_group=1`` are built unit by unit (:mod:`generator.deep`)."""
 
     shape: str = "burr6"
     min_level: int = 1
     pieces: int = 0  # cube partitions only
-    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs)
-    hill_steps: int = 300
+    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs); cubes:
+    # the share of inner cells left empty (at least one, see generator.cubes)
+    hill_steps: int = 300  # improvement steps (cubes: steering one level deeper at a time)
     goal: Literal["disassemble", "assemble"] = "disassemble"
     max_group: int | None = None
     seconds: float | None = None  # optional time limit of each search (machine-dependent!)
@@ -64,39 +66,6 @@ class PuzzleConfig:
 
     def to_json(self) -> dict[str, object]:
         return asdict(self)
-
-
-Score = tuple[int, int]
-
-
-class _Candidate:
-    """One puzzle being improved: its pieces and how well it scores."""
-
-    def __init__(self, shapes: list[Shape], analysis: Analysis) -> None:
-        self.shapes = shapes
-        self.analysis = analysis
-
-    @property
-    def score(self) -> Score:
-        a = self.analysis
-        return (a.first_level or 0, a.moves or 0)
-
-
-def _evaluate(shapes: Sequence[Shape], config: PuzzleConfig) -> Analysis | None:
-    """The BurrTools-style analysis, or None if a piece is broken or the puzzle is stuck."""
-    if any(len(s) == 0 or not s.is_connected() for s in shapes):
-        return None
-    named = {f"p{i:02d}": s for i, s in enumerate(shapes)}
-    limits = SearchLimits(
-        max_states=config.probe_states,
-        seconds=config.seconds,
-        max_total_states=10 * config.probe_states,
-    )
-    try:
-        result = analyze(named, max_group=config.max_group, limits=limits, optimal=False)
-    except SearchLimitError:
-        return None
-    return result if result.disassemblable else None
 
 
 def _broken(shapes: Sequence[Shape]) -> int:
@@ -109,7 +78,7 @@ def _mutate(owners: Sequence[int], current: int, hole_rate: float, rng: np.rando
     return int(choices[int(rng.integers(len(choices)))]) if choices else current
 
 
-def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate | None:
+def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> Candidate | None:
     layout = get_layout(config.shape)
     shared = layout.shared
     options = [layout.owners(c) for c in shared]
@@ -117,7 +86,7 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate
         -1 if rng.random() < config.hole_rate else int(opts[rng.integers(len(opts))])
         for opts in options
     ]
-    best: _Candidate | None = None
+    best: Candidate | None = None
     for _ in range(40):  # repair towards connected pieces, then look for one that comes apart
         for _ in range(400):
             broken = _broken(layout.pieces(design))
@@ -129,9 +98,9 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate
             if _broken(layout.pieces(design)) > broken:
                 design[i] = old
         shapes = layout.pieces(design)
-        result = _evaluate(shapes, config)
+        result = evaluate(shapes, config)
         if result is not None:
-            best = _Candidate(shapes, result)
+            best = Candidate(shapes, result)
             break
         for _ in range(3):  # shake and retry
             i = int(rng.integers(len(design)))
@@ -143,118 +112,12 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> _Candidate
         old = design[i]
         design[i] = _mutate(options[i], old, config.hole_rate, rng)
         shapes = layout.pieces(design)
-        result = _evaluate(shapes, config)
-        if result is not None and _Candidate(shapes, result).score >= best.score:
-            best = _Candidate(shapes, result)
+        result = evaluate(shapes, config)
+        if result is not None and Candidate(shapes, result).score >= best.score:
+            best = Candidate(shapes, result)
         else:
             design[i] = old
     return best
-
-
-def _cube_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Candidate | None:
-    cells = cube_cells(n)
-    k = config.pieces or max(3, n)
-    if not 2 <= k <= len(cells):
-        raise ValueError(f"a {n}x{n}x{n} cube cannot be cut into {k} pieces")
-    owner: dict[Cell, int] = {}
-    for i, j in enumerate(rng.permutation(len(cells))[:k]):
-        owner[cells[int(j)]] = i
-    while len(owner) < len(cells):
-        frontier = sorted(
-            {
-                (nb, owner[c])
-                for c in owner
-                for d in NEIGHBOURS
-                if (nb := (c[0] + d[0], c[1] + d[1], c[2] + d[2])) not in owner
-                and all(0 <= v < n for v in nb)
-            }
-        )
-        cell, who = frontier[int(rng.integers(len(frontier)))]
-        owner[cell] = who
-
-    def shapes_of(own: dict[Cell, int]) -> list[Shape]:
-        groups: list[list[Cell]] = [[] for _ in range(k)]
-        for c, w in sorted(own.items()):
-            groups[w].append(c)
-        return [Shape(g) for g in groups]
-
-    shapes = shapes_of(owner)
-    result = _evaluate(shapes, config)
-    best = _Candidate(shapes, result) if result is not None else None
-    for _ in range(config.hill_steps):
-        c = cells[int(rng.integers(len(cells)))]
-        near = sorted(
-            {
-                owner[nb]
-                for d in NEIGHBOURS
-                if (nb := (c[0] + d[0], c[1] + d[1], c[2] + d[2])) in owner
-                and owner[nb] != owner[c]
-            }
-        )
-        if not near:
-            continue
-        old = owner[c]
-        owner[c] = near[int(rng.integers(len(near)))]
-        shapes = shapes_of(owner)
-        result = _evaluate(shapes, config) if len(shapes[old]) >= 2 else None
-        if result is not None and (best is None or _Candidate(shapes, result).score >= best.score):
-            best = _Candidate(shapes, result)
-        else:
-            owner[c] = old
-    return best
-
-
-def _maze_search(config: PuzzleConfig, n: int, rng: np.random.Generator) -> _Candidate | None:
-    """A maze burr (:mod:`generator.maze`): ``hill_steps`` random walks, the one with the most
-    straight runs kept; its level is measured by the solver and must equal the runs."""
-    found = maze_search(n, config.min_level, config.hill_steps, rng)
-    if found is None:
-        return None
-    path, plate, pin = found
-    result = _evaluate([plate, pin], config)
-    if result is None or result.first_level != runs(with_exit(path, n)):
-        raise RuntimeError(f"maze construction broken: runs {runs(with_exit(path, n))}, {result}")
-    return _Candidate([plate, pin], result)
-
-
-def _last_piece(plan: Sequence[Move], n: int) -> str | None:
-    """The piece a full single-piece plan never takes out (it is left alone at the end), if
-    it never moves either."""
-    moved = {p for m in plan for p in m.pieces}
-    left = [f"p{i}" for i in range(n) if f"p{i}" not in moved]
-    return left[0] if len(left) == 1 else None
-
-
-def _tower_search(config: PuzzleConfig, units: int, rng: np.random.Generator) -> _Candidate | None:
-    """A tower of ``units`` burr units (layout ``burr{6*units}``), each unit designed and
-    climbed on its own as a six-piece burr (the units share no cells), then stacked. A unit is
-    kept when its optimal plan never moves down and leaves one of its z-sticks (slots 4, 5)
-    unmoved to the end, so that the tower can be taken apart unit by unit from the top in the
-    block bound's number of moves, each unit's last piece touching the unit below as it leaves
-    (:mod:`solvers.blockbound`)."""
-    unit_config = replace(config, shape="burr6", min_level=1)
-    shapes: list[Shape] = []
-    for u in range(units):
-        for _ in range(60):  # a unit whose optimal plan lets it leave the top of the stack
-            unit = _layout_search(unit_config, rng)
-            if unit is None:
-                continue
-            named = {f"p{i}": s for i, s in enumerate(unit.shapes)}
-            try:
-                plan = analyze(named, max_group=1, optimal=True).plan
-            except SearchLimitError:
-                continue
-            if any(m.direction == "-z" for m in plan) or _last_piece(plan, len(named)) not in (
-                "p4",
-                "p5",
-            ):
-                continue
-            shapes.extend(s.translate((0, 0, 6 * u)) for s in unit.shapes)
-            break
-        else:
-            return None
-    result = _evaluate(shapes, replace(config, probe_states=config.max_states))
-    return None if result is None else _Candidate(shapes, result)
 
 
 def difficulty_of(first_level: int, optimal_steps: int, pieces: int) -> Difficulty:
@@ -287,8 +150,8 @@ def puzzle_level(
     For 'assemble' the stored plan is the optimal disassembly reversed with each move inverted
     (the assembly optimum equals the disassembly optimum: the two state graphs are mirror
     images). Raises :class:`SearchLimitError` when o_i cannot be computed within ``limits``.
-    ``blocks`` (indices into ``shapes``; single-piece moves only) proves o_i with the block
-    bound of :mod:`solvers.blockbound`.
+    ``blocks`` (indices into ``shapes``, a stack of units along z; single-piece moves only)
+    proves o_i with the block bound of :mod:`solvers.blockbound` instead of searching.
     """
     base = np.min(np.concatenate([s.voxels for s in shapes]), axis=0)
     placed = [s.translate(-base) for s in shapes]
@@ -360,17 +223,20 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
         try:
             n = int(config.shape[4:])
         except ValueError:
-            raise ValueError(f"cube shapes are cube2..cube5, got {config.shape!r}") from None
-        best = _cube_search(config, n, rng)
+            raise ValueError(f"cube shapes are cube3..cube5, got {config.shape!r}") from None
+        best = cube_search(config, n, rng)
     elif config.shape.startswith("maze"):
-        best = _maze_search(config, parse_maze_shape(config.shape), rng)
+        best = maze_candidate(config, parse_maze_shape(config.shape), rng)
     elif config.max_group == 1 and config.shape in TOWERS:
         units = TOWERS[config.shape]
-        best = _tower_search(config, units, rng)
+        best = tower_candidate(config, units, rng, _layout_search)
         blocks = [list(range(6 * u, 6 * u + 6)) for u in range(units)]
     else:
         best = _layout_search(config, rng)
     if best is None:
+        if config.shape.startswith("cube"):
+            target = interlocking_target(config.min_level)
+            return Rejection(f"no cube design comes apart at level {target} or more", seed, index)
         return Rejection("no design that comes apart", seed, index)
     if best.score[0] < config.min_level:
         return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)

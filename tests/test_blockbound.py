@@ -20,13 +20,9 @@ from solvers.disassemble import analyze
 
 @cache
 def _small_puzzles() -> list[dict[str, Shape]]:
-    """Generated four- and five-piece cube puzzles that come apart with single-piece moves."""
-    out = []
-    for pieces, index in ((4, 0), (4, 1), (4, 2), (5, 0), (5, 1), (5, 3)):
-        config = PuzzleConfig(shape="cube3", pieces=pieces, hill_steps=10, max_group=1)
-        item = make(config, 11, index)
-        if isinstance(item, Level):
-            out.append(item.shapes)
+    """Generated six-piece burrs that come apart with single-piece moves."""
+    config = PuzzleConfig(shape="burr6", hill_steps=0, max_group=1)
+    out = [item.shapes for i in range(4) if isinstance(item := make(config, 11, i), Level)]
     assert len(out) >= 3
     return out
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -16,7 +17,7 @@ from generator.layouts import get_layout
 from generator.puzzle import PuzzleConfig, difficulty_of, make
 from generator.result import Rejection
 
-SMALL = PuzzleConfig(shape="cube3", pieces=4, hill_steps=20)
+SMALL = PuzzleConfig(shape="cube3", pieces=3, hill_steps=20, hole_rate=0.3)
 
 
 def test_layout_designs_are_disjoint_pieces_of_the_slots() -> None:
@@ -40,11 +41,11 @@ def test_make_is_deterministic_and_exact() -> None:
     assert ref is not None and first.optimal_steps == len(ref)
     assert replay_disassembly(first.shapes, first.solution.moves).is_separated()  # type: ignore[union-attr]
     stats = first.stats
-    assert first.difficulty == difficulty_of(stats["first_level"], first.optimal_steps, 4)
+    assert first.difficulty == difficulty_of(stats["first_level"], first.optimal_steps, 3)
 
 
 def test_assemble_goal_stores_the_reversed_plan() -> None:
-    level = make(PuzzleConfig(shape="cube3", pieces=4, hill_steps=20, goal="assemble"), 5, 0)
+    level = make(dataclasses.replace(SMALL, goal="assemble"), 5, 0)
     plain = make(SMALL, 5, 0)
     assert isinstance(level, Level) and isinstance(plain, Level)
     assert level.goal == "assemble" and level.optimal_steps == plain.optimal_steps
@@ -53,13 +54,13 @@ def test_assemble_goal_stores_the_reversed_plan() -> None:
 
 
 def test_rejections_say_why() -> None:
-    item = make(PuzzleConfig(shape="cube3", pieces=4, hill_steps=0, min_level=9), 5, 0)
+    item = make(PuzzleConfig(shape="burr6", hill_steps=0, min_level=9), 5, 0)
     assert isinstance(item, Rejection) and "below 9" in item.reason
 
 
 def test_chain_generate_puzzle(tmp_path: Path, capsys: object) -> None:
     out = tmp_path / "gen"
-    args = ["generate", "puzzle", "--shape", "cube3", "--pieces", "4", "--count", "1"]
+    args = ["generate", "puzzle", "--shape", "cube3", "--pieces", "3", "--count", "1"]
     args += [
         "--seed",
         "5",
@@ -69,6 +70,8 @@ def test_chain_generate_puzzle(tmp_path: Path, capsys: object) -> None:
         "--no-pictures",
         "--hill-steps",
         "20",
+        "--hole-rate",
+        "0.3",
     ]
     assert main(args) == 0
     (path,) = sorted(out.glob("*.json"))

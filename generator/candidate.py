@@ -1,0 +1,64 @@
+"""One puzzle design under improvement, and the solver's verdict on it.
+
+Shared by the layout search (:mod:`generator.puzzle`) and the cube search
+(:mod:`generator.cubes`): a candidate is a list of pieces (assembled position) with the
+BurrTools-style analysis of :func:`solvers.disassemble.analyze`, scored by (level, total moves).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from chaingeo.geometry import Shape
+from chaingeo.kinematics import SearchLimitError
+from solvers.disassemble import Analysis, analyze
+from solvers.partsearch import SearchLimits
+
+if TYPE_CHECKING:  # the config lives with make(); only its type is needed here
+    from generator.puzzle import PuzzleConfig
+
+Score = tuple[int, int]
+
+
+class Candidate:
+    """One puzzle being improved: its pieces and how well it scores."""
+
+    def __init__(self, shapes: list[Shape], analysis: Analysis) -> None:
+        self.shapes = shapes
+        self.analysis = analysis
+
+    @property
+    def score(self) -> Score:
+        a = self.analysis
+        return (a.first_level or 0, a.moves or 0)
+
+
+def probe_limits(config: PuzzleConfig) -> SearchLimits:
+    """The caps of one evaluation while climbing (state caps: the same on every machine)."""
+    return SearchLimits(
+        max_states=config.probe_states,
+        seconds=config.seconds,
+        max_total_states=10 * config.probe_states,
+    )
+
+
+def piece_names(shapes: Sequence[Shape]) -> dict[str, Shape]:
+    """Working names ``p00, p01, ...`` (sorted like the pieces) for the solver."""
+    return {f"p{i:02d}": s for i, s in enumerate(shapes)}
+
+
+def evaluate(shapes: Sequence[Shape], config: PuzzleConfig) -> Analysis | None:
+    """The BurrTools-style analysis, or None if a piece is broken or the puzzle is stuck."""
+    if any(len(s) == 0 or not s.is_connected() for s in shapes):
+        return None
+    try:
+        result = analyze(
+            piece_names(shapes),
+            max_group=config.max_group,
+            limits=probe_limits(config),
+            optimal=False,
+        )
+    except SearchLimitError:
+        return None
+    return result if result.disassemblable else None
