@@ -3,7 +3,8 @@
 A layout is a list of slots (voxel sets) that overlap; a *design* says, for every cell shared by
 two or more slots, which slot owns it (or that it stays empty). Piece ``k`` is its slot's own
 cells plus the shared cells it owns, so any design is a non-overlapping assembly of the target:
-six-piece burrs and towers of stacked burr units (12 pieces and up). Cube
+six-piece burrs, towers of stacked burr units (12 pieces and up), three-piece burrs and
+three-plate burrs. Cube
 layouts instead partition an ``n x n x n`` cube (:func:`cube_cells`), handled by the generator.
 """
 
@@ -76,7 +77,68 @@ def burr_tower(units: int) -> Layout:
     )
 
 
+def _box(lo: Cell, size: Cell) -> Shape:
+    return Shape(
+        [
+            (lo[0] + i, lo[1] + j, lo[2] + k)
+            for i in range(size[0])
+            for j in range(size[1])
+            for k in range(size[2])
+        ]
+    )
+
+
+def three_crossing(
+    name: str, length: int, first: tuple[int, int], second: tuple[int, int], description: str
+) -> Layout:
+    """Three mutually orthogonal boxes in a cyclic ("twisted") arrangement.
+
+    The box along axis ``a`` is ``length`` long on ``a``; on axis ``a + 1`` it covers
+    ``first = (width, start)`` and on axis ``a + 2`` ``second = (width, start)`` (axes mod 3),
+    so the three boxes are images of one another under the cyclic permutation x -> y -> z.
+    When the two starts differ, each box crosses the others off-centre: every stick (or plate)
+    covers only part of the others' paths, which is what lets translation-only designs come
+    apart. Boxes sharing one centred core (equal starts, full cross-sections) are always locked:
+    each piece must keep a bridge through the core, and every bridge lies in the others' paths.
+    """
+    slots = []
+    for axis in range(3):
+        lo = [0, 0, 0]
+        size = [0, 0, 0]
+        size[axis] = length
+        for (width, start), other in ((first, (axis + 1) % 3), (second, (axis + 2) % 3)):
+            lo[other], size[other] = start, width
+        slots.append(_box((lo[0], lo[1], lo[2]), (size[0], size[1], size[2])))
+    return Layout(name, tuple(slots), description)
+
+
+def burr3() -> Layout:
+    """Three-piece burr: three 3x3x7 sticks; each pair overlaps two units deep (38 shared cells;
+    random designs with holes plus hill climbing reach levels 2 to 5, see the README)."""
+    return three_crossing(
+        "burr3",
+        7,
+        (3, 2),
+        (3, 1),
+        "three-piece burr: three 3x3x7 sticks crossing pairwise, off-centre",
+    )
+
+
+def plate3() -> Layout:
+    """Three-plate burr: three notched 6x4x1 plates, each slotted through the other two
+    (10 shared cells; every design that comes apart has level 2 or 3, checked exhaustively)."""
+    return three_crossing(
+        "plate3",
+        6,
+        (4, 1),
+        (1, 2),
+        "three-plate burr: three 6x4x1 notched plates, mutually orthogonal",
+    )
+
+
 LAYOUTS: dict[str, Callable[[], Layout]] = {
+    "burr3": burr3,
+    "plate3": plate3,
     "burr6": burr6,
     "burr12": partial(burr_tower, 2),
     "burr18": partial(burr_tower, 3),

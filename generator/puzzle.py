@@ -46,8 +46,8 @@ VERSION = "1"
 
 @dataclass(frozen=True)
 class PuzzleConfig:
-    """What to make. ``shape``: a layout name (burr6, burr3, plate3, burr10, burr14, burr18,
-    burr34), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
+    """What to make. ``shape``: a layout name (burr3, plate3, burr6, burr12, burr18, burr24,
+    burr36), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
     of ``hill_steps`` walks); ``min_level``: moves until the first part comes free. Towers
     (burr12..burr36) with ``max_group=1`` are built unit by unit (:mod:`generator.deep`)."""
 

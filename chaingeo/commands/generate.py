@@ -158,8 +158,8 @@ def _register_puzzle(fam: Any) -> None:
         "--shape",
         default="burr6",
         help=(
-            "burr6, burr12, burr18, burr24, burr36 (towers; with --max-group 1 built and "
-            "proven unit by unit), cubeN or mazeN (maze burr: level grows with N); "
+            "burr3, plate3, burr6, burr12, burr18, burr24, burr36 (towers; with --max-group 1 "
+            "built and proven unit by unit), cubeN or mazeN (maze burr: level grows with N); "
             "default burr6"
         ),
     )
