@@ -32,9 +32,12 @@ from chaingeo.level import (
 from chaingeo.rules import PuzzleRules
 from generator.candidate import Candidate, evaluate
 from generator.cubes import cube_search, interlocking_target
+from generator.deep import TOWERS, maze_candidate, tower_candidate
 from generator.layouts import get_layout
+from generator.maze import parse_maze_shape
 from generator.result import Rejection
-from solvers.disassemble import analyze
+from solvers.blockbound import analyze_by_blocks
+from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
 
 GENERATOR = "chaingeo.generator.puzzle"
@@ -44,7 +47,9 @@ VERSION = "1"
 @dataclass(frozen=True)
 class PuzzleConfig:
     """What to make. ``shape``: a layout name (burr3, plate3, burr6, burr12, burr18, burr24,
-    burr36) or ``cubeN`` with ``pieces``; ``min_level``: moves until the first part comes free."""
+    burr36), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
+    of ``hill_steps`` walks); ``min_level``: moves until the first part comes free. Towers
+    (burr12..burr36) with ``max_group=1`` are built unit by unit (:mod:`generator.deep`)."""
 
     shape: str = "burr6"
     min_level: int = 1
@@ -138,18 +143,33 @@ def puzzle_level(
     index: int | None = None,
     difficulty: Difficulty | None = None,
     extra_stats: dict[str, object] | None = None,
+    blocks: Sequence[Sequence[int]] | None = None,
 ) -> Level:
     """Build and verify a puzzle level: palette names, the exact optimal plan (o_i) and stats.
 
     For 'assemble' the stored plan is the optimal disassembly reversed with each move inverted
     (the assembly optimum equals the disassembly optimum: the two state graphs are mirror
     images). Raises :class:`SearchLimitError` when o_i cannot be computed within ``limits``.
+    ``blocks`` (indices into ``shapes``, a stack of units along z; single-piece moves only)
+    proves o_i with the block bound of :mod:`solvers.blockbound` instead of searching.
     """
     base = np.min(np.concatenate([s.voxels for s in shapes]), axis=0)
     placed = [s.translate(-base) for s in shapes]
     colors = assign_colors(len(placed))
     named = {c.name: s for c, s in zip(colors, placed, strict=True)}
-    result = analyze(named, max_group=max_group, limits=limits, optimal=True)
+    if blocks is None:
+        result = analyze(named, max_group=max_group, limits=limits, optimal=True)
+    else:
+        if max_group != 1:
+            raise ValueError("blocks prove o_i for single-piece moves (max_group=1) only")
+        names = [c.name for c in colors]
+        result = analyze_by_blocks(
+            named,
+            [[names[i] for i in b] for b in blocks],
+            limits=limits,
+            stacked=True,
+            search=False,
+        )
     if not result.disassemblable or result.optimal_steps is None:
         raise ValueError(f"{level_id}: the puzzle does not come apart")
     plan = list(result.plan)
@@ -173,7 +193,8 @@ def puzzle_level(
         pieces=tuple(Piece(c.name, c.hex, s) for c, s in zip(colors, placed, strict=True)),
         solution=PuzzleSolution(tuple(moves)),
         optimal_steps=result.optimal_steps,
-        max_steps=default_step_budget(result.optimal_steps),
+        # Past 30 moves the benchmark's 60-step cap would leave no room: twice the optimum.
+        max_steps=max(default_step_budget(result.optimal_steps), 2 * result.optimal_steps),
         rules=PuzzleRules(max_group=max_group),
         provenance=Provenance(GENERATOR, VERSION, seed, index, puzzle_signature(placed)),
         stats=stats,
@@ -181,15 +202,35 @@ def puzzle_level(
     return revalidate(level)
 
 
+def analyze_level(level: Level, limits: SearchLimits | None = None) -> Analysis:
+    """Analyse a puzzle level again as :func:`puzzle_level` did: towers made with single-piece
+    moves (``stats['shape']`` in :data:`TOWERS`, ``max_group=1``) with the block bound, one
+    block per unit of six pieces in file order; every other level with the plain search."""
+    mg = level.rules.max_group if isinstance(level.rules, PuzzleRules) else None
+    shapes = level.shapes
+    if mg == 1 and level.stats.get("shape") in TOWERS:
+        names = [p.name for p in level.pieces]
+        blocks = [names[i : i + 6] for i in range(0, len(names), 6)]
+        return analyze_by_blocks(shapes, blocks, limits=limits, stacked=True, search=False)
+    return analyze(shapes, max_group=mg, limits=limits, optimal=True)
+
+
 def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
+    blocks: list[list[int]] | None = None
     if config.shape.startswith("cube"):
         try:
             n = int(config.shape[4:])
         except ValueError:
             raise ValueError(f"cube shapes are cube3..cube5, got {config.shape!r}") from None
         best = cube_search(config, n, rng)
+    elif config.shape.startswith("maze"):
+        best = maze_candidate(config, parse_maze_shape(config.shape), rng)
+    elif config.max_group == 1 and config.shape in TOWERS:
+        units = TOWERS[config.shape]
+        best = tower_candidate(config, units, rng, _layout_search)
+        blocks = [list(range(6 * u, 6 * u + 6)) for u in range(units)]
     else:
         best = _layout_search(config, rng)
     if best is None:
@@ -215,6 +256,7 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
             seed=seed,
             index=index,
             extra_stats={"shape": config.shape},
+            blocks=blocks,
         )
     except SearchLimitError as e:
         return Rejection(f"optimal plan not found within limits: {e}", seed, index)

@@ -162,10 +162,11 @@ class _Solver:
 
     # -- optimal full disassembly --------------------------------------------------------------
     def optimal(
-        self, members: tuple[int, ...], offsets: np.ndarray, budget: int
+        self, members: tuple[int, ...], offsets: np.ndarray, budget: int, floor: int = 0
     ) -> tuple[int, list[Move] | None]:
         """``(f, plan)`` with ``f`` the fewest moves to take the part apart if that is below
-        ``budget``; otherwise ``(lower bound >= budget, None)``."""
+        ``budget``; otherwise ``(lower bound >= budget, None)``. ``floor`` is a proven lower
+        bound on ``f`` from the caller: the search stops as soon as a plan meets it."""
         n = len(members)
         if n == 1:
             return 0, []
@@ -181,8 +182,10 @@ class _Solver:
                 return value, None
         s = self.search(members, offsets)
         best, best_plan = budget, None
-        while not s.exhausted and s.depth + 1 + (n - 2) < best:
+        while not s.exhausted and s.depth + 1 + (n - 2) < best and best > floor:
             for sp in s.unique_splits(s.expand_layer()):
+                if best <= floor:
+                    break
                 r = sp.removal
                 rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
                 base = r.depth + 1
@@ -218,9 +221,12 @@ def analyze(
     max_group: int | None = None,
     limits: SearchLimits | None = None,
     optimal: bool = True,
+    lower_bound: int | None = None,
 ) -> Analysis:
     """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
-    state (every piece at offset zero, one part)."""
+    state (every piece at offset zero, one part). ``lower_bound``: a *proven* lower bound on
+    o_i (e.g. :func:`solvers.blockbound.block_lower_bound`); the search stops at a plan that
+    meets it, and a plan below it raises ``ValueError`` (the bound was not a bound)."""
     solver = _Solver(shapes, max_group, limits or SearchLimits())
     n = len(solver.table.names)
     members = tuple(range(n))
@@ -234,8 +240,14 @@ def analyze(
     plan = tree.all_moves()
     steps: int | None = None
     if optimal:
-        found, better = solver.optimal(members, offsets, total)
-        steps, plan = (found, better) if better is not None else (total, plan)
+        floor = lower_bound or 0
+        if total > floor:
+            found, better = solver.optimal(members, offsets, total, floor)
+            steps, plan = (found, better) if better is not None else (total, plan)
+        else:
+            steps = total
+        if steps < floor:
+            raise ValueError(f"a plan of {steps} moves is below the lower bound {floor}")
     return Analysis(
         disassemblable=True,
         level=tree.level_text(),

@@ -118,9 +118,12 @@ def closures(gaps: I64, a: int, n: int) -> U64:
 
 
 @njit(cache=True)
-def closed_groups(c: U64, n: int, limit: int, out: U64) -> int:
+def closed_groups(c: U64, n: int, limit: int, out: U64, max_group: int = -1) -> int:
     """Write every proper, non-empty set closed under ``c`` into ``out``; return the count, or
-    -1 if there are more than ``limit`` (or more than ``out`` holds).
+    -1 if there are more than ``limit`` (or more than ``out`` holds). With ``max_group >= 0``
+    only sets that a move can carry are written: the set or the rest has at most
+    ``max_group`` pieces (a branch whose chosen and excluded pieces both exceed it is cut, as
+    every set it leads to contains the one and avoids the other).
 
     Depth first over pieces in index order: piece ``i`` is in (forced if a chosen closure
     holds it, allowed if its closure avoids every excluded piece) or out (if not forced), so
@@ -141,6 +144,9 @@ def closed_groups(c: U64, n: int, limit: int, out: U64) -> int:
         i = stack_i[top]
         s = stack_s[top]
         x = stack_x[top]
+        if max_group >= 0 and _popcount(s) > max_group and _popcount(x) > max_group:
+            top -= 1
+            continue
         if i == n:
             if s != np.uint64(0) and s != full:
                 if count >= limit or count >= out.shape[0]:
@@ -215,7 +221,7 @@ def node_moves(
     rows = 0
     for a in range(3):
         c = closures(gaps, a, n)
-        ng = closed_groups(c, n, group_limit, groups)
+        ng = closed_groups(c, n, group_limit, groups, max_group)
         if ng < 0:
             return -2
         for gi in range(ng):

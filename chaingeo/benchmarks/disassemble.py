@@ -1,8 +1,9 @@
 """``chain bench disassemble``: the numba disassembly search against the reference kinematics.
 
 Instances: every level of the shipped puzzle suite (``levels/puzzle``), plus puzzles generated
-on the spot with the highest level the generator reaches from fixed seeds (goal: level >= 10;
-the level actually reached is printed). For each instance, ``ours`` is the full analysis
+on the spot from seed 10: six-piece burrs (the hill climber's best level) and maze burrs of
+level >= 10 (:data:`DEEP_CONFIG`; the level reached and the seconds generation took are
+printed). For each instance, ``ours`` is the full analysis
 (BurrTools-style level and the exact optimal plan) and ``states_per_s`` the states it visited
 per second; ``reference`` is a breadth-first search with the pure-Python reference kinematics
 (:mod:`chaingeo.kinematics`) on the same puzzle, stopped after expanding
@@ -23,6 +24,7 @@ from pathlib import Path
 
 from chaingeo.geometry import Shape
 from chaingeo.kinematics import Assembly, legal_moves, state_key
+from chaingeo.level import Level
 
 
 def reference_rate(
@@ -52,12 +54,15 @@ def reference_rate(
 
 
 def _ours(
-    shapes: Mapping[str, Shape], max_group: int | None
+    shapes: Mapping[str, Shape], max_group: int | None, level: Level | None = None
 ) -> tuple[float, int, dict[str, object]]:
+    """Our full analysis; a suite level is analysed as it was made (towers with single-piece
+    moves by the block bound, :func:`generator.puzzle.analyze_level`)."""
+    from generator.puzzle import analyze_level
     from solvers.disassemble import analyze
 
     t0 = time.perf_counter()
-    result = analyze(shapes, max_group=max_group)
+    result = analyze_level(level) if level is not None else analyze(shapes, max_group=max_group)
     seconds = time.perf_counter() - t0
     info: dict[str, object] = {
         "level": result.level,
@@ -67,23 +72,34 @@ def _ours(
     return seconds, result.states, info
 
 
-def _instances(quick: bool) -> list[tuple[str, dict[str, Shape], int | None]]:
+Instance = tuple[str, dict[str, Shape], int | None, dict[str, object], Level | None]
+
+#: Generated deep puzzles: maze burrs (:mod:`generator.maze`) of level >= 10 from seed 10.
+DEEP_CONFIG = {"shape": "maze8", "min_level": 10, "hill_steps": 300}
+
+
+def _instances(quick: bool) -> list[Instance]:
     from chaingeo.level import load_levels
     from chaingeo.rules import PuzzleRules
     from generator.puzzle import PuzzleConfig, make
 
-    out: list[tuple[str, dict[str, Shape], int | None]] = []
+    out: list[Instance] = []
     suite = Path(__file__).resolve().parents[2] / "levels" / "puzzle"
     levels = load_levels(suite) if suite.is_dir() else []
     for lv in levels[:3] if quick else levels:
         mg = lv.rules.max_group if isinstance(lv.rules, PuzzleRules) else None
-        out.append((lv.id, lv.shapes, mg))
+        out.append((lv.id, lv.shapes, mg, {}, lv))
     n_gen = 1 if quick else int(os.environ.get("CHAIN_BENCH_GENERATED", "2"))
-    config = PuzzleConfig(shape="burr6", min_level=1, hill_steps=60 if quick else 600)
-    for i in range(n_gen):
-        item = make(config, 10, i)
-        if hasattr(item, "pieces"):
-            out.append((f"generated-burr6-s10-i{i}", item.shapes, None))  # type: ignore[union-attr]
+    burr6 = PuzzleConfig(shape="burr6", min_level=1, hill_steps=60 if quick else 600)
+    deep = PuzzleConfig(**DEEP_CONFIG)  # type: ignore[arg-type]
+    for config in (burr6, deep):
+        for i in range(n_gen):
+            t0 = time.perf_counter()
+            item = make(config, 10, i)
+            extra: dict[str, object] = {"generate_seconds": round(time.perf_counter() - t0, 3)}
+            if hasattr(item, "pieces"):
+                name = f"generated-{config.shape}-s10-i{i}"
+                out.append((name, item.shapes, None, extra, None))  # type: ignore[union-attr]
     return out
 
 
@@ -92,12 +108,12 @@ def run(args: argparse.Namespace) -> int:
     warm = {"a": Shape([(0, 0, 0), (1, 0, 0)]), "b": Shape([(0, 1, 0), (1, 1, 0)])}
     _ours(warm, None)  # JIT warm-up, not timed
     rows = []
-    for name, shapes, max_group in _instances(args.quick):
+    for name, shapes, max_group, extra, level in _instances(args.quick):
         best = float("inf")
         states = 0
         info: dict[str, object] = {}
         for _ in range(max(1, args.repeat)):
-            seconds, states, info = _ours(shapes, max_group)
+            seconds, states, info = _ours(shapes, max_group, level)
             best = min(best, seconds)
         ours_rate = states / best if best > 0 else float("inf")
         n_ref, ref_seconds = reference_rate(shapes, ref_states)
@@ -106,6 +122,7 @@ def run(args: argparse.Namespace) -> int:
             "instance": name,
             "pieces": len(shapes),
             **info,
+            **extra,
             "seconds": round(best, 4),
             "states": states,
             "states_per_s": round(ours_rate),

@@ -157,7 +157,11 @@ def _register_puzzle(fam: Any) -> None:
     p.add_argument(
         "--shape",
         default="burr6",
-        help="burr3, plate3, burr6, burr12, burr18, burr24, burr36 or cubeN (default burr6)",
+        help=(
+            "burr3, plate3, burr6, burr12, burr18, burr24, burr36 (towers; with --max-group 1 "
+            "built and proven unit by unit), cubeN or mazeN (maze burr: level grows with N); "
+            "default burr6"
+        ),
     )
     p.add_argument("--min-level", type=int, default=1, help="least moves to free the first part")
     p.add_argument("--pieces", type=int, default=0, help="pieces of a cubeN partition")
