@@ -42,6 +42,7 @@ _CUBE3 = PuzzleConfig(shape="cube3", pieces=3, min_level=2, hole_rate=0.3, hill_
 _CUBE4 = PuzzleConfig(shape="cube4", pieces=6, min_level=3, hole_rate=0.5, hill_steps=0)
 _CUBE4H = PuzzleConfig(shape="cube4", pieces=6, min_level=3, hole_rate=0.5, hill_steps=20000)
 _TOWER = PuzzleConfig(shape="burr12", hole_rate=0.1, hill_steps=100)
+_TOWER36 = PuzzleConfig(shape="burr36", hole_rate=0.1, hill_steps=0, max_group=1)
 
 D, A = "disassemble", "assemble"
 
@@ -56,9 +57,10 @@ SUITE: tuple[SuiteEntry, ...] = (
     SuiteEntry("mid", _BURR3M, 402, 2, (D, A)),
     SuiteEntry("mid", _PLATE3M, 412, 2, (D, A)),
     SuiteEntry("mid", _CUBE4, 202, 4, (D, D, A, D)),
-    SuiteEntry("hard", _HARD6, 301, 3, (D, A, D)),
+    SuiteEntry("hard", _HARD6, 301, 2, (D, A)),
     SuiteEntry("hard", _BURR3H, 403, 2, (D, A)),
-    SuiteEntry("hard", _TOWER, 303, 2, (D, A)),
+    SuiteEntry("hard", _TOWER, 303, 1, (D,)),
+    SuiteEntry("hard", _TOWER36, 401, 2, (D, A)),
     SuiteEntry("hard", _CUBE4H, 302, 3, (D, A, D)),
 )
 

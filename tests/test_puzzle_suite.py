@@ -21,9 +21,16 @@ def test_the_split_and_the_goals() -> None:
     assert Counter(lv.difficulty for lv in LEVELS) == {"easy": 10, "mid": 12, "hard": 10}
     assert {lv.goal for lv in LEVELS} == {"disassemble", "assemble"}
     assert len({lv.provenance.signature for lv in LEVELS}) == 32
-    shapes = {str(lv.stats["shape"]) for lv in LEVELS}
-    assert {"burr6", "burr12", "cube3", "cube4"} <= shapes
-    assert max(len(lv.pieces) for lv in LEVELS) >= 12
+    # every family of issue 4, each with both goals, from six pieces to more than thirty
+    goals: dict[str, set[str]] = {}
+    for lv in LEVELS:
+        goals.setdefault(str(lv.stats["shape"]), set()).add(lv.goal)
+    for shape in ("burr6", "burr3", "plate3", "cube3", "cube4", "burr36"):
+        assert goals.get(shape) == {"disassemble", "assemble"}, shape
+    assert "burr12" in goals
+    assert max(len(lv.pieces) for lv in LEVELS) > 30
+    # interlocking: nothing comes free in one move (level of the first part >= 2)
+    assert min(int(lv.stats["first_level"]) for lv in LEVELS) >= 2
 
 
 @pytest.mark.parametrize("level", LEVELS, ids=lambda lv: lv.id)
