@@ -353,6 +353,34 @@ def blocking_matrix(state: Assembly, direction: str) -> dict[tuple[str, str], in
     return out
 
 
+def reference_first_level(
+    shapes: Mapping[str, Shape], max_group: int | None = None, max_states: int = 200_000
+) -> int | None:
+    """Fewest moves until some group leaves the assembled puzzle (the removal counts): the first
+    number of BurrTools' level, by plain breadth-first search; None if nothing ever leaves.
+    Raises :class:`SearchLimitError` past ``max_states`` states. For tests."""
+    start = Assembly.assembled(shapes)
+    seen = {state_key(start)}
+    frontier = [start]
+    depth = 0
+    while frontier:
+        depth += 1
+        nxt: list[Assembly] = []
+        for state in frontier:
+            for move in legal_moves(state, max_group):
+                if state.removes(move):
+                    return depth
+                child = state.apply(move)
+                key = state_key(child)
+                if key not in seen:
+                    seen.add(key)
+                    nxt.append(child)
+        if len(seen) > max_states:
+            raise SearchLimitError(f"reference search passed {max_states} states")
+        frontier = nxt
+    return None
+
+
 def reference_optimal_disassembly(
     shapes: Mapping[str, Shape], max_group: int | None = None, max_states: int = 200_000
 ) -> list[Move] | None:

@@ -114,7 +114,31 @@ def _placed(shape: Shape, offset: Cell) -> np.ndarray:
     return np.asarray(shape.voxels, dtype=np.int64) + np.asarray(offset, dtype=np.int64)
 
 
-class MoveRange(Sequence[MoveAction]):
+class _Lazy(Sequence[MoveAction]):
+    """A sorted block of actions that builds its ``i``-th member only when asked."""
+
+    __slots__ = ()
+
+    def _build(self, i: int) -> MoveAction:
+        raise NotImplementedError
+
+    @overload
+    def __getitem__(self, index: int) -> MoveAction: ...
+    @overload
+    def __getitem__(self, index: slice) -> list[MoveAction]: ...
+    def __getitem__(self, index: int | slice) -> MoveAction | list[MoveAction]:
+        if isinstance(index, slice):
+            return [self[i] for i in range(*index.indices(len(self)))]
+        i = index + len(self) if index < 0 else index
+        if not 0 <= i < len(self):
+            raise IndexError(f"action index {index} out of range for {len(self)}")
+        return self._build(i)
+
+    def __iter__(self) -> Iterator[MoveAction]:
+        return (self._build(i) for i in range(len(self)))
+
+
+class MoveRange(_Lazy):
     """The moves of ``pieces`` along ``direction``: distances ``1..kmax``, then ``inf`` when
     ``removable``, in the order of the actions' sort keys."""
 
@@ -130,20 +154,8 @@ class MoveRange(Sequence[MoveAction]):
     def __len__(self) -> int:
         return self.kmax + (1 if self.removable else 0)
 
-    @overload
-    def __getitem__(self, index: int) -> MoveAction: ...
-    @overload
-    def __getitem__(self, index: slice) -> list[MoveAction]: ...
-    def __getitem__(self, index: int | slice) -> MoveAction | list[MoveAction]:
-        if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(len(self)))]
-        i = index + len(self) if index < 0 else index
-        if not 0 <= i < len(self):
-            raise IndexError(f"move index {index} out of range for {len(self)}")
+    def _build(self, i: int) -> MoveAction:
         return MoveAction(Move(self.pieces, self.direction, i + 1 if i < self.kmax else None))
-
-    def __iter__(self) -> Iterator[MoveAction]:
-        return (self[i] for i in range(len(self)))
 
     def __contains__(self, value: object) -> bool:
         if not (
@@ -158,7 +170,7 @@ class MoveRange(Sequence[MoveAction]):
         return self.removable if k is None else 1 <= k <= self.kmax
 
 
-class InsertionBlock(Sequence[MoveAction]):
+class InsertionBlock(_Lazy):
     """The insertions of ``part`` along ``direction`` into ``into``, sorted by offset.
 
     ``delta`` turns a shift into the agent's offset (the shift of ``part``'s first piece
@@ -191,22 +203,10 @@ class InsertionBlock(Sequence[MoveAction]):
         x, y, z = (int(v) for v in self.rows[i])
         return (x + self.delta[0], y + self.delta[1], z + self.delta[2])
 
-    @overload
-    def __getitem__(self, index: int) -> MoveAction: ...
-    @overload
-    def __getitem__(self, index: slice) -> list[MoveAction]: ...
-    def __getitem__(self, index: int | slice) -> MoveAction | list[MoveAction]:
-        if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(len(self)))]
-        i = index + len(self) if index < 0 else index
-        if not 0 <= i < len(self):
-            raise IndexError(f"insertion index {index} out of range for {len(self)}")
+    def _build(self, i: int) -> MoveAction:
         return MoveAction(
             Move(self.pieces, self.direction, None), into=self.into, offset=self.offset(i)
         )
-
-    def __iter__(self) -> Iterator[MoveAction]:
-        return (self[i] for i in range(len(self)))
 
     def __contains__(self, value: object) -> bool:
         if not (

@@ -30,7 +30,7 @@ class SuiteEntry:
     goals: tuple[str, ...]  # goal of each of the ``count`` levels, in order
 
 
-_EASY6 = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=0)
+_EASY6 = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=0, min_level=2)
 _HOLEY = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=300, min_level=3)
 _HARD6 = PuzzleConfig(shape="burr6", hole_rate=0.1, hill_steps=400, min_level=4)
 _BURR3E = PuzzleConfig(shape="burr3", hole_rate=0.8, hill_steps=20, min_level=2)

@@ -6,13 +6,17 @@ Checked against the reference kinematics (:mod:`chaingeo.kinematics`), not the n
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Mapping
 
 import numpy as np
 import pytest
 
 from chaingeo.geometry import Shape
-from chaingeo.kinematics import Assembly, legal_moves, reference_optimal_disassembly, state_key
+from chaingeo.kinematics import (
+    Assembly,
+    legal_moves,
+    reference_first_level,
+    reference_optimal_disassembly,
+)
 from chaingeo.level import Level, level_bytes
 from generator.cubes import (
     VOID,
@@ -27,27 +31,6 @@ from generator.result import Rejection
 from solvers.partsearch import PieceTable
 
 EASY = PuzzleConfig(shape="cube3", pieces=3, min_level=2, hole_rate=0.3, hill_steps=10)
-
-
-def first_removal_depth(shapes: Mapping[str, Shape], cap: int = 20_000) -> int:
-    """Fewest moves until some group leaves, by breadth-first search on the reference rules."""
-    frontier = [Assembly.assembled(shapes)]
-    seen = {state_key(frontier[0])}
-    depth = 1
-    while frontier:
-        nxt = []
-        for state in frontier:
-            for move in legal_moves(state):
-                if state.removes(move):
-                    return depth
-                child = state.apply(move)
-                key = state_key(child)
-                if key not in seen:
-                    seen.add(key)
-                    nxt.append(child)
-        assert len(seen) < cap
-        frontier, depth = nxt, depth + 1
-    raise AssertionError("nothing ever comes free")
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -95,7 +78,7 @@ def test_generated_cube_interlocks_and_its_level_is_what_the_stats_say() -> None
     shapes = level.shapes
     start = Assembly.assembled(shapes)
     assert not any(start.removes(m) for m in legal_moves(start))  # nothing lifts straight off
-    assert level.stats["first_level"] == first_removal_depth(shapes) >= 2
+    assert level.stats["first_level"] == reference_first_level(shapes) >= 2
     assert str(level.stats["level"]).split(".")[0] == str(level.stats["first_level"])
     reference = reference_optimal_disassembly(shapes)
     assert reference is not None and len(reference) == level.optimal_steps
@@ -110,7 +93,9 @@ def test_generated_four_cubes_reach_level_three(index: int) -> None:
     config = PuzzleConfig(shape="cube4", pieces=6, min_level=3, hole_rate=0.5, hill_steps=40)
     level = make(config, 202, index)
     assert isinstance(level, Level)
-    assert level.stats["first_level"] == first_removal_depth(level.shapes, 200_000) >= 3
+    assert (
+        level.stats["first_level"] == reference_first_level(level.shapes, max_states=200_000) >= 3
+    )
 
 
 @pytest.mark.slow

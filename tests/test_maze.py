@@ -9,11 +9,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from chaingeo.kinematics import (
-    Assembly,
-    legal_moves,
+    reference_first_level,
     reference_optimal_disassembly,
     replay_disassembly,
-    state_key,
 )
 from chaingeo.level import Level, level_bytes
 from generator.maze import maze_pieces, parse_maze_shape, random_walk, runs, with_exit
@@ -30,33 +28,12 @@ def _deep(index: int = 0, goal: str = "disassemble") -> Level:
     return item
 
 
-def _first_removal_depth(shapes: dict[str, object]) -> int:
-    """Breadth first with the reference kinematics: fewest moves until a part comes free."""
-    start = Assembly.assembled(shapes)  # type: ignore[arg-type]
-    seen = {state_key(start)}
-    frontier = [start]
-    depth = 0
-    while frontier:
-        depth += 1
-        nxt = []
-        for state in frontier:
-            for m in legal_moves(state):
-                if state.removes(m):
-                    return depth
-                child = state.apply(m)
-                if (k := state_key(child)) not in seen:
-                    seen.add(k)
-                    nxt.append(child)
-        frontier = nxt
-    raise AssertionError("the reference search found no removal")
-
-
 def test_deep_maze_has_the_claimed_level_under_the_reference_kinematics() -> None:
     level = _deep()
     claimed = level.stats["first_level"]
     assert isinstance(claimed, int) and claimed >= 10
     assert level.stats["level"] == str(claimed)
-    assert _first_removal_depth(level.shapes) == claimed
+    assert reference_first_level(level.shapes) == claimed
     # Two pieces: the first removal finishes the disassembly, so o_i is the level too.
     plan = reference_optimal_disassembly(level.shapes)
     assert plan is not None and len(plan) == claimed == level.optimal_steps

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,13 +18,13 @@ from chaingeo.kinematics import (
     Move,
     insertion_shifts,
 )
-from chaingeo.level import Level, load_level
+from chaingeo.level import Level, load_levels
 from chaingeo.puzzle import PuzzleState
 from chaingeo.puzzle_actions import reference_actions, shifts
 from tests.env_levels import puzzle_levels
 from tests.strategies import polycubes
 
-SUITE = "levels/puzzle"
+SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
 
 
 @settings(max_examples=150)
@@ -43,16 +44,21 @@ def test_insertion_kernel_is_the_reference(
 
 
 def small_levels() -> list[Level]:
-    shipped = [
-        load_level(f"{SUITE}/{name}.json")
-        for name in (
-            "puzzle-easy-01-burr6",
-            "puzzle-easy-03-burr6",
-            "puzzle-easy-05-cube3",
-            "puzzle-easy-10-cube3",
-        )
-    ]
-    return [*puzzle_levels(), *shipped]
+    """The test levels and, per (shape, goal), the first shipped level of at most 6 pieces."""
+    picked: dict[tuple[str, str], Level] = {}
+    for lv in load_levels(SUITE):
+        if len(lv.pieces) <= 6:
+            picked.setdefault((str(lv.stats["shape"]), lv.goal), lv)
+    return [*puzzle_levels(), *(picked[k] for k in sorted(picked))]
+
+
+def large_assembly_levels() -> list[Level]:
+    """The shipped assemble levels of 12 pieces and more (one per shape)."""
+    picked: dict[str, Level] = {}
+    for lv in sorted(load_levels(SUITE), key=lambda lv: (-len(lv.pieces), lv.id)):
+        if lv.goal == "assemble":
+            picked.setdefault(str(lv.stats["shape"]), lv)
+    return [lv for lv in picked.values() if len(lv.pieces) >= 12]
 
 
 @pytest.mark.parametrize("lv", small_levels(), ids=lambda lv: lv.id)
@@ -68,13 +74,13 @@ def test_legal_actions_are_the_reference_along_random_walks(lv: Level) -> None:
         state.apply(legal[int(rng.integers(moves))])
 
 
-@pytest.mark.parametrize("name", ["puzzle-hard-07-burr12", "puzzle-hard-09-cube4"])
-def test_large_assembly_states_are_counted_without_building_them(name: str) -> None:
-    """Twelve loose pieces offer ~10^5 insertions: counted and indexed, never all built; every
-    listed action is legal and a sample of them matches the reference blocks."""
-    state = PuzzleState(load_level(f"{SUITE}/{name}.json"))
+@pytest.mark.parametrize("lv", large_assembly_levels(), ids=lambda lv: lv.id)
+def test_large_assembly_states_are_counted_without_building_them(lv: Level) -> None:
+    """Many loose pieces offer 10^5 to 10^6 insertions: counted and indexed, never all built;
+    every sampled action is legal, and a wrong offset is not."""
+    state = PuzzleState(lv)
     legal = state.legal_actions()
-    assert isinstance(legal, ActionList) and len(legal) > 50_000
+    assert isinstance(legal, ActionList) and len(legal) > 100_000
     assert isinstance(legal[-1], FinishAction)
     rng = np.random.default_rng(3)
     picks = sorted(int(i) for i in rng.choice(len(legal) - 1, size=40, replace=False))

@@ -29,8 +29,11 @@ def test_the_split_and_the_goals() -> None:
         assert goals.get(shape) == {"disassemble", "assemble"}, shape
     assert "burr12" in goals
     assert max(len(lv.pieces) for lv in LEVELS) > 30
-    # interlocking: nothing comes free in one move (level of the first part >= 2)
-    assert min(int(lv.stats["first_level"]) for lv in LEVELS) >= 2
+    # interlocking: nothing comes free in one move (first part's level >= 2), except in the
+    # towers of burr units, which come apart from the top
+    for lv in LEVELS:
+        if not str(lv.stats["shape"]).startswith(("burr12", "burr36")):
+            assert int(lv.stats["first_level"]) >= 2, lv.id
 
 
 @pytest.mark.parametrize("level", LEVELS, ids=lambda lv: lv.id)
