@@ -239,7 +239,8 @@ class PuzzleState(BaseState):
                     continue
                 for d in DIRECTIONS if direction is None else (direction,):
                     out.extend(
-                        Insertion(a, b, d, self._offset_of(a, b, t)) for t in self._shifts(a, b, d)
+                        Insertion(a, b, d, self._offset_of(a, b, (x, y, z)))
+                        for x, y, z in self._shift_rows(a, b, d).tolist()
                     )
         return out
 
@@ -257,11 +258,11 @@ class PuzzleState(BaseState):
             offset[2] + ob[2] - oa[2],
         )
 
-    def _shifts(self, a: frozenset[str], b: frozenset[str], direction: str) -> list[Cell]:
+    def _shift_rows(self, a: frozenset[str], b: frozenset[str], direction: str) -> np.ndarray:
         """Every translation of part ``a`` that makes it come in along ``direction`` and join
-        ``b`` (:func:`chaingeo.kinematics.insertion_shifts`, computed by the fast kernel)."""
-        rows = shifts(part_cells(self._asm, a), part_cells(self._asm, b), direction)
-        return [(int(x), int(y), int(z)) for x, y, z in rows]
+        ``b`` (:func:`chaingeo.kinematics.insertion_shifts`, computed by the fast kernel), as
+        int64 rows in lexicographic order."""
+        return shifts(part_cells(self._asm, a), part_cells(self._asm, b), direction)
 
     def _insertion_action(self, ins: Insertion) -> MoveAction:
         return MoveAction(
@@ -488,7 +489,7 @@ class PuzzleState(BaseState):
         if move.distance is not None:
             return "an insertion comes in from infinity: its distance is inf"
         shift = self._shift_of(part, into, action.offset)
-        rows = shifts(part_cells(self._asm, part), part_cells(self._asm, into), move.direction)
+        rows = self._shift_rows(part, into, move.direction)
         if bool(np.any(np.all(rows == np.asarray(shift, dtype=np.int64), axis=1))):
             return None
         return self._why_no_insertion(part, into, move.direction, shift)

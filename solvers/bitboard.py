@@ -32,6 +32,7 @@ from solvers.kernels import (
     REG_UPDATES,
     RUNNING,
     shuffle_prefix,
+    store_solution,
 )
 from solvers.placements import Int32Array
 from solvers.problem import CoverProblem
@@ -247,11 +248,7 @@ def bitboard_run(
             if ok:
                 found += 1
                 if max_store > 0:
-                    for d in range(k + 1):
-                        out[n_out, d] = rid[chosen[d]]
-                    for d in range(k + 1, out.shape[1]):
-                        out[n_out, d] = -1
-                    n_out += 1
+                    n_out = store_solution(out, n_out, chosen, rid, k)
                 if (max_store > 0 and n_out == max_store) or found == stop_after:
                     stop = True
             continue

@@ -33,6 +33,7 @@ from solvers.kernels import (
     REG_UPDATES,
     RUNNING,
     shuffle_prefix,
+    store_solution,
 )
 from solvers.placements import Int32Array
 from solvers.problem import CoverProblem
@@ -181,11 +182,7 @@ def dlx_run(
                 if ok:
                     found += 1
                     if max_store > 0:
-                        for d in range(k + 1):
-                            out[n_out, d] = RW[chosen[d]]
-                        for d in range(k + 1, out.shape[1]):
-                            out[n_out, d] = -1
-                        n_out += 1
+                        n_out = store_solution(out, n_out, chosen, RW, k)
                 _unselect(r, L, R, U, D, C, S, kind, hi, cnt)
                 if ok and ((max_store > 0 and n_out == max_store) or found == stop_after):
                     break

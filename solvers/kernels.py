@@ -49,3 +49,16 @@ def shuffle_prefix(buf: np.ndarray, n: int, state: np.ndarray) -> None:
         tmp = buf[i]
         buf[i] = buf[j]
         buf[j] = tmp
+
+
+@njit(cache=True)
+def store_solution(
+    out: np.ndarray, n_out: int, chosen: np.ndarray, row_ids: np.ndarray, k: int
+) -> int:
+    """Write the rows ``row_ids[chosen[0..k]]`` of a solution into ``out[n_out]`` (the rest of
+    the row -1); return the new solution count."""
+    for d in range(k + 1):
+        out[n_out, d] = row_ids[chosen[d]]
+    for d in range(k + 1, out.shape[1]):
+        out[n_out, d] = -1
+    return n_out + 1
