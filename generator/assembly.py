@@ -12,8 +12,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from chaingeo.geometry import NEIGHBOURS, Cell, Shape
-from chaingeo.kinematics import DIRECTIONS, OPPOSITE
+from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
+from chaingeo.core.kinematics import DIRECTIONS, OPPOSITE
 
 
 def has_isolated_piece(placements: Sequence[Shape]) -> bool:

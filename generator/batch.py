@@ -20,14 +20,14 @@ import json
 import os
 import sys
 import time
-import uuid
 from collections import Counter
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from chaingeo.level import Level, level_bytes
+from chaingeo.core.files import atomic_write
+from chaingeo.core.level import Level, level_bytes
 from generator.dedup import Reservation, SignatureStore
 from generator.result import ATTEMPTS_KEY, Rejection
 
@@ -255,12 +255,6 @@ class Summary:
         }
 
 
-def _write_atomic(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex}.tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)
-
-
 def _store(out: Path, store: SignatureStore, res: ItemResult) -> bool:
     """Reserve and write one level; False if its puzzle is already taken."""
     assert res.level is not None and res.level_id is not None and res.signature is not None
@@ -275,11 +269,11 @@ def _store(out: Path, store: SignatureStore, res: ItemResult) -> bool:
             f"{path} already holds a different level with id {res.level_id}; "
             "use another output folder or seed"
         )
-    _write_atomic(path, res.level)
+    atomic_write(path, res.level)
     if res.pictures:
         (out / PICTURES_DIR).mkdir(exist_ok=True)
         for view, png in sorted(res.pictures.items()):
-            _write_atomic(out / PICTURES_DIR / f"{res.level_id}-{view}.png", png)
+            atomic_write(out / PICTURES_DIR / f"{res.level_id}-{view}.png", png)
     return True
 
 

@@ -8,15 +8,12 @@ BurrTools-style analysis of :func:`solvers.disassemble.analyze`, scored by (leve
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import SearchLimitError
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import SearchLimitError
+from generator.config import PuzzleConfig
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
-
-if TYPE_CHECKING:  # the config lives with make(); only its type is needed here
-    from generator.puzzle import PuzzleConfig
 
 Score = tuple[int, int]
 

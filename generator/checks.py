@@ -9,7 +9,7 @@ recorded search effort.
 
 from __future__ import annotations
 
-from chaingeo.level import Level, StackingSolution
+from chaingeo.core.level import Level, StackingSolution
 from generator import packing
 from generator.assembly import assembly_order, has_isolated_piece
 from generator.config import StackingConfig

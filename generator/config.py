@@ -1,4 +1,5 @@
-"""Stacking generator settings: one frozen dataclass and a registry of named configurations.
+"""Generator settings: one frozen dataclass per family (stacking, puzzles) and a registry of
+named stacking configurations.
 
 As in reasoning-gym, a configuration is plain data (it pickles to any worker and is written into
 every run summary) and ``make(config, seed, index)`` is the only code that reads it. The named
@@ -13,7 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import Any, Final, Literal
 
-from chaingeo.rules import SUPPORT_RULES, SupportRule
+from chaingeo.core.rules import SUPPORT_RULES, SupportRule
 
 Mode = Literal["easy", "mid", "hard"]
 MODES: Final[tuple[str, ...]] = ("easy", "mid", "hard")
@@ -192,3 +193,27 @@ def config_names() -> list[str]:
 for _box in BOX_LIMITS:
     for _mode in MODES:
         register_config(f"{box_text(_box)}-{_mode}", stacking_config(_box, _mode))
+
+
+@dataclass(frozen=True)
+class PuzzleConfig:
+    """What to make. ``shape``: a layout name (burr3, plate3, burr6, burr12, burr18, burr24,
+    burr36), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
+    of ``hill_steps`` walks); ``min_level``: moves until the first part comes free. Towers
+    (burr12..burr36) with ``max_group=1`` are built unit by unit (:mod:`generator.deep`)."""
+
+    shape: str = "burr6"
+    min_level: int = 1
+    pieces: int = 0  # cube partitions only
+    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs); cubes:
+    # the share of inner cells left empty (at least one, see generator.cubes)
+    hill_steps: int = 300  # improvement steps (cubes: steering one level deeper at a time)
+    goal: Literal["disassemble", "assemble"] = "disassemble"
+    max_group: int | None = None
+    seconds: float | None = None  # optional time limit of each search (machine-dependent!)
+    max_states: int = 500_000  # state cap per part in the final search
+    max_total_states: int = 3_000_000  # state cap of the whole optimal-plan search
+    probe_states: int = 20_000  # state cap of each evaluation while climbing (over: rejected)
+
+    def to_json(self) -> dict[str, object]:
+        return dataclasses.asdict(self)

@@ -26,20 +26,17 @@ search is capped by states, never by time, so the same (seed, index) gives the s
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from chaingeo.geometry import NEIGHBOURS, Shape
-from chaingeo.kinematics import Assembly, SearchLimitError
+from chaingeo.core.geometry import NEIGHBOURS, Shape
+from chaingeo.core.kinematics import Assembly, SearchLimitError
 from generator.candidate import Candidate, evaluate, piece_names, probe_limits
+from generator.config import PuzzleConfig
 from solvers.disassemble import fast_legal_moves
 from solvers.partsearch import Deadline, PartSearch, PieceTable, Removal
-
-if TYPE_CHECKING:  # the config lives with make(); only its type is needed here
-    from generator.puzzle import PuzzleConfig
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]

@@ -9,24 +9,21 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import Move, SearchLimitError
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import Move, SearchLimitError
 from generator.candidate import Candidate, evaluate
+from generator.config import PuzzleConfig
 from generator.maze import maze_search, runs, with_exit
 from solvers.disassemble import analyze
-
-if TYPE_CHECKING:  # the config lives with make(); only its type is needed here
-    from generator.puzzle import PuzzleConfig
 
 #: Towers of burr units; with single-piece moves (max_group=1) they are built unit by unit and
 #: their o_i is proven with the block bound (:mod:`solvers.blockbound`), one block per unit.
 TOWERS = {"burr12": 2, "burr18": 3, "burr24": 4, "burr36": 6}
 
-UnitSearch = Callable[["PuzzleConfig", np.random.Generator], Candidate | None]
+UnitSearch = Callable[[PuzzleConfig, np.random.Generator], Candidate | None]
 
 
 def maze_candidate(config: PuzzleConfig, n: int, rng: np.random.Generator) -> Candidate | None:

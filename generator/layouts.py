@@ -14,8 +14,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cache, partial
 
-from chaingeo.geometry import Cell, Shape
-from chaingeo.piecesets.burrs import SLOTS, slot_cells
+from chaingeo.core.geometry import Cell, Shape
+from chaingeo.core.piecesets.burrs import SLOTS, slot_cells
 
 
 @dataclass(frozen=True)

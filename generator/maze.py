@@ -22,7 +22,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from chaingeo.geometry import Shape
+from chaingeo.core.geometry import Shape
 
 Cell2 = tuple[int, int]
 STEPS: tuple[Cell2, ...] = ((1, 0), (-1, 0), (0, 1), (0, -1))

@@ -17,7 +17,7 @@ from typing import Any, Final
 
 import numpy as np
 
-from chaingeo.geometry import Shape
+from chaingeo.core.geometry import Shape
 from solvers.cover import (
     CoverLimitError,
     CoverSearch,

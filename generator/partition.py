@@ -15,7 +15,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from chaingeo.geometry import NEIGHBOURS, Cell, Shape
+from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
 
 Labels = list[int]
 

@@ -12,15 +12,14 @@ level file is built and verified. Everything random comes from ``SeedSequence([s
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
 from typing import Literal
 
 import numpy as np
 
-from chaingeo.colors import assign_colors
-from chaingeo.geometry import Shape, puzzle_signature
-from chaingeo.kinematics import SearchLimitError
-from chaingeo.level import (
+from chaingeo.core.colors import assign_colors
+from chaingeo.core.geometry import Shape, puzzle_signature
+from chaingeo.core.kinematics import SearchLimitError
+from chaingeo.core.level import (
     Difficulty,
     Level,
     Piece,
@@ -29,43 +28,19 @@ from chaingeo.level import (
     default_step_budget,
     revalidate,
 )
-from chaingeo.rules import PuzzleRules
+from chaingeo.core.rules import PuzzleRules
 from generator.candidate import Candidate, evaluate
+from generator.config import PuzzleConfig
 from generator.cubes import cube_search, interlocking_target
 from generator.deep import TOWERS, maze_candidate, tower_candidate
 from generator.layouts import get_layout
 from generator.maze import parse_maze_shape
 from generator.result import Rejection
-from solvers.blockbound import analyze_by_blocks
-from solvers.disassemble import Analysis, analyze
+from solvers.analysis import BLOCKS_KEY, analyze_puzzle
 from solvers.partsearch import SearchLimits
 
-GENERATOR = "chaingeo.generator.puzzle"
+GENERATOR = "generator.puzzle"
 VERSION = "1"
-
-
-@dataclass(frozen=True)
-class PuzzleConfig:
-    """What to make. ``shape``: a layout name (burr3, plate3, burr6, burr12, burr18, burr24,
-    burr36), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
-    of ``hill_steps`` walks); ``min_level``: moves until the first part comes free. Towers
-    (burr12..burr36) with ``max_group=1`` are built unit by unit (:mod:`generator.deep`)."""
-
-    shape: str = "burr6"
-    min_level: int = 1
-    pieces: int = 0  # cube partitions only
-    hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs); cubes:
-    # the share of inner cells left empty (at least one, see generator.cubes)
-    hill_steps: int = 300  # improvement steps (cubes: steering one level deeper at a time)
-    goal: Literal["disassemble", "assemble"] = "disassemble"
-    max_group: int | None = None
-    seconds: float | None = None  # optional time limit of each search (machine-dependent!)
-    max_states: int = 500_000  # state cap per part in the final search
-    max_total_states: int = 3_000_000  # state cap of the whole optimal-plan search
-    probe_states: int = 20_000  # state cap of each evaluation while climbing (over: rejected)
-
-    def to_json(self) -> dict[str, object]:
-        return asdict(self)
 
 
 def _broken(shapes: Sequence[Shape]) -> int:
@@ -151,25 +126,17 @@ def puzzle_level(
     (the assembly optimum equals the disassembly optimum: the two state graphs are mirror
     images). Raises :class:`SearchLimitError` when o_i cannot be computed within ``limits``.
     ``blocks`` (indices into ``shapes``, a stack of units along z; single-piece moves only)
-    proves o_i with the block bound of :mod:`solvers.blockbound` instead of searching.
+    proves o_i with the block bound of :mod:`solvers.blockbound` instead of searching; the
+    level carries them (``stats["blocks"]``) so that :func:`solvers.analysis.analyze_level`
+    analyses it the same way.
     """
     base = np.min(np.concatenate([s.voxels for s in shapes]), axis=0)
     placed = [s.translate(-base) for s in shapes]
     colors = assign_colors(len(placed))
     named = {c.name: s for c, s in zip(colors, placed, strict=True)}
-    if blocks is None:
-        result = analyze(named, max_group=max_group, limits=limits, optimal=True)
-    else:
-        if max_group != 1:
-            raise ValueError("blocks prove o_i for single-piece moves (max_group=1) only")
-        names = [c.name for c in colors]
-        result = analyze_by_blocks(
-            named,
-            [[names[i] for i in b] for b in blocks],
-            limits=limits,
-            stacked=True,
-            search=False,
-        )
+    names = [c.name for c in colors]
+    named_blocks = None if blocks is None else [[names[i] for i in b] for b in blocks]
+    result = analyze_puzzle(named, max_group=max_group, limits=limits, blocks=named_blocks)
     if not result.disassemblable or result.optimal_steps is None:
         raise ValueError(f"{level_id}: the puzzle does not come apart")
     plan = list(result.plan)
@@ -184,6 +151,8 @@ def puzzle_level(
         "states": result.states,
     }
     stats.update(extra_stats or {})
+    if named_blocks is not None:
+        stats[BLOCKS_KEY] = named_blocks
     level = Level(
         id=level_id,
         family="puzzle",
@@ -200,19 +169,6 @@ def puzzle_level(
         stats=stats,
     )
     return revalidate(level)
-
-
-def analyze_level(level: Level, limits: SearchLimits | None = None) -> Analysis:
-    """Analyse a puzzle level again as :func:`puzzle_level` did: towers made with single-piece
-    moves (``stats['shape']`` in :data:`TOWERS`, ``max_group=1``) with the block bound, one
-    block per unit of six pieces in file order; every other level with the plain search."""
-    mg = level.rules.max_group if isinstance(level.rules, PuzzleRules) else None
-    shapes = level.shapes
-    if mg == 1 and level.stats.get("shape") in TOWERS:
-        names = [p.name for p in level.pieces]
-        blocks = [names[i : i + 6] for i in range(0, len(names), 6)]
-        return analyze_by_blocks(shapes, blocks, limits=limits, stacked=True, search=False)
-    return analyze(shapes, max_group=mg, limits=limits, optimal=True)
 
 
 def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:

@@ -16,8 +16,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from chaingeo.level import Difficulty, Level, revalidate, save_level
-from generator.puzzle import PuzzleConfig, make
+from chaingeo.core.level import Difficulty, Level, revalidate, save_level
+from generator.config import PuzzleConfig
+from generator.puzzle import make
 from generator.result import Rejection
 
 

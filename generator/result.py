@@ -1,6 +1,6 @@
 """What one generation item gives back when it gives no level: the family-neutral rejection.
 
-Every family's ``make(config, seed, index)`` returns a :class:`~chaingeo.level.Level` or a
+Every family's ``make(config, seed, index)`` returns a :class:`~chaingeo.core.level.Level` or a
 :class:`Rejection`; the batch runner needs nothing else to count outcomes.
 """
 

@@ -2,7 +2,7 @@
 
 ``make(config, seed, index)`` is a pure function: it draws everything from its own
 ``numpy.random.Generator`` seeded by ``SeedSequence([seed, index])`` and returns a verified
-:class:`~chaingeo.level.Level` or a :class:`Rejection` saying why no level came out. Modes:
+:class:`~chaingeo.core.level.Level` or a :class:`Rejection` saying why no level came out. Modes:
 
 - **easy**: cuboid pieces with at least two equal sides (rods, 2x2 plates, 2x2x2 cubes), a
   random multiset that fills the volume, packed (and so verified packable) by the exact-cover
@@ -35,10 +35,10 @@ from typing import Any, Final
 
 import numpy as np
 
-from chaingeo.colors import assign_colors
-from chaingeo.geometry import ROTATIONS, Shape
-from chaingeo.level import Level, stacking_level
-from chaingeo.rules import StackingRules
+from chaingeo.core.colors import assign_colors
+from chaingeo.core.geometry import ROTATIONS, Shape
+from chaingeo.core.level import Level, stacking_level
+from chaingeo.core.rules import StackingRules
 from generator import packing
 from generator.assembly import assembly_order, has_isolated_piece
 from generator.config import StackingConfig, box_text
@@ -54,7 +54,7 @@ from generator.partition import (
 )
 from generator.result import ATTEMPTS_KEY, Rejection
 
-GENERATOR: Final = "chaingeo.generator.stacking"
+GENERATOR: Final = "generator.stacking"
 #: Bump when a change to the algorithm changes what a (config, seed, index) produces.
 VERSION: Final = "1"
 

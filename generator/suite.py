@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Final
 
-from generator.batch import GenerationJob, Summary, run
+from generator.batch import GenerationJob, PictureFn, Summary, run
 from generator.config import StackingConfig, get_config
 from generator.stacking import GENERATOR, make
 
@@ -79,14 +79,16 @@ def build_suite(
     dask: str | None = None,
     progress: bool = True,
     pictures: str | os.PathLike[str] | None = None,
+    picture_maker: PictureFn | None = None,
 ) -> list[Summary]:
     """Generate the whole suite and write its level files into ``out``.
 
     Earlier suite files in ``out`` (levels made by this generator) are replaced; other files
-    are left alone. With ``pictures``, the assembly and piece pictures go to that folder.
-    Raises :class:`RuntimeError` if some entry cannot be filled.
+    are left alone. With ``pictures``, the pictures ``picture_maker`` draws of each level go to
+    that folder. Raises :class:`RuntimeError` if some entry cannot be filled.
     """
-    from generator.pictures import level_pictures
+    if (pictures is None) != (picture_maker is None):
+        raise ValueError("pictures and picture_maker go together")
 
     target = Path(out)
     summaries: list[Summary] = []
@@ -95,7 +97,7 @@ def build_suite(
             job = entry.job()
             if pictures is not None:
                 job = GenerationJob(
-                    job.family, job.make, job.config, job.seed, job.count, pictures=level_pictures
+                    job.family, job.make, job.config, job.seed, job.count, pictures=picture_maker
                 )
             s = run(job, scratch, jobs=jobs, dask=dask, progress=progress, write_summary=False)
             summaries.append(s)

@@ -14,7 +14,7 @@ import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
-from chaingeo.geometry import Shape
+from chaingeo.core.geometry import Shape
 from solvers.cover import iter_solutions
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
@@ -92,7 +92,7 @@ def count_solutions(
 def solid_burr_codes() -> tuple[int, ...]:
     """Recompute the burr catalogue: the codes of the notchable pieces used by any assembly
     of the whole notchable family (each 0..6 times) into the Solid Knot."""
-    from chaingeo.piecesets.burrs import notchable_family, solid_knot
+    from chaingeo.core.piecesets.burrs import notchable_family, solid_knot
 
     family = notchable_family()
     code_of = {s.canonical(): c for c, s in family.items()}

@@ -39,8 +39,8 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import Assembly, Move, MoveError, SearchLimitError
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import Assembly, Move, MoveError, SearchLimitError
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
 
@@ -87,7 +87,7 @@ def _block_plans(
 def _boxes_touch(state: Assembly, *names: str) -> bool:
     """Do the bounding boxes of ``names`` and the rest of their part touch or overlap on every
     axis? (Played backwards, the removal is an insertion, which the assemble game allows only
-    then: :mod:`chaingeo.puzzle`.)"""
+    then: :mod:`chaingeo.envs.puzzle`.)"""
     mine = [c for n in names for c in state.cells_of(n)]
     others = sorted(state.part_of(names[0]) - set(names))
     rest = [c for n in others for c in state.cells_of(n)]

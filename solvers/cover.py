@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from chaingeo.geometry import Shape
+from chaingeo.core.geometry import Shape
 from solvers.placements import Int32Array
 from solvers.problem import (
     CoverError,
@@ -95,12 +95,6 @@ class Solution:
     @property
     def shapes(self) -> list[Shape]:
         return [s for _, s in self.placements]
-
-    def by_piece(self) -> dict[str, list[Shape]]:
-        out: dict[str, list[Shape]] = {}
-        for name, s in self.placements:
-            out.setdefault(name, []).append(s)
-        return out
 
 
 def make_solution(problem: CoverProblem, rows: Int32Array) -> Solution:

@@ -1,6 +1,6 @@
 """Disassembly search: the BurrTools level, and the optimal full disassembly o_i.
 
-Semantics are those of :mod:`chaingeo.kinematics` (the reference); the search itself runs on
+Semantics are those of :mod:`chaingeo.core.kinematics` (the reference); the search itself runs on
 :mod:`solvers.movement` (numba). Two questions are answered:
 
 * **Level** (BurrTools' notation, e.g. ``"4.9.3"``): breadth first to the first removal whose two
@@ -21,8 +21,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from solvers import movement as mv
 from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
 
@@ -260,16 +260,6 @@ def analyze(
     )
 
 
-def can_disassemble(
-    shapes: Mapping[str, Shape],
-    *,
-    max_group: int | None = None,
-    limits: SearchLimits | None = None,
-) -> bool:
-    """Can the assembled puzzle be taken completely apart?"""
-    return analyze(shapes, max_group=max_group, limits=limits, optimal=False).disassemblable
-
-
 # -------------------------------------------------------------------------------------------
 # Per-state helpers (for environments and for the conformance tests against the reference)
 # -------------------------------------------------------------------------------------------
@@ -284,7 +274,7 @@ def move_rows(
     """The legal moves of ``state`` in the movement kernel's raw form: per part of two or
     more pieces, its piece names (sorted) and int64 rows ``(mask, direction index, kmax,
     removable)`` (bit ``i`` of ``mask``: the part's ``i``-th piece; direction index into
-    :data:`chaingeo.kinematics.DIRECTIONS`; finite moves ``1..kmax``; ``removable``: it can
+    :data:`chaingeo.core.kinematics.DIRECTIONS`; finite moves ``1..kmax``; ``removable``: it can
     also leave for good). Raises :class:`SearchLimitError` past ``group_limit`` groups along a
     direction."""
     table = PieceTable(state.shapes) if table is None else table
@@ -317,7 +307,7 @@ def move_rows(
 def fast_legal_moves(
     state: Assembly, max_group: int | None = None, group_limit: int = 4096
 ) -> list[Move]:
-    """Every legal move of ``state``, as :func:`chaingeo.kinematics.legal_moves` lists them,
+    """Every legal move of ``state``, as :func:`chaingeo.core.kinematics.legal_moves` lists them,
     computed by the numba movement analysis."""
     dirs = list(DIRECTIONS)
     moves: list[Move] = []

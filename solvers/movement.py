@@ -9,7 +9,7 @@ Moving ``G`` along ``+a`` and moving the rest along ``-a`` give the same relativ
 
 Pieces are the voxels of one *part* (a sub-puzzle) in their assembled position; a state is one
 ``int16`` row of ``3 n`` offsets, piece 0 always at the origin. Directions are indexed as in
-:data:`chaingeo.kinematics.DIRECTIONS`: ``2 a`` is ``+a`` and ``2 a + 1`` is ``-a``.
+:data:`chaingeo.core.kinematics.DIRECTIONS`: ``2 a`` is ``+a`` and ``2 a + 1`` is ``-a``.
 """
 
 from __future__ import annotations

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import DIRECTIONS, Move, SearchLimitError
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import DIRECTIONS, Move, SearchLimitError
 from solvers import movement as mv
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)

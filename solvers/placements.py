@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.geometry import SYMMETRIES, Shape
+from chaingeo.core.geometry import SYMMETRIES, Shape
 
 IntArray = npt.NDArray[np.int64]
 Int32Array = npt.NDArray[np.int32]
@@ -145,7 +145,7 @@ def target_symmetries(target: Shape, reflections: bool = True) -> list[tuple[Int
     """The lattice symmetries ``v -> M v + t`` mapping ``target`` onto itself, identity first.
 
     Same order as :data:`SYMMETRIES` (rotations first); for a box at the origin this is exactly
-    :func:`chaingeo.geometry.box_symmetries`. ``reflections=False`` keeps the rotations only.
+    :func:`chaingeo.core.geometry.box_symmetries`. ``reflections=False`` keeps the rotations only.
     """
     mats = SYMMETRIES if reflections else SYMMETRIES[:24]
     lo = target.min_corner

@@ -19,9 +19,8 @@ from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
 
 import numpy as np
-import numpy.typing as npt
 
-from chaingeo.geometry import Shape, box_cells
+from chaingeo.core.geometry import Shape, box_cells
 from solvers.placements import (
     Int32Array,
     IntArray,
@@ -156,11 +155,6 @@ class CoverProblem:
     def placed_shape(self, row: int) -> Shape:
         return Shape(self.target.voxels[self.row_cells(row)])
 
-    def row_of(self, type_index: int, placed: Shape) -> int:
-        """Row of a placed shape of the given type, or -1 if it is not a placement."""
-        i = self.table[type_index].find(placed)
-        return -1 if i < 0 else int(self.row_start[type_index]) + i
-
     # -- symmetry ------------------------------------------------------------------------------
     @cached_property
     def mirror_invariant(self) -> bool:
@@ -282,7 +276,3 @@ def _cover_problem(
     np.cumsum(sizes, out=row_start[1:])
     row_type = np.repeat(np.arange(len(types), dtype=np.int32), sizes)
     return CoverProblem(target, opt, tuple(types), table, row_type, row_start, reflections)
-
-
-def rows_array(rows: npt.ArrayLike) -> Int32Array:
-    return np.ascontiguousarray(np.asarray(rows, dtype=np.int32).reshape(-1))

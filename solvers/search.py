@@ -14,7 +14,7 @@ from typing import Literal
 
 import numpy as np
 
-from chaingeo.kinematics import SearchLimitError
+from chaingeo.core.kinematics import SearchLimitError
 from solvers import kernels
 from solvers.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
 from solvers.dlx import DLXArrays, dlx_run

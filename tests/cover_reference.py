@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from chaingeo.geometry import SYMMETRIES
+from chaingeo.core.geometry import SYMMETRIES
 
 Cell = tuple[int, int, int]
 Piece = tuple[frozenset[Cell], int, int]  # cells, min copies, max copies

@@ -11,11 +11,10 @@ from collections import deque
 from collections.abc import Hashable, Sequence
 from functools import cache
 
-from chaingeo.actions import MoveAction
-from chaingeo.colors import assign_colors
-from chaingeo.geometry import Cell, Shape, box_cells, puzzle_signature
-from chaingeo.kinematics import Move, disassembly_of_assembly_plan
-from chaingeo.level import (
+from chaingeo.core.colors import assign_colors
+from chaingeo.core.geometry import Cell, Shape, box_cells, puzzle_signature
+from chaingeo.core.kinematics import Move, disassembly_of_assembly_plan
+from chaingeo.core.level import (
     Level,
     Piece,
     Provenance,
@@ -24,9 +23,10 @@ from chaingeo.level import (
     revalidate,
     stacking_level,
 )
-from chaingeo.piecesets import BEDLAM_SOLUTION, SOMA
-from chaingeo.puzzle import PuzzleState
-from chaingeo.rules import PuzzleRules, StackingRules
+from chaingeo.core.piecesets import BEDLAM_SOLUTION, SOMA
+from chaingeo.core.rules import PuzzleRules, StackingRules
+from chaingeo.envs.actions import MoveAction
+from chaingeo.envs.puzzle import PuzzleState
 
 # ---------------------------------------------------------------------------------------------
 # Stacking

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from hypothesis import strategies as st
 
-from chaingeo.geometry import NEIGHBOURS, Shape
+from chaingeo.core.geometry import NEIGHBOURS, Shape
 
 
 def random_partition(dims: tuple[int, int, int], k: int, seed: int) -> dict[str, Shape]:

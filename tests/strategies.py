@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from hypothesis import strategies as st
 
-from chaingeo.geometry import NEIGHBOURS, ROTATIONS, Shape
+from chaingeo.core.geometry import NEIGHBOURS, ROTATIONS, Shape
 
 
 @st.composite

@@ -8,7 +8,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from chaingeo.actions import (
+from chaingeo.core.colors import PALETTE
+from chaingeo.core.kinematics import DIRECTIONS, Move
+from chaingeo.envs.action_text import action_from_text, parse_action, parse_text
+from chaingeo.envs.actions import (
     Action,
     ActionError,
     ActionFormatError,
@@ -21,16 +24,11 @@ from chaingeo.actions import (
     PlaceAction,
     UnparseableActionError,
     action_from_json,
-    action_from_text,
     action_to_json,
     cell_text,
-    parse_action,
-    parse_text,
     rules_text,
 )
-from chaingeo.colors import PALETTE
-from chaingeo.kinematics import DIRECTIONS, Move
-from chaingeo.state import new_state
+from chaingeo.envs.machines import new_state
 from tests.env_levels import puzzle_levels, soma_level
 
 names = st.sampled_from([c.name for c in PALETTE])

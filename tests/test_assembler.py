@@ -7,8 +7,8 @@ import json
 
 import pytest
 
-from chaingeo.cli import main
-from chaingeo.geometry import Shape
+from chaingeo.cli.main import main
+from chaingeo.core.geometry import Shape
 from solvers.assemble import count_solutions, iter_assemblies
 from solvers.problem import PieceSpec
 from tests.test_burrtools import BT, needs_files

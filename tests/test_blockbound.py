@@ -8,11 +8,12 @@ from functools import cache
 
 import pytest
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import disassembly_of_assembly_plan, replay_disassembly
-from chaingeo.level import Level, PuzzleSolution
-from chaingeo.state import new_state
-from generator.puzzle import PuzzleConfig, make
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import disassembly_of_assembly_plan, replay_disassembly
+from chaingeo.core.level import Level, PuzzleSolution
+from chaingeo.envs.machines import new_state
+from generator.config import PuzzleConfig
+from generator.puzzle import make
 from generator.result import Rejection
 from solvers.blockbound import analyze_by_blocks, block_lower_bound
 from solvers.disassemble import analyze

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from chaingeo.piecesets.burrs import (
+from chaingeo.core.piecesets.burrs import (
     SOLID_BURR_CODES,
     notchable_family,
     six_piece_family,
@@ -32,7 +32,7 @@ def test_314_solid_six_piece_burrs() -> None:
 
 @needs_files
 def test_catalogue_is_burrtools_list() -> None:
-    from chaingeo.formats.burrtools import read_xmpuzzle
+    from chaingeo.core.formats.burrtools import read_xmpuzzle
 
     assert BT is not None
     puzzle = read_xmpuzzle(BT / "SolidSixPieceBurrs.xmpuzzle")

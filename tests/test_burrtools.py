@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.cli import main
-from chaingeo.formats.burrtools import (
+from chaingeo.cli.main import main
+from chaingeo.core.formats.burrtools import (
     TRANSFORMS_BT,
     BurrToolsError,
     assembled_puzzle,
@@ -18,8 +18,8 @@ from chaingeo.formats.burrtools import (
     read_xmpuzzle,
     xmpuzzle_bytes,
 )
-from chaingeo.geometry import ROTATIONS, Shape
-from chaingeo.piecesets.burrs import six_piece_family, solid_knot
+from chaingeo.core.geometry import ROTATIONS, Shape
+from chaingeo.core.piecesets.burrs import six_piece_family, solid_knot
 from solvers.disassemble import analyze
 
 

@@ -7,10 +7,10 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.collision_check import move_is_legal, swept_collision
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import DIRECTIONS, Assembly, Move, MoveError
-from chaingeo.mesh import mesh_arrays, piece_mesh
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, MoveError
+from chaingeo.envs.collision_check import move_is_legal, swept_collision
+from chaingeo.envs.mesh import mesh_arrays, piece_mesh
 
 DISTANCES = (1, 2, 3, None)
 

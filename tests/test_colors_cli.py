@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.cli import COMMANDS, main
-from chaingeo.colors import BY_NAME, PALETTE, assign_colors
-from chaingeo.formats.chain_json import export_chain_stacking
-from chaingeo.level import load_level, save_level, stacking_level
-from chaingeo.piecesets import BEDLAM_SOLUTION
+from chaingeo.cli.main import COMMANDS, main
+from chaingeo.core.colors import BY_NAME, PALETTE, assign_colors
+from chaingeo.core.formats.chain_json import export_chain_stacking
+from chaingeo.core.level import load_level, save_level, stacking_level
+from chaingeo.core.piecesets import BEDLAM_SOLUTION
 
 
 def test_palette_has_40_distinct_typable_colours() -> None:
@@ -38,7 +38,10 @@ def test_assign_colors_is_deterministic_and_bounded() -> None:
 
 def test_help_lists_every_subcommand() -> None:
     out = subprocess.run(
-        [sys.executable, "-m", "chaingeo.cli", "--help"], capture_output=True, text=True, check=True
+        [sys.executable, "-m", "chaingeo.cli.main", "--help"],
+        capture_output=True,
+        text=True,
+        check=True,
     )
     for mod in COMMANDS:
         assert mod.rsplit(".", 1)[1] in out.stdout

@@ -12,9 +12,11 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.actions import Action, MoveAction, PlaceAction, parse_action
-from chaingeo.level import Level, PuzzleSolution, StackingSolution, load_levels
-from chaingeo.state import BaseState, new_state
+from chaingeo.core.level import Level, PuzzleSolution, StackingSolution, load_levels
+from chaingeo.envs.action_text import parse_action
+from chaingeo.envs.actions import Action, MoveAction, PlaceAction
+from chaingeo.envs.machines import new_state
+from chaingeo.envs.state import BaseState
 from tests.env_levels import puzzle_levels, stacking_levels
 
 LEVELS_DIR = Path(__file__).resolve().parent.parent / "levels"

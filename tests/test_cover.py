@@ -7,9 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.geometry import Shape, box_cells, box_symmetries
-from chaingeo.kinematics import SearchLimitError
-from chaingeo.piecesets import BEDLAM, PENTOMINOES, SOMA
+from chaingeo.core.geometry import Shape, box_cells, box_symmetries
+from chaingeo.core.kinematics import SearchLimitError
+from chaingeo.core.piecesets import BEDLAM, PENTOMINOES, SOMA
 from solvers.cover import (
     CoverError,
     CoverLimitError,

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.cli import main
-from chaingeo.geometry import Shape
-from chaingeo.level import save_level, stacking_level
+from chaingeo.cli.main import main
+from chaingeo.core.geometry import Shape
+from chaingeo.core.level import save_level, stacking_level
 
 
 def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

@@ -1,6 +1,6 @@
 """Interlocking cubes: why they need empty cells, and that generated ones really interlock.
 
-Checked against the reference kinematics (:mod:`chaingeo.kinematics`), not the numba search.
+Checked against the reference kinematics (:mod:`chaingeo.core.kinematics`), not the numba search.
 """
 
 from __future__ import annotations
@@ -10,14 +10,15 @@ import dataclasses
 import numpy as np
 import pytest
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import (
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import (
     Assembly,
     legal_moves,
     reference_first_level,
     reference_optimal_disassembly,
 )
-from chaingeo.level import Level, level_bytes
+from chaingeo.core.level import Level, level_bytes
+from generator.config import PuzzleConfig
 from generator.cubes import (
     VOID,
     nearest_to_leaving,
@@ -26,7 +27,7 @@ from generator.cubes import (
     void_count,
     void_sites,
 )
-from generator.puzzle import PuzzleConfig, make
+from generator.puzzle import make
 from generator.result import Rejection
 from solvers.partsearch import PieceTable
 

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import (
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import (
     Assembly,
     Move,
     SearchLimitError,
@@ -142,7 +142,7 @@ def test_limits_raise_clear_errors() -> None:
 @given(small_scenes(), st.integers(0, 10**6), st.integers(0, 4))
 def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, steps: int) -> None:
     """Cutler's pairwise matrix from the numba kernel equals the reference blocking_matrix."""
-    from chaingeo.kinematics import DIRECTIONS, blocking_matrix
+    from chaingeo.core.kinematics import DIRECTIONS, blocking_matrix
     from solvers import movement
 
     state = random_walk(shapes, seed, steps)

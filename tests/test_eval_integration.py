@@ -7,18 +7,14 @@ from pathlib import Path
 
 import pytest
 
-pytest.importorskip("chaingeo.state")
-pytest.importorskip("chaingeo.observation")
+pytest.importorskip("chaingeo.envs.state")
+pytest.importorskip("chaingeo.envs.observation")
 
-from chaingeo.agents.base import AgentSpec
-from chaingeo.agents.baselines import oracle_plan
-from chaingeo.cli import main
-from chaingeo.colors import assign_colors
-from chaingeo.evaluation.episode import EpisodeTask, ProtocolConfig, run_episode
-from chaingeo.evaluation.runner import RunConfig, evaluate
-from chaingeo.geometry import Shape, puzzle_signature
-from chaingeo.kinematics import Move
-from chaingeo.level import (
+from chaingeo.cli.main import main
+from chaingeo.core.colors import assign_colors
+from chaingeo.core.geometry import Shape, puzzle_signature
+from chaingeo.core.kinematics import Move
+from chaingeo.core.level import (
     Level,
     Piece,
     Provenance,
@@ -28,7 +24,11 @@ from chaingeo.level import (
     save_level,
     stacking_level,
 )
-from chaingeo.rules import PuzzleRules
+from chaingeo.core.rules import PuzzleRules
+from chaingeo.evaluation.agents.base import AgentSpec
+from chaingeo.evaluation.agents.baselines import oracle_plan
+from chaingeo.evaluation.episode import EpisodeTask, ProtocolConfig, run_episode
+from chaingeo.evaluation.runner import RunConfig, evaluate
 from tests.eval_support.fake_openai import Script, fake_openai, reply
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -7,15 +7,15 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.agents import AGENTS
-from chaingeo.agents.base import Agent, AgentError, AgentSpec, Reply, Turn
-from chaingeo.agents.http import ChatClient, RetryPolicy, parse_retry_after
-from chaingeo.agents.prompt import extract_action, extract_plan
+from chaingeo.core.geometry import Shape
+from chaingeo.core.level import Level, stacking_level
+from chaingeo.evaluation.agents.base import Agent, AgentError, AgentSpec, Reply, Turn
+from chaingeo.evaluation.agents.http import ChatClient, RetryPolicy, parse_retry_after
+from chaingeo.evaluation.agents.prompt import extract_action, extract_plan
+from chaingeo.evaluation.agents.registry import AGENTS
 from chaingeo.evaluation.episode import ProtocolConfig
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from chaingeo.evaluation.usage import PriceTable
-from chaingeo.geometry import Shape
-from chaingeo.level import Level, stacking_level
 from tests.eval_support.fake_openai import Script, fake_openai, reply
 
 FAKE = ProtocolConfig(env="tests.eval_support.fake_env")

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.agents.base import AgentSpec
-from chaingeo.cli import main
+from chaingeo.cli.main import main
+from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import ProtocolConfig
 from chaingeo.evaluation.report import find_runs, load_run, table1
 from chaingeo.evaluation.runner import RunConfig, evaluate

@@ -14,13 +14,13 @@ from typing import Any
 
 import pytest
 
-from chaingeo.agents import AGENTS
-from chaingeo.agents.base import Agent, AgentSpec, Reply, Turn
+from chaingeo.core.geometry import Shape
+from chaingeo.core.level import Level, stacking_level
+from chaingeo.evaluation.agents.base import Agent, AgentSpec, Reply, Turn
+from chaingeo.evaluation.agents.registry import AGENTS
 from chaingeo.evaluation.episode import ProtocolConfig
 from chaingeo.evaluation.logs import RunError
 from chaingeo.evaluation.runner import RunConfig, evaluate
-from chaingeo.geometry import Shape
-from chaingeo.level import Level, stacking_level
 
 ROOT = Path(__file__).resolve().parents[1]
 FAKE = ProtocolConfig(env="tests.eval_support.fake_env")
@@ -73,7 +73,7 @@ import sys
 from pathlib import Path
 sys.path.insert(0, {root!r})
 from tests.test_eval_runner import _levels, FAKE
-from chaingeo.agents.base import AgentSpec
+from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.runner import RunConfig, evaluate
 evaluate(_levels(8), AgentSpec("random"), Path({run!r}), FAKE,
          RunConfig(samples=2, seed=1, progress=False, resume={resume}))

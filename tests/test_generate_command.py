@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.cli import main
-from chaingeo.level import load_levels
+from chaingeo.cli.main import main
+from chaingeo.core.level import load_levels
 
 
 def test_generate_stacking_writes_levels_pictures_and_a_summary(

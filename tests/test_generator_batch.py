@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.geometry import Shape
-from chaingeo.level import Level, load_levels, stacking_level
+from chaingeo.core.geometry import Shape
+from chaingeo.core.level import Level, load_levels, stacking_level
+from chaingeo.envs.pictures import level_pictures
 from generator.batch import SUMMARY_FILE, GenerationError, GenerationJob, run
 from generator.config import get_config
-from generator.pictures import level_pictures
 from generator.result import Rejection
 from generator.stacking import make
 

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from chaingeo.geometry import Shape, box_cells
-from chaingeo.kinematics import DIRECTIONS, Assembly
+from chaingeo.core.geometry import Shape, box_cells
+from chaingeo.core.kinematics import DIRECTIONS, Assembly
 from generator.assembly import assembly_order, has_isolated_piece, removal_sequence
 from generator.partition import (
     PieceRules,

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.level import Level, level_bytes, revalidate
+from chaingeo.core.level import Level, level_bytes, revalidate
 from generator.checks import level_problems
 from generator.config import (
     StackingConfig,

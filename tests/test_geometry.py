@@ -6,7 +6,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from chaingeo.geometry import (
+from chaingeo.core.geometry import (
     QUARTER_TURNS,
     ROTATIONS,
     SYMMETRIES,
@@ -18,7 +18,7 @@ from chaingeo.geometry import (
     quarter_turn_distance,
     rotation_index,
 )
-from chaingeo.piecesets import BEDLAM, BEDLAM_SOLUTION, PENTOMINOES, SOMA
+from chaingeo.core.piecesets import BEDLAM, BEDLAM_SOLUTION, PENTOMINOES, SOMA
 from tests.strategies import offsets, polycubes, rotations
 
 

@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.level import load_level
-from chaingeo.state import new_state
+from chaingeo.core.level import load_level
+from chaingeo.envs.machines import new_state
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from chaingeo.actions import MoveAction, PlaceAction
-from chaingeo.gym import CHARSET, PuzzleEnv, StackingEnv
+from chaingeo.envs.actions import MoveAction, PlaceAction
+from chaingeo.envs.gym import CHARSET, PuzzleEnv, StackingEnv
 from tests.env_levels import drop_level, puzzle_levels, soma_level, tiny_level
 
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import Assembly, Move, MoveError, legal_moves, movable_groups
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import Assembly, Move, MoveError, legal_moves, movable_groups
 
 SCENE = {
     "red": Shape([(0, 0, 0), (1, 0, 0), (2, 0, 0)]),

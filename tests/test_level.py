@@ -9,13 +9,13 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from chaingeo.formats.chain_json import (
+from chaingeo.core.formats.chain_json import (
     export_chain_stacking,
     import_chain_stacking,
     read_chain_stacking,
 )
-from chaingeo.geometry import ROTATIONS, Shape, puzzle_signature
-from chaingeo.level import (
+from chaingeo.core.geometry import ROTATIONS, Shape, puzzle_signature
+from chaingeo.core.level import (
     Level,
     LevelError,
     content_hash,
@@ -26,8 +26,8 @@ from chaingeo.level import (
     save_level,
     stacking_level,
 )
-from chaingeo.piecesets import BEDLAM_SOLUTION
-from chaingeo.rules import StackingRules
+from chaingeo.core.piecesets import BEDLAM_SOLUTION
+from chaingeo.core.rules import StackingRules
 
 
 def bedlam_level() -> Level:

@@ -8,14 +8,15 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.kinematics import (
+from chaingeo.core.kinematics import (
     reference_first_level,
     reference_optimal_disassembly,
     replay_disassembly,
 )
-from chaingeo.level import Level, level_bytes
+from chaingeo.core.level import Level, level_bytes
+from generator.config import PuzzleConfig
 from generator.maze import maze_pieces, parse_maze_shape, random_walk, runs, with_exit
-from generator.puzzle import PuzzleConfig, make
+from generator.puzzle import make
 
 DEEP = PuzzleConfig(shape="maze5", min_level=10, hill_steps=300)
 

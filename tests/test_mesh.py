@@ -11,11 +11,12 @@ import trimesh
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.cli import main
-from chaingeo.commands.export import FORMATS as CLI_FORMATS
-from chaingeo.geometry import Shape
-from chaingeo.level import save_level, stacking_level
-from chaingeo.mesh import (
+from chaingeo.cli.commands.export import FORMATS as CLI_FORMATS
+from chaingeo.cli.main import main
+from chaingeo.core.geometry import Shape
+from chaingeo.core.level import save_level, stacking_level
+from chaingeo.core.piecesets import BEDLAM_SOLUTION
+from chaingeo.envs.mesh import (
     FORMATS,
     eroded_mesh,
     export_level,
@@ -23,7 +24,6 @@ from chaingeo.mesh import (
     load_meshes,
     piece_mesh,
 )
-from chaingeo.piecesets import BEDLAM_SOLUTION
 from tests.strategies import polycubes
 
 #: Two cubes of one piece meeting only along an edge (through a third cube): the union has a

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from chaingeo.actions import MoveAction
-from chaingeo.kinematics import Move
-from chaingeo.observation import observe, scene, state_text
-from chaingeo.state import new_state
+from chaingeo.core.kinematics import Move
+from chaingeo.envs.actions import MoveAction
+from chaingeo.envs.machines import new_state
+from chaingeo.envs.observation import observe, scene, state_text
 from tests.env_levels import drop_level, puzzle_levels, soma_level
 
 

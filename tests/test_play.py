@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.cli import main
-from chaingeo.level import save_level
+from chaingeo.cli.main import main
+from chaingeo.core.level import save_level
 from tests.env_levels import tiny_level
 
 

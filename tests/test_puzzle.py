@@ -6,17 +6,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.actions import (
-    AmbiguousActionError,
-    FinishAction,
-    IllegalActionError,
-    MoveAction,
-    parse_action,
-)
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import DIRECTIONS, OPPOSITE, Move, MoveError, legal_moves
-from chaingeo.level import Level
-from chaingeo.puzzle import PuzzleState, normal_key
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import DIRECTIONS, OPPOSITE, Move, MoveError, legal_moves
+from chaingeo.core.level import Level
+from chaingeo.envs.action_text import parse_action
+from chaingeo.envs.actions import AmbiguousActionError, FinishAction, IllegalActionError, MoveAction
+from chaingeo.envs.puzzle import PuzzleState, normal_key
 from tests.env_levels import LOCK3, bfs_plan, puzzle_level, puzzle_levels, tube
 
 

@@ -10,17 +10,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.action_list import ActionList
-from chaingeo.actions import FinishAction, MoveAction
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import (
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import (
     DIRECTIONS,
     Move,
     insertion_shifts,
 )
-from chaingeo.level import Level, load_levels
-from chaingeo.puzzle import PuzzleState
-from chaingeo.puzzle_actions import reference_actions, shifts
+from chaingeo.core.level import Level, load_levels
+from chaingeo.envs.action_list import ActionList
+from chaingeo.envs.actions import FinishAction, MoveAction
+from chaingeo.envs.puzzle import PuzzleState
+from chaingeo.envs.puzzle_actions import reference_actions, shifts
 from tests.env_levels import puzzle_levels
 from tests.strategies import polycubes
 

@@ -6,15 +6,16 @@ import dataclasses
 import json
 from pathlib import Path
 
-from chaingeo.cli import main
-from chaingeo.kinematics import (
+from chaingeo.cli.main import main
+from chaingeo.core.kinematics import (
     disassembly_of_assembly_plan,
     reference_optimal_disassembly,
     replay_disassembly,
 )
-from chaingeo.level import Level, level_bytes, load_level
+from chaingeo.core.level import Level, level_bytes, load_level
+from generator.config import PuzzleConfig
 from generator.layouts import get_layout
-from generator.puzzle import PuzzleConfig, difficulty_of, make
+from generator.puzzle import difficulty_of, make
 from generator.result import Rejection
 
 SMALL = PuzzleConfig(shape="cube3", pieces=3, hill_steps=20, hole_rate=0.3)

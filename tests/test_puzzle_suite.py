@@ -7,9 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.kinematics import disassembly_of_assembly_plan, replay_disassembly
-from chaingeo.level import Level, PuzzleSolution, level_bytes, load_levels
-from generator.puzzle import analyze_level, difficulty_of
+from chaingeo.core.kinematics import disassembly_of_assembly_plan, replay_disassembly
+from chaingeo.core.level import Level, PuzzleSolution, level_bytes, load_levels
+from generator.puzzle import difficulty_of
+from solvers.analysis import analyze_level
 from solvers.partsearch import SearchLimits
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"

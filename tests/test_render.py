@@ -15,12 +15,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image
 
-from chaingeo.colors import PALETTE
-from chaingeo.geometry import Shape
-from chaingeo.level import stacking_level
-from chaingeo.piecesets import BEDLAM_SOLUTION
-from chaingeo.raster import SHADE, parse_color, png_bytes
-from chaingeo.render import (
+from chaingeo.core.colors import PALETTE
+from chaingeo.core.geometry import Shape
+from chaingeo.core.level import stacking_level
+from chaingeo.core.piecesets import BEDLAM_SOLUTION
+from chaingeo.envs.raster import SHADE, parse_color, png_bytes
+from chaingeo.envs.render import (
     _FLOOR,
     CAMERAS,
     VIEWS,
@@ -95,7 +95,7 @@ def test_same_bytes_in_a_fresh_interpreter_with_another_hash_seed() -> None:
     ).hexdigest()
     code = (
         "import hashlib, tests.test_render as t\n"
-        "from chaingeo.render import render_views, render_tray\n"
+        "from chaingeo.envs.render import render_views, render_tray\n"
         "b, tr = t._bedlam_half()\n"
         "print(hashlib.sha256(b''.join(render_views(b, (4, 4, 4), size=200).values())"
         " + render_tray(tr, 200)).hexdigest())\n"
@@ -273,8 +273,8 @@ def test_bad_input_raises_a_clear_error(call: object, message: str) -> None:
 
 
 def test_chain_render_writes_the_pictures(tmp_path: Path) -> None:
-    from chaingeo.cli import main
-    from chaingeo.level import save_level
+    from chaingeo.cli.main import main
+    from chaingeo.core.level import save_level
 
     level = stacking_level("bedlam-known", "hard", (4, 4, 4), list(BEDLAM_SOLUTION.values()))
     path = save_level(level, tmp_path / "bedlam.json")

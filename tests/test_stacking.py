@@ -6,16 +6,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.actions import (
+from chaingeo.core.geometry import Shape
+from chaingeo.core.level import Level, stacking_level
+from chaingeo.core.rules import placement_problem
+from chaingeo.envs.actions import (
     FinishAction,
     IllegalActionError,
     PickupAction,
     PlaceAction,
 )
-from chaingeo.geometry import Shape
-from chaingeo.level import Level, stacking_level
-from chaingeo.rules import placement_problem
-from chaingeo.stacking import StackingState
+from chaingeo.envs.stacking import StackingState
 from tests.env_levels import bedlam_level, drop_level, soma_level, tiny_level
 
 

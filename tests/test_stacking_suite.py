@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.level import Level, level_bytes, load_level
+from chaingeo.core.level import Level, level_bytes, load_level
 from generator.checks import level_problems
 from generator.stacking import make
 from generator.suite import SUITE, suite_entry

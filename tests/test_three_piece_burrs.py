@@ -13,8 +13,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.cli import main
-from chaingeo.kinematics import (
+from chaingeo.cli.main import main
+from chaingeo.core.kinematics import (
     Assembly,
     SearchLimitError,
     disassembly_of_assembly_plan,
@@ -23,9 +23,10 @@ from chaingeo.kinematics import (
     reference_optimal_disassembly,
     replay_disassembly,
 )
-from chaingeo.level import Level, level_bytes, load_level
+from chaingeo.core.level import Level, level_bytes, load_level
+from generator.config import PuzzleConfig
 from generator.layouts import Layout, get_layout, three_crossing
-from generator.puzzle import PuzzleConfig, difficulty_of, make
+from generator.puzzle import difficulty_of, make
 from solvers.disassemble import analyze
 from solvers.partsearch import SearchLimits
 

@@ -7,7 +7,7 @@ seeded random walk (loose parts, where groups and insertions are most numerous).
 ``PuzzleState.legal_actions()`` on a fresh state (numba movement analysis and insertion kernel,
 actions left lazy) plus building ``CHAIN_BENCH_PICKS`` of them (default 64: what an agent looks
 at); ``reference`` builds the same list one action at a time with the pure-Python kinematics
-(:func:`chaingeo.puzzle_actions.reference_actions`). ``speedup`` = reference / ours on the same
+(:func:`chaingeo.envs.puzzle_actions.reference_actions`). ``speedup`` = reference / ours on the same
 states in the same run; the two lists are checked equal on the first state of each level.
 JIT compilation is excluded (a warm-up call runs first). ``--quick``: one level, three states.
 """
@@ -18,15 +18,15 @@ import argparse
 import json
 import os
 import time
-from pathlib import Path
 
 import numpy as np
 
-from chaingeo.actions import MoveAction
-from chaingeo.kinematics import Assembly
-from chaingeo.level import Level, load_levels
-from chaingeo.puzzle import PuzzleState
-from chaingeo.puzzle_actions import reference_actions
+from chaingeo.core.kinematics import Assembly
+from chaingeo.core.level import Level, load_levels
+from chaingeo.core.suite import shipped_levels
+from chaingeo.envs.actions import MoveAction
+from chaingeo.envs.puzzle import PuzzleState
+from chaingeo.envs.puzzle_actions import reference_actions
 
 #: The pure-Python reference takes seconds per state at 12 pieces; larger levels are left out.
 REFERENCE_PIECES = 12
@@ -62,7 +62,7 @@ def _ours(asm: Assembly, level: Level, picks: int) -> tuple[float, int]:
 
 
 def run(args: argparse.Namespace) -> int:
-    suite = Path(__file__).resolve().parents[2] / "levels" / "puzzle"
+    suite = shipped_levels("puzzle")
     levels = [
         lv
         for lv in (load_levels(suite) if suite.is_dir() else [])

@@ -22,8 +22,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from chaingeo.geometry import Shape
-from chaingeo.piecesets import BEDLAM, PENTOMINOES, SOMA
+from chaingeo.core.geometry import Shape
+from chaingeo.core.piecesets import BEDLAM, PENTOMINOES, SOMA
 
 
 @dataclass(frozen=True)

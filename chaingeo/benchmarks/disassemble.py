@@ -6,7 +6,7 @@ level >= 10 (:data:`DEEP_CONFIG`; the level reached and the seconds generation t
 printed). For each instance, ``ours`` is the full analysis
 (BurrTools-style level and the exact optimal plan) and ``states_per_s`` the states it visited
 per second; ``reference`` is a breadth-first search with the pure-Python reference kinematics
-(:mod:`chaingeo.kinematics`) on the same puzzle, stopped after expanding
+(:mod:`chaingeo.core.kinematics`) on the same puzzle, stopped after expanding
 ``CHAIN_BENCH_REF_STATES`` states (default 2000) or 5 seconds, giving its states per second.
 ``speedup`` is the ratio of the two rates.
 JIT compilation is excluded (a warm-up analysis runs first). ``--quick``: three suite levels and
@@ -20,11 +20,11 @@ import json
 import os
 import time
 from collections.abc import Mapping
-from pathlib import Path
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import Assembly, legal_moves, state_key
-from chaingeo.level import Level
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import Assembly, legal_moves, state_key
+from chaingeo.core.level import Level
+from chaingeo.core.suite import shipped_levels
 
 
 def reference_rate(
@@ -57,12 +57,14 @@ def _ours(
     shapes: Mapping[str, Shape], max_group: int | None, level: Level | None = None
 ) -> tuple[float, int, dict[str, object]]:
     """Our full analysis; a suite level is analysed as it was made (towers with single-piece
-    moves by the block bound, :func:`generator.puzzle.analyze_level`)."""
-    from generator.puzzle import analyze_level
-    from solvers.disassemble import analyze
+    moves by the block bound, :func:`solvers.analysis.analyze_level`)."""
+    from solvers.analysis import analyze_level, analyze_puzzle
 
     t0 = time.perf_counter()
-    result = analyze_level(level) if level is not None else analyze(shapes, max_group=max_group)
+    if level is not None:
+        result = analyze_level(level)
+    else:
+        result = analyze_puzzle(shapes, max_group=max_group)
     seconds = time.perf_counter() - t0
     info: dict[str, object] = {
         "level": result.level,
@@ -79,12 +81,13 @@ DEEP_CONFIG = {"shape": "maze8", "min_level": 10, "hill_steps": 300}
 
 
 def _instances(quick: bool) -> list[Instance]:
-    from chaingeo.level import load_levels
-    from chaingeo.rules import PuzzleRules
-    from generator.puzzle import PuzzleConfig, make
+    from chaingeo.core.level import load_levels
+    from chaingeo.core.rules import PuzzleRules
+    from generator.config import PuzzleConfig
+    from generator.puzzle import make
 
     out: list[Instance] = []
-    suite = Path(__file__).resolve().parents[2] / "levels" / "puzzle"
+    suite = shipped_levels("puzzle")
     levels = load_levels(suite) if suite.is_dir() else []
     for lv in levels[:3] if quick else levels:
         mg = lv.rules.max_group if isinstance(lv.rules, PuzzleRules) else None

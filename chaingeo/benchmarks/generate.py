@@ -22,7 +22,7 @@ SEED = 2026
 
 
 def _reference_seconds(repeat: int) -> float:
-    from chaingeo.piecesets import SOMA
+    from chaingeo.core.piecesets import SOMA
     from solvers.cover import count_solutions
 
     best = float("inf")

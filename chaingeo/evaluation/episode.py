@@ -30,7 +30,10 @@ from typing import Any, Literal
 
 import numpy as np
 
-from chaingeo.agents.base import (
+from chaingeo.core.level import Level, content_hash
+from chaingeo.envs.machines import new_state
+from chaingeo.envs.observation import observe
+from chaingeo.evaluation.agents.base import (
     TRANSPORT,
     AgentError,
     AgentSpec,
@@ -40,10 +43,11 @@ from chaingeo.agents.base import (
     StepResultLike,
     Turn,
 )
+from chaingeo.evaluation.agents.registry import make_agent
+from chaingeo.evaluation.judges import make_judge
 from chaingeo.evaluation.logs import episode_key
-from chaingeo.evaluation.selection import Judge, make_judge, verify
+from chaingeo.evaluation.selection import Judge, verify
 from chaingeo.evaluation.usage import Usage
-from chaingeo.level import Level, content_hash
 
 ProtocolName = Literal["interactive", "oneshot"]
 #: Pictures that show what the pieces or the goal are rather than the scene (kept in one-shot).
@@ -113,10 +117,10 @@ def episode_seed(run_seed: int, level: Level, sample: int) -> int:
 
 
 def _environment(module: str) -> tuple[Callable[[Level], StateLike], Callable[..., Any]]:
+    """The state machine factory and observation function: ours, or those of the module named
+    (any module exposing ``new_state`` and ``observe``, e.g. a test double)."""
     if module == "chaingeo":
-        state_mod = importlib.import_module("chaingeo.state")
-        obs_mod = importlib.import_module("chaingeo.observation")
-        return state_mod.new_state, obs_mod.observe
+        return new_state, observe
     mod = importlib.import_module(module)
     return mod.new_state, mod.observe
 
@@ -159,10 +163,8 @@ def _step_record(turn: int, reply: Reply, sent: str, result: StepResultLike) -> 
 
 
 def run_episode(task: EpisodeTask) -> EpisodeResult:
-    from chaingeo.agents import make_agent
-
     level, proto = task.level, task.protocol
-    new_state, observe = _environment(proto.env)
+    make_state, observe_state = _environment(proto.env)
     seed = episode_seed(task.seed, level, task.sample)
     started = time.monotonic()
     images = _Images()
@@ -182,7 +184,7 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
         "protocol": proto.name,
         "agent": task.agent.label,
     }
-    state = new_state(level)
+    state = make_state(level)
     agent = make_agent(task.agent)
     record["model"] = agent.model
     finished = False
@@ -192,7 +194,7 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
         agent.start(level, seed)
 
         def see(window: int) -> ObservationLike:
-            obs: ObservationLike = observe(
+            obs: ObservationLike = observe_state(
                 state, history_window=window, text_state=proto.text_state, images=agent.uses_images
             )
             return obs

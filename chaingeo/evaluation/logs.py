@@ -27,7 +27,8 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any, Final
 
-from chaingeo import canonical_json
+from chaingeo.core import canonical_json
+from chaingeo.core.files import atomic_write
 
 RUN_FORMAT: Final = "chain-run/1"
 HEADER: Final = "header.json"
@@ -150,7 +151,9 @@ class RunLog:
         if log.path.exists() and any(log.path.iterdir()):
             raise RunError(f"{log.path}: exists and is not a run directory")
         (log.path / IMAGES).mkdir(parents=True, exist_ok=True)
-        _atomic_write(head, log.redact(canonical_json.dumps(dict(header))).encode("utf-8"))
+        atomic_write(
+            head, log.redact(canonical_json.dumps(dict(header))).encode("utf-8"), durable=True
+        )
         (log.path / EPISODES).touch()
         return log
 
@@ -190,7 +193,7 @@ class RunLog:
         target = self.path / IMAGES / name
         if not target.exists():
             target.parent.mkdir(parents=True, exist_ok=True)
-            _atomic_write(target, png)
+            atomic_write(target, png, durable=True)
         return name
 
     def _drop_partial_tail(self) -> None:
@@ -246,15 +249,6 @@ def read_records(file: Path) -> list[dict[str, Any]]:
             raise RunError(f"{file}: line {i + 1} is not an episode record")
         out.append(rec)
     return out
-
-
-def _atomic_write(target: Path, data: bytes) -> None:
-    tmp = target.with_name(f".{target.name}.{os.getpid()}.tmp")
-    with open(tmp, "wb") as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, target)
 
 
 def _short(value: Any) -> str:

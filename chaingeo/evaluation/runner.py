@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import multiprocessing
-import os
 import sys
 import time
 from collections.abc import Iterator, Sequence
@@ -20,12 +19,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
 
-from chaingeo.agents.base import AgentSpec
+from chaingeo.core.level import Level, level_set_hash
+from chaingeo.evaluation.agents.base import AgentSpec
+from chaingeo.evaluation.agents.http import api_key
+from chaingeo.evaluation.agents.registry import make_agent
 from chaingeo.evaluation.episode import EpisodeResult, EpisodeTask, ProtocolConfig, run_episode
 from chaingeo.evaluation.logs import RunLog, make_header
 from chaingeo.evaluation.metrics import Outcome
 from chaingeo.evaluation.usage import PriceTable, Usage
-from chaingeo.level import Level, level_set_hash
 
 
 @dataclass(frozen=True)
@@ -156,7 +157,7 @@ def _secrets(agent: AgentSpec, protocol: ProtocolConfig) -> list[str]:
     """Every secret the agent or a model judge may send, to be scrubbed from whatever is logged."""
     out = [v for v in agent.secrets.values() if v]
     for options in (agent.options, protocol.judge_options):
-        key = os.environ.get(str(options.get("api_key_env", "OPENAI_API_KEY")))
+        key = api_key(options)
         if key:
             out.append(key)
     return out
@@ -177,8 +178,6 @@ def evaluate(
     prices = prices or PriceTable.load()
     if cfg.samples < 1:
         raise ValueError("samples must be >= 1")
-    from chaingeo.agents import make_agent
-
     make_agent(agent).close()  # bad options fail here, before anything is written
     ids = [lv.id for lv in levels]
     if len(set(ids)) != len(ids):

@@ -10,20 +10,19 @@ commits the first one. Built-in judges:
 - ``progress``: a reward model without a network: prefers a candidate that solves the level,
   then one after which the most legal actions remain (keeps options open), then sampling order;
 - ``model``: a vision-language judge on any OpenAI-compatible server
-  (:mod:`chaingeo.agents.model_judge`; options ``judge_options``: model, base_url, ...).
+  (:mod:`chaingeo.evaluation.model_judge`; options ``judge_options``: model, base_url, ...).
 
-Register another (a trained reward model, ...) with :func:`register_judge`: a factory taking
-the judge options. A judge that calls a model adds what it spent to ``usage``.
+Judges are made by name from :mod:`chaingeo.evaluation.judges`, where another (a trained reward
+model, ...) is registered. A judge that calls a model adds what it spent to ``usage``.
 """
 
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
-from chaingeo.agents.base import ObservationLike, Reply, StateLike, StepResultLike
+from chaingeo.evaluation.agents.base import ObservationLike, Reply, StateLike, StepResultLike
 from chaingeo.evaluation.usage import Usage
 
 
@@ -102,32 +101,6 @@ class Progress(Judge):
             return (False, not c.after.is_success(), -len(c.after.legal_actions()), c.index)
 
         return [c.index for c in sorted(candidates, key=key)]
-
-
-def _model_judge(options: Mapping[str, Any]) -> Judge:
-    from chaingeo.agents.model_judge import ModelJudge
-
-    return ModelJudge(options)
-
-
-JUDGES: dict[str, Callable[[Mapping[str, Any]], Judge]] = {
-    "first": lambda options: FirstLegal(),
-    "vote": lambda options: Vote(),
-    "progress": lambda options: Progress(),
-    "model": _model_judge,
-}
-
-
-def register_judge(name: str, factory: Callable[[Mapping[str, Any]], Judge]) -> None:
-    JUDGES[name] = factory
-
-
-def make_judge(name: str, options: Mapping[str, Any] | None = None) -> Judge:
-    try:
-        factory = JUDGES[name]
-    except KeyError:
-        raise ValueError(f"unknown judge {name!r}; known: {sorted(JUDGES)}") from None
-    return factory(options or {})
 
 
 def verify(state: StateLike, replies: Sequence[Reply]) -> list[Candidate]:

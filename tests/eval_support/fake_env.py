@@ -1,4 +1,4 @@
-"""A minimal stand-in for ``chaingeo.state`` / ``chaingeo.observation`` (a test double).
+"""A minimal stand-in for ``chaingeo.envs.state`` / ``chaingeo.envs.observation`` (a test double).
 
 The game: take every piece once (``take NAME``), in any order. It follows the contract the
 harness relies on: ``step_text`` parses and applies, an unparseable or illegal action changes
@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from PIL import Image
 
-from chaingeo.level import Level
+from chaingeo.core.level import Level
 
 
 @dataclass(frozen=True, order=True)

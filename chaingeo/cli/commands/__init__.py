@@ -1,0 +1,1 @@
+"""One module per ``chain`` subcommand; see :mod:`chaingeo.cli.main`."""

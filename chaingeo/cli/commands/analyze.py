@@ -1,0 +1,52 @@
+"""``chain analyze FILE [--problem N]``: assemblies, solutions, level, moves and o_i of a puzzle
+(one of our level files or a BurrTools ``.xmpuzzle``), printed as one JSON object."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+from chaingeo.cli.errors import CommandError
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser(
+        "analyze", help="assemblies, solutions, level and optimal steps of a puzzle file"
+    )
+    p.add_argument("file", type=Path, help="a chain-level/1 puzzle file or a .xmpuzzle file")
+    p.add_argument("--problem", type=int, default=0, help="problem index in a .xmpuzzle file")
+    p.add_argument("--seconds", type=float, default=120.0, help="time limit of each search")
+    p.add_argument("--max-states", type=int, default=2_000_000, help="state cap per part")
+    p.add_argument("--no-optimal", action="store_true", help="skip the optimal-plan search")
+    p.add_argument(
+        "--no-assemble", action="store_true", help="skip counting assemblies (level only)"
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from chaingeo.core.kinematics import SearchLimitError
+    from chaingeo.core.level import load_level
+    from solvers.analysis import level_figures, xmpuzzle_figures
+    from solvers.partsearch import SearchLimits
+
+    limits = SearchLimits(max_states=args.max_states, seconds=args.seconds)
+    start = time.perf_counter()
+    try:
+        if args.file.suffix == ".xmpuzzle":
+            out = xmpuzzle_figures(
+                args.file, args.problem, limits, not args.no_optimal, not args.no_assemble
+            )
+        else:
+            level = load_level(args.file)
+            out = level_figures(level, limits, not args.no_optimal, not args.no_assemble)
+    except SearchLimitError as e:
+        raise CommandError(str(e)) from None
+    except (IndexError, RuntimeError) as e:
+        raise CommandError(str(e)) from None
+    out["seconds"] = round(time.perf_counter() - start, 3)
+    print(json.dumps(out, sort_keys=True))
+    return 0

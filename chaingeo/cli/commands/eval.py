@@ -1,0 +1,177 @@
+"""``chain eval``: run agents on a level suite and print the leaderboard.
+
+With no arguments it runs the built-in baselines (oracle, greedy, random) on the shipped suite
+``levels/`` and prints Table 1. ``chain eval --agent openai --model NAME --base-url URL``
+evaluates a model on any OpenAI-compatible server (the key comes from ``$OPENAI_API_KEY`` or the
+variable named by ``--api-key-env``; it is never logged). Each (agent, protocol) pair writes one
+run directory under ``--out``; ``--resume`` continues killed runs there.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import re
+import sys
+from pathlib import Path
+from typing import Any
+
+from chaingeo.cli.errors import CommandError
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser(
+        "eval",
+        help="evaluate agents on a level suite (no arguments: the baselines on the shipped suite)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "--levels",
+        type=Path,
+        default=None,
+        help="level file or folder (default: the shipped suite)",
+    )
+    p.add_argument(
+        "--agent",
+        action="append",
+        default=None,
+        help="agent to run, repeatable (default: oracle, greedy, random)",
+    )
+    p.add_argument("--model", help="model name (openai agent)")
+    p.add_argument("--base-url", help="OpenAI-compatible base URL, e.g. http://127.0.0.1:8000/v1")
+    p.add_argument("--api-key-env", default=None, help="variable holding the API key")
+    p.add_argument("--label", help="name shown in reports (default: the model or agent)")
+    p.add_argument(
+        "--agent-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="agent option (VALUE read as JSON when it parses), repeatable",
+    )
+    p.add_argument("--protocol", choices=("interactive", "oneshot", "both"), default="interactive")
+    p.add_argument("--samples", type=int, default=1, help="episodes per level (Pass@k, Avg@k)")
+    p.add_argument("--candidates", type=int, default=1, help="candidates per turn (verifier)")
+    p.add_argument(
+        "--judge",
+        default="first",
+        help="ranks verified candidates: first, vote, progress, or model (a VLM judge)",
+    )
+    p.add_argument(
+        "--judge-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="judge option, e.g. model=NAME base_url=URL (for --judge model), repeatable",
+    )
+    p.add_argument("--history-window", type=int, default=5)
+    p.add_argument("--text-state", action="store_true", help="add every piece's cells as text")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--jobs", type=int, default=1, help="episodes in parallel (processes)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run episodes on a Dask scheduler")
+    p.add_argument("--family", choices=("stacking", "puzzle"), help="only this family")
+    p.add_argument("--difficulty", choices=("easy", "mid", "hard"), help="only this tier")
+    p.add_argument("--limit", type=int, help="only the first N levels (by id)")
+    p.add_argument("--out", type=Path, help="folder for the run directories (runs/<time>)")
+    p.add_argument("--resume", action="store_true", help="continue the runs in --out")
+    p.add_argument("--retry-errors", action="store_true", help="with --resume: rerun errors")
+    p.add_argument("--prices", action="append", default=[], help="extra price table (JSON)")
+    p.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=run)
+
+
+def _option(text: str) -> tuple[str, Any]:
+
+    if "=" not in text:
+        raise CommandError(f"--agent-option {text!r}: expected KEY=VALUE")
+    key, value = text.split("=", 1)
+    try:
+        return key.strip(), json.loads(value)
+    except json.JSONDecodeError:
+        return key.strip(), value
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "-", text).strip("-") or "agent"
+
+
+def run(args: argparse.Namespace) -> int:
+    from chaingeo.core.level import load_level, load_levels
+    from chaingeo.core.suite import shipped_levels
+    from chaingeo.evaluation.agents.base import AgentSpec
+    from chaingeo.evaluation.agents.registry import BASELINES
+    from chaingeo.evaluation.episode import ProtocolConfig
+    from chaingeo.evaluation.report import Run, load_run, table1
+    from chaingeo.evaluation.runner import RunConfig, evaluate
+    from chaingeo.evaluation.usage import PriceTable
+
+    source = args.levels or shipped_levels()
+    if source.is_dir():
+        levels = load_levels(source)
+    elif source.exists():
+        levels = [load_level(source)]
+    else:
+        raise CommandError(f"{source}: no such level file or folder")
+    if args.family:
+        levels = [lv for lv in levels if lv.family == args.family]
+    if args.difficulty:
+        levels = [lv for lv in levels if lv.difficulty == args.difficulty]
+    if args.limit is not None:
+        levels = levels[: args.limit]
+    if not levels:
+        raise CommandError(f"{source}: no levels to evaluate")
+
+    names = args.agent or list(BASELINES)
+    options = dict(_option(o) for o in args.agent_option)
+    if args.model:
+        options["model"] = args.model
+    if args.base_url:
+        options["base_url"] = args.base_url
+    if args.api_key_env:
+        options["api_key_env"] = args.api_key_env
+    if args.label:
+        options["label"] = args.label
+    protocols = ["interactive", "oneshot"] if args.protocol == "both" else [args.protocol]
+    if args.out is None:
+        if args.resume:
+            raise CommandError("--resume needs --out (the folder of the runs to continue)")
+        stamp = _dt.datetime.now(_dt.UTC).strftime("%Y%m%d-%H%M%S")
+        args.out = Path("runs") / stamp
+    prices = PriceTable.load(*args.prices)
+    cfg = RunConfig(
+        samples=args.samples,
+        seed=args.seed,
+        jobs=args.jobs,
+        dask=args.dask,
+        resume=args.resume,
+        retry_errors=args.retry_errors,
+        progress=not args.no_progress,
+    )
+    runs: list[Run] = []
+    for name in names:
+        # Built-in baselines take no model options; only pass what was given explicitly.
+        opts = (
+            options
+            if name not in BASELINES
+            else {k: v for k, v in options.items() if k not in ("model", "base_url", "api_key_env")}
+        )
+        spec = AgentSpec(name, opts)
+        for proto_name in protocols:
+            try:
+                proto = ProtocolConfig(
+                    name=proto_name,  # type: ignore[arg-type]
+                    history_window=args.history_window,
+                    text_state=args.text_state,
+                    candidates=args.candidates,
+                    judge=args.judge,
+                    judge_options=dict(_option(o) for o in args.judge_option),
+                )
+            except ValueError as e:
+                raise CommandError(str(e)) from None
+            run_dir = args.out / f"{_slug(spec.label)}-{proto_name}"
+            evaluate(levels, spec, run_dir, proto, cfg, prices, stream=sys.stderr)
+            runs.append(load_run(run_dir))
+    print(table1(runs).markdown())
+    print(f"runs written to {args.out}; `chain report {args.out}` for every table and the plot")
+    return 0

@@ -1,0 +1,214 @@
+"""``chain generate FAMILY``: make levels at scale (joblib locally, or a Dask cluster).
+
+``chain generate stacking --box 3x3x4 --mode hard --count 100 --seed 7 --out DIR --jobs 2``
+``chain generate suite [--out levels/stacking]``: rebuild the shipped 77-level stacking suite.
+Each family is one subparser; the run options (``--count --seed --out --jobs --dask``...) and
+the runner are shared, so a new family only adds how to build its configuration.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from chaingeo.cli.errors import CommandError
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser("generate", help="generate levels (stacking) or rebuild the stacking suite")
+    fam = p.add_subparsers(dest="family", metavar="FAMILY", required=True)
+    _register_stacking(fam)
+    _register_suite(fam)
+    _register_puzzle(fam)
+    _register_puzzle_suite(fam)
+
+
+def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
+    """Options every family shares: how many, which seed, where, on what."""
+    if count:
+        p.add_argument("--count", type=int, default=10, help="levels to accept (default 10)")
+        p.add_argument("--seed", type=int, default=0, help="item i uses SeedSequence([seed, i])")
+        p.add_argument("--out", type=Path, required=True, help="output folder")
+        p.add_argument(
+            "--max-items",
+            type=int,
+            default=None,
+            help="most items to try (default: 10 x count, at least 100)",
+        )
+        p.add_argument("--first-index", type=int, default=0, help="first item index (default 0)")
+        p.add_argument("--no-pictures", action="store_true", help="skip the PNG pictures")
+    p.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run on the Dask cluster at ADDRESS")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def run_job(args: argparse.Namespace, family: str, make: Any, config: Any) -> int:
+    """Run one generation job from parsed options; print the summary as one JSON line."""
+    from chaingeo.envs.pictures import level_pictures
+    from generator.batch import GenerationError, GenerationJob, run
+
+    try:
+        job = GenerationJob(
+            family,
+            make,
+            config,
+            args.seed,
+            args.count,
+            max_items=args.max_items,
+            first_index=args.first_index,
+            pictures=None if args.no_pictures else level_pictures,
+        )
+        summary = run(job, args.out, jobs=args.jobs, dask=args.dask, progress=not args.no_progress)
+    except GenerationError as e:
+        raise CommandError(str(e)) from None
+    print(json.dumps(summary.to_json(), sort_keys=True))
+    return 0 if summary.complete else 1
+
+
+# -- stacking ------------------------------------------------------------------------------------
+
+
+def _register_stacking(fam: Any) -> None:
+    p = fam.add_parser("stacking", help="pack-the-box levels (easy / mid / hard)")
+    p.add_argument("--box", help="box size AxBxC, e.g. 3x3x4")
+    p.add_argument("--mode", choices=("easy", "mid", "hard"), help="difficulty mode")
+    p.add_argument("--config", help="a registered config name instead of --box/--mode")
+    p.add_argument("--min-nodes", type=int, help="least exact-cover nodes to a first packing")
+    p.add_argument("--max-pieces", type=int, help="most pieces")
+    p.add_argument("--min-piece", type=int, help="smallest piece (first stage)")
+    p.add_argument("--max-piece-cells", type=int, help="largest piece")
+    p.add_argument("--attempts", type=int, help="attempts per item")
+    p.add_argument(
+        "--no-linear-assembly", action="store_true", help="do not require a linear assembly"
+    )
+    add_run_options(p)
+    p.set_defaults(func=_run_stacking)
+
+
+def stacking_config_from_args(args: argparse.Namespace) -> Any:
+    from generator.config import get_config, parse_box, stacking_config
+
+    overrides: dict[str, Any] = {}
+    for opt, fld in (
+        ("min_nodes", "min_nodes"),
+        ("max_pieces", "max_pieces"),
+        ("min_piece", "min_piece"),
+        ("max_piece_cells", "max_piece_cells"),
+        ("attempts", "attempts"),
+    ):
+        if getattr(args, opt) is not None:
+            overrides[fld] = getattr(args, opt)
+    if args.no_linear_assembly:
+        overrides["linear_assembly"] = False
+    if args.config:
+        if args.box or args.mode:
+            raise CommandError("give either --config or --box/--mode, not both")
+        return get_config(args.config).replace(**overrides)
+    box = parse_box(args.box) if args.box else None
+    if box is None or not args.mode:
+        raise CommandError("--box and --mode are required (or --config NAME)")
+    return stacking_config(box, args.mode, **overrides)
+
+
+def _run_stacking(args: argparse.Namespace) -> int:
+    from generator.stacking import make
+
+    return run_job(args, "stacking", make, stacking_config_from_args(args))
+
+
+# -- the suite -----------------------------------------------------------------------------------
+
+
+def _register_suite(fam: Any) -> None:
+    p = fam.add_parser("suite", help="rebuild the shipped 77-level stacking suite, byte for byte")
+    p.add_argument("--out", type=Path, default=Path("levels") / "stacking", help="target folder")
+    p.add_argument("--pictures", type=Path, help="also write the pictures into this folder")
+    add_run_options(p, count=False)
+    p.set_defaults(func=_run_suite)
+
+
+def _run_suite(args: argparse.Namespace) -> int:
+    from chaingeo.envs.pictures import level_pictures
+    from generator.suite import build_suite
+
+    try:
+        summaries = build_suite(
+            args.out,
+            jobs=args.jobs,
+            dask=args.dask,
+            progress=not args.no_progress,
+            pictures=args.pictures,
+            picture_maker=level_pictures if args.pictures is not None else None,
+        )
+    except RuntimeError as e:
+        raise CommandError(str(e)) from None
+    for s in summaries:
+        print(json.dumps(s.to_json() | {"levels": len(s.accepted)}, sort_keys=True))
+    print(json.dumps({"suite": str(args.out), "levels": sum(len(s.accepted) for s in summaries)}))
+    return 0
+
+
+# -- puzzles -------------------------------------------------------------------------------------
+
+
+def _register_puzzle(fam: Any) -> None:
+    p = fam.add_parser("puzzle", help="interlocking puzzles (burrs, plate burrs, cubes)")
+    p.add_argument(
+        "--shape",
+        default="burr6",
+        help=(
+            "burr3, plate3, burr6, burr12, burr18, burr24, burr36 (towers; with --max-group 1 "
+            "built and proven unit by unit), cubeN or mazeN (maze burr: level grows with N); "
+            "default burr6"
+        ),
+    )
+    p.add_argument("--min-level", type=int, default=1, help="least moves to free the first part")
+    p.add_argument("--pieces", type=int, default=0, help="pieces of a cubeN partition")
+    p.add_argument("--hole-rate", type=float, help="chance a shared cell starts empty")
+    p.add_argument("--hill-steps", type=int, help="single-voxel improvement steps")
+    p.add_argument("--goal", choices=("disassemble", "assemble"), default="disassemble")
+    p.add_argument("--max-group", type=int, help="most pieces one move may carry")
+    p.add_argument("--seconds", type=float, help="time limit of the optimal-plan search")
+    add_run_options(p)
+    p.set_defaults(func=_run_puzzle)
+
+
+def _run_puzzle(args: argparse.Namespace) -> int:
+    from generator.config import PuzzleConfig
+    from generator.puzzle import make
+
+    fields: dict[str, Any] = {
+        "shape": args.shape,
+        "min_level": args.min_level,
+        "pieces": args.pieces,
+        "goal": args.goal,
+        "max_group": args.max_group,
+    }
+    for opt in ("hole_rate", "hill_steps", "seconds"):
+        if getattr(args, opt) is not None:
+            fields[opt] = getattr(args, opt)
+    return run_job(args, "puzzle", make, PuzzleConfig(**fields))
+
+
+def _register_puzzle_suite(fam: Any) -> None:
+    p = fam.add_parser("puzzle-suite", help="rebuild the shipped 32-level puzzle suite")
+    p.add_argument("--out", type=Path, default=Path("levels") / "puzzle", help="target folder")
+    p.add_argument("--jobs", type=int, default=1, help="suite entries built in parallel")
+    p.set_defaults(func=_run_puzzle_suite)
+
+
+def _run_puzzle_suite(args: argparse.Namespace) -> int:
+    import sys
+
+    from generator.puzzle_suite import build_puzzle_suite
+
+    try:
+        levels = build_puzzle_suite(
+            args.out, jobs=args.jobs, log=lambda s: print(s, file=sys.stderr, flush=True)
+        )
+    except RuntimeError as e:
+        raise CommandError(str(e)) from None
+    print(json.dumps({"suite": str(args.out), "levels": len(levels)}))
+    return 0

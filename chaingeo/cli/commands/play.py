@@ -1,0 +1,112 @@
+"""``chain play LEVEL``: play a level in the terminal with the agents' own action text.
+
+After every turn it prints the feedback (the very text an agent gets), the state with every
+piece's cells (1-based) and the paths of the freshly rendered views. ``undo`` takes back the
+last action that was carried out (and the step it cost, and any failed turns after it);
+``help`` repeats the task; ``quit`` (or end of input) stops. Exit status 0 when solved, else 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any, TextIO
+
+from chaingeo.cli.errors import CommandError
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser("play", help="play a level in the terminal (same actions as an agent)")
+    p.add_argument("level", help="a level file, or the id of a level under --levels")
+    p.add_argument(
+        "--levels",
+        type=Path,
+        default=None,
+        help="folder to look ids up in (default: the shipped suite)",
+    )
+    p.add_argument("--views", type=Path, default=None, help="folder for the rendered views")
+    p.add_argument("--no-images", action="store_true", help="do not render views")
+    p.add_argument("--size", type=int, default=512, help="image size in pixels")
+    p.set_defaults(func=run)
+
+
+def _find_level(spec: str, folder: Path | None) -> Any:
+    from chaingeo.core.level import load_level, load_levels
+    from chaingeo.core.suite import shipped_levels
+
+    path = Path(spec)
+    if path.suffix == ".json" or path.is_file():
+        return load_level(path)
+    root = folder if folder is not None else shipped_levels()
+    for level in load_levels(root) if root.is_dir() else []:
+        if level.id == spec:
+            return level
+    raise CommandError(f"no level file or level id {spec!r} (looked in {root})")
+
+
+def run(args: argparse.Namespace) -> int:
+    level = _find_level(args.level, args.levels)
+    views = None
+    if not args.no_images:
+        views = args.views or Path(tempfile.mkdtemp(prefix=f"chain-play-{level.id}-"))
+    return play(level, sys.stdin, sys.stdout, views, args.size)
+
+
+def play(level: Any, stdin: TextIO, out: TextIO, views: Path | None, size: int = 512) -> int:
+    """The game loop (separate from argument handling so tests can drive it)."""
+    from chaingeo.envs.machines import new_state
+    from chaingeo.envs.observation import instruction, render_state, state_text
+
+    state = new_state(level)
+
+    def show() -> None:
+        print(state_text(state), file=out)
+        print(f"Steps used: {state.steps_used} of {state.max_steps}", file=out)
+        if views is not None:
+            views.mkdir(parents=True, exist_ok=True)
+            for name, png in render_state(state, size).items():
+                path = views / f"{name}.png"
+                path.write_bytes(png)
+                print(f"view {name}: {path}", file=out)
+        print("> ", end="", file=out, flush=True)
+
+    print(f"Level {level.id} ({level.family}, {level.goal}, {level.difficulty})", file=out)
+    print(instruction(state), file=out)
+    print("Type an action, 'undo', 'help' or 'quit'.", file=out)
+    show()
+    for line in stdin:
+        text = line.strip()
+        if not text:
+            print("> ", end="", file=out, flush=True)
+            continue
+        word = text.lower()
+        if word in ("quit", "exit"):
+            break
+        if word == "help":
+            print(instruction(state), file=out)
+        elif word == "undo":
+            try:
+                undone = state.pop()
+            except IndexError:
+                print("Nothing to undo.", file=out)
+            else:
+                print(f"Undone: {undone.to_text()}", file=out)
+        else:
+            result = state.step_text(text)
+            print(result.feedback, file=out)
+            if result.success:
+                print(
+                    f"Solved in {state.steps_used} steps (optimal: {level.optimal_steps}).",
+                    file=out,
+                )
+                return 0
+            if state.finished:
+                return 1
+            if result.truncated:
+                print(f"Out of steps ({state.max_steps}).", file=out)
+                return 1
+        show()
+    print("", file=out)
+    return 0 if state.is_success() else 1

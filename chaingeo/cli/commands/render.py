@@ -1,0 +1,30 @@
+"""``chain render LEVEL``: pictures of a level solved (four views) and of its pieces (tray)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser("render", help="write PNG pictures of a level, solved, and of its pieces")
+    p.add_argument("level", type=Path, help="a chain-level/1 file")
+    p.add_argument("--out", type=Path, default=Path("."), help="folder for the PNGs (default .)")
+    p.add_argument("--size", type=int, default=512, help="picture size in pixels (default 512)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from chaingeo.core.level import load_level
+    from chaingeo.envs.render import render_level_tray, render_solution_views
+
+    level = load_level(args.level)
+    pictures = dict(render_solution_views(level, size=args.size))
+    pictures["pieces"] = render_level_tray(level, args.size)
+    args.out.mkdir(parents=True, exist_ok=True)
+    for view, data in pictures.items():
+        target = args.out / f"{level.id}-{view}.png"
+        target.write_bytes(data)
+        print(target)
+    return 0

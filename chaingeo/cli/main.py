@@ -1,0 +1,52 @@
+"""The ``chain`` command: a thin face over the toolkit.
+
+Each subcommand lives in its own module under :mod:`chaingeo.cli.commands` and exposes
+``register(subparsers)``; modules are discovered, so adding a command touches no shared file.
+Heavy imports happen inside each command, so ``chain --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import pkgutil
+import sys
+from collections.abc import Sequence
+
+import chaingeo.cli.commands
+from chaingeo.cli.errors import CommandError
+from chaingeo.core.level import LevelError
+
+#: Subcommand modules, alphabetical (the order ``chain --help`` lists them).
+COMMANDS: tuple[str, ...] = tuple(
+    f"chaingeo.cli.commands.{m.name}"
+    for m in sorted(pkgutil.iter_modules(chaingeo.cli.commands.__path__), key=lambda m: m.name)
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="chain",
+        description="CHAIN-geo: exact discrete-geometry levels, solvers and agent evaluation.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 0
+    try:
+        return int(args.func(args) or 0)
+    except (CommandError, LevelError, FileNotFoundError, ValueError) as e:
+        print(f"chain {args.command}: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

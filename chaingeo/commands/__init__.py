@@ -1,1 +1,0 @@
-"""One module per ``chain`` subcommand; see :mod:`chaingeo.cli`."""

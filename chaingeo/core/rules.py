@@ -1,0 +1,116 @@
+"""The environment rules a level is solved under, and the stacking placement checks.
+
+One set of rules serves the level validator, the stacking state machine and the generator, so a
+level's ``optimal_steps`` means the same thing everywhere.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import asdict, dataclass
+from typing import Final, Literal
+
+from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
+
+SupportRule = Literal["contact", "drop"]
+SUPPORT_RULES: Final[tuple[str, ...]] = ("contact", "drop")
+
+
+@dataclass(frozen=True)
+class StackingRules:
+    """``contact``: a placed piece must touch the floor or a placed piece face to face.
+    ``drop``: additionally it must be lowerable straight down from above without collision."""
+
+    support: SupportRule = "contact"
+
+    def to_json(self) -> dict[str, object]:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class PuzzleRules:
+    """``max_group``: the most pieces one move may carry (None: any group that moves together)."""
+
+    max_group: int | None = None
+
+    def to_json(self) -> dict[str, object]:
+        return asdict(self)
+
+
+def placement_problem(
+    cells: Shape,
+    occupied: Mapping[Cell, str],
+    box: Sequence[int],
+    rules: StackingRules,
+) -> str | None:
+    """Why ``cells`` cannot be placed now (a sentence with 0-based cells), or None if it can.
+
+    ``occupied`` maps every filled box cell to the name of the piece there.
+    """
+    bx, by, bz = box
+    for x, y, z in cells:
+        if not (0 <= x < bx and 0 <= y < by and 0 <= z < bz):
+            return f"out of box at {(x, y, z)}"
+    for c in cells:
+        if c in occupied:
+            return f"collision with {occupied[c]} at {c}"
+    supported = any(z == 0 for _, _, z in cells) or any(
+        (x + dx, y + dy, z + dz) in occupied for x, y, z in cells for dx, dy, dz in NEIGHBOURS
+    )
+    if not supported:
+        return "floating: it touches neither the floor nor another piece"
+    if rules.support == "drop":
+        for x, y, z in cells:
+            for zz in range(z + 1, bz):
+                if (x, y, zz) in occupied:
+                    who = occupied[(x, y, zz)]
+                    return f"cannot be lowered into place: {who} is above it at {(x, y, zz)}"
+    return None
+
+
+def placement_order_problem(
+    placements: Mapping[str, Shape], order: Iterable[str], box: Sequence[int], rules: StackingRules
+) -> str | None:
+    """Replay placements in ``order`` under ``rules``; the first problem found, or None."""
+    occupied: dict[Cell, str] = {}
+    for name in order:
+        why = placement_problem(placements[name], occupied, box, rules)
+        if why is not None:
+            return f"placing {name}: {why}"
+        occupied.update({c: name for c in placements[name]})
+    return None
+
+
+def find_placing_order(
+    placements: Mapping[str, Shape], box: Sequence[int], rules: StackingRules
+) -> list[str] | None:
+    """A legal order to place a packing under ``rules`` (smallest names first), or None.
+
+    Depth-first over subsets with memoised dead ends, so it stays exact for drop rules where a
+    greedy order can paint itself into a corner.
+    """
+    names = sorted(placements)
+    dead: set[frozenset[str]] = set()
+
+    def extend(placed: list[str], occupied: dict[Cell, str]) -> list[str] | None:
+        if len(placed) == len(names):
+            return list(placed)
+        key = frozenset(placed)
+        if key in dead:
+            return None
+        for n in names:
+            if n in placed:
+                continue
+            if placement_problem(placements[n], occupied, box, rules) is None:
+                placed.append(n)
+                occupied.update({c: n for c in placements[n]})
+                found = extend(placed, occupied)
+                if found is not None:
+                    return found
+                placed.pop()
+                for c in placements[n]:
+                    del occupied[c]
+        dead.add(key)
+        return None
+
+    return extend([], {})

@@ -1,0 +1,268 @@
+"""What an agent is shown each turn: the task, the pieces, recent turns, the budget, pictures.
+
+Text follows the agent convention: cells are 1-based (converted by :mod:`chaingeo.envs.actions`).
+The pictures come from :mod:`chaingeo.envs.render`, called from :func:`render_state` only. Stacking
+shows the box (placed pieces where they are) and the tray of unplaced pieces; a puzzle shows its
+largest part where it is and every other part laid out beside it along +x (parts apart never
+interact, so only their shapes matter), and its goal as ``target``: assembled (assembly) or
+every piece apart (disassembly).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Final
+
+from chaingeo.core.geometry import Cell, Shape
+from chaingeo.core.rules import PuzzleRules, StackingRules
+from chaingeo.envs.actions import cells_text
+from chaingeo.envs.state import BaseState
+
+#: The views rendered for every state (the tray and the target are added where they apply).
+VIEWS: Final[tuple[str, ...]] = ("front", "side", "top", "iso")
+DEFAULT_HISTORY: Final = 5
+DEFAULT_IMAGE_SIZE: Final = 512
+_LAYOUT_GAP: Final = 2
+
+
+@dataclass(frozen=True)
+class Observation:
+    """One turn's observation. ``color_table`` maps colour name -> description; ``history``
+    holds one line per recent turn; ``images`` maps a view name to PNG bytes."""
+
+    instruction: str
+    color_table: dict[str, str]
+    history: list[str]
+    steps_left: int
+    text_state: str | None = None
+    images: dict[str, bytes] = field(default_factory=dict)
+
+    def to_text(self) -> str:
+        """Everything but the pictures, as one prompt text."""
+        parts = [
+            self.instruction,
+            "Pieces:\n" + "\n".join(f"  {k}: {v}" for k, v in self.color_table.items()),
+        ]
+        if self.history:
+            parts.append("Recent turns:\n" + "\n".join(f"  {h}" for h in self.history))
+        if self.text_state:
+            parts.append("Current state:\n" + self.text_state)
+        parts.append(f"Steps left: {self.steps_left}")
+        if self.images:
+            parts.append("Views: " + ", ".join(self.images))
+        return "\n\n".join(parts)
+
+
+# ---------------------------------------------------------------------------------------------
+# Instruction
+# ---------------------------------------------------------------------------------------------
+
+_COORDS = (
+    "Cells are written (x,y,z) and counted from 1; z points up. The pictures label the axes and "
+    "the cell numbers."
+)
+
+
+def instruction(state: BaseState) -> str:
+    """The task, its rules and the action grammar, for this level."""
+    level = state.level
+    if level.family == "stacking":
+        assert level.box is not None and isinstance(level.rules, StackingRules)
+        a, b, c = level.box
+        drop = (
+            " It must also be lowerable straight down into place: no piece may already be above "
+            "any of its cells."
+            if level.rules.support == "drop"
+            else ""
+        )
+        return (
+            f"Pack all {len(level.pieces)} pieces into the {a}x{b}x{c} box so that it is "
+            f"completely full. {_COORDS} The box spans x 1-{a}, y 1-{b}, z 1-{c}. The pieces "
+            "start in the tray, shown in the orientation they are handed out; you may place a "
+            "piece in any rotation. A placed piece must lie inside the box, overlap no other "
+            f"piece, and rest on the floor (z=1) or touch another piece face to face.{drop} "
+            "Actions, one per turn:\n"
+            "  place COLOUR (x,y,z) (x,y,z) ...  list every cell the piece will fill, e.g. "
+            "place red (1,1,1) (2,1,1) (1,2,1)\n"
+            "  pickup COLOUR  take a placed piece back to the tray (it may not leave another "
+            "piece floating)\n"
+            "  finish  end the game when you are done\n"
+            "Every turn costs one step, including a turn whose action fails."
+        )
+    assert isinstance(level.rules, PuzzleRules)
+    mg = level.rules.max_group
+    group_rule = f" A move may carry at most {mg} piece(s)." if mg is not None else ""
+    moves = (
+        "A move slides a group of pieces that hold together along one axis, by a number of "
+        "units or out to infinity; it is legal only if no unit step on the way collides with "
+        f"another piece. Every move is one step, whatever its distance.{group_rule} "
+        f"{_COORDS}\n"
+    )
+    if level.goal == "disassemble":
+        return (
+            "Take the interlocking puzzle apart until every piece stands alone. "
+            + moves
+            + "Actions, one per turn:\n"
+            "  move GROUP DIRECTION DISTANCE  e.g. move red +x 2, move red+blue -z inf "
+            "(GROUP joins colour names with +; DIRECTION is one of +x -x +y -y +z -z; inf takes "
+            "the group out of the puzzle)\n"
+            "  finish  end the game when you are done\n"
+            "Every turn costs one step, including a turn whose action fails."
+        )
+    return (
+        "Put the interlocking puzzle together: bring every piece into the target shape (the "
+        "target view; the text state lists its cells). The pieces start apart. " + moves + ""
+        "Actions, one per turn:\n"
+        "  move GROUP DIRECTION inf  insert a whole part: it travels along DIRECTION from far "
+        "away and joins another part, e.g. move red +x inf. Add 'into COLOUR' to say which part "
+        "it joins and 'offset (dx,dy,dz)' to say where it lands, as a displacement from its place "
+        "in the target ((0,0,0) is exactly there); left out, the engine takes the only fit, or "
+        "the target place, or asks you to choose.\n"
+        "  move GROUP DIRECTION DISTANCE  slide pieces within a part, e.g. move red -x 2\n"
+        "  finish  end the game when you are done\n"
+        "Nothing leaves a part once it has joined. Every turn costs one step, including a turn "
+        "whose action fails."
+    )
+
+
+def color_table(state: BaseState) -> dict[str, str]:
+    """Colour name -> its hex colour and size, in the level's piece order."""
+    return {
+        p.name: f"{p.rgb}, {len(p.shape)} cube{'s' if len(p.shape) != 1 else ''}"
+        for p in state.level.pieces
+    }
+
+
+def history_lines(state: BaseState, window: int = DEFAULT_HISTORY) -> list[str]:
+    turns = state.history[-window:] if window > 0 else []
+    return [f"step {t.step}: {t.text.strip()} -> {t.feedback}" for t in turns]
+
+
+# ---------------------------------------------------------------------------------------------
+# Text state (for text-only ablations and the terminal)
+# ---------------------------------------------------------------------------------------------
+
+
+def state_text(state: BaseState) -> str:
+    """Every piece's cells (1-based): where it is, or its shape in the tray."""
+    from chaingeo.envs.puzzle import PuzzleState
+    from chaingeo.envs.stacking import StackingState
+
+    if isinstance(state, StackingState):
+        a, b, c = state.box
+        lines = [f"Box {a}x{b}x{c}: {a * b * c - state.empty_cells()} of {a * b * c} cells filled."]
+        placed = state.placed
+        lines.append("In the box:" if placed else "In the box: nothing yet.")
+        for p in state.level.pieces:
+            if p.name in placed:
+                lines.append(f"  {p.name}: {cells_text(placed[p.name])}")
+        tray = state.tray
+        if tray:
+            lines.append("In the tray (the piece's own cells, counted from 1):")
+            for name in tray:
+                lines.append(f"  {name}: {cells_text(state.tables.shapes[name].normalized())}")
+        return "\n".join(lines)
+    assert isinstance(state, PuzzleState)
+    lines = []
+    parts = ordered_parts(state)
+    if len(parts) == 1:
+        lines.append(f"One part: {', '.join(sorted(parts[0]))}.")
+    else:
+        lines.append(f"{len(parts)} parts (pieces of different parts never touch again):")
+    for i, part in enumerate(parts, 1):
+        if len(parts) > 1:
+            label = "apart" if len(part) == 1 else "held together"
+            lines.append(f"  part {i} ({label}): {', '.join(sorted(part))}")
+        for name in sorted(part):
+            lines.append(f"    {name}: {cells_text(state.cells_of(name))}")
+    if state.mode == "assemble":
+        lines.append("Target (every piece in its place):")
+        for p in state.level.pieces:
+            lines.append(f"    {p.name}: {cells_text(p.shape)}")
+    return "\n".join(lines)
+
+
+def ordered_parts(state: BaseState) -> list[frozenset[str]]:
+    """A puzzle's parts, largest first (then by name)."""
+    from chaingeo.envs.puzzle import PuzzleState
+
+    assert isinstance(state, PuzzleState)
+    return sorted(state.assembly.parts, key=lambda p: (-len(p), sorted(p)))
+
+
+# ---------------------------------------------------------------------------------------------
+# Pictures: the one place that calls the renderer
+# ---------------------------------------------------------------------------------------------
+
+PieceMap = dict[str, tuple[Shape, str]]
+
+
+def scene(state: BaseState) -> tuple[PieceMap, tuple[int, int, int] | None, PieceMap]:
+    """(pieces to draw where they are, the box or None, pieces for the tray)."""
+    from chaingeo.envs.puzzle import PuzzleState
+    from chaingeo.envs.stacking import StackingState
+
+    rgb = {p.name: p.rgb for p in state.level.pieces}
+    if isinstance(state, StackingState):
+        placed = {n: (Shape(c), rgb[n]) for n, c in state.placed.items()}
+        tray = {n: (state.tables.shapes[n], rgb[n]) for n in state.tray}
+        return placed, state.box, tray
+    assert isinstance(state, PuzzleState)
+    pieces: PieceMap = {}
+    cursor: int | None = None
+    for part in ordered_parts(state):
+        cells = {n: state.cells_of(n) for n in sorted(part)}
+        if cursor is None:  # the largest part stays where it is
+            shift: Cell = (0, 0, 0)
+        else:
+            lo = [min(c[i] for cs in cells.values() for c in cs) for i in range(3)]
+            shift = (cursor - lo[0], 0, 0)
+        for n, cs in cells.items():
+            pieces[n] = (Shape(cs).translate(shift), rgb[n])
+        cursor = max(c[0] for n in part for c in pieces[n][0].cells) + 1 + _LAYOUT_GAP
+    return pieces, None, {}
+
+
+def render_state(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> dict[str, bytes]:
+    """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (puzzles)."""
+    import chaingeo.envs.render as render
+
+    pieces, box, tray = scene(state)
+    images = dict(render.render_views(pieces, box, VIEWS, size))
+    if state.level.family == "stacking":
+        images["tray"] = render.render_tray(tray, size)
+    else:
+        images["target"] = render.render_views(target_scene(state), None, ("iso",), size)["iso"]
+    return images
+
+
+def target_scene(state: BaseState) -> PieceMap:
+    """A puzzle's goal: assembled (assembly), or every piece apart side by side (disassembly)."""
+    pieces: PieceMap = {}
+    cursor = 0
+    for p in sorted(state.level.pieces, key=lambda p: p.name):
+        if state.level.goal == "assemble":
+            pieces[p.name] = (p.shape, p.rgb)
+            continue
+        shape = p.shape.translate((cursor - int(p.shape.min_corner[0]), 0, 0))
+        pieces[p.name] = (shape, p.rgb)
+        cursor += shape.extent[0] + _LAYOUT_GAP
+    return pieces
+
+
+def observe(
+    state: BaseState,
+    history_window: int = DEFAULT_HISTORY,
+    text_state: bool = False,
+    images: bool = True,
+    image_size: int = DEFAULT_IMAGE_SIZE,
+) -> Observation:
+    """The observation of ``state`` (which is not changed)."""
+    return Observation(
+        instruction=instruction(state),
+        color_table=color_table(state),
+        history=history_lines(state, history_window),
+        steps_left=state.steps_left,
+        text_state=state_text(state) if text_state else None,
+        images=render_state(state, image_size) if images else {},
+    )

@@ -1,0 +1,508 @@
+"""Pictures of voxel pieces for agents and people: numpy + Pillow, no GUI, no OpenGL.
+
+Every view is an orthographic projection: shaded unit cubes coloured by piece with black edges,
+the box (or, without one, the scene's bounding box) as a wire frame over a gridded floor and
+back walls, and 1-based cell indices along labelled axes, so a model can read coordinates off
+the picture. The axis views (front, side, top) also print, on every visible face, the 1-based
+coordinate along the line of sight ("y=2"), which turns three flat views into a readable map.
+
+Hidden faces: exact painter's algorithm over the visible cube faces (see
+:mod:`chaingeo.envs.raster`).
+
+Input is plain data (piece name -> (Shape, colour)), so this module knows nothing of the state
+machines; PNG bytes are deterministic (fixed encoder settings, no metadata, no timestamps).
+Coordinates are 0-based in code; only the printed labels are 1-based.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Final
+
+import numpy as np
+import numpy.typing as npt
+from PIL import Image, ImageDraw
+
+from chaingeo.core.geometry import Shape
+from chaingeo.envs.raster import (
+    RGB,
+    Camera,
+    ColorLike,
+    Faces,
+    FloatArray,
+    Projector,
+    arrow,
+    draw_faces,
+    fit,
+    fit_centre,
+    frame_corners,
+    line,
+    oblique_camera,
+    parse_color,
+    png_bytes,
+    polygon,
+    put_text,
+    scaled,
+    text_color,
+    visible_faces,
+)
+
+if TYPE_CHECKING:
+    from chaingeo.core.level import Level
+
+#: A scene: piece name -> (its cells where they are, its colour).
+PieceMap = Mapping[str, tuple[Shape, ColorLike]]
+
+VIEWS: Final[tuple[str, ...]] = ("front", "side", "top", "iso")
+DEFAULT_SIZE: Final = 512
+MIN_SIZE: Final = 128
+_SUPERSAMPLE: Final = 2  # polygons are drawn at twice the size and box-filtered (anti-aliasing)
+
+_BACKGROUND: Final[RGB] = (255, 255, 255)
+_FLOOR: Final[RGB] = (232, 232, 228)
+_WALL: Final[RGB] = (244, 244, 241)
+_GRID: Final[RGB] = (185, 185, 180)
+_FRAME: Final[RGB] = (90, 90, 90)
+_TEXT: Final[RGB] = (20, 20, 20)
+_AXIS_COLORS: Final[tuple[RGB, RGB, RGB]] = ((190, 30, 30), (20, 130, 40), (30, 60, 200))
+_AXIS_NAMES: Final = "xyz"
+
+#: Azimuth and elevation of the oblique view (camera at +x, -y, +z, like matplotlib's default
+#: but slightly off the true isometric so that no two cube corners project onto one point).
+ISO_AZIMUTH: Final = -58.0
+ISO_ELEVATION: Final = 32.0
+
+CAMERAS: Final[dict[str, Camera]] = {
+    "front": Camera(
+        "front",
+        "FRONT: looking along +y (x right, z up)",
+        (1.0, 0.0, 0.0),
+        (0.0, 0.0, 1.0),
+        (0.0, -1.0, 0.0),
+        1,
+        ((0, ("*", "lo", "lo")), (2, ("lo", "lo", "*"))),
+    ),
+    "side": Camera(
+        "side",
+        "SIDE: looking along -x (y right, z up)",
+        (0.0, 1.0, 0.0),
+        (0.0, 0.0, 1.0),
+        (1.0, 0.0, 0.0),
+        0,
+        ((1, ("hi", "*", "lo")), (2, ("hi", "lo", "*"))),
+    ),
+    "top": Camera(
+        "top",
+        "TOP: looking down along -z (x right, y up)",
+        (1.0, 0.0, 0.0),
+        (0.0, 1.0, 0.0),
+        (0.0, 0.0, 1.0),
+        2,
+        ((0, ("*", "lo", "hi")), (1, ("lo", "*", "hi"))),
+    ),
+    "iso": oblique_camera("iso", "3D view from front-right-above", ISO_AZIMUTH, ISO_ELEVATION),
+}
+
+
+# ---------------------------------------------------------------------------------------------
+# Input checking
+# ---------------------------------------------------------------------------------------------
+
+
+def _check_size(size: int) -> None:
+    if size < MIN_SIZE:
+        raise ValueError(f"image size must be at least {MIN_SIZE} pixels, got {size}")
+
+
+def _check_views(views: Sequence[str]) -> None:
+    unknown = [v for v in views if v not in CAMERAS]
+    if unknown:
+        raise ValueError(f"unknown view(s) {unknown}; known: {list(CAMERAS)}")
+
+
+@dataclass(frozen=True)
+class _Scene:
+    """Every filled cell with its piece's colour, and the frame the axes are drawn on."""
+
+    cells: npt.NDArray[np.int64]  # (n, 3)
+    colors: npt.NDArray[np.float64]  # (n, 3) rgb of each cell's piece
+    lo: tuple[int, int, int]
+    hi: tuple[int, int, int]  # exclusive
+    has_box: bool
+
+
+def _scene(pieces: PieceMap, box: Sequence[int] | None) -> _Scene:
+    chunks: list[npt.NDArray[np.int64]] = []
+    colors: list[npt.NDArray[np.float64]] = []
+    for name in sorted(pieces):
+        shape, color = pieces[name]
+        rgb = parse_color(color)
+        chunks.append(shape.voxels)
+        colors.append(np.tile(np.array(rgb, dtype=np.float64), (len(shape), 1)))
+    cells = np.concatenate(chunks) if chunks else np.zeros((0, 3), dtype=np.int64)
+    rgbs = np.concatenate(colors) if colors else np.zeros((0, 3))
+    if len(cells) and len(np.unique(cells, axis=0)) != len(cells):
+        owners: dict[tuple[int, int, int], str] = {}
+        for name in sorted(pieces):
+            for c in pieces[name][0]:
+                if c in owners:
+                    raise ValueError(f"pieces {owners[c]} and {name} overlap at {list(c)}")
+                owners[c] = name
+    if box is not None:
+        if len(box) != 3 or any(int(b) < 1 for b in box):
+            raise ValueError(f"box must be three positive sizes, got {list(box)}")
+        lo = np.zeros(3, dtype=np.int64)
+        hi = np.array([int(b) for b in box], dtype=np.int64)
+        if len(cells):
+            lo = np.minimum(lo, cells.min(axis=0))
+            hi = np.maximum(hi, cells.max(axis=0) + 1)
+    elif len(cells):
+        lo, hi = cells.min(axis=0), cells.max(axis=0) + 1
+    else:
+        lo, hi = np.zeros(3, dtype=np.int64), np.ones(3, dtype=np.int64)
+    return _Scene(
+        cells,
+        rgbs,
+        (int(lo[0]), int(lo[1]), int(lo[2])),
+        (int(hi[0]), int(hi[1]), int(hi[2])),
+        box is not None,
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# One view
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Layout:
+    size: int
+    title_px: int
+    tick_px: int
+
+    @staticmethod
+    def of(size: int) -> _Layout:
+        return _Layout(size, max(11, size // 34), max(10, size // 30))
+
+    def edge_px(self, scale: int) -> int:
+        """Cube edge width when drawing at ``scale`` times the final size."""
+        return max(1, round(self.size * scale / 340))
+
+
+def _plane_is_back(axis: int, side: str, cam: Camera) -> bool:
+    """A frame wall is behind the scene when its inward normal points toward the viewer."""
+    inward = 1.0 if side == "lo" else -1.0
+    return inward * cam.toward_viewer[axis] > 1e-9
+
+
+def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
+    lo, hi = scene.lo, scene.hi
+    b, c = [i for i in range(3) if i != axis]
+    fixed = lo[axis] if side == "lo" else hi[axis]
+    pts = []
+    for ub, uc in ((lo[b], lo[c]), (hi[b], lo[c]), (hi[b], hi[c]), (lo[b], hi[c])):
+        p = [0.0, 0.0, 0.0]
+        p[axis], p[b], p[c] = fixed, ub, uc
+        pts.append(p)
+    return np.array(pts)
+
+
+def _draw_walls(
+    draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector, width: int
+) -> None:
+    """Back walls and floor with a line per cell boundary, so empty cells can be counted."""
+    for axis in (2, 0, 1):
+        for side in ("lo", "hi"):
+            if not _plane_is_back(axis, side, cam):
+                continue
+            fill = _FLOOR if axis == 2 and side == "lo" else _WALL
+            polygon(draw, proj(_wall_corners(scene, axis, side)), fill=fill)
+            b, c = [i for i in range(3) if i != axis]
+            ends: list[list[float]] = []
+            for along, across in ((b, c), (c, b)):
+                for t in range(scene.lo[along], scene.hi[along] + 1):
+                    for at in (scene.lo[across], scene.hi[across]):
+                        p = [0.0, 0.0, 0.0]
+                        p[axis] = scene.lo[axis] if side == "lo" else scene.hi[axis]
+                        p[along], p[across] = t, at
+                        ends.append(p)
+            pix = proj(np.array(ends)).tolist()
+            for i in range(0, len(pix), 2):
+                draw.line([tuple(pix[i]), tuple(pix[i + 1])], fill=_GRID, width=width)
+
+
+def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArray, FloatArray]]:
+    """The 12 frame edges that lie between two back walls (``back``) or the others."""
+    out = []
+    lo, hi = scene.lo, scene.hi
+    for axis in range(3):
+        b, c = [i for i in range(3) if i != axis]
+        for sb in ("lo", "hi"):
+            for sc in ("lo", "hi"):
+                is_back = _plane_is_back(b, sb, cam) and _plane_is_back(c, sc, cam)
+                if is_back != back:
+                    continue
+                p = np.zeros(3)
+                p[b] = lo[b] if sb == "lo" else hi[b]
+                p[c] = lo[c] if sc == "lo" else hi[c]
+                q = p.copy()
+                p[axis], q[axis] = lo[axis], hi[axis]
+                out.append((p, q))
+    return out
+
+
+def _draw_ticks(
+    image: Image.Image, scene: _Scene, cam: Camera, proj: Projector, lay: _Layout
+) -> None:
+    """1-based cell indices along one frame edge per displayed axis, then the axis name and an
+    arrow pointing the way the index grows."""
+    draw = ImageDraw.Draw(image)
+    centre = proj(np.add(scene.lo, scene.hi) / 2.0)
+    for axis, spec in cam.tick_edges:
+        base = np.array(
+            [
+                0.0 if s == "*" else float(scene.lo[i] if s == "lo" else scene.hi[i])
+                for i, s in enumerate(spec)
+            ]
+        )
+        start, end = base.copy(), base.copy()
+        start[axis], end[axis] = scene.lo[axis], scene.hi[axis]
+        a, b = proj(start), proj(end)
+        d = b - a
+        length = float(np.hypot(*d))
+        if length < 1e-6:
+            continue
+        d /= length
+        normal = np.array([-d[1], d[0]])
+        mid = (a + b) / 2
+        if float(np.dot(normal, mid - centre)) < 0:
+            normal = -normal
+        count = scene.hi[axis] - scene.lo[axis]
+        cell_px = length / count
+        px = int(min(lay.tick_px, max(8, cell_px * 0.8)))
+        every = max(1, math.ceil(px * 1.4 / cell_px))
+        offset = normal * (px * 0.95 + 3)
+        for i, c in enumerate(range(scene.lo[axis], scene.hi[axis])):
+            if i % every and c != scene.hi[axis] - 1:
+                continue
+            p = base.copy()
+            p[axis] = c + 0.5
+            put_text(image, proj(p) + offset, str(c + 1), px, _TEXT)
+        # The arrow continues the row of numbers; the axis name sits just outside it.
+        color = _AXIS_COLORS[axis]
+        tail = b + offset + d * (px * 0.5)
+        head = tail + d * (lay.tick_px * 1.2)
+        arrow(draw, tail, head, color, max(2, lay.tick_px // 8))
+        name_at = (tail + head) / 2 + normal * (lay.tick_px * 0.9)
+        put_text(image, name_at, _AXIS_NAMES[axis], lay.tick_px + 3, color)
+
+
+def _draw_depth_labels(image: Image.Image, faces: Faces, cam: Camera, proj: Projector) -> None:
+    """On each visible face of an axis view, the 1-based coordinate along the line of sight."""
+    depth = cam.depth_axis
+    assert depth is not None
+    nearest: dict[tuple[int, int], int] = {}
+    others = [i for i in range(3) if i != depth]
+    for i, cell in enumerate(faces.cells.tolist()):
+        nearest[(cell[others[0]], cell[others[1]])] = i  # far to near: the last one is in front
+    cell_px = proj.scale
+    px = int(min(22, max(9, cell_px * 0.24)))
+    if cell_px < 1.6 * px:
+        return  # too small to print legibly
+    prefix = f"{_AXIS_NAMES[depth]}=" if cell_px >= 3.2 * px else ""  # small cells: number only
+    for i in sorted(nearest.values()):
+        centre = proj.screen(faces.corners[i].mean(axis=0))
+        fill = faces.fills[i]
+        text = f"{prefix}{int(faces.cells[i][depth]) + 1}"
+        put_text(image, centre, text, px, text_color(fill))
+
+
+def _title(image: Image.Image, lines: Sequence[str], lay: _Layout) -> None:
+    y = max(4, lay.size // 100)
+    for text in lines:
+        put_text(image, (max(4, lay.size // 64), y), text, lay.title_px, _TEXT, anchor="la")
+        y += int(lay.title_px * 1.25)
+
+
+def _view_titles(cam: Camera, scene: _Scene) -> list[str]:
+    what = "box" if scene.has_box else "frame = bounding box"
+    if cam.depth_axis is None:
+        return [cam.title, f"cells numbered from 1; {what}"]
+    return [
+        cam.title,
+        f"labels on faces: {_AXIS_NAMES[cam.depth_axis]} of the visible cube; {what}",
+    ]
+
+
+def _view_projector(scene: _Scene, cam: Camera, lay: _Layout) -> Projector:
+    """The frame fitted into the picture, leaving room for the title and the axis labels."""
+    top = lay.title_px * 2.6 + lay.tick_px * 1.9 + 8
+    side = lay.tick_px * 2.8
+    content = (side, top, lay.size - side, lay.size - lay.tick_px * 2.8)
+    return fit(frame_corners(scene.lo, scene.hi), cam, content)
+
+
+def _render_view(scene: _Scene, cam: Camera, size: int) -> Image.Image:
+    lay = _Layout.of(size)
+    # Axis views have only axis-parallel edges: no aliasing, so no supersampling needed.
+    k = _SUPERSAMPLE if cam.depth_axis is None else 1
+    proj = _view_projector(scene, cam, lay)
+    big_proj = scaled(proj, k)
+    big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
+    draw = ImageDraw.Draw(big)
+    _draw_walls(draw, scene, cam, big_proj, k)
+    for p, q in _frame_edges(scene, cam, back=True):
+        line(draw, big_proj(p), big_proj(q), _FRAME, k)
+    faces = visible_faces(scene.cells, scene.colors, cam)
+    draw_faces(draw, faces, big_proj, lay.edge_px(k))
+    if scene.has_box:
+        for p, q in _frame_edges(scene, cam, back=False):
+            line(draw, big_proj(p), big_proj(q), _FRAME, k)
+    image = big.reduce(k) if k > 1 else big
+    _title(image, _view_titles(cam, scene), lay)
+    _draw_ticks(image, scene, cam, proj, lay)
+    if cam.depth_axis is not None and len(faces.cells):
+        _draw_depth_labels(image, faces, cam, proj)
+    return image
+
+
+# ---------------------------------------------------------------------------------------------
+# The tray
+# ---------------------------------------------------------------------------------------------
+
+
+def _render_tray(pieces: PieceMap, size: int) -> Image.Image:
+    """Every piece on its own square, at one common scale, labelled with its name and size."""
+    lay = _Layout.of(size)
+    k = _SUPERSAMPLE
+    cam = CAMERAS["iso"]
+    names = sorted(pieces)
+    title_h = lay.title_px * 1.6 + 6
+    if not names:
+        image = Image.new("RGB", (size, size), _BACKGROUND)
+        _title(image, ["TRAY: pieces not yet placed"], lay)
+        put_text(image, (size / 2, size / 2), "(the tray is empty)", lay.tick_px, _TEXT)
+        return image
+    big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
+    cols = math.ceil(math.sqrt(len(names)))
+    rows = math.ceil(len(names) / cols)
+    cell_w = size / cols
+    cell_h = (size - title_h) / rows
+    label_px = int(min(lay.tick_px, max(9, cell_w / 7)))
+    label_h = label_px * 1.7
+    shapes = {n: pieces[n][0].normalized() for n in names}
+    r, u = np.array(cam.right), np.array(cam.up)
+    spans = []
+    for n in names:
+        corners = frame_corners((0, 0, 0), shapes[n].extent)
+        spans.append((np.ptp(corners @ r), np.ptp(corners @ u)))
+    max_w = max(max(w for w, _ in spans), 1e-9)
+    max_h = max(max(h for _, h in spans), 1e-9)
+    scale = min(cell_w * 0.84 / max_w, (cell_h - label_h) * 0.84 / max_h)
+    draw = ImageDraw.Draw(big)
+    slots: list[tuple[str, float, float]] = []
+    for i, n in enumerate(names):
+        col, row = i % cols, i // cols
+        x0, y0 = col * cell_w, title_h + row * cell_h
+        box = (x0, y0, x0 + cell_w, y0 + cell_h - label_h)
+        corners = frame_corners((0, 0, 0), shapes[n].extent)
+        proj = Projector(r, u, scale, fit_centre(corners, cam, box, scale))
+        rgb = parse_color(pieces[n][1])
+        colors = np.tile(np.array(rgb, dtype=np.float64), (len(shapes[n]), 1))
+        faces = visible_faces(shapes[n].voxels, colors, cam)
+        draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
+        slots.append((f"{n} ({len(shapes[n])})", x0 + cell_w / 2, y0 + cell_h - label_h / 2))
+    image = big.reduce(k)
+    small = ImageDraw.Draw(image)
+    _title(image, ["TRAY: pieces not yet placed (name, number of cubes)"], lay)
+    for text, x, y in slots:
+        put_text(image, (x, y), text, label_px, _TEXT)
+    for c in range(1, cols):
+        small.line([(c * cell_w, title_h), (c * cell_w, size)], fill=_GRID, width=1)
+    for rr in range(1, rows):
+        y = title_h + rr * cell_h
+        small.line([(0, y), (size, y)], fill=_GRID, width=1)
+    return image
+
+
+# ---------------------------------------------------------------------------------------------
+# Public API
+# ---------------------------------------------------------------------------------------------
+
+
+def render_images(
+    pieces: PieceMap,
+    box: Sequence[int] | None = None,
+    views: Sequence[str] = VIEWS,
+    size: int = DEFAULT_SIZE,
+) -> dict[str, Image.Image]:
+    """The pictures of a scene (pieces at their cells) as RGB images, one per view name."""
+    _check_size(size)
+    _check_views(views)
+    scene = _scene(pieces, box)
+    return {v: _render_view(scene, CAMERAS[v], size) for v in views}
+
+
+def render_views(
+    pieces: PieceMap,
+    box: Sequence[int] | None = None,
+    views: Sequence[str] = VIEWS,
+    size: int = DEFAULT_SIZE,
+) -> dict[str, bytes]:
+    """PNG bytes per view of a scene; ``box`` is drawn as a wire frame (stacking) if given."""
+    return {v: png_bytes(img) for v, img in render_images(pieces, box, views, size).items()}
+
+
+def view_projector(
+    pieces: PieceMap, box: Sequence[int] | None, view: str, size: int = DEFAULT_SIZE
+) -> Projector:
+    """Where world points land in the picture of ``view`` (pixels of the final image), for
+    anyone who annotates the pictures or checks them."""
+    _check_size(size)
+    _check_views([view])
+    return _view_projector(_scene(pieces, box), CAMERAS[view], _Layout.of(size))
+
+
+def render_tray_image(pieces: PieceMap, size: int = DEFAULT_SIZE) -> Image.Image:
+    """The unplaced pieces (only their shapes matter, not where they are), each labelled."""
+    _check_size(size)
+    for shape, color in pieces.values():
+        parse_color(color)
+        if len(shape) == 0:
+            raise ValueError("a piece needs at least one cell")
+    return _render_tray(pieces, size)
+
+
+def render_tray(pieces: PieceMap, size: int = DEFAULT_SIZE) -> bytes:
+    """PNG bytes of the tray picture."""
+    return png_bytes(render_tray_image(pieces, size))
+
+
+def solution_pieces(level: Level) -> dict[str, tuple[Shape, ColorLike]]:
+    """A level's pieces where its solution puts them: packed in the box (stacking) or assembled
+    (puzzle). For pictures of a finished level; an observation must never show this."""
+    from chaingeo.core.level import StackingSolution
+
+    if isinstance(level.solution, StackingSolution):
+        placed = level.solution.placements
+        return {p.name: (placed[p.name], p.rgb) for p in level.pieces}
+    return {p.name: (p.shape, p.rgb) for p in level.pieces}
+
+
+def handed_pieces(level: Level) -> dict[str, tuple[Shape, ColorLike]]:
+    """A level's pieces as handed to the agent (their file orientation)."""
+    return {p.name: (p.shape, p.rgb) for p in level.pieces}
+
+
+def render_solution_views(
+    level: Level, views: Sequence[str] = VIEWS, size: int = DEFAULT_SIZE
+) -> dict[str, bytes]:
+    """PNG per view of the level solved (generators and documentation use this)."""
+    return render_views(solution_pieces(level), level.box, views, size)
+
+
+def render_level_tray(level: Level, size: int = DEFAULT_SIZE) -> bytes:
+    """PNG of all of a level's pieces as handed out."""
+    return render_tray(handed_pieces(level), size)

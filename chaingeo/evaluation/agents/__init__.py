@@ -1,0 +1,2 @@
+"""The agents: each module one kind (baselines, replay, external command, OpenAI-compatible
+chat); :mod:`chaingeo.evaluation.agents.registry` maps names to factories."""
