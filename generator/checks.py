@@ -1,5 +1,9 @@
 """Re-verify a generated stacking level against the rules of the configuration that made it.
 
+A test oracle that ships with the package on purpose: the suite tests run it on every shipped
+stacking level, and whoever generates levels with their own configuration can check the
+output against the generator's promises the same way.
+
 The level loader already proves the file sound (connected pieces, an exact fill of the box by
 rotations of the pieces, a legal placing order, the signature). This adds the generator's own
 promises: piece sizes, no filled 2x3 face, the mode's shape rules, no isolated piece, a linear

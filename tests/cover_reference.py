@@ -10,6 +10,7 @@ import itertools
 from collections.abc import Sequence
 
 import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.geometry import SYMMETRIES
 
@@ -24,8 +25,12 @@ def _normal(cells: frozenset[Cell]) -> frozenset[Cell]:
     return frozenset((x - mx, y - my, z - mz) for x, y, z in cells)
 
 
-def _apply(m: np.ndarray, cells: frozenset[Cell]) -> frozenset[Cell]:  # type: ignore[type-arg]
-    return frozenset(tuple(int(v) for v in m @ np.array(c)) for c in cells)  # type: ignore[misc]
+def _apply(m: npt.NDArray[np.int64], cells: frozenset[Cell]) -> frozenset[Cell]:
+    out: set[Cell] = set()
+    for c in cells:
+        x, y, z = (int(v) for v in m @ np.array(c))
+        out.add((x, y, z))
+    return frozenset(out)
 
 
 def placements(shape: frozenset[Cell], target: frozenset[Cell]) -> list[frozenset[Cell]]:
@@ -112,7 +117,7 @@ def distinct(
             continue
         orbits += 1
         for m, shift in group:
-            img = frozenset(
+            image = frozenset(
                 (
                     norm_key(_apply(m, cells)),
                     frozenset(
@@ -121,8 +126,8 @@ def distinct(
                 )
                 for _, cells in sol
             )
-            if img in canon:
-                seen.add(img)
+            if image in canon:
+                seen.add(image)
     return orbits
 
 

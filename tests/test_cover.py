@@ -24,18 +24,19 @@ from solvers.cover import (
     random_solutions,
 )
 from solvers.placements import placements, target_symmetries
+from solvers.search import Engine
 from tests import cover_reference as ref
 from tests.strategies import polycubes
 
-ENGINES = ("bitboard", "dlx")
+ENGINES: tuple[Engine, ...] = ("bitboard", "dlx")
 DOMINO = Shape([(0, 0, 0), (1, 0, 0)])
 MONO = Shape([(0, 0, 0)])
 L_TROMINO = Shape([(0, 0, 0), (1, 0, 0), (0, 1, 0)])
 
 
 @pytest.mark.parametrize("engine", ENGINES)
-def test_soma_cube(engine: str) -> None:
-    r = count_solutions(SOMA.pieces, (3, 3, 3), engine=engine)  # type: ignore[arg-type]
+def test_soma_cube(engine: Engine) -> None:
+    r = count_solutions(SOMA.pieces, (3, 3, 3), engine=engine)
     assert (r.solutions, r.distinct, r.symmetry_order) == (11520, 240, 48)
     assert r.stats.nodes > 0 and r.stats.engine == engine
 
@@ -60,8 +61,8 @@ def _known(box: tuple[int, int, int]) -> tuple[int | None, int]:
     ("box", "engine"),
     [((6, 10, 1), "auto"), ((5, 12, 1), "auto"), ((5, 12, 1), "dlx"), ((2, 5, 6), "auto")],
 )
-def test_pentomino_packings(box: tuple[int, int, int], engine: str) -> None:
-    r = count_solutions(PENTOMINOES.pieces, box, engine=engine)  # type: ignore[arg-type]
+def test_pentomino_packings(box: tuple[int, int, int], engine: Engine) -> None:
+    r = count_solutions(PENTOMINOES.pieces, box, engine=engine)
     assert (r.solutions, r.distinct) == _known(box)
 
 
@@ -97,20 +98,20 @@ def test_placement_counts() -> None:
 
 @pytest.mark.parametrize("engine", ENGINES)
 @pytest.mark.parametrize("n", [1, 2, 3, 4, 5, 6, 7])
-def test_domino_tilings_are_fibonacci(engine: str, n: int) -> None:
+def test_domino_tilings_are_fibonacci(engine: Engine, n: int) -> None:
     fib = [1, 1]
     while len(fib) <= n:
         fib.append(fib[-1] + fib[-2])
-    r = count_solutions([PieceSpec(DOMINO, "d", 0, n)], (2, n, 1), engine=engine)  # type: ignore[arg-type]
+    r = count_solutions([PieceSpec(DOMINO, "d", 0, n)], (2, n, 1), engine=engine)
     assert r.solutions == fib[n]
 
 
 @pytest.mark.parametrize("engine", ENGINES)
-def test_multiplicity_ranges(engine: str) -> None:
+def test_multiplicity_ranges(engine: Engine) -> None:
     line = (3, 1, 1)
 
     def count(*specs: PieceSpec) -> int:
-        return count_solutions(list(specs), line, engine=engine, distinct=False).solutions  # type: ignore[arg-type]
+        return count_solutions(list(specs), line, engine=engine, distinct=False).solutions
 
     # mmm, dm, md
     assert count(PieceSpec(MONO, "m", 0, 3), PieceSpec(DOMINO, "d", 0, 1)) == 3
@@ -131,13 +132,13 @@ def test_identical_pieces_are_not_permuted() -> None:
 
 
 @pytest.mark.parametrize("engine", ENGINES)
-def test_optional_cells(engine: str) -> None:
+def test_optional_cells(engine: Engine) -> None:
     line = box_cells((3, 1, 1))
     d = [PieceSpec(DOMINO, "d")]
     one_end = Shape([(2, 0, 0)])
     both_ends = Shape([(0, 0, 0), (2, 0, 0)])
-    assert count_solutions(d, line, optional=one_end, engine=engine).solutions == 1  # type: ignore[arg-type]
-    assert count_solutions(d, line, optional=both_ends, engine=engine).solutions == 2  # type: ignore[arg-type]
+    assert count_solutions(d, line, optional=one_end, engine=engine).solutions == 1
+    assert count_solutions(d, line, optional=both_ends, engine=engine).solutions == 2
 
 
 def test_irregular_target() -> None:
@@ -163,14 +164,14 @@ def test_no_solution() -> None:
 
 
 @pytest.mark.parametrize("engine", ENGINES)
-def test_node_limit(engine: str) -> None:
+def test_node_limit(engine: Engine) -> None:
     with pytest.raises(CoverLimitError) as info:
-        count_solutions(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=50, symmetry=False)  # type: ignore[arg-type]
+        count_solutions(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=50, symmetry=False)
     assert isinstance(info.value, SearchLimitError)
     assert info.value.stats.nodes <= 50
     got = []
     with pytest.raises(CoverLimitError):
-        for s in iter_solutions(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=100_000):  # type: ignore[arg-type]
+        for s in iter_solutions(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=100_000):
             got.append(s)
     assert 0 < len(got) < 11520
     # Within the limit nothing is raised.
@@ -191,24 +192,24 @@ def test_bad_input() -> None:
 
 
 @pytest.mark.parametrize("engine", ENGINES)
-def test_random_order_is_seeded_and_complete(engine: str) -> None:
+def test_random_order_is_seeded_and_complete(engine: Engine) -> None:
     dominoes = [PieceSpec(DOMINO, "d", 0, 8)]
 
     def run(seed: int) -> list[tuple[int, ...]]:
         rng = np.random.default_rng(np.random.SeedSequence([seed, 0]))
-        sols = random_solutions(dominoes, (4, 4, 1), rng, engine=engine)  # type: ignore[arg-type]
+        sols = random_solutions(dominoes, (4, 4, 1), rng, engine=engine)
         return [s.rows for s in sols]
 
     a, b, c = run(7), run(7), run(8)
     assert a == b
     assert a != c
-    fixed = [s.rows for s in iter_solutions(dominoes, (4, 4, 1), engine=engine)]  # type: ignore[arg-type]
+    fixed = [s.rows for s in iter_solutions(dominoes, (4, 4, 1), engine=engine)]
     assert len(a) == 36 and sorted(a) == sorted(fixed) and a != fixed
     # On a big instance the first few differ between seeds and repeat for the same seed.
     rng1, rng2 = (np.random.default_rng(np.random.SeedSequence([3, i])) for i in (0, 0))
     first = [
         next(random_solutions(SOMA.pieces, (3, 3, 3), r, engine=engine)).rows for r in (rng1, rng2)
-    ]  # type: ignore[arg-type]
+    ]
     assert first[0] == first[1]
 
 
@@ -264,7 +265,7 @@ def test_engines_agree_with_naive_oracle(
     expected_distinct = ref.distinct(sols, merged, target, mirrors, opt)
     for engine in ENGINES:
         for symmetry in (True, False):
-            r = count_solutions(problem, engine=engine, symmetry=symmetry)  # type: ignore[arg-type]
+            r = count_solutions(problem, engine=engine, symmetry=symmetry)
             assert (r.solutions, r.distinct) == (len(sols), expected_distinct), (engine, symmetry)
 
 

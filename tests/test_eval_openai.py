@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -38,7 +39,7 @@ def _prices(tmp_path: Path) -> PriceTable:
     return PriceTable.load(f)
 
 
-def _run(tmp_path: Path, script: Script, name: str = "run", **opts: object) -> list[dict]:
+def _run(tmp_path: Path, script: Script, name: str = "run", **opts: object) -> list[dict[str, Any]]:
     script.expect_key = KEY
     with fake_openai(script) as url:
         evaluate(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import signal
@@ -270,3 +271,16 @@ def test_bad_agent_options_fail_before_anything_is_written(tmp_path: Path) -> No
     with pytest.raises(ValueError, match="unknown agent"):
         evaluate(_levels(1), AgentSpec("nobody"), tmp_path / "r", FAKE, RunConfig(progress=False))
     assert not (tmp_path / "r").exists()
+
+
+def test_progress_off_a_terminal_is_one_line_per_episode_then_the_totals(tmp_path: Path) -> None:
+    stream = io.StringIO()  # not a terminal: a log file, CI
+    evaluate(
+        _levels(3), AgentSpec("random"), tmp_path / "p", FAKE, RunConfig(seed=2), stream=stream
+    )
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 4
+    for i, line in enumerate(lines[:3]):
+        assert line.startswith(f"[random] {i + 1}/3 | solved ")
+        assert line.endswith(("solved", "unsolved", "error"))
+    assert lines[3].startswith("[random] 3/3 | solved ")

@@ -113,7 +113,7 @@ def test_glb_keeps_names_and_colours() -> None:
     assert sorted(scene.geometry) == sorted(pieces)
     for name, (_, color) in pieces.items():
         rgb = [int(color[i : i + 2], 16) for i in (1, 3, 5)]
-        material = scene.geometry[name].visual.material  # type: ignore[union-attr]
+        material = scene.geometry[name].visual.material
         assert list(material.baseColorFactor[:3]) == rgb
 
 

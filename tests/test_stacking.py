@@ -88,7 +88,7 @@ def test_place_accepts_any_rotation_and_explains_refusals() -> None:
         "out of box at (": PlaceAction(other, other_shape.translate((2, 2, 0)).cells),
         f"collision with {name} at (": PlaceAction(
             other,
-            other_shape.translate(first).cells,  # type: ignore[arg-type]
+            other_shape.translate(first).cells,
         ),
     }
     for reason, action in cases.items():
@@ -156,7 +156,9 @@ def test_push_pop_clone_and_key() -> None:
     assert a.steps_used == 1 and b.steps_used == 2 and a.key() != b.key()
     assert b.pop() == PlaceAction(order[1], placements[order[1]].cells)
     assert b.key() == a.key() and b.steps_used == 1
-    assert a.pop().piece == order[0] and a.key() == start and a.steps_used == 0
+    popped = a.pop()
+    assert isinstance(popped, PlaceAction) and popped.piece == order[0]
+    assert a.key() == start and a.steps_used == 0
     with pytest.raises(IndexError):
         a.pop()
     # the key is the position, whatever the order it was reached in

@@ -1,5 +1,9 @@
 """An independent check of the voxel kinematics with FCL (python-fcl) on the piece meshes.
 
+A test oracle that ships with the package on purpose: the property tests compare every move the
+voxel engine allows with this verdict, and anyone who imports levels or adds a kind of move
+(turns, other lattices) can run the same comparison on their own data without our test tree.
+
 :mod:`chaingeo.core.kinematics` decides a move by testing every unit step on voxel sets. Here the
 same question is put to a different engine on different data: the pieces are watertight
 manifold3d meshes, the group's motion is FCL's continuous collision query along the straight

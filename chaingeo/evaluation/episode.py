@@ -140,10 +140,6 @@ class _Images:
         return out
 
 
-def _is_finish(result: StepResultLike) -> bool:
-    return result.action is not None and result.action.to_text() == "finish"
-
-
 def _step_record(turn: int, reply: Reply, sent: str, result: StepResultLike) -> dict[str, Any]:
     rec: dict[str, Any] = {
         "turn": turn,
@@ -255,7 +251,7 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                 steps.append(rec)
                 note = chosen.note if chosen.action is None else None
                 turn += 1
-                if _is_finish(result):
+                if state.finished:
                     finished = True
                     break
         else:
@@ -280,7 +276,7 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                     break
                 result = state.step_text(text)
                 steps.append(_step_record(i, Reply(text, text), text, result))
-                if _is_finish(result):
+                if state.finished:
                     finished = True
                     break
     except AgentError as e:

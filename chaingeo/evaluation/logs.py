@@ -45,7 +45,6 @@ PACKAGES: Final = (
     "matplotlib",
     "trimesh",
     "manifold3d",
-    "networkx",
 )
 
 

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TextIO
 
+from tqdm import tqdm
+
 from chaingeo.core.level import Level, level_set_hash
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.agents.http import api_key
@@ -59,7 +61,9 @@ def outcome_of(record: dict[str, Any]) -> Outcome:
 
 
 class ProgressBar:
-    """One status line: episodes done, solved, tokens and dollars so far."""
+    """Episodes done, solved, tokens and dollars so far: a tqdm bar on a terminal (like the
+    generator's); elsewhere (logs, CI) one plain line per finished episode, so a log shows
+    progress, and the totals at the end."""
 
     def __init__(self, label: str, total: int, stream: TextIO | None, enabled: bool) -> None:
         self.label, self.total, self.stream = label, total, stream or sys.stderr
@@ -68,35 +72,46 @@ class ProgressBar:
         self.tokens = 0
         self.cost: float | None = 0.0
         self.started = time.monotonic()
+        self.tty = enabled and bool(getattr(self.stream, "isatty", lambda: False)())
+        self._bar = tqdm(
+            total=total, desc=label, unit="episode", file=self.stream, disable=not self.tty
+        )
 
-    def add(self, record: dict[str, Any]) -> None:
+    def add(self, record: dict[str, Any], *, resumed: bool = False) -> None:
+        """Count one episode; ``resumed``: recorded by an earlier run (no line of its own)."""
         self.done += 1
         self.solved += bool(record.get("success"))
         self.errors += record.get("status") == "error"
         self.tokens += Usage.from_json(record.get("usage", {})).total_tokens
         cost = record.get("cost_usd")
         self.cost = None if cost is None or self.cost is None else self.cost + cost
-        self.show()
+        if self.tty:
+            self._bar.update(1)
+            self._bar.set_postfix_str(self.totals())
+        elif self.enabled and not resumed:
+            outcome = (
+                "error"
+                if record.get("status") == "error"
+                else ("solved" if record.get("success") else "unsolved")
+            )
+            self.stream.write(f"{self.line()} | {record.get('key', '?')} {outcome}\n")
+            self.stream.flush()
 
-    def line(self) -> str:
+    def totals(self) -> str:
         cost = "$?" if self.cost is None else f"${self.cost:.4f}"
         err = f" | {self.errors} errors" if self.errors else ""
-        secs = time.monotonic() - self.started
-        return (
-            f"[{self.label}] {self.done}/{self.total} | solved {self.solved} | "
-            f"{_tokens(self.tokens)} tok | {cost}{err} | {secs:.0f}s"
-        )
+        return f"solved {self.solved} | {_tokens(self.tokens)} tok | {cost}{err}"
 
-    def show(self, final: bool = False) -> None:
-        """Redraw in place on a terminal; elsewhere (logs, CI) only the final line."""
-        if not self.enabled:
-            return
-        tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        if tty:
-            self.stream.write("\r" + self.line() + ("\n" if final else ""))
-        elif final:
+    def line(self) -> str:
+        secs = time.monotonic() - self.started
+        return f"[{self.label}] {self.done}/{self.total} | {self.totals()} | {secs:.0f}s"
+
+    def close(self) -> None:
+        """Close the bar; print the totals where no bar was shown."""
+        self._bar.close()
+        if self.enabled and not self.tty:
             self.stream.write(self.line() + "\n")
-        self.stream.flush()
+            self.stream.flush()
 
 
 def _tokens(n: int) -> str:
@@ -202,7 +217,7 @@ def evaluate(
     bar = ProgressBar(agent.label, len(levels) * cfg.samples, stream, cfg.progress)
     for rec in log.latest().values():
         if rec["key"] in done:
-            bar.add(rec)
+            bar.add(rec, resumed=True)
     for result in _execute(tasks, cfg):
         for png in result.images.values():
             log.put_image(png)  # stored under its SHA-256, the name the record uses
@@ -210,5 +225,5 @@ def evaluate(
         rec["cost_usd"] = _cost(prices, rec)
         log.append(rec)
         bar.add(rec)
-    bar.show(final=True)
+    bar.close()
     return [outcome_of(r) for r in log.latest().values()]

@@ -119,9 +119,10 @@ class PriceTable:
 
     @staticmethod
     def load(*extra: str | Path) -> PriceTable:
-        """The shipped ``chaingeo/data/prices.json``, then each extra file on top (later wins)."""
-        text = resources.files("chaingeo").joinpath("data/prices.json").read_text("utf-8")
-        prices = _parse_prices(json.loads(text), "chaingeo/data/prices.json")
+        """The shipped ``chaingeo/evaluation/prices.json``, then each extra file on top (later
+        wins)."""
+        text = resources.files("chaingeo.evaluation").joinpath("prices.json").read_text("utf-8")
+        prices = _parse_prices(json.loads(text), "chaingeo/evaluation/prices.json")
         for path in extra:
             try:
                 data = json.loads(Path(path).read_text("utf-8"))

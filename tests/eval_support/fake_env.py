@@ -43,9 +43,12 @@ class FakeState:
         self.max_steps = level.max_steps
         self.steps_used = 0
         self.taken: tuple[str, ...] = ()
+        self.finished = False
         self.history: list[str] = []
 
     def legal_actions(self) -> list[FakeAction]:
+        if self.finished:
+            return []
         names = sorted(p.name for p in self.level.pieces if p.name not in self.taken)
         return [FakeAction(f"take {n}") for n in names] + [FakeAction("finish")]
 
@@ -70,7 +73,9 @@ class FakeState:
 
     def _commit(self, action: FakeAction) -> None:
         self.steps_used += 1
-        if action.text != "finish":
+        if action.text == "finish":
+            self.finished = True
+        else:
             self.taken = (*self.taken, action.text.split()[1])
 
     def step_text(self, text: str) -> FakeResult:
@@ -91,9 +96,10 @@ class FakeState:
 
     def clone(self) -> FakeState:
         other = FakeState(self.level)
-        other.steps_used, other.taken, other.history = (
+        other.steps_used, other.taken, other.finished, other.history = (
             self.steps_used,
             self.taken,
+            self.finished,
             list(self.history),
         )
         return other

@@ -17,7 +17,9 @@ from chaingeo.cli.errors import CommandError
 
 
 def register(sub: Any) -> None:
-    p = sub.add_parser("generate", help="generate levels (stacking) or rebuild the stacking suite")
+    p = sub.add_parser(
+        "generate", help="generate stacking or puzzle levels, or rebuild a shipped suite"
+    )
     fam = p.add_subparsers(dest="family", metavar="FAMILY", required=True)
     _register_stacking(fam)
     _register_suite(fam)

@@ -24,13 +24,12 @@ from typing import Any
 import numpy as np
 
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
+from chaingeo.envs.actions import FinishAction, MoveAction, PickupAction, PlaceAction
 from chaingeo.evaluation.agents.base import Agent, AgentError, Reply, StateLike, Turn
 
 
 def oracle_plan(level: Level) -> list[str]:
     """The stored optimal plan as agent action text (1-based cells, via chaingeo.envs.actions)."""
-    from chaingeo.envs.actions import MoveAction, PlaceAction
-
     sol = level.solution
     if isinstance(sol, StackingSolution):
         return [PlaceAction(n, tuple(sol.placements[n].cells)).to_text() for n in sol.order]
@@ -58,16 +57,12 @@ class OracleAgent(Agent):
         return Reply("\n".join(self._plan), None, actions=tuple(self._plan))
 
 
-def _is_finish(action: Any) -> bool:
-    return bool(action.to_text() == "finish")
-
-
 def _move_count(actions: Sequence[Any]) -> int:
-    """How many of ``actions`` are not ``finish``: a state lists finish last, so the moves are
-    ``actions[:n]``. Counted without building the actions (an assembly state can offer a
-    hundred thousand insertions, built only when indexed)."""
-    n = len(actions)
-    return n - 1 if n and _is_finish(actions[n - 1]) else n
+    """How many of ``actions`` are not ``finish``: a state that is not finished lists finish
+    last (and a finished one lists nothing), so the moves are ``actions[:n]``. Counted without
+    building the actions (an assembly state can offer a hundred thousand insertions, built only
+    when indexed)."""
+    return max(0, len(actions) - 1)
 
 
 class _Seeded(Agent):
@@ -100,7 +95,7 @@ class _Seeded(Agent):
             text = self.choose(state, turn)
             plan.append(text)
             result = state.step_text(text)
-            if text == "finish" or not result.legal:
+            if state.finished or not result.legal:
                 break
         return Reply("\n".join(plan), None, actions=tuple(plan))
 
@@ -119,13 +114,11 @@ class RandomAgent(_Seeded):
 def _step_kind(action: Any) -> int:
     """+1 for a step forward (place / a move out to or in from infinity), -1 for a step back
     (pickup), 0 otherwise: what an action does when the state says nothing more."""
-    kind = type(action).__name__
-    if kind == "PlaceAction":
+    if isinstance(action, PlaceAction):
         return 1
-    if kind == "PickupAction":
+    if isinstance(action, PickupAction):
         return -1
-    move = getattr(action, "move", None)
-    if move is not None and getattr(move, "distance", 0) is None:
+    if isinstance(action, MoveAction) and action.move.distance is None:
         return 1
     return 0
 
@@ -149,7 +142,7 @@ def _options_left(state: StateLike) -> int:
     actions = state.legal_actions()
     if getattr(state, "placed", None) is None:
         return _move_count(actions)
-    return sum(1 for a in actions if _step_kind(a) >= 0 and not _is_finish(a))
+    return sum(1 for a in actions if _step_kind(a) >= 0 and not isinstance(a, FinishAction))
 
 
 class GreedyAgent(_Seeded):

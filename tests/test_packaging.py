@@ -1,0 +1,29 @@
+"""The wheel's package list is complete: pyproject lists packages by hand (the suite folder is
+mapped in as chaingeo.levels), so a new sub-package must be added there; this test says so."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from chaingeo.core.suite import shipped_levels
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_package_of_the_tree_goes_into_the_wheel() -> None:
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]
+    listed = set(config["setuptools"]["packages"])
+    found = {
+        ".".join(init.parent.relative_to(ROOT).parts)
+        for top in ("chaingeo", "solvers", "generator")
+        for init in (ROOT / top).rglob("__init__.py")
+    }
+    assert found | {"chaingeo.levels"} == listed
+    assert config["setuptools"]["package-dir"]["chaingeo.levels"] == "levels"
+
+
+def test_the_shipped_suite_is_found_as_package_data() -> None:
+    assert shipped_levels().resolve() == (ROOT / "levels").resolve()
+    assert len(list(shipped_levels("puzzle").glob("*.json"))) == 32
+    assert len(list(shipped_levels("stacking").glob("*.json"))) == 77
