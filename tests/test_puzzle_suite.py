@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import json
 from collections import Counter
 from pathlib import Path
 
 import pytest
 
+from chaingeo.cli.main import main
 from chaingeo.core.kinematics import disassembly_of_assembly_plan, replay_disassembly
 from chaingeo.core.level import Level, PuzzleSolution, level_bytes, load_levels
 from generator.puzzle import difficulty_of
@@ -65,3 +67,17 @@ def test_suite_rebuilds_byte_for_byte(tmp_path: Path) -> None:
     build_puzzle_suite(tmp_path)
     for lv in LEVELS:
         assert (tmp_path / f"{lv.id}.json").read_bytes() == level_bytes(lv)
+
+
+@pytest.mark.parametrize(
+    "level", [lv for lv in LEVELS if "blocks" in lv.stats], ids=lambda lv: lv.id
+)
+def test_chain_analyze_proves_a_tower_as_the_generator_did(
+    level: Level, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One analysis everywhere: ``chain analyze`` reads the blocks the level carries and
+    proves the stored o_i with the block bound (the plain search would stop at its caps)."""
+    path = SUITE / f"{level.id}.json"
+    assert main(["analyze", str(path), "--no-assemble", "--seconds", "60"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["optimal_steps"] == level.optimal_steps and out["level"] == level.stats["level"]
