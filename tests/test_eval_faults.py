@@ -4,6 +4,11 @@ that refuse the key or keep failing, and a run killed while its workers play."""
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -192,3 +197,49 @@ def test_server_errors_after_every_retry_are_errored_episodes(
 
 def test_auth_error_is_an_agent_error() -> None:
     assert issubclass(AuthenticationError, RuntimeError)
+
+
+# ------------------------------------------------------------------------------ a killed run
+
+
+def _session(sid: int) -> list[int]:
+    """Live (not zombie) processes of session ``sid``: the run and everything it started, even
+    once reparented."""
+    out = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            stat = (Path("/proc") / entry / "stat").read_text()
+        except OSError:
+            continue
+        fields = stat[stat.rindex(")") + 2 :].split()
+        if int(fields[3]) == sid and fields[0] != "Z":
+            out.append(int(entry))
+    return out
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
+def test_a_killed_parallel_run_leaves_no_process_behind(tmp_path: Path) -> None:
+    suite = _suite(tmp_path, 8)
+    cmd = [sys.executable, "-m", "chaingeo.cli.main", "eval", "--levels", str(suite)]
+    cmd += ["--out", str(tmp_path / "r"), "--env", FAKE.env, "--agent", "random"]
+    cmd += ["--samples", "4", "--jobs", "2", "--no-progress"]
+    env = dict(os.environ, FAKE_ENV_DELAY="0.05", PYTHONPATH=str(ROOT))
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=env, start_new_session=True, stdout=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 60
+        while len(_session(proc.pid)) < 4:  # the run, two workers, the resource tracker
+            assert time.monotonic() < deadline and proc.poll() is None, "no workers started"
+            time.sleep(0.05)
+        os.kill(proc.pid, signal.SIGKILL)  # the parent only: its workers must follow
+        proc.wait()
+        killed = time.monotonic()
+        while _session(proc.pid) and time.monotonic() - killed < 10:
+            time.sleep(0.05)
+        assert _session(proc.pid) == [], "processes outlived the killed run"
+        assert proc.stdout is not None
+        assert proc.stdout.read() is not None  # EOF: nobody holds the run's stdout any more
+    finally:
+        for pid in _session(proc.pid):
+            os.kill(pid, signal.SIGKILL)
