@@ -35,8 +35,10 @@ from chaingeo.envs.machines import new_state
 from chaingeo.envs.observation import observe
 from chaingeo.evaluation.agents.base import (
     TRANSPORT,
+    Agent,
     AgentError,
     AgentSpec,
+    AuthenticationError,
     ObservationLike,
     Reply,
     StateLike,
@@ -158,15 +160,9 @@ def _step_record(turn: int, reply: Reply, sent: str, result: StepResultLike) -> 
     return rec
 
 
-def run_episode(task: EpisodeTask) -> EpisodeResult:
-    level, proto = task.level, task.protocol
-    make_state, observe_state = _environment(proto.env)
-    seed = episode_seed(task.seed, level, task.sample)
-    started = time.monotonic()
-    images = _Images()
-    steps: list[dict[str, Any]] = []
-    usage = Usage()
-    record: dict[str, Any] = {
+def _header(task: EpisodeTask, seed: int) -> dict[str, Any]:
+    level = task.level
+    return {
         "key": task.key,
         "level_id": level.id,
         "level_hash": content_hash(level),
@@ -177,16 +173,72 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
         "max_steps": level.max_steps,
         "sample": task.sample,
         "seed": seed,
-        "protocol": proto.name,
+        "protocol": task.protocol.name,
         "agent": task.agent.label,
     }
-    state = make_state(level)
-    agent = make_agent(task.agent)
-    record["model"] = agent.model
+
+
+#: The longest exception message an errored record keeps.
+MAX_ERROR_CHARS = 500
+
+
+def describe_error(exc: BaseException) -> str:
+    """``Class: message`` of an exception, one line, bounded, with no traceback; an agent error
+    is the harness's own wording and keeps just its message."""
+    message = " ".join(str(exc).split())
+    if len(message) > MAX_ERROR_CHARS:
+        message = message[: MAX_ERROR_CHARS - 3] + "..."
+    if type(exc) is AgentError:
+        return message
+    return f"{type(exc).__name__}: {message}" if message else type(exc).__name__
+
+
+def error_record(task: EpisodeTask, exc: BaseException) -> EpisodeResult:
+    """The record of an episode that never produced one (its worker died, its result could not
+    come back): status ``error``, nothing played."""
+    record = _header(task, episode_seed(task.seed, task.level, task.sample))
+    record.update(
+        model=None,
+        status="error",
+        error=describe_error(exc),
+        error_type=type(exc).__name__,
+        success=False,
+        steps_used=0,
+        invalid=0,
+        unparseable=0,
+        illegal=0,
+        ambiguous=0,
+        finished=False,
+        truncated=False,
+        usage=Usage().to_json(),
+        wall_seconds=0.0,
+        steps=[],
+    )
+    return EpisodeResult(record, {})
+
+
+def run_episode(task: EpisodeTask) -> EpisodeResult:
+    """Play one episode. Whatever an agent or the environment raises becomes an errored record
+    (class and message, never a traceback), except :class:`AuthenticationError`, which no
+    other episode would survive either: it propagates so the run stops at once."""
+    level, proto = task.level, task.protocol
+    seed = episode_seed(task.seed, level, task.sample)
+    started = time.monotonic()
+    images = _Images()
+    steps: list[dict[str, Any]] = []
+    usage = Usage()
+    record = _header(task, seed)
+    record["model"] = None
+    state: StateLike | None = None
+    agent: Agent | None = None
     finished = False
     judge: Judge | None = None
-    status, error = "done", None
+    status, error, error_type = "done", None, None
     try:
+        make_state, observe_state = _environment(proto.env)
+        state = make_state(level)
+        agent = make_agent(task.agent)
+        record["model"] = agent.model
         agent.start(level, seed)
 
         def see(window: int) -> ObservationLike:
@@ -279,28 +331,53 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                 if state.finished:
                     finished = True
                     break
-    except AgentError as e:
-        status, error = "error", str(e)
+    except AuthenticationError:
+        raise
+    except Exception as e:  # one bad episode must never stop a run
+        status, error, error_type = "error", describe_error(e), type(e).__name__
     finally:
-        agent.close()
+        if agent is not None:
+            try:
+                agent.close()
+            except Exception as e:
+                if status == "done":
+                    status, error, error_type = "error", describe_error(e), type(e).__name__
     if judge is not None and judge.usage.calls:
         record["judge"] = {"model": judge.model, "usage": judge.usage.to_json()}
+    try:
+        ended = _ending(state)
+    except Exception as e:  # a state that cannot report its end
+        ended = _ending(None)
+        if status == "done":
+            status, error, error_type = "error", describe_error(e), type(e).__name__
+    record.update(status=status, error=error)
+    if error_type is not None:
+        record["error_type"] = error_type
     record.update(
-        status=status,
-        error=error,
-        success=bool(state.is_success()),
-        steps_used=int(state.steps_used),
+        success=ended["success"],
+        steps_used=ended["steps_used"],
         invalid=sum(1 for s in steps if not s["legal"]),
         unparseable=sum(1 for s in steps if s["error"] == "unparseable"),
         illegal=sum(1 for s in steps if s["error"] == "illegal"),
         ambiguous=sum(1 for s in steps if s["error"] == "ambiguous"),
         finished=finished,
-        truncated=bool(state.is_truncated()) and not state.is_success(),
+        truncated=ended["truncated"],
         usage=usage.to_json(),
         wall_seconds=round(time.monotonic() - started, 3),
         steps=steps,
     )
     return EpisodeResult(record, images.files)
+
+
+def _ending(state: StateLike | None) -> dict[str, Any]:
+    if state is None:
+        return {"success": False, "steps_used": 0, "truncated": False}
+    success = bool(state.is_success())
+    return {
+        "success": success,
+        "steps_used": int(state.steps_used),
+        "truncated": bool(state.is_truncated()) and not success,
+    }
 
 
 def _spent(now: Usage, before: Usage) -> Usage:

@@ -6,13 +6,25 @@ processes, or on a Dask cluster) and writes each finished episode (images first,
 record, fsynced) from this process only, so records never interleave. Killing the run at any
 moment loses at most the episodes in flight, which ``--resume`` runs again; none is recorded
 twice.
+
+Faults stay inside their episode: whatever an agent or the environment raises, or a worker that
+dies under its episode, is recorded as an errored episode (class and message) and the run goes
+on, except an :class:`~chaingeo.evaluation.agents.base.AuthenticationError`, which stops the run
+at once (no episode would get further). Worker processes die with the run: on Linux the kernel
+kills them when the parent dies (``PR_SET_PDEATHSIG``), elsewhere a watchdog thread in each
+worker exits once its parent is gone; the multiprocessing resource tracker then sees its pipe
+close and exits too.
 """
 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import ctypes
 import multiprocessing
+import os
+import signal
 import sys
+import threading
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -22,10 +34,16 @@ from typing import Any, TextIO
 from tqdm import tqdm
 
 from chaingeo.core.level import Level, level_set_hash
-from chaingeo.evaluation.agents.base import AgentSpec
+from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
 from chaingeo.evaluation.agents.http import api_key
 from chaingeo.evaluation.agents.registry import make_agent
-from chaingeo.evaluation.episode import EpisodeResult, EpisodeTask, ProtocolConfig, run_episode
+from chaingeo.evaluation.episode import (
+    EpisodeResult,
+    EpisodeTask,
+    ProtocolConfig,
+    error_record,
+    run_episode,
+)
 from chaingeo.evaluation.logs import RunLog, make_header
 from chaingeo.evaluation.metrics import Outcome
 from chaingeo.evaluation.usage import PriceTable, Usage
@@ -122,6 +140,54 @@ def _tokens(n: int) -> str:
     return str(n)
 
 
+#: ``prctl`` option: the signal the kernel sends this process when its parent dies (Linux).
+PR_SET_PDEATHSIG = 1
+#: How often a worker's watchdog looks for its parent, in seconds.
+WATCH_INTERVAL = 0.25
+
+
+def _die_with_parent(parent: int) -> None:
+    """Worker initializer: never outlive the run. On Linux ask the kernel for SIGKILL when the
+    parent dies; everywhere, a daemon thread exits the process once it has been reparented."""
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError):
+            pass  # the watchdog below still applies
+    if os.getppid() != parent:  # the parent died before the request took effect
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(WATCH_INTERVAL)
+    os._exit(1)
+
+
+def _played(task: EpisodeTask) -> EpisodeResult:
+    """``run_episode`` in this process, with anything that still escapes it made a record."""
+    try:
+        return run_episode(task)
+    except AuthenticationError:
+        raise
+    except Exception as e:
+        return error_record(task, e)
+
+
+def _collected(fut: Any, task: EpisodeTask) -> EpisodeResult:
+    """A finished future's result; a worker that died or a result that could not come back
+    becomes the episode's error record."""
+    try:
+        result: EpisodeResult = fut.result()
+    except AuthenticationError:
+        raise
+    except Exception as e:
+        return error_record(task, e)
+    return result
+
+
 def _execute(tasks: Sequence[EpisodeTask], cfg: RunConfig) -> Iterator[EpisodeResult]:
     if not tasks:
         return
@@ -135,24 +201,31 @@ def _execute(tasks: Sequence[EpisodeTask], cfg: RunConfig) -> Iterator[EpisodeRe
         client: Any = distributed.Client(cfg.dask)  # type: ignore[no-untyped-call]
         try:
             futures = client.map(run_episode, list(tasks), pure=False)
+            by_key = {f.key: t for f, t in zip(futures, tasks, strict=True)}
             completed: Any = distributed.as_completed(futures)  # type: ignore[no-untyped-call]
             for fut in completed:
-                yield fut.result()
+                yield _collected(fut, by_key[fut.key])
         finally:
             client.close()
         return
     if cfg.jobs <= 1:
         for t in tasks:
-            yield run_episode(t)
+            yield _played(t)
         return
     ctx = multiprocessing.get_context("spawn")
-    with cf.ProcessPoolExecutor(max_workers=cfg.jobs, mp_context=ctx) as pool:
-        pending = {pool.submit(run_episode, t) for t in tasks}
+    with cf.ProcessPoolExecutor(
+        max_workers=cfg.jobs,
+        mp_context=ctx,
+        initializer=_die_with_parent,
+        initargs=(os.getpid(),),
+    ) as pool:
+        submitted = {pool.submit(run_episode, t): t for t in tasks}
+        pending = set(submitted)
         try:
             while pending:
                 finished, pending = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-                for fut in sorted(finished, key=lambda f: f.result().record["key"]):
-                    yield fut.result()
+                for fut in sorted(finished, key=lambda f: submitted[f].key):
+                    yield _collected(fut, submitted[fut])
         finally:
             for fut in pending:
                 fut.cancel()
@@ -218,12 +291,14 @@ def evaluate(
     for rec in log.latest().values():
         if rec["key"] in done:
             bar.add(rec, resumed=True)
-    for result in _execute(tasks, cfg):
-        for png in result.images.values():
-            log.put_image(png)  # stored under its SHA-256, the name the record uses
-        rec = result.record
-        rec["cost_usd"] = _cost(prices, rec)
-        log.append(rec)
-        bar.add(rec)
-    bar.close()
+    try:
+        for result in _execute(tasks, cfg):
+            for png in result.images.values():
+                log.put_image(png)  # stored under its SHA-256, the name the record uses
+            rec = result.record
+            rec["cost_usd"] = _cost(prices, rec)
+            log.append(rec)
+            bar.add(rec)
+    finally:
+        bar.close()
     return [outcome_of(r) for r in log.latest().values()]

@@ -5,6 +5,11 @@ With no arguments it runs the built-in baselines (oracle, greedy, random) on the
 evaluates a model on any OpenAI-compatible server (the key comes from ``$OPENAI_API_KEY`` or the
 variable named by ``--api-key-env``; it is never logged). Each (agent, protocol) pair writes one
 run directory under ``--out``; ``--resume`` continues killed runs there.
+
+Exit status: 0 when every episode was played; 1 when some episode errored (agent or environment
+fault, server down after every retry; said above the leaderboard), unless ``--allow-errors``;
+2 for a usage error or refused credentials (HTTP 401/403, or no key for a remote server), which
+stop the run at the first call.
 """
 
 from __future__ import annotations
@@ -78,6 +83,13 @@ def register(sub: Any) -> None:
     p.add_argument("--retry-errors", action="store_true", help="with --resume: rerun errors")
     p.add_argument("--prices", action="append", default=[], help="extra price table (JSON)")
     p.add_argument("--no-progress", action="store_true")
+    p.add_argument(
+        "--allow-errors",
+        action="store_true",
+        help="exit 0 even when some episodes errored (they are still reported)",
+    )
+    # The module providing new_state and observe; tests point it at a double.
+    p.add_argument("--env", default="chaingeo", help=argparse.SUPPRESS)
     p.set_defaults(func=run)
 
 
@@ -99,9 +111,10 @@ def _slug(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.level import load_level, load_levels
     from chaingeo.core.suite import shipped_levels
-    from chaingeo.evaluation.agents.base import AgentSpec
+    from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
     from chaingeo.evaluation.agents.registry import BASELINES
     from chaingeo.evaluation.episode import ProtocolConfig
+    from chaingeo.evaluation.logs import RunLog
     from chaingeo.evaluation.report import Run, load_run, table1
     from chaingeo.evaluation.runner import RunConfig, evaluate
     from chaingeo.evaluation.usage import PriceTable
@@ -149,6 +162,7 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.no_progress,
     )
     runs: list[Run] = []
+    errored: dict[str, int] = {}
     for name in names:
         # Built-in baselines take no model options; only pass what was given explicitly.
         opts = (
@@ -166,12 +180,27 @@ def run(args: argparse.Namespace) -> int:
                     candidates=args.candidates,
                     judge=args.judge,
                     judge_options=dict(_option(o) for o in args.judge_option),
+                    env=args.env,
                 )
             except ValueError as e:
                 raise CommandError(str(e)) from None
             run_dir = args.out / f"{_slug(spec.label)}-{proto_name}"
-            evaluate(levels, spec, run_dir, proto, cfg, prices, stream=sys.stderr)
+            try:
+                evaluate(levels, spec, run_dir, proto, cfg, prices, stream=sys.stderr)
+            except AuthenticationError as e:
+                raise CommandError(f"{spec.label}: authentication failed: {e}") from None
             runs.append(load_run(run_dir))
+            errored[run_dir.name] = sum(
+                r.get("status") == "error" for r in RunLog(run_dir).latest().values()
+            )
+    total = sum(errored.values())
+    if total:
+        where = ", ".join(f"{name}: {n}" for name, n in errored.items() if n)
+        verdict = "accepted (--allow-errors)" if args.allow_errors else "exit status 1"
+        print(
+            f"WARNING: {total} episode(s) errored ({where}); they count as unsolved;"
+            f" {verdict}; `--resume --retry-errors` reruns them"
+        )
     print(table1(runs).markdown())
     print(f"runs written to {args.out}; `chain report {args.out}` for every table and the plot")
-    return 0
+    return 1 if total and not args.allow_errors else 0

@@ -102,6 +102,11 @@ class AgentError(RuntimeError):
     died): the episode is recorded with status ``error`` and can be retried with ``--resume``."""
 
 
+class AuthenticationError(AgentError):
+    """The server refused the credentials (HTTP 401/403) or a remote server was given no key:
+    no episode can succeed, so the run stops at the first call instead of recording errors."""
+
+
 #: Options that say how to reach an agent, not how it behaves.
 TRANSPORT = frozenset(
     {"base_url", "timeout", "max_retries", "backoff_base", "backoff_max", "api_key_env"}

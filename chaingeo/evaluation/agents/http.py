@@ -4,18 +4,22 @@ Works with any server speaking ``POST {base_url}/chat/completions`` (hosted APIs
 Ollama, llama.cpp). Transient faults are retried with exponential backoff and full jitter drawn
 from a seeded generator (so a rerun waits the same way): timeouts, connection errors, 429 (the
 server's ``Retry-After`` is honoured when longer), 5xx, and bodies that are not JSON or carry no
-choice. Other 4xx answers are the caller's mistake and fail at once. The API key goes only into
-the ``Authorization`` header and never into an error message.
+choice. Other 4xx answers are the caller's mistake and fail at once; 401 and 403, and a remote
+(non-loopback) server given no key, raise :class:`AuthenticationError` before any retry, which
+stops a whole run. The API key goes only into the ``Authorization`` header and never into an
+error message.
 """
 
 from __future__ import annotations
 
 import email.utils
 import http.client
+import ipaddress
 import json
 import os
 import time
 import urllib.error
+import urllib.parse
 import urllib.request
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -23,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from chaingeo.evaluation.agents.base import AgentError
+from chaingeo.evaluation.agents.base import AgentError, AuthenticationError
 
 
 @dataclass(frozen=True)
@@ -156,6 +160,10 @@ class ChatClient:
                 raise TransientError(
                     f"HTTP {e.code} {detail}", parse_retry_after(e.headers.get("Retry-After"))
                 ) from None
+            if e.code in (401, 403):
+                raise AuthenticationError(
+                    f"{self.url}: HTTP {e.code} {detail} (check the API key and --api-key-env)"
+                ) from None
             raise AgentError(f"{self.url}: HTTP {e.code} {detail}") from None
         except TimeoutError as e:
             raise TransientError(f"timeout after {self.timeout}s ({e})") from None
@@ -175,6 +183,11 @@ class ChatClient:
 
     def complete(self, body: Mapping[str, Any]) -> dict[str, Any]:
         """POST with retries; the decoded answer, or :class:`AgentError` once retries run out."""
+        if not self._key and not is_loopback(self.url):
+            raise AuthenticationError(
+                f"{self.url}: no API key for a remote server; set $OPENAI_API_KEY or the"
+                " variable named by --api-key-env"
+            )
         policy = self.retry
         for attempt in range(policy.max_retries + 1):
             try:
@@ -192,6 +205,18 @@ class ChatClient:
                 self.waits.append(wait)
                 self._sleep(wait)
         raise AssertionError("unreachable")
+
+
+def is_loopback(url: str) -> bool:
+    """Whether ``url`` names this machine (``localhost``, 127.0.0.0/8, ``::1``): a local server
+    may run without a key; any other needs one."""
+    host = urllib.parse.urlsplit(url).hostname or ""
+    if host == "localhost" or host.endswith(".localhost"):
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
 
 
 def _error_text(e: urllib.error.HTTPError) -> str:
