@@ -31,6 +31,7 @@ import re
 from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import total_ordering
+from itertools import pairwise
 from typing import Any, ClassVar, Final
 
 from chaingeo.core.kinematics import Move
@@ -108,7 +109,7 @@ class PlaceAction(_Ordered):
         cells = tuple(sorted((int(x), int(y), int(z)) for x, y, z in self.cells))
         if not cells:
             raise ValueError("a placement needs at least one cell")
-        for a, b in zip(cells, cells[1:], strict=False):  # sorted: a repeat is adjacent
+        for a, b in pairwise(cells):  # sorted: a repeat is adjacent
             if a == b:
                 raise ValueError(f"cell {cell_text(a)} is listed twice")
         object.__setattr__(self, "cells", cells)
