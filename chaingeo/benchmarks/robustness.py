@@ -37,7 +37,18 @@ LEVEL_FILES = (
     ("puzzle", "puzzle-mid-11-cube4.json"),
 )
 
-_UNICODE_DIGITS = ("١٢٣", "٣", "۴", "५", "๓", "１２", "²", "Ⅻ", "𝟙", "〇")
+_UNICODE_DIGITS = (  # Arabic-Indic, Persian, Devanagari, Thai, fullwidth, superscript, ...
+    "\u0661\u0662\u0663",
+    "\u0663",
+    "\u06f4",
+    "\u096b",
+    "\u0e53",
+    "\uff11\uff12",
+    "\u00b2",
+    "\u216b",
+    "\U0001d7d9",
+    "\u3007",
+)
 _ODD = ("\x00", "\u2212", "\u221e", "\u200b", "\ufeff", "\n", "\t", "\\", '"', "'", "`", "é")
 _SYMS = "()[]{},;:&+-.*/#!?=<>|~^%$@_"
 _WORDS = (
