@@ -112,7 +112,10 @@ def quarter_turn_distance(a: npt.ArrayLike, b: npt.ArrayLike) -> int:
 
 
 def _as_cells(cells: npt.ArrayLike) -> IntArray:
-    arr = np.asarray(cells, dtype=np.int64)
+    try:
+        arr = np.asarray(cells, dtype=np.int64)
+    except OverflowError:
+        raise ValueError("voxel coordinates must fit in 64-bit integers") from None
     if arr.size == 0:
         return np.zeros((0, 3), dtype=np.int64)
     if arr.ndim != 2 or arr.shape[1] != 3:

@@ -79,18 +79,27 @@ def _shifted(cells: Iterable[Cell], d: Cell, k: int) -> set[Cell]:
 
 def _max_free_run(group: frozenset[Cell], rest: frozenset[Cell], d: Cell) -> int | None:
     """Largest k such that steps 1..k are all collision-free, or None if the group never meets
-    the rest again (it can leave to infinity)."""
+    the rest again (it can leave to infinity).
+
+    A step k collides iff some rest cell lies k ahead of a group cell on the same line along
+    the axis, so the answer is the smallest such k less one: work bounded by the cells, never
+    by the coordinates' span.
+    """
     if not rest:
         return None
     axis = next(i for i in range(3) if d[i])
-    # After passing the far side of the rest, no collision can happen any more.
-    span = max(c[axis] for c in rest) - min(c[axis] for c in rest)
-    gspan = max(c[axis] for c in group) - min(c[axis] for c in group)
-    limit = span + gspan + 2
-    for k in range(1, limit + 1):
-        if not _shifted(group, d, k).isdisjoint(rest):
-            return k - 1
-    return None
+    sign = d[axis]
+    a, b = (axis + 1) % 3, (axis + 2) % 3
+    lines: dict[tuple[int, int], list[int]] = {}
+    for r in rest:
+        lines.setdefault((r[a], r[b]), []).append(r[axis])
+    first: int | None = None
+    for g in group:
+        for at in lines.get((g[a], g[b]), ()):
+            k = sign * (at - g[axis])
+            if k >= 1 and (first is None or k < first):
+                first = k
+    return None if first is None else first - 1
 
 
 @dataclass(frozen=True)

@@ -11,12 +11,13 @@ from __future__ import annotations
 import json
 import os
 import re
+from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Final, Literal
 
-from chaingeo.core import canonical_json
+from chaingeo.core import canonical_json, limits
 from chaingeo.core.files import atomic_write
 from chaingeo.core.geometry import Shape, box_cells, puzzle_signature
 from chaingeo.core.kinematics import (
@@ -208,12 +209,19 @@ class _Reader:
             raise self.fail(fld, f"{value!r} is not one of {list(choices)}")
         return value
 
-    def integer(self, value: Any, fld: str, minimum: int | None = None) -> int:
+    def integer(
+        self, value: Any, fld: str, minimum: int | None = None, maximum: int | None = None
+    ) -> int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.fail(fld, f"expected an integer, got {_kind(value)}")
         if minimum is not None and value < minimum:
             raise self.fail(fld, f"must be >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            raise self.fail(fld, f"must be <= {maximum}, got {value}")
         return value
+
+    def coord(self, value: Any, fld: str) -> int:
+        return self.integer(value, fld, -limits.MAX_COORD, limits.MAX_COORD)
 
     def opt_integer(self, value: Any, fld: str) -> int | None:
         return None if value is None else self.integer(value, fld)
@@ -222,20 +230,32 @@ class _Reader:
         cells = self.lst(value, fld)
         if not cells:
             raise self.fail(fld, "a piece needs at least one voxel")
+        if len(cells) > limits.MAX_PIECE_VOXELS:
+            raise self.fail(
+                fld, f"{len(cells)} voxels; a piece has at most {limits.MAX_PIECE_VOXELS}"
+            )
         out: list[tuple[int, int, int]] = []
+        seen: set[tuple[int, int, int]] = set()
         for i, c in enumerate(cells):
             f = f"{fld}[{i}]"
             if not (isinstance(c, list) and len(c) == 3):
-                raise self.fail(f, f"a voxel is a list of three integers, got {c!r}")
-            out.append((self.integer(c[0], f), self.integer(c[1], f), self.integer(c[2], f)))
-        if len(set(out)) != len(out):
-            dup = sorted({c for c in out if out.count(c) > 1})[0]
-            raise self.fail(fld, f"voxel {list(dup)} is listed twice")
+                raise self.fail(f, f"a voxel is a list of three integers, got {_short(c)}")
+            cell = (self.coord(c[0], f), self.coord(c[1], f), self.coord(c[2], f))
+            if cell in seen:
+                raise self.fail(fld, f"voxel {list(cell)} is listed twice")
+            seen.add(cell)
+            out.append(cell)
         return Shape(out)
 
 
 def _kind(value: Any) -> str:
     return "null" if value is None else type(value).__name__
+
+
+def _short(value: Any) -> str:
+    """``repr`` cut to a line, so an error message never echoes a huge value."""
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def parse_level(data: Any, source: str = "<level>") -> Level:
@@ -258,7 +278,10 @@ def parse_level(data: Any, source: str = "<level>") -> Level:
         dims = r.lst(r.get(top, "box", "box"), "box")
         if len(dims) != 3:
             raise r.fail("box", f"expected three sizes [x, y, z], got {len(dims)}")
-        a, b, c = (r.integer(v, f"box[{i}]", minimum=1) for i, v in enumerate(dims))
+        a, b, c = (
+            r.integer(v, f"box[{i}]", minimum=1, maximum=limits.MAX_COORD)
+            for i, v in enumerate(dims)
+        )
         box = (a, b, c)
     elif raw_box is not None:
         raise r.fail("box", "puzzle levels have no box; use null or leave it out")
@@ -274,10 +297,16 @@ def parse_level(data: Any, source: str = "<level>") -> Level:
     else:
         _only_keys(r, rules_obj, {"max_group"}, "rules")
         mg = rules_obj.get("max_group")
-        rules = PuzzleRules(max_group=None if mg is None else r.integer(mg, "rules.max_group", 1))
+        rules = PuzzleRules(
+            max_group=None if mg is None else r.integer(mg, "rules.max_group", 1, limits.MAX_PIECES)
+        )
 
-    optimal = r.integer(r.get(top, "optimal_steps", "optimal_steps"), "optimal_steps", minimum=0)
-    max_steps = r.integer(r.get(top, "max_steps", "max_steps"), "max_steps", minimum=1)
+    max_steps = r.integer(
+        r.get(top, "max_steps", "max_steps"), "max_steps", minimum=1, maximum=limits.MAX_STEPS
+    )
+    optimal = r.integer(
+        r.get(top, "optimal_steps", "optimal_steps"), "optimal_steps", 0, limits.MAX_STEPS
+    )
     if max_steps < optimal:
         raise r.fail("max_steps", f"budget {max_steps} is below optimal_steps {optimal}")
 
@@ -341,6 +370,9 @@ def _parse_pieces(
     items = r.lst(raw, "pieces")
     if not items:
         raise r.fail("pieces", "a level needs at least one piece")
+    if len(items) > limits.MAX_PIECES:
+        raise r.fail("pieces", f"{len(items)} pieces; a level has at most {limits.MAX_PIECES}")
+    total = 0
     pieces: list[Piece] = []
     seen_names: set[str] = set()
     seen_rgb: dict[str, str] = {}
@@ -358,6 +390,9 @@ def _parse_pieces(
         if rgb in seen_rgb:
             raise r.fail(f"{f}.rgb", f"duplicate colour {rgb} (also {seen_rgb[rgb]})")
         shape = r.voxels(r.get(obj, "voxels", f"{f}.voxels"), f"{f}.voxels")
+        total += len(shape)
+        if total > limits.MAX_LEVEL_VOXELS:
+            raise r.fail(f"{f}.voxels", f"a level has at most {limits.MAX_LEVEL_VOXELS} voxels")
         if not shape.is_connected():
             raise r.fail(f"{f}.voxels", f"piece {name} is not face-connected")
         seen_names.add(name)
@@ -426,6 +461,8 @@ def _parse_puzzle_solution(
     r: _Reader, sol: Mapping[str, Any], pieces: Sequence[Piece], goal: str, rules: PuzzleRules
 ) -> PuzzleSolution:
     raw_moves = r.lst(r.get(sol, "moves", "solution.moves"), "solution.moves")
+    if len(raw_moves) > limits.MAX_STEPS:
+        raise r.fail("solution.moves", f"{len(raw_moves)} moves; at most {limits.MAX_STEPS}")
     names = {p.name for p in pieces}
     moves: list[Move] = []
     for i, m in enumerate(raw_moves):
@@ -446,7 +483,9 @@ def _parse_puzzle_solution(
             r.get(obj, "direction", f"{f}.direction"), f"{f}.direction", list(DIRECTIONS)
         )
         dist = r.get(obj, "distance", f"{f}.distance")
-        distance = None if dist is None else r.integer(dist, f"{f}.distance", minimum=1)
+        distance = (
+            None if dist is None else r.integer(dist, f"{f}.distance", 1, limits.MAX_DISTANCE)
+        )
         try:
             moves.append(Move(tuple(group), direction, distance))
         except ValueError as e:
@@ -471,25 +510,43 @@ def load_level(path: str | os.PathLike[str]) -> Level:
     """Read and fully validate one level file."""
     source = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        size = Path(path).stat().st_size
+        if size > limits.MAX_FILE_BYTES:
+            raise LevelError(
+                source, "(file)", f"{size} bytes; a level file has at most {limits.MAX_FILE_BYTES}"
+            )
+        with open(path, "rb") as fh:
+            raw = fh.read(limits.MAX_FILE_BYTES + 1)
     except OSError as e:
         raise LevelError(source, "(file)", f"cannot read: {e.strerror or e}") from None
+    if len(raw) > limits.MAX_FILE_BYTES:
+        raise LevelError(source, "(file)", f"more than {limits.MAX_FILE_BYTES} bytes")
+    try:
+        text = raw.decode("utf-8")
     except UnicodeDecodeError:
         raise LevelError(source, "(file)", "not UTF-8 text") from None
+    return parse_level(decode_json(text, source), source)
+
+
+def decode_json(text: str, source: str) -> Any:
+    """``json.loads`` within :mod:`chaingeo.core.limits`; :class:`LevelError` otherwise."""
     try:
-        data = json.loads(text)
+        return limits.loads_bounded(text)
+    except limits.LimitError as e:
+        raise LevelError(source, "(file)", e.reason) from None
     except json.JSONDecodeError as e:
         raise LevelError(
             source, "(file)", f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}"
         ) from None
-    return parse_level(data, source)
+    except (ValueError, RecursionError) as e:  # defensive: never a traceback for a file
+        raise LevelError(source, "(file)", f"invalid JSON: {type(e).__name__}") from None
 
 
 def load_levels(folder: str | os.PathLike[str]) -> list[Level]:
     """All ``*.json`` levels under ``folder`` (recursively), sorted by id."""
     levels = [load_level(p) for p in sorted(Path(folder).rglob("*.json"))]
-    ids = [lv.id for lv in levels]
-    dup = sorted({i for i in ids if ids.count(i) > 1})
+    counts = Counter(lv.id for lv in levels)
+    dup = sorted(i for i, n in counts.items() if n > 1)
     if dup:
         raise LevelError(str(folder), "id", f"duplicate level id {dup[0]!r}")
     return sorted(levels, key=lambda lv: lv.id)

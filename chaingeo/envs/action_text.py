@@ -12,6 +12,7 @@ import re
 from collections.abc import Hashable, Iterable, Sequence
 from typing import Final, Protocol
 
+from chaingeo.core import limits
 from chaingeo.core.kinematics import Move
 from chaingeo.core.level import Level
 from chaingeo.envs.actions import (
@@ -39,7 +40,7 @@ GRAMMAR: Final[dict[str, str]] = {
 }
 
 _TOKEN_RE: Final = re.compile(
-    r"\s*(?:(?P<num>\d+)|(?P<word>[a-z][a-z0-9_]*(?:-[a-z0-9_]+)*)|(?P<sym>[+\-()\[\]{},;:&]))"
+    r"\s*(?:(?P<num>[0-9]+)|(?P<word>[a-z][a-z0-9_]*(?:-[a-z0-9_]+)*)|(?P<sym>[+\-()\[\]{},;:&]))"
 )
 _VERBS: Final[dict[str, str]] = {
     "place": "place",
@@ -110,6 +111,12 @@ def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
     "assemble").
     """
     hint_all = GRAMMAR.get(family, GRAMMAR["stacking"])
+    if len(text) > limits.MAX_TEXT_CHARS:
+        raise UnparseableActionError(
+            text,
+            f"the text has {len(text)} characters; an action has at most "
+            f"{limits.MAX_TEXT_CHARS}; {hint_all}",
+        )
     try:
         tokens = _tokenise(_normalise(text))
         if not tokens:
@@ -157,13 +164,20 @@ def _parse_place(rest: list[Token]) -> PlaceAction:
         raise _Meaningless(str(e)) from None
 
 
+def _number(digits: str) -> int:
+    """A number token, bounded before it is converted (no huge int is ever built)."""
+    if len(digits.lstrip("0")) > limits.MAX_AGENT_DIGITS or int(digits) > limits.MAX_AGENT_NUMBER:
+        raise _Meaningless(f"numbers in an action are at most {limits.MAX_AGENT_NUMBER}")
+    return int(digits)
+
+
 def _signed_numbers(tokens: Sequence[Token], allow_words: bool) -> list[int]:
     """All integers of a cell list (a '-' right before a number makes it negative)."""
     out: list[int] = []
     sign = 1
     for kind, value in tokens:
         if kind == "num":
-            out.append(sign * int(value))
+            out.append(sign * _number(value))
             sign = 1
         elif kind == "sym" and value == "-":
             sign = -1
@@ -246,7 +260,7 @@ def _parse_move(rest: list[Token]) -> MoveRequest:
     given = False
     j = 0
     if j < len(tail) and tail[j][0] == "num":
-        distance, given = int(tail[j][1]), True
+        distance, given = _number(tail[j][1]), True
         j += 1
     elif j < len(tail) and tail[j][0] == "word" and tail[j][1] in _INFINITY:
         given = True

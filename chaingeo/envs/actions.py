@@ -31,6 +31,7 @@ import re
 from collections.abc import Hashable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import total_ordering
+from itertools import pairwise
 from typing import Any, ClassVar, Final
 
 from chaingeo.core.kinematics import Move
@@ -108,9 +109,9 @@ class PlaceAction(_Ordered):
         cells = tuple(sorted((int(x), int(y), int(z)) for x, y, z in self.cells))
         if not cells:
             raise ValueError("a placement needs at least one cell")
-        if len(set(cells)) != len(cells):
-            dup = next(c for c in cells if cells.count(c) > 1)
-            raise ValueError(f"cell {cell_text(dup)} is listed twice")
+        for a, b in pairwise(cells):  # sorted: a repeat is adjacent
+            if a == b:
+                raise ValueError(f"cell {cell_text(a)} is listed twice")
         object.__setattr__(self, "cells", cells)
 
     def sort_key(self) -> tuple[Any, ...]:
@@ -342,6 +343,16 @@ def action_from_json(obj: Any) -> Action:
 # ---------------------------------------------------------------------------------------------
 
 
+#: Characters of agent text quoted back in feedback (the rest is elided).
+SHOWN_CHARS: Final = 200
+
+
+def shown_text(text: str) -> str:
+    """Agent text as quoted in feedback: stripped, and cut to :data:`SHOWN_CHARS`."""
+    s = text.strip()
+    return s if len(s) <= SHOWN_CHARS else s[:SHOWN_CHARS] + f"... ({len(s)} characters)"
+
+
 class ActionError(Exception):
     """Agent input that was not carried out. Nothing changed; ``feedback`` is for the agent."""
 
@@ -360,7 +371,7 @@ class UnparseableActionError(ActionError):
     kind = "unparseable"
 
     def __init__(self, text: str, hint: str, state_key: Hashable | None = None) -> None:
-        shown = text.strip() or "(empty)"
+        shown = shown_text(text) or "(empty)"
         feedback = f"Could not read the action {shown!r}: {hint}. Nothing changed."
         super().__init__(text, feedback, state_key)
         self.hint = hint
@@ -380,7 +391,7 @@ class IllegalActionError(ActionError):
         state_key: Hashable | None = None,
     ) -> None:
         shown = text if text is not None else action.to_text() if action is not None else ""
-        feedback = f"Illegal action '{shown.strip()}': {reason}. Nothing changed."
+        feedback = f"Illegal action '{shown_text(shown)}': {reason}. Nothing changed."
         super().__init__(shown, feedback, state_key)
         self.reason = reason
         self.action = action
@@ -399,7 +410,7 @@ class AmbiguousActionError(ActionError):
         listed = "; ".join(a.to_text() for a in cands[: self.SHOWN])
         more = f" (and {len(cands) - self.SHOWN} more)" if len(cands) > self.SHOWN else ""
         feedback = (
-            f"Ambiguous action '{text.strip()}': it fits {len(cands)} legal actions: "
+            f"Ambiguous action '{shown_text(text)}': it fits {len(cands)} legal actions: "
             f"{listed}{more}. Nothing changed; say which one."
         )
         super().__init__(text, feedback, state_key)

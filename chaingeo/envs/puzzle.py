@@ -506,16 +506,25 @@ class PuzzleState(BaseState):
             if c in owner:
                 return f"{landed[c]} would overlap {owner[c]} at {cell_text(c)}"
         ax, sign = _axis(direction)
+        # Cells of ``into`` by the line along the axis they lie on: a landed cell passed
+        # through one of them iff one lies behind it on its line (work bounded by the cells,
+        # never by how far away the offset puts the part).
+        lines: dict[tuple[int, int], list[tuple[int, str]]] = {}
+        for v, n in owner.items():
+            rest = (v[(ax + 1) % 3], v[(ax + 2) % 3])
+            lines.setdefault(rest, []).append((v[ax], n))
         for c in sorted(landed):
-            for k in range(1, 1 + max(abs(v[ax] - c[ax]) for v in owner) + 1):
-                back = list(c)
-                back[ax] -= sign * k
-                who = owner.get((back[0], back[1], back[2]))
-                if who is not None:
-                    return (
-                        f"{group_text(part)} cannot reach that place along {direction}: "
-                        f"on the way in it would pass through {who}"
-                    )
+            behind = [
+                (sign * (c[ax] - at), who)
+                for at, who in lines.get((c[(ax + 1) % 3], c[(ax + 2) % 3]), [])
+                if sign * (c[ax] - at) >= 1
+            ]
+            if behind:
+                who = min(behind)[1]
+                return (
+                    f"{group_text(part)} cannot reach that place along {direction}: "
+                    f"on the way in it would pass through {who}"
+                )
         return (
             f"{group_text(part)} would land away from {group_text(into)}: parts join only where "
             "their bounding boxes touch or overlap"
