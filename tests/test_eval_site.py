@@ -4,19 +4,26 @@ Runs are made here, small and real: a scripted model (the fake OpenAI server) pl
 shipped levels through the real environment, so turns carry real rendered pictures, model
 replies laced with markup, parsed actions, errors, tokens and cost; the oracle and the random
 baseline play the same levels. The site is then checked as files (same numbers as the report,
-escaping, relative local assets only, deterministic bytes).
+escaping, relative local assets only, deterministic bytes) and in headless Chromium, which
+loads it from disk and drives the real click and key handlers through the page's self-test
+hook (see ``chaingeo/evaluation/site.js``).
 """
 
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import re
-from html import escape
+import shutil
+import subprocess
+from html import escape, unescape
 from html.parser import HTMLParser
 from pathlib import Path
+from typing import Any
 
 import pytest
+from PIL import Image
 
 from chaingeo.cli.main import main
 from chaingeo.core.level import Level, load_level
@@ -249,3 +256,135 @@ def test_chain_report_html(made: tuple[Path, PriceTable], tmp_path: Path) -> Non
     (tmp_path / "other").mkdir()
     (tmp_path / "other" / "x").write_text("")
     assert main([*args[:-1], str(tmp_path / "other")]) == 2
+
+
+# ---------------------------------------------------------------------------------------------
+# The site in a browser: headless Chromium from disk, no driver
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def chromium() -> str:
+    """The browser, or a skip that says how to get one (asked first, before runs are made)."""
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        found = shutil.which(name)
+        if found:
+            return found
+    pytest.skip(
+        "no Chromium on PATH: the browser test of the HTML run viewer needs it "
+        "(Debian: apt-get install chromium; .ci/run installs it where apt is usable)"
+    )
+
+
+def _browse(chromium: str, tmp_path: Path, url: str, *extra: str) -> str:
+    """Run headless Chromium on ``url``; returns what it printed (the DOM for --dump-dom)."""
+    cmd = [
+        chromium,
+        "--headless",
+        "--disable-gpu",
+        "--no-sandbox",
+        "--no-first-run",
+        "--hide-scrollbars",
+        "--disable-dev-shm-usage",
+        f"--user-data-dir={tmp_path / 'profile'}",
+        "--virtual-time-budget=5000",
+        *extra,
+        url,
+    ]
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    return done.stdout
+
+
+def _selftest(dom: str) -> tuple[list[tuple[str, dict[str, Any]]], dict[str, str]]:
+    """What the page's self-test wrote, (action, state shown after it) per line, and the
+    attributes of its element."""
+    match = re.search(r'<pre id="selftest"([^>]*)>(.*?)</pre>', dom, re.S)
+    assert match, "the self-test did not run (no <pre id=selftest> in the DOM)"
+    attrs = dict(re.findall(r'([\w-]+)="([^"]*)"', match.group(1)))
+    lines = [ln.split(" ", 1) for ln in unescape(match.group(2)).strip().splitlines()]
+    return [(action, json.loads(state)) for action, state in lines], attrs
+
+
+def _click_sorted(rows: list[list[Any]], col: int, desc: bool) -> list[list[Any]]:
+    """What the page's sort should give: stable, by raw value, rows without one last."""
+    have = [r for r in rows if r[col] is not None]
+    return sorted(have, key=lambda r: r[col], reverse=desc) + [r for r in rows if r[col] is None]
+
+
+def test_browser_sorts_the_leaderboard(
+    chromium: str, made: tuple[Path, PriceTable], site: Path, tmp_path: Path
+) -> None:
+    rows = table1([load_run(p) for p in find_runs([made[0]])]).rows
+    clicks = [(3, False), (3, True), (11, False), (11, True), (0, False)]  # All, Solved/1M tok
+    # Telling data: "All" differs between runs; "Solved/1M tok" is blank for the baselines.
+    assert len({r[3] for r in rows}) > 1 and {r[11] is None for r in rows} == {True, False}
+    expected = [[r[0] for r in rows]]
+    for col, desc in clicks:
+        rows = _click_sorted(rows, col, desc)
+        expected.append([r[0] for r in rows])
+    actions = ",".join(f"sort:table1.{col}" for col, _ in clicks)
+    dom = _browse(
+        chromium, tmp_path, (site / "index.html").as_uri() + f"?selftest={actions}", "--dump-dom"
+    )
+    lines, attrs = _selftest(dom)
+    assert attrs.get("data-done") == "yes"
+    assert [action for action, _ in lines] == ["start", *actions.split(",")]
+    assert [shown["table1"] for _, shown in lines] == expected
+    assert all(shown["levels"] == lines[0][1]["levels"] for _, shown in lines)  # untouched
+    # The final DOM carries the state the click handler set, and the plot was loaded.
+    assert re.search(r'<th scope="col" class="text" aria-sort="ascending"><button[^>]*>Agent<', dom)
+    assert attrs["data-images"] == "1/1"
+    # The URL hash sorts too (what a shared link does).
+    dom = _browse(
+        chromium, tmp_path, (site / "index.html").as_uri() + "#sort=table1.3&dir=desc", "--dump-dom"
+    )
+    assert [r[0] for r in _tables(dom)["table1"][1:]] == expected[2]
+
+
+def test_browser_steps_an_episode(chromium: str, site: Path, tmp_path: Path) -> None:
+    page = _episode(site, "vlm-interactive", _levels()[0].id)
+    actions = (
+        "key:ArrowRight,key:ArrowRight,key:ArrowLeft,click:next,click:prev,click:last,key:Home"
+    )
+    dom = _browse(chromium, tmp_path, page.as_uri() + f"?selftest={actions}#step=2", "--dump-dom")
+    lines, attrs = _selftest(dom)
+    assert attrs.get("data-done") == "yes"
+    assert lines == [
+        ("start", {"step": 2}),
+        ("key:ArrowRight", {"step": 3}),
+        ("key:ArrowRight", {"step": 4}),
+        ("key:ArrowLeft", {"step": 3}),
+        ("click:next", {"step": 4}),
+        ("click:prev", {"step": 3}),
+        ("click:last", {"step": 4}),
+        ("key:Home", {"step": 1}),
+    ]
+    # One turn visible, the others hidden; its five pictures loaded from ../../images.
+    shown = re.findall(r'<article class="frame" id="frame-(\d)"([^>]*)>', dom)
+    assert [(i, "hidden" in a) for i, a in shown] == [
+        ("1", False),
+        ("2", True),
+        ("3", True),
+        ("4", True),
+    ]
+    assert attrs["data-images"] == "5/5"
+    assert 'id="position">Turn 1 (1 of 4)<' in dom
+    assert "<img src=x" not in dom and "alert(1)&gt;" in dom
+
+
+def test_browser_screenshot_is_not_blank(chromium: str, site: Path, tmp_path: Path) -> None:
+    page = _episode(site, "vlm-interactive", _levels()[2].id)  # a puzzle: coloured pieces
+    shot = tmp_path / "shot.png"
+    _browse(
+        chromium,
+        tmp_path,
+        page.as_uri() + "#step=1",
+        f"--screenshot={shot}",
+        "--window-size=1200,900",
+    )
+    img = Image.open(io.BytesIO(shot.read_bytes())).convert("RGB")
+    assert img.size == (1200, 900)
+    colours = img.getcolors(maxcolors=1 << 20)
+    assert colours is not None and len(colours) > 200, f"{len(colours or [])} colours"
+    assert max(n for n, _ in colours) < 0.9 * img.size[0] * img.size[1]  # not one flat colour
