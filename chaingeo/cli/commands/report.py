@@ -1,4 +1,5 @@
-"""``chain report RUN...``: the paper's tables over run directories, and the cost plot."""
+"""``chain report RUN...``: the paper's tables over run directories, the cost plot, and with
+``--html DIR`` a static site to browse the runs (leaderboard, levels, every episode's turns)."""
 
 from __future__ import annotations
 
@@ -10,19 +11,39 @@ from typing import Any
 def register(sub: Any) -> None:
     p = sub.add_parser(
         "report",
-        help="Table 1, difficulty and protocol tables (markdown + CSV) and the cost plot",
+        help="Table 1, difficulty and protocol tables (markdown + CSV), the cost plot, "
+        "and optionally an HTML run viewer",
     )
     p.add_argument("runs", nargs="+", type=Path, help="run directories, or folders of them")
     p.add_argument("--out", type=Path, default=Path("report"), help="where to write files")
+    p.add_argument(
+        "--html",
+        type=Path,
+        metavar="DIR",
+        help="also write a static site here (open DIR/index.html; no server, no network)",
+    )
+    p.add_argument(
+        "--prices",
+        type=Path,
+        action="append",
+        default=[],
+        help="the extra price table the runs used, to price each turn in the site",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.evaluation.report import find_runs, load_run, tables, write_report
+    from chaingeo.evaluation.usage import PriceTable
 
     runs = [load_run(p) for p in find_runs(args.runs)]
     for _, table in tables(runs):
         print(table.markdown())
     for path in write_report(runs, args.out):
         print(f"wrote {path}")
+    if args.html is not None:
+        from chaingeo.evaluation.site import write_site
+
+        site = write_site(runs, args.html, PriceTable.load(*args.prices))
+        print(f"wrote {site / 'index.html'}")
     return 0
