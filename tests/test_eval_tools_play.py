@@ -261,3 +261,19 @@ def test_a_oneshot_plan_of_tool_calls(tmp_path: Path) -> None:
     assert rec["success"] and rec["steps_used"] == 4
     assert rec["plan"]["actions"][2] == "place blue (3,1,1)"
     assert [c["name"] for c in rec["plan"]["calls"]] == ["place"] * 4 + ["finish"]
+
+
+def test_bad_model_options_are_a_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    levels = tmp_path / "one"
+    save_level(_cubes(), levels / "b-cubes.json")
+    for option, why in [
+        ("model=other", "the agent sets 'model' itself"),
+        ("extra_body=[1]", "extra_body must be a JSON object"),
+        ("reasoning_effort", "expected KEY=VALUE"),
+    ]:
+        code = _eval("http://127.0.0.1:9/v1", levels, tmp_path / "runs", "--model-option", option)
+        assert code == 2
+        assert why in capsys.readouterr().err
+    assert not (tmp_path / "runs").exists()
