@@ -17,7 +17,7 @@ from chaingeo.evaluation.agents.registry import AGENTS
 from chaingeo.evaluation.episode import ProtocolConfig
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from chaingeo.evaluation.usage import PriceTable
-from tests.eval_support.fake_openai import Script, fake_openai, reply
+from tests.eval_support.fake_openai import Script, calls, fake_openai, reply
 
 FAKE = ProtocolConfig(env="tests.eval_support.fake_env")
 KEY = "sk-fake-key-do-not-log-0123456789"
@@ -111,21 +111,28 @@ def test_replies_without_an_action_cost_a_step_not_a_crash(tmp_path: Path) -> No
             reply("I am not sure what to do."),
             reply("Let me think... <action>take re", fault="cutoff"),
             reply("<action>take blue</action>"),  # illegal: no such piece
-            reply("calling the tool", tool_action="take red"),
+            calls(("finish", "{not json"), text="calling the tool"),  # malformed: unparseable
+            reply("<action>take red</action>"),
             reply("<action>take green</action>"),
         ]
     )
-    (rec,) = _run(tmp_path, script, tools=True)
-    assert rec["success"] and rec["steps_used"] == 5
+    (rec,) = _run(tmp_path, script)
+    assert rec["success"] and rec["steps_used"] == 6
     notes = [s.get("note") for s in rec["steps"]]
-    assert notes[0] == "no <action>...</action> found in your reply"
+    assert notes[0] == "your reply called no tool and had no <action>...</action>"
     assert notes[1] == "your reply was cut off before </action>"
-    assert [s["legal"] for s in rec["steps"]] == [False, False, False, True, True]
-    assert rec["invalid"] == 3 and rec["illegal"] == 1
-    assert script.requests[0]["body"]["tools"][0]["function"]["name"] == "act"
+    assert [s["legal"] for s in rec["steps"]] == [False, False, False, False, True, True]
+    assert rec["invalid"] == 4 and rec["illegal"] == 1 and rec["unparseable"] == 3
+    assert rec["steps"][3]["sent"].startswith("!malformed finish call: the arguments are not")
+    assert rec["steps"][3]["calls"][0]["arguments"] == "{not json"
+    offered = [t["function"]["name"] for t in script.requests[0]["body"]["tools"]]
+    assert offered == ["place", "pickup", "state", "finish"]
     # The agent is told why its reply could not be read.
     second = script.requests[1]["body"]["messages"][1]["content"][0]["text"]
-    assert "no <action>...</action> found" in second
+    assert "called no tool and had no <action>" in second
+    # The malformed call was answered (the fake server checks the ids) with the reason.
+    tool_msg = script.requests[4]["body"]["messages"][3]
+    assert tool_msg["role"] == "tool" and "arguments are not a JSON object" in tool_msg["content"]
 
 
 def test_giving_up_is_an_episode_error_and_resume_retries_it(tmp_path: Path) -> None:

@@ -10,8 +10,11 @@ Protocols:
   the last ``history_window`` turns, steps left, views) and answers one action; the environment
   applies it or explains why not (an unparseable, illegal or ambiguous action changes nothing
   but costs a step) until the level is solved, the agent says ``finish`` or the step budget is
-  spent. With ``candidates > 1`` each turn asks the agent that many times and commits the
-  candidate the judge ranks first after every one was checked in a cloned state.
+  spent. A reply may hold several actions (a model's native tool calls): they are taken in
+  order, each a step with its own record, stopping at the first one rejected; the next turn
+  hands the agent that reply and what each executed action did. With ``candidates > 1`` each
+  turn asks the agent that many times and commits the candidate the judge ranks first after
+  every one was checked in a cloned state (its first action: the verifier tries that one).
 - ``oneshot`` (open loop): the agent sees one fixed view once (plus the tray of pieces, or the
   assembly target, where the level has one: they say what there is to place, not where things
   are) and writes its whole plan, which
@@ -142,20 +145,30 @@ class _Images:
         return out
 
 
-def _step_record(turn: int, reply: Reply, sent: str, result: StepResultLike) -> dict[str, Any]:
+def _step_record(
+    turn: int, reply: Reply, sent: str, result: StepResultLike, call: int = 0
+) -> dict[str, Any]:
+    """One step. Of a reply with several actions, the first step holds the reply, its usage,
+    reasoning and every tool call it made (executed or not), later ones an empty reply and no
+    usage (nothing is counted twice); each step of a tool-calling reply gives its call's index."""
+    first = call == 0
     rec: dict[str, Any] = {
         "turn": turn,
-        "reply": reply.text,
+        "reply": reply.text if first else "",
         "sent": sent,
         "action": result.action.to_text() if result.action is not None else None,
         "legal": result.legal,
         "error": result.error,
         "feedback": result.feedback,
-        "usage": reply.usage.to_json(),
+        "usage": (reply.usage if first else Usage()).to_json(),
     }
-    if reply.note:
+    if reply.calls:
+        rec["call"] = call
+        if first:
+            rec["calls"] = [c.to_json() for c in reply.calls]
+    if reply.note and first:
         rec["note"] = reply.note
-    if reply.reasoning:
+    if reply.reasoning and first:
         rec["reasoning"] = reply.reasoning
     return rec
 
@@ -188,7 +201,7 @@ def describe_error(exc: BaseException) -> str:
     message = " ".join(str(exc).split())
     if len(message) > MAX_ERROR_CHARS:
         message = message[: MAX_ERROR_CHARS - 3] + "..."
-    if type(exc) is AgentError:
+    if isinstance(exc, AgentError):
         return message
     return f"{type(exc).__name__}: {message}" if message else type(exc).__name__
 
@@ -251,6 +264,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
             judge = make_judge(proto.judge, proto.judge_options)
             judge.start(seed)
             note: str | None = None
+            previous: Reply | None = None
+            results: tuple[StepResultLike, ...] = ()
             turn = 0
             while not (state.is_success() or state.is_truncated()):
                 if turn >= state.max_steps:
@@ -267,6 +282,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                             task.sample,
                             c,
                             note,
+                            previous,
+                            results,
                         )
                     )
                     for c in range(proto.candidates)
@@ -284,6 +301,7 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                         {
                             "reply": c.reply.text,
                             "action": c.reply.action,
+                            **({"actions": list(c.reply.actions)} if c.reply.actions else {}),
                             "legal": c.legal,
                             "error": c.result.error if c.result else None,
                             "usage": c.reply.usage.to_json(),
@@ -291,17 +309,26 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                         }
                         for c in checked
                     ]
-                sent = chosen.action if chosen.action is not None else ""
-                result = state.step_text(sent)
-                rec = _step_record(turn, chosen, sent, result)
-                rec["images"] = shown
-                if cands:
-                    rec["candidates"] = cands
-                    rec["usage"] = sum((r.usage for r in replies), Usage()).to_json()
-                    if judge.usage != spent:
-                        rec["judge_usage"] = _spent(judge.usage, spent).to_json()
-                steps.append(rec)
+                todo = chosen.actions or (chosen.action if chosen.action is not None else "",)
+                done: list[StepResultLike] = []
+                for i, sent in enumerate(todo):
+                    if i and (state.finished or state.is_success() or state.is_truncated()):
+                        break
+                    result = state.step_text(sent)
+                    done.append(result)
+                    rec = _step_record(turn, chosen, sent, result, i)
+                    if i == 0:
+                        rec["images"] = shown
+                        if cands:
+                            rec["candidates"] = cands
+                            rec["usage"] = sum((r.usage for r in replies), Usage()).to_json()
+                            if judge.usage != spent:
+                                rec["judge_usage"] = _spent(judge.usage, spent).to_json()
+                    steps.append(rec)
+                    if not result.legal:
+                        break  # the actions after a rejected one are not taken
                 note = chosen.note if chosen.action is None else None
+                previous, results = chosen, tuple(done)
                 turn += 1
                 if state.finished:
                     finished = True
@@ -323,6 +350,8 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
                 "usage": plan.usage.to_json(),
                 "images": shown,
             }
+            if plan.calls:
+                record["plan"]["calls"] = [c.to_json() for c in plan.calls]
             for i, text in enumerate(plan.actions):
                 if state.is_success() or state.is_truncated():
                     break
@@ -338,6 +367,9 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
     finally:
         if agent is not None:
             try:
+                notes = agent.notes()
+                if notes:
+                    record["agent_notes"] = notes
                 agent.close()
             except Exception as e:
                 if status == "done":

@@ -60,22 +60,31 @@ class Usage:
 
     @staticmethod
     def from_openai(obj: Mapping[str, Any] | None) -> Usage:
-        """Read an OpenAI-style ``usage`` block (missing fields count as zero)."""
+        """Read an OpenAI-style ``usage`` block (missing fields count as zero). Reasoning and
+        cached tokens come from ``completion_tokens_details``/``prompt_tokens_details``, or from
+        the ``output_``/``input_tokens_details`` some servers write, or from a bare top-level
+        ``reasoning_tokens``/``cached_tokens``."""
         if not isinstance(obj, Mapping):
             return Usage(calls=1)
-        out_details = obj.get("completion_tokens_details") or {}
-        in_details = obj.get("prompt_tokens_details") or {}
         return Usage(
             input_tokens=_count(obj.get("prompt_tokens")),
             output_tokens=_count(obj.get("completion_tokens")),
-            reasoning_tokens=_count(
-                out_details.get("reasoning_tokens") if isinstance(out_details, Mapping) else 0
+            reasoning_tokens=_detail(
+                obj, ("completion_tokens_details", "output_tokens_details"), "reasoning_tokens"
             ),
-            cached_tokens=_count(
-                in_details.get("cached_tokens") if isinstance(in_details, Mapping) else 0
+            cached_tokens=_detail(
+                obj, ("prompt_tokens_details", "input_tokens_details"), "cached_tokens"
             ),
             calls=1,
         )
+
+
+def _detail(obj: Mapping[str, Any], blocks: tuple[str, ...], key: str) -> int:
+    for block in blocks:
+        details = obj.get(block)
+        if isinstance(details, Mapping) and key in details:
+            return _count(details[key])
+    return _count(obj.get(key))
 
 
 def _count(value: Any) -> int:

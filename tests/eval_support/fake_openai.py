@@ -1,9 +1,15 @@
 """A local OpenAI-compatible chat-completions server for the tests (127.0.0.1, ephemeral port).
 
 It checks every request's shape (model, system + user messages, base64 PNG images, the sampling
-parameters, the bearer key) and answers from a script: each entry is a reply text, or a fault
-(``timeout``, ``500``, ``429`` with Retry-After, ``malformed`` JSON, ``cutoff``). When the script
-runs out it answers ``<action>finish</action>``.
+parameters, the bearer key) and answers from a script: each entry is a reply text, native tool
+calls (:func:`calls`), or a fault (``timeout``, ``500``, ``429`` with Retry-After, ``malformed``
+JSON, ``cutoff``). When the script runs out it answers ``<action>finish</action>``.
+
+Tool calling: an answer's calls get ids ``call_<request>_<i>``. The next request must answer
+them (unless its entry says ``new_episode``): the previous observation, the assistant message
+with exactly those calls, then one ``tool`` message per id, in order; anything else is a problem
+(HTTP 400). With ``refuse_tools`` every request offering tools is refused as vLLM does without
+``--enable-auto-tool-choice`` (HTTP 400, not a problem).
 """
 
 from __future__ import annotations
@@ -24,15 +30,80 @@ class Script:
     requests: list[dict[str, Any]] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
     expect_key: str | None = None
+    refuse_tools: bool = False
+    #: the calls of the last answer (id, name, arguments), which the next request must answer
+    pending: list[tuple[str, str, str]] = field(default_factory=list)
     lock: threading.Lock = field(default_factory=threading.Lock)
 
     def next(self) -> dict[str, Any]:
         with self.lock:
             return self.entries.pop(0) if self.entries else {"reply": "<action>finish</action>"}
 
+    def peek(self) -> dict[str, Any]:
+        with self.lock:
+            return self.entries[0] if self.entries else {}
+
 
 def reply(text: str, prompt: int = 100, completion: int = 20, **extra: Any) -> dict[str, Any]:
     return {"reply": text, "usage": (prompt, completion), **extra}
+
+
+def calls(
+    *made: tuple[str, Any], text: str = "", prompt: int = 100, completion: int = 20, **extra: Any
+) -> dict[str, Any]:
+    """An answer made of tool calls ``(name, arguments)``: arguments as an object (sent as JSON
+    text, as OpenAI does) or as raw text (sent as is)."""
+    return {"reply": text, "usage": (prompt, completion), "tool_calls": list(made), **extra}
+
+
+REFUSAL = '"auto" tool choice requires --enable-auto-tool-choice and --tool-call-parser to be set'
+
+
+def _check_tool_history(middle: list[Any], script: Script, fresh: bool) -> str | None:
+    """The messages between the system prompt and the new observation answer the last calls."""
+    pending = script.pending
+    if not middle:
+        missing = pending and not fresh
+        return "the tool results of the last answer did not come back" if missing else None
+    if not pending:
+        return "tool history sent, but the last answer made no tool calls"
+    if len(middle) != 2 + len(pending):
+        return f"expected user, assistant and {len(pending)} tool messages before the new turn"
+    before, assistant, *results = middle
+    if before.get("role") != "user" or not isinstance(before.get("content"), str):
+        return "the previous observation must come back as a user text message"
+    if assistant.get("role") != "assistant":
+        return "the calls must come back in an assistant message"
+    echoed = [
+        (c.get("id"), c.get("function", {}).get("name"), c.get("function", {}).get("arguments"))
+        for c in assistant.get("tool_calls") or []
+        if isinstance(c, dict) and c.get("type") == "function"
+    ]
+    if echoed != pending:
+        return f"assistant tool_calls {echoed} are not the calls made {pending}"
+    ids = [m.get("tool_call_id") for m in results if m.get("role") == "tool"]
+    if ids != [p[0] for p in pending]:
+        return f"tool results for {ids}, expected {[p[0] for p in pending]}"
+    if not all(isinstance(m.get("content"), str) and m["content"] for m in results):
+        return "a tool result has no text"
+    return None
+
+
+def _check_tools(tools: Any) -> str | None:
+    if tools is None:
+        return None
+    if not isinstance(tools, list) or not tools:
+        return "tools must be a non-empty list"
+    names = []
+    for t in tools:
+        fn = t.get("function") if isinstance(t, dict) else None
+        if t.get("type") != "function" or not isinstance(fn, dict):
+            return "every tool must be a function"
+        params = fn.get("parameters")
+        if not isinstance(params, dict) or params.get("type") != "object":
+            return f"tool {fn.get('name')}: parameters must be a JSON schema object"
+        names.append(fn.get("name"))
+    return "duplicate tool names" if len(set(names)) != len(names) else None
 
 
 def _check_shape(body: Any, headers: Any, script: Script) -> str | None:
@@ -41,11 +112,17 @@ def _check_shape(body: Any, headers: Any, script: Script) -> str | None:
     if not isinstance(body.get("model"), str):
         return "no model"
     msgs = body.get("messages")
-    if not (isinstance(msgs, list) and len(msgs) == 2):
+    if not (isinstance(msgs, list) and len(msgs) >= 2):
         return "expected system + user messages"
-    if msgs[0].get("role") != "system" or msgs[1].get("role") != "user":
-        return "roles must be system, user"
-    content = msgs[1].get("content")
+    if msgs[0].get("role") != "system" or msgs[-1].get("role") != "user":
+        return "roles must be system, (tool history,) user"
+    problem = _check_tools(body.get("tools"))
+    problem = problem or _check_tool_history(
+        msgs[1:-1], script, bool(script.peek().get("new_episode"))
+    )
+    if problem:
+        return problem
+    content = msgs[-1].get("content")
     if not isinstance(content, list) or content[0].get("type") != "text":
         return "user content must be parts starting with text"
     for part in content:
@@ -91,9 +168,13 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
             problem = _check_shape(body, self.headers, script)
             with script.lock:
                 script.requests.append({"body": body, "headers": dict(self.headers)})
+                number = len(script.requests)
             if problem:
                 script.problems.append(problem)
                 self._send(400, json.dumps({"error": {"message": problem}}).encode())
+                return
+            if script.refuse_tools and "tools" in body:
+                self._send(400, json.dumps({"error": {"message": REFUSAL}}).encode())
                 return
             entry = script.next()
             fault = entry.get("fault")
@@ -128,17 +209,20 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
                 return
             text = entry.get("reply", "")
             prompt, completion = entry.get("usage", (100, 20))
-            message: dict[str, Any] = {"role": "assistant", "content": text}
-            if "tool_action" in entry:
+            message: dict[str, Any] = {"role": "assistant", "content": text or None}
+            made = [
+                (
+                    f"call_{number}_{i}",
+                    name,
+                    args if isinstance(args, str) else json.dumps(args),
+                )
+                for i, (name, args) in enumerate(entry.get("tool_calls", []))
+            ]
+            script.pending = made
+            if made:
                 message["tool_calls"] = [
-                    {
-                        "id": "call_1",
-                        "type": "function",
-                        "function": {
-                            "name": "act",
-                            "arguments": json.dumps({"action": entry["tool_action"]}),
-                        },
-                    }
+                    {"id": cid, "type": "function", "function": {"name": name, "arguments": a}}
+                    for cid, name, a in made
                 ]
             answer = {
                 "id": "x",

@@ -6,6 +6,12 @@ evaluates a model on any OpenAI-compatible server (the key comes from ``$OPENAI_
 variable named by ``--api-key-env``; it is never logged). Each (agent, protocol) pair writes one
 run directory under ``--out``; ``--resume`` continues killed runs there.
 
+Tools: a model is offered one function per action kind and plays by calling them (``--tools``,
+i.e. ``on``); by default (``auto``) a server that refuses tools is played in text instead, said
+once per run. ``--model-option KEY=VALUE`` passes a field through to the server's request body
+(``reasoning_effort=high``, ``max_tokens=4096``, ``temperature=null`` to drop one,
+``extra_body='{"top_k": 20}'`` merged in).
+
 Exit status: 0 when every episode was played; 1 when some episode errored (agent or environment
 fault, server down after every retry; said above the leaderboard), unless ``--allow-errors``;
 2 for a usage error or refused credentials (HTTP 401/403, or no key for a remote server), which
@@ -55,6 +61,23 @@ def register(sub: Any) -> None:
         metavar="KEY=VALUE",
         help="agent option (VALUE read as JSON when it parses), repeatable",
     )
+    p.add_argument(
+        "--tools",
+        nargs="?",
+        const="on",
+        choices=("auto", "on", "off"),
+        default=None,
+        help="native tool calls for the openai agent: on (the flag alone), off, or auto (the"
+        " default: tools, or text when the server refuses them)",
+    )
+    p.add_argument(
+        "--model-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="request body field for the model server (VALUE read as JSON when it parses), e.g."
+        " reasoning_effort=high or extra_body='{\"top_k\": 20}', repeatable",
+    )
     p.add_argument("--protocol", choices=("interactive", "oneshot", "both"), default="interactive")
     p.add_argument("--samples", type=int, default=1, help="episodes per level (Pass@k, Avg@k)")
     p.add_argument("--candidates", type=int, default=1, help="candidates per turn (verifier)")
@@ -93,10 +116,9 @@ def register(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _option(text: str) -> tuple[str, Any]:
-
+def _option(text: str, flag: str = "--agent-option") -> tuple[str, Any]:
     if "=" not in text:
-        raise CommandError(f"--agent-option {text!r}: expected KEY=VALUE")
+        raise CommandError(f"{flag} {text!r}: expected KEY=VALUE")
     key, value = text.split("=", 1)
     try:
         return key.strip(), json.loads(value)
@@ -104,14 +126,33 @@ def _option(text: str) -> tuple[str, Any]:
         return key.strip(), value
 
 
+#: Options only a model agent takes; the built-in baselines are run without them.
+MODEL_ONLY = ("model", "base_url", "api_key_env", "tools", "model_options")
+
+
 def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "-", text).strip("-") or "agent"
+
+
+def _say_tool_fallback(run: str, records: list[dict[str, Any]]) -> None:
+    """One line per run whose server refused native tools (its episodes were played in text)."""
+    refused = [
+        str(r["agent_notes"]["tools_refused"])
+        for r in records
+        if isinstance(r.get("agent_notes"), dict) and r["agent_notes"].get("tools_refused")
+    ]
+    if refused:
+        print(
+            f"NOTE: {run}: the server refused tools ({refused[0]}); {len(refused)} episode(s)"
+            " played with text actions instead"
+        )
 
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.level import load_level, load_levels
     from chaingeo.core.suite import shipped_levels
     from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
+    from chaingeo.evaluation.agents.openai_chat import provider_fields
     from chaingeo.evaluation.agents.registry import BASELINES
     from chaingeo.evaluation.episode import ProtocolConfig
     from chaingeo.evaluation.logs import RunLog
@@ -145,6 +186,16 @@ def run(args: argparse.Namespace) -> int:
         options["api_key_env"] = args.api_key_env
     if args.label:
         options["label"] = args.label
+    if args.tools:
+        options["tools"] = args.tools
+    if args.model_option:
+        model_options = dict(options.get("model_options") or {})
+        model_options.update(_option(o, "--model-option") for o in args.model_option)
+        try:
+            provider_fields(model_options)
+        except ValueError as e:
+            raise CommandError(f"--model-option: {e}") from None
+        options["model_options"] = model_options
     protocols = ["interactive", "oneshot"] if args.protocol == "both" else [args.protocol]
     if args.out is None:
         if args.resume:
@@ -168,7 +219,7 @@ def run(args: argparse.Namespace) -> int:
         opts = (
             options
             if name not in BASELINES
-            else {k: v for k, v in options.items() if k not in ("model", "base_url", "api_key_env")}
+            else {k: v for k, v in options.items() if k not in MODEL_ONLY}
         )
         spec = AgentSpec(name, opts)
         for proto_name in protocols:
@@ -190,9 +241,9 @@ def run(args: argparse.Namespace) -> int:
             except AuthenticationError as e:
                 raise CommandError(f"{spec.label}: authentication failed: {e}") from None
             runs.append(load_run(run_dir))
-            errored[run_dir.name] = sum(
-                r.get("status") == "error" for r in RunLog(run_dir).latest().values()
-            )
+            records = list(RunLog(run_dir).latest().values())
+            errored[run_dir.name] = sum(r.get("status") == "error" for r in records)
+            _say_tool_fallback(run_dir.name, records)
     total = sum(errored.values())
     if total:
         where = ", ".join(f"{name}: {n}" for name, n in errored.items() if n)

@@ -5,7 +5,10 @@ The harness (``chaingeo.evaluation.runner``) owns the game state; an agent only 
 clone of the state they may explore freely). An agent returns a :class:`Reply`: the raw text it
 produced, the action text it means (``None`` when none could be read: the harness then counts an
 unparseable step, it never crashes), and the tokens it used. In the one-shot protocol it returns
-its whole plan as ``actions``.
+its whole plan as ``actions``. An interactive reply may carry several actions too (a model's
+native tool calls, in ``calls``): the harness executes them in order, each a step, stopping at the
+first one rejected, and hands the next turn that reply (``previous``) with the result of every
+call it executed (``results``), so the agent can answer each call.
 
 Agents are built from an :class:`AgentSpec` (name + options) by the registry in
 :mod:`chaingeo.evaluation.agents.registry`, so a worker process or a Dask worker can build its
@@ -85,16 +88,40 @@ class Turn:
     sample: int  # which of the K samples of this level
     candidate: int = 0  # which candidate of this turn (verifier-based selection)
     last_feedback: str | None = None
+    previous: Reply | None = None  # the reply the last turn committed
+    results: tuple[StepResultLike, ...] = ()  # what each of its executed actions did, in order
+
+
+@dataclass(frozen=True)
+class ToolCall:
+    """One native tool (function) call of a model, as its server sent it, and the action text
+    it was translated to."""
+
+    id: str
+    name: str
+    arguments: str  # the JSON text of the arguments, as sent
+    action: str
+
+    def to_json(self) -> dict[str, str]:
+        return {
+            "id": self.id,
+            "name": self.name,
+            "arguments": self.arguments,
+            "action": self.action,
+        }
 
 
 @dataclass(frozen=True)
 class Reply:
     text: str  # the raw reply, logged as is (no images, no secrets)
-    action: str | None  # the action text read from it; None: nothing readable
+    action: str | None  # the action text read from it (the first, with several); None: nothing
     usage: Usage = field(default_factory=Usage)
-    actions: tuple[str, ...] = ()  # one-shot: the whole plan, in order
+    #: one-shot: the whole plan, in order; interactive: several actions to take in order (the
+    #: first is ``action``), each a step, stopping at the first one rejected
+    actions: tuple[str, ...] = ()
     note: str | None = None  # why no action could be read, shown to the agent as feedback
     reasoning: str | None = None  # a model's separate reasoning text, logged when present
+    calls: tuple[ToolCall, ...] = ()  # native tool calls, one per action, in order
 
 
 class AgentError(RuntimeError):
@@ -159,3 +186,8 @@ class Agent:
 
     def close(self) -> None:
         """Release processes or connections."""
+
+    def notes(self) -> dict[str, Any]:
+        """Facts about how this episode was played that belong in its record (e.g. whether a
+        model server took native tool calls); empty by default."""
+        return {}

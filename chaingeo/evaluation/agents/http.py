@@ -114,6 +114,16 @@ def parse_retry_after(value: str | None, now: float | None = None) -> float | No
     return max(0.0, when.timestamp() - (time.time() if now is None else now))
 
 
+class RequestRejected(AgentError):
+    """The server refused the request itself (a 4xx other than 401/403/429): retrying the same
+    body cannot help; ``status`` and ``detail`` (its error message) let a caller change it."""
+
+    def __init__(self, url: str, status: int, detail: str) -> None:
+        super().__init__(f"{url}: HTTP {status} {detail}")
+        self.status = status
+        self.detail = detail
+
+
 class ChatClient:
     def __init__(
         self,
@@ -164,7 +174,7 @@ class ChatClient:
                 raise AuthenticationError(
                     f"{self.url}: HTTP {e.code} {detail} (check the API key and --api-key-env)"
                 ) from None
-            raise AgentError(f"{self.url}: HTTP {e.code} {detail}") from None
+            raise RequestRejected(self.url, e.code, detail) from None
         except TimeoutError as e:
             raise TransientError(f"timeout after {self.timeout}s ({e})") from None
         except urllib.error.URLError as e:

@@ -27,6 +27,21 @@ ONESHOT_PROMPT: Final = (
     "plan, one action per line, between <plan> and </plan> at the end of your reply."
 )
 
+TOOLS_PROMPT: Final = (
+    "You are playing a 3D physical reasoning game made of voxel pieces. Each turn you see the "
+    "task, the pieces by colour, recent history and rendered views with labelled axes; "
+    "coordinates are 1-based. Act by calling the tools: each call is one action and costs one "
+    "step. You may make several calls in one reply: they run in order and stop at the first one "
+    "that is rejected, and each call's result comes back to you. (Without tools, give exactly "
+    "one action as <action>ACTION</action> at the end of your reply.)"
+)
+ONESHOT_TOOLS_PROMPT: Final = (
+    "You are solving a 3D physical reasoning game made of voxel pieces from a single view; "
+    "coordinates are 1-based. You will not see the result of any action: give your complete "
+    "plan in this one reply by calling the tools once per action, in order. (Without tools, "
+    "write the plan, one action per line, between <plan> and </plan>.)"
+)
+
 _ACTION_RE: Final = re.compile(r"<action>(.*?)</action>", re.IGNORECASE | re.DOTALL)
 _OPEN_RE: Final = re.compile(r"<action>", re.IGNORECASE)
 _PLAN_RE: Final = re.compile(r"<plan>(.*?)</plan>", re.IGNORECASE | re.DOTALL)
