@@ -80,10 +80,10 @@ class StackingRules:
 
     def tag(self, rejection: Rejection) -> Rejection:
         """The rejection as the agent reads it: under the ``chain`` profile the reason starts
-        with CHAIN's error name (``Collision: collision with red at ...``)."""
+        with CHAIN's error name (``[Collision] collision with red at ...``)."""
         if self.profile != "chain" or rejection.code is None:
             return rejection
-        return Rejection(f"{rejection.code}: {rejection.reason}", rejection.code)
+        return Rejection(f"[{rejection.code}] {rejection.reason}", rejection.code)
 
 
 @dataclass(frozen=True)
