@@ -335,3 +335,25 @@ def test_a_model_answering_in_chain_json_solves_a_converted_level(tmp_path: Path
     assert rec["steps"][1]["error"] == "illegal" and "[Floating]" in rec["steps"][1]["feedback"]
     # The model saw the state action's answer in its next observation.
     assert "In the tray" in json.dumps(script.requests[1])
+
+
+def test_gym_env_on_a_chain_level_reports_codes_and_state() -> None:
+    import warnings
+
+    from gymnasium.utils.env_checker import check_env
+
+    from chaingeo.envs.gym import StackingEnv
+
+    level = import_chain_file(DATA / TRAY, None, None, "chain")
+    env = StackingEnv([level], images=False, text_state=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warnings.filterwarnings("ignore", message=".*environment not having a spec.*")
+        check_env(env, skip_render_check=True)
+    env.reset(options={"level": level.id})
+    _, _, terminated, _, info = env.step(call("state"))
+    assert info["legal"] and info["code"] is None and info["steps_used"] == 1
+    assert "In the tray" in info["feedback"] and not terminated
+    floating = call("place", piece_id="1", cells=[[1, 1, 2], [2, 1, 2], [1, 2, 2], [1, 1, 3]])
+    info = env.step(floating)[4]
+    assert info["error"] == "illegal" and info["code"] == "Floating"

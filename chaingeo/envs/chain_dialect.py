@@ -136,12 +136,6 @@ def _int(literal: str) -> int:
     return int(literal)
 
 
-def _float(literal: str) -> float:
-    if len(literal) > 2 * limits.MAX_AGENT_DIGITS + 8:
-        raise _TooBig
-    return float(literal)
-
-
 def _constant(name: str) -> Any:
     raise _Bad(f"{name} is not a number")
 
@@ -151,7 +145,7 @@ def _loads(body: str) -> Any:
     if depth > limits.MAX_JSON_DEPTH:
         raise _Bad(f"JSON nested {depth} deep")
     try:
-        return json.loads(body, parse_int=_int, parse_float=_float, parse_constant=_constant)
+        return json.loads(body, parse_int=_int, parse_constant=_constant)
     except json.JSONDecodeError as e:
         raise _Bad(f"not valid JSON ({e.msg} at character {e.pos + 1})") from None
     except (RecursionError, ValueError) as e:  # defensive: json's own limits
