@@ -74,7 +74,11 @@ def test_validate_and_convert(tmp_path: Path, capsys: pytest.CaptureFixture[str]
         == 0
     )
     imported = load_level(back)
-    assert imported.pieces == level.pieces and imported.solution == level.solution
+    assert [(p.name, p.rgb, p.shape) for p in imported.pieces] == [
+        (p.name, p.rgb, p.shape) for p in level.pieces
+    ]
+    assert [p.chain_id for p in imported.pieces] == [str(i) for i in range(len(level.pieces))]
+    assert imported.solution == level.solution
 
 
 def test_bad_file_is_one_line_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

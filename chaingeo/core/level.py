@@ -27,7 +27,15 @@ from chaingeo.core.kinematics import (
     disassembly_of_assembly_plan,
     replay_disassembly,
 )
-from chaingeo.core.rules import SUPPORT_RULES, PuzzleRules, StackingRules, placement_order_problem
+from chaingeo.core.level_reader import LevelError as LevelError  # re-exported
+from chaingeo.core.level_reader import Reader, only_keys, short
+from chaingeo.core.rules import (
+    STACKING_PROFILES,
+    SUPPORT_RULES,
+    PuzzleRules,
+    StackingRules,
+    placement_order_problem,
+)
 
 FORMAT: Final = "chain-level/1"
 FAMILIES: Final = ("stacking", "puzzle")
@@ -36,20 +44,12 @@ GOALS: Final = {"stacking": ("pack",), "puzzle": ("disassemble", "assemble")}
 _NAME_RE: Final = re.compile(r"^[a-z][a-z0-9_-]{0,31}$")
 _ID_RE: Final = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,127}$")
 _HEX_RE: Final = re.compile(r"^#[0-9a-f]{6}$")
+#: CHAIN's piece ids: the piece's index in CHAIN's level file, in decimal.
+_CHAIN_ID_RE: Final = re.compile(r"^(?:0|[1-9][0-9]{0,5})$")
 
 Family = Literal["stacking", "puzzle"]
 Difficulty = Literal["easy", "mid", "hard"]
 Goal = Literal["pack", "disassemble", "assemble"]
-
-
-class LevelError(ValueError):
-    """A level that cannot be loaded or is not valid: which file, which field, and why."""
-
-    def __init__(self, source: str, field: str, reason: str) -> None:
-        super().__init__(f"{source}: {field}: {reason}")
-        self.source = source
-        self.field = field
-        self.reason = reason
 
 
 @dataclass(frozen=True)
@@ -57,6 +57,9 @@ class Piece:
     name: str
     rgb: str
     shape: Shape  # stacking: as handed to the agent; puzzle: assembled position
+    #: CHAIN's id of the piece (its index in CHAIN's level file, ``"0"``, ``"1"``, ...) when
+    #: the level came from CHAIN: agents may name the piece by it. All pieces or none have one.
+    chain_id: str | None = None
 
 
 @dataclass(frozen=True)
@@ -123,10 +126,7 @@ class Level:
             "difficulty": self.difficulty,
             "goal": self.goal,
             "box": list(self.box) if self.box is not None else None,
-            "pieces": [
-                {"name": p.name, "rgb": p.rgb, "voxels": [list(c) for c in p.shape.cells]}
-                for p in self.pieces
-            ],
+            "pieces": [_piece_json(p) for p in self.pieces],
             "solution": sol,
             "optimal_steps": self.optimal_steps,
             "max_steps": self.max_steps,
@@ -140,6 +140,13 @@ class Level:
             },
             "stats": dict(self.stats),
         }
+
+
+def _piece_json(p: Piece) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": p.name, "rgb": p.rgb, "voxels": [list(c) for c in p.shape.cells]}
+    if p.chain_id is not None:
+        out["chain_id"] = p.chain_id
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -178,89 +185,9 @@ def default_step_budget(optimal_steps: int) -> int:
 # ---------------------------------------------------------------------------------------------
 
 
-class _Reader:
-    """Typed field access that turns every problem into a LevelError for one source."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, fld: str, reason: str) -> LevelError:
-        return LevelError(self.source, fld, reason)
-
-    def get(self, obj: Mapping[str, Any], key: str, fld: str) -> Any:
-        if key not in obj:
-            raise self.fail(fld, "missing field")
-        return obj[key]
-
-    def obj(self, value: Any, fld: str) -> Mapping[str, Any]:
-        if not isinstance(value, dict):
-            raise self.fail(fld, f"expected an object, got {_kind(value)}")
-        return value
-
-    def lst(self, value: Any, fld: str) -> list[Any]:
-        if not isinstance(value, list):
-            raise self.fail(fld, f"expected a list, got {_kind(value)}")
-        return value
-
-    def string(self, value: Any, fld: str, choices: Sequence[str] | None = None) -> str:
-        if not isinstance(value, str):
-            raise self.fail(fld, f"expected a string, got {_kind(value)}")
-        if choices is not None and value not in choices:
-            raise self.fail(fld, f"{value!r} is not one of {list(choices)}")
-        return value
-
-    def integer(
-        self, value: Any, fld: str, minimum: int | None = None, maximum: int | None = None
-    ) -> int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise self.fail(fld, f"expected an integer, got {_kind(value)}")
-        if minimum is not None and value < minimum:
-            raise self.fail(fld, f"must be >= {minimum}, got {value}")
-        if maximum is not None and value > maximum:
-            raise self.fail(fld, f"must be <= {maximum}, got {value}")
-        return value
-
-    def coord(self, value: Any, fld: str) -> int:
-        return self.integer(value, fld, -limits.MAX_COORD, limits.MAX_COORD)
-
-    def opt_integer(self, value: Any, fld: str) -> int | None:
-        return None if value is None else self.integer(value, fld)
-
-    def voxels(self, value: Any, fld: str) -> Shape:
-        cells = self.lst(value, fld)
-        if not cells:
-            raise self.fail(fld, "a piece needs at least one voxel")
-        if len(cells) > limits.MAX_PIECE_VOXELS:
-            raise self.fail(
-                fld, f"{len(cells)} voxels; a piece has at most {limits.MAX_PIECE_VOXELS}"
-            )
-        out: list[tuple[int, int, int]] = []
-        seen: set[tuple[int, int, int]] = set()
-        for i, c in enumerate(cells):
-            f = f"{fld}[{i}]"
-            if not (isinstance(c, list) and len(c) == 3):
-                raise self.fail(f, f"a voxel is a list of three integers, got {_short(c)}")
-            cell = (self.coord(c[0], f), self.coord(c[1], f), self.coord(c[2], f))
-            if cell in seen:
-                raise self.fail(fld, f"voxel {list(cell)} is listed twice")
-            seen.add(cell)
-            out.append(cell)
-        return Shape(out)
-
-
-def _kind(value: Any) -> str:
-    return "null" if value is None else type(value).__name__
-
-
-def _short(value: Any) -> str:
-    """``repr`` cut to a line, so an error message never echoes a huge value."""
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
-
-
 def parse_level(data: Any, source: str = "<level>") -> Level:
     """Validate a decoded JSON value and build the level; :class:`LevelError` if anything is off."""
-    r = _Reader(source)
+    r = Reader(source)
     top = r.obj(data, "(top level)")
     fmt = r.string(r.get(top, "format", "format"), "format")
     if fmt != FORMAT:
@@ -291,11 +218,17 @@ def parse_level(data: Any, source: str = "<level>") -> Level:
     rules_obj = r.obj(r.get(top, "rules", "rules"), "rules")
     rules: StackingRules | PuzzleRules
     if family == "stacking":
-        _only_keys(r, rules_obj, {"support"}, "rules")
+        only_keys(r, rules_obj, {"support", "profile"}, "rules")
         support = r.string(rules_obj.get("support", "contact"), "rules.support", SUPPORT_RULES)
-        rules = StackingRules(support=support)  # type: ignore[arg-type]
+        if "profile" in rules_obj:  # written only when not the default
+            profile = r.string(rules_obj["profile"], "rules.profile", STACKING_PROFILES[1:])
+        else:
+            profile = "default"
+        if profile == "chain" and support != "contact":
+            raise r.fail("rules.support", "the chain profile has contact support only")
+        rules = StackingRules(support=support, profile=profile)  # type: ignore[arg-type]
     else:
-        _only_keys(r, rules_obj, {"max_group"}, "rules")
+        only_keys(r, rules_obj, {"max_group"}, "rules")
         mg = rules_obj.get("max_group")
         rules = PuzzleRules(
             max_group=None if mg is None else r.integer(mg, "rules.max_group", 1, limits.MAX_PIECES)
@@ -358,14 +291,8 @@ def parse_level(data: Any, source: str = "<level>") -> Level:
     )
 
 
-def _only_keys(r: _Reader, obj: Mapping[str, Any], allowed: set[str], fld: str) -> None:
-    extra = sorted(set(obj) - allowed)
-    if extra:
-        raise r.fail(f"{fld}.{extra[0]}", f"unknown rule; known: {sorted(allowed)}")
-
-
 def _parse_pieces(
-    r: _Reader, raw: Any, box: tuple[int, int, int] | None, family: str
+    r: Reader, raw: Any, box: tuple[int, int, int] | None, family: str
 ) -> list[Piece]:
     items = r.lst(raw, "pieces")
     if not items:
@@ -390,6 +317,12 @@ def _parse_pieces(
         if rgb in seen_rgb:
             raise r.fail(f"{f}.rgb", f"duplicate colour {rgb} (also {seen_rgb[rgb]})")
         shape = r.voxels(r.get(obj, "voxels", f"{f}.voxels"), f"{f}.voxels")
+        only_keys(r, obj, {"name", "rgb", "voxels", "chain_id"}, f, "field")
+        chain_id = None
+        if "chain_id" in obj:
+            chain_id = r.string(obj["chain_id"], f"{f}.chain_id")
+            if not _CHAIN_ID_RE.match(chain_id):
+                raise r.fail(f"{f}.chain_id", f"{short(chain_id)} is not a piece index")
         total += len(shape)
         if total > limits.MAX_LEVEL_VOXELS:
             raise r.fail(f"{f}.voxels", f"a level has at most {limits.MAX_LEVEL_VOXELS} voxels")
@@ -397,7 +330,14 @@ def _parse_pieces(
             raise r.fail(f"{f}.voxels", f"piece {name} is not face-connected")
         seen_names.add(name)
         seen_rgb[rgb] = name
-        pieces.append(Piece(name, rgb, shape))
+        pieces.append(Piece(name, rgb, shape, chain_id))
+    ids = [p.chain_id for p in pieces]
+    if any(i is not None for i in ids):
+        if None in ids:
+            raise r.fail("pieces", "every piece or none has a chain_id")
+        dup = sorted({i for i in ids if i is not None and ids.count(i) > 1})
+        if dup:
+            raise r.fail("pieces", f"duplicate chain_id {dup[0]!r}")
     if family == "stacking":
         assert box is not None
         total = sum(len(p.shape) for p in pieces)
@@ -414,7 +354,7 @@ def _parse_pieces(
 
 
 def _parse_stacking_solution(
-    r: _Reader,
+    r: Reader,
     sol: Mapping[str, Any],
     pieces: Sequence[Piece],
     box: tuple[int, int, int],
@@ -458,7 +398,7 @@ def _parse_stacking_solution(
 
 
 def _parse_puzzle_solution(
-    r: _Reader, sol: Mapping[str, Any], pieces: Sequence[Piece], goal: str, rules: PuzzleRules
+    r: Reader, sol: Mapping[str, Any], pieces: Sequence[Piece], goal: str, rules: PuzzleRules
 ) -> PuzzleSolution:
     raw_moves = r.lst(r.get(sol, "moves", "solution.moves"), "solution.moves")
     if len(raw_moves) > limits.MAX_STEPS:
@@ -566,12 +506,15 @@ def stacking_level(
     index: int | None = None,
     stats: Mapping[str, Any] | None = None,
     max_steps: int | None = None,
+    chain_ids: Sequence[str] | None = None,
 ) -> Level:
     """Build and verify a stacking level from a packing (pieces in placement order).
 
     Pieces get palette colours in order; ``handed`` gives the orientation each piece is shown
-    in (default: its normalised placement). ``optimal_steps`` is the number of pieces: each
-    must be placed at least once and a legal order is found and stored, so that many suffice.
+    in (default: its normalised placement); ``chain_ids`` CHAIN's id of each piece. The
+    ``optimal_steps`` is the number of pieces under either rules profile: each piece must be
+    placed at least once, and a legal order (the placement checks of both profiles are the
+    same) is found and stored, so that many suffice.
     """
     from chaingeo.core.colors import assign_colors
     from chaingeo.core.rules import find_placing_order
@@ -591,7 +534,10 @@ def stacking_level(
         difficulty=difficulty,
         goal="pack",
         box=dims,
-        pieces=tuple(Piece(c.name, c.hex, s) for c, s in zip(colors, shapes, strict=True)),
+        pieces=tuple(
+            Piece(c.name, c.hex, s, None if chain_ids is None else chain_ids[i])
+            for i, (c, s) in enumerate(zip(colors, shapes, strict=True))
+        ),
         solution=StackingSolution(placements=by_name, order=tuple(order)),
         optimal_steps=len(placements),
         max_steps=max_steps if max_steps is not None else default_step_budget(len(placements)),

@@ -1,9 +1,14 @@
 """Reading agent text: the tokenizer and grammar behind :func:`parse_action`.
 
 Forgiving in syntax where that is unambiguous (case, spaces, commas, brackets, ``x+`` for
-``+x``, ``inf``/``infinity``/``out``, a leading ``action:``), strict in meaning. Cells are read
-through :func:`chaingeo.envs.actions.cell_from_agent` (1-based text -> 0-based code), the only
-place that converts.
+``+x``, ``inf``/``infinity``/``out``, a leading ``action:``, ``<action>`` tags), strict in
+meaning. Cells are read through :func:`chaingeo.envs.actions.cell_from_agent` (1-based text ->
+0-based code), the only place that converts.
+
+Two dialects: ours (``place red (1,1,1) ...``) and CHAIN's JSON tool calls
+(:mod:`chaingeo.envs.chain_dialect`), chosen by whether the text is a JSON object. In both a
+stacking piece may be named by its colour or, on levels converted from CHAIN, by CHAIN's id
+(``place 2 (1,1,1) ...``); ``state`` shows every piece's cells.
 """
 
 from __future__ import annotations
@@ -15,6 +20,8 @@ from typing import Final, Protocol
 from chaingeo.core import limits
 from chaingeo.core.kinematics import Move
 from chaingeo.core.level import Level
+from chaingeo.core.rules import Rejection, StackingRules
+from chaingeo.envs import chain_dialect
 from chaingeo.envs.actions import (
     Action,
     AmbiguousActionError,
@@ -25,9 +32,11 @@ from chaingeo.envs.actions import (
     MoveRequest,
     PickupAction,
     PlaceAction,
+    StateAction,
     UnparseableActionError,
     cell_from_agent,
 )
+from chaingeo.envs.chain_dialect import PlacementCellsError
 
 GRAMMAR: Final[dict[str, str]] = {
     "stacking": "expected 'place COLOUR (x,y,z) (x,y,z) ...' listing every cell the piece "
@@ -52,6 +61,7 @@ _VERBS: Final[dict[str, str]] = {
     "finish": "finish",
     "finished": "finish",
     "done": "finish",
+    "state": "state",
 }
 _INFINITY: Final = frozenset({"inf", "infinity", "infinite", "out"})
 _AXES: Final = frozenset({"x", "y", "z"})
@@ -117,8 +127,11 @@ def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
             f"the text has {len(text)} characters; an action has at most "
             f"{limits.MAX_TEXT_CHARS}; {hint_all}",
         )
+    body = chain_dialect.unwrap(text)
+    if chain_dialect.is_tool_call(body):
+        return chain_dialect.parse_tool_call(text, body)
     try:
-        tokens = _tokenise(_normalise(text))
+        tokens = _tokenise(_normalise(body))
         if not tokens:
             raise _Unparseable("the text is empty")
         if tokens[0] == ("word", "pick") and len(tokens) > 1 and tokens[1] == ("word", "up"):
@@ -127,12 +140,12 @@ def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
             raise _Unparseable(f"unknown command {tokens[0][1]!r}")
         verb = _VERBS[tokens[0][1]]
         rest = tokens[1:]
-        if verb == "finish":
+        if verb in ("finish", "state"):
             if rest:
-                raise _Unparseable("'finish' takes nothing after it")
-            return FinishAction()
+                raise _Unparseable(f"'{verb}' takes nothing after it")
+            return FinishAction() if verb == "finish" else StateAction()
         if verb == "pickup":
-            if len(rest) != 1 or rest[0][0] != "word":
+            if len(rest) != 1 or rest[0][0] not in ("word", "num"):
                 raise _Unparseable("'pickup' takes exactly one colour name")
             return PickupAction(rest[0][1])
         if verb == "place":
@@ -144,8 +157,20 @@ def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
         raise IllegalActionError(e.reason, text=text) from None
 
 
+def _leading_id(rest: Sequence[Token]) -> bool:
+    """Whether a number right after 'place' is CHAIN's id of the piece (``place 2 (1,1,1)``):
+    a bracket or a filler word follows it, or it is one number more than whole cells."""
+    if not rest or rest[0][0] != "num":
+        return False
+    after = [t for t in rest[1:] if t not in (("sym", ","), ("sym", ":"))]
+    if after and (after[0][1] in _OPEN or after[0][1] in _PLACE_FILLER):
+        return True
+    return sum(1 for k, _ in rest if k == "num") % 3 == 1
+
+
 def _parse_place(rest: list[Token]) -> PlaceAction:
-    if not rest or rest[0][0] != "word" or rest[0][1] in _PLACE_FILLER:
+    named = bool(rest) and rest[0][0] == "word" and rest[0][1] not in _PLACE_FILLER
+    if not (named or _leading_id(rest)):
         raise _Unparseable("'place' needs a colour name first")
     piece = rest[0][1]
     body = [t for t in rest[1:] if not (t[0] == "word" and t[1] in _PLACE_FILLER)]
@@ -161,7 +186,7 @@ def _parse_place(rest: list[Token]) -> PlaceAction:
     try:
         return PlaceAction(piece, tuple(cells))
     except ValueError as e:  # a repeated cell
-        raise _Meaningless(str(e)) from None
+        raise PlacementCellsError(str(e), piece, len(cells), sorted(set(cells))) from None
 
 
 def _number(digits: str) -> int:
@@ -303,18 +328,31 @@ class ResolvingState(Protocol):
     def key(self) -> Hashable: ...
     def resolve(self, action: Action | MoveRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
+    def rejection(self, action: Action) -> Rejection | None: ...
 
 
 def _known(names: Iterable[str], state: ResolvingState) -> None:
     """Raise IllegalActionError for the first name that is no piece of the level."""
-    known = sorted(p.name for p in state.level.pieces)
+    known = {p.name for p in state.level.pieces}
     for n in names:
         if n not in known:
-            raise IllegalActionError(
-                f"unknown piece {n!r}; the pieces are {', '.join(known)}",
-                text=None,
-                state_key=state.key(),
+            why = Rejection(
+                f"unknown piece {n!r}; the pieces are {chain_dialect.piece_list(state.level)}",
+                "PieceNotFound" if state.level.family == "stacking" else None,
             )
+            raise _illegal(why, state, None)
+
+
+def _illegal(
+    why: Rejection, state: ResolvingState, text: str | None, action: Action | None = None
+) -> IllegalActionError:
+    """A refusal as the agent reads it (CHAIN's error name first under the chain profile)."""
+    rules = state.level.rules
+    if isinstance(rules, StackingRules):
+        why = rules.tag(why)
+    return IllegalActionError(
+        why.reason, action=action, text=text, state_key=state.key(), code=why.code
+    )
 
 
 def parse_action(text: str, state: ResolvingState) -> Action:
@@ -325,11 +363,13 @@ def parse_action(text: str, state: ResolvingState) -> Action:
     """
     mode = state.level.goal if state.level.family == "puzzle" else "stacking"
     try:
-        parsed = parse_text(text, mode)
+        parsed = chain_dialect.resolve_ids(parse_text(text, mode), state.level)
     except UnparseableActionError as e:
         raise UnparseableActionError(text, e.hint, state.key()) from None
+    except PlacementCellsError as e:
+        raise _cells_error(e, text, state) from None
     except IllegalActionError as e:
-        raise IllegalActionError(e.reason, text=text, state_key=state.key()) from None
+        raise _illegal(Rejection(e.reason, e.code), state, text) from None
     try:
         names: list[str] = []
         if isinstance(parsed, PlaceAction | PickupAction):
@@ -338,16 +378,31 @@ def parse_action(text: str, state: ResolvingState) -> Action:
             names = [*parsed.pieces, *(parsed.into or ())]
         _known(names, state)
         action = state.resolve(parsed)
-        reason = state.problem(action)
+        why = state.rejection(action)
     except IllegalActionError as e:
         raise IllegalActionError(
-            e.reason, action=e.action, text=text, state_key=state.key()
+            e.reason, action=e.action, text=text, state_key=state.key(), code=e.code
         ) from None
     except AmbiguousActionError as e:
         raise AmbiguousActionError(text, e.candidates, state.key()) from None
-    if reason is not None:
-        raise IllegalActionError(reason, action=action, text=text, state_key=state.key())
+    if why is not None:
+        raise IllegalActionError(
+            why.reason, action=action, text=text, state_key=state.key(), code=why.code
+        )
     return action
+
+
+def _cells_error(e: PlacementCellsError, text: str, state: ResolvingState) -> IllegalActionError:
+    """An empty or repeating cell list, judged in CHAIN's order (the piece first)."""
+    name = chain_dialect.resolve_id(e.piece, state.level)
+    try:
+        _known([name], state)
+    except IllegalActionError as unknown:
+        return IllegalActionError(
+            unknown.reason, text=text, state_key=state.key(), code=unknown.code
+        )
+    why = chain_dialect.cells_rejection(e, name, state.level, state)
+    return IllegalActionError(why.reason, text=text, state_key=state.key(), code=why.code)
 
 
 def action_from_text(text: str) -> Action:

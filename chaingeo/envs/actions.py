@@ -23,6 +23,7 @@ Grammar (``GROUP`` is colour names joined by ``+``; ``DIR`` is ``+x -x +y -y +z 
     move GROUP DIR inf into GROUP offset (dx,dy,dz)   assembly: the part it joins, and how
                                           far from its place in the target it lands
     finish                                declare the task done (ends the episode)
+    state                                 show every piece's cells (changes nothing; a step)
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from itertools import pairwise
 from typing import Any, ClassVar, Final
 
 from chaingeo.core.kinematics import Move
+from chaingeo.core.rules import ChainCode
 
 Cell = tuple[int, int, int]
 
@@ -211,7 +213,22 @@ class FinishAction(_Ordered):
         return "finish"
 
 
-Action = PlaceAction | PickupAction | MoveAction | FinishAction
+@dataclass(frozen=True, eq=True)
+class StateAction(_Ordered):
+    """Ask for the text state (every piece's cells): legal in both families while the game is
+    not finished, costs a step and changes nothing else. Not listed by ``legal_actions()``
+    (it never advances a game, so searches and baselines have no use for it)."""
+
+    RANK: ClassVar[int] = 4
+
+    def sort_key(self) -> tuple[Any, ...]:
+        return ()
+
+    def to_text(self) -> str:
+        return "state"
+
+
+Action = PlaceAction | PickupAction | MoveAction | FinishAction | StateAction
 
 
 @dataclass(frozen=True)
@@ -259,6 +276,8 @@ def action_to_json(action: Action) -> dict[str, Any]:
         if action.offset is not None:
             out["offset"] = list(action.offset)
         return out
+    if isinstance(action, StateAction):
+        return {"type": "state"}
     return {"type": "finish"}
 
 
@@ -289,6 +308,7 @@ _JSON_KEYS: Final[dict[str, set[str]]] = {
     "pickup": {"type", "piece"},
     "move": {"type", "pieces", "direction", "distance", "into", "offset"},
     "finish": {"type"},
+    "state": {"type"},
 }
 
 
@@ -331,6 +351,8 @@ def action_from_json(obj: Any) -> Action:
                 into=None if into is None else _json_names(into, "into"),
                 offset=None if offset is None else _json_triple(offset, "offset"),
             )
+        if kind == "state":
+            return StateAction()
         return FinishAction()
     except ActionFormatError:
         raise
@@ -354,9 +376,11 @@ def shown_text(text: str) -> str:
 
 
 class ActionError(Exception):
-    """Agent input that was not carried out. Nothing changed; ``feedback`` is for the agent."""
+    """Agent input that was not carried out. Nothing changed; ``feedback`` is for the agent.
+    ``code`` is CHAIN's error name for the refusal (stacking levels), else None."""
 
     kind: ClassVar[str] = "error"
+    code: ChainCode | None = None
 
     def __init__(self, text: str, feedback: str, state_key: Hashable | None) -> None:
         super().__init__(feedback)
@@ -378,7 +402,8 @@ class UnparseableActionError(ActionError):
 
 
 class IllegalActionError(ActionError):
-    """A well-formed action the rules forbid here; ``reason`` says why (1-based cells)."""
+    """A well-formed action the rules forbid here; ``reason`` says why (1-based cells), and
+    ``code`` is CHAIN's name for it where CHAIN's stacking game has one."""
 
     kind = "illegal"
 
@@ -389,12 +414,14 @@ class IllegalActionError(ActionError):
         action: Action | None = None,
         text: str | None = None,
         state_key: Hashable | None = None,
+        code: ChainCode | None = None,
     ) -> None:
         shown = text if text is not None else action.to_text() if action is not None else ""
         feedback = f"Illegal action '{shown_text(shown)}': {reason}. Nothing changed."
         super().__init__(shown, feedback, state_key)
         self.reason = reason
         self.action = action
+        self.code = code
 
 
 class AmbiguousActionError(ActionError):
@@ -428,6 +455,7 @@ __all__ = [
     "MoveRequest",
     "PickupAction",
     "PlaceAction",
+    "StateAction",
     "UnparseableActionError",
     "action_from_json",
     "action_to_json",

@@ -16,7 +16,8 @@ state machine of :mod:`chaingeo.envs.state`, so its steps are the agents' and th
   with ``images=True``, ``images``: one ``uint8`` array ``(H, W, 3)`` per view.
 * Reward 1 on the step that solves the level, else 0. ``terminated`` when the level is solved
   or ``finish`` was played; ``truncated`` when the step budget is spent.
-* ``info``: ``legal``, ``error`` (None, "unparseable", "illegal", "ambiguous"), ``feedback``,
+* ``info``: ``legal``, ``error`` (None, "unparseable", "illegal", "ambiguous"), ``code``
+  (CHAIN's error name of an illegal stacking action, else None), ``feedback``,
   ``steps_used``, ``level_id``, ``optimal_steps``, ``success``. Stacking levels also give
   ``action_mask`` (``int8``) over :meth:`ChainEnv.action_catalogue`, every action that can
   ever be legal in the level, in sorted order. Puzzle moves are not enumerable up front (the
@@ -154,6 +155,7 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
             "success": state.is_success(),
             "legal": True if result is None else result.legal,
             "error": None if result is None else result.error,
+            "code": None if result is None else result.code,
             "feedback": "" if result is None else result.feedback,
         }
         if isinstance(state, StackingState):

@@ -15,7 +15,7 @@ from typing import Final
 
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.rules import PuzzleRules, StackingRules
-from chaingeo.envs.actions import cells_text
+from chaingeo.envs import text_state
 from chaingeo.envs.state import BaseState
 
 #: The views rendered for every state (the tray and the target are added where they apply).
@@ -75,6 +75,13 @@ def instruction(state: BaseState) -> str:
             if level.rules.support == "drop"
             else ""
         )
+        chain = level.rules.profile == "chain"
+        pickup = (
+            "  pickup COLOUR  take a placed piece back to the tray\n"
+            if chain
+            else "  pickup COLOUR  take a placed piece back to the tray (it may not leave "
+            "another piece floating)\n"
+        )
         return (
             f"Pack all {len(level.pieces)} pieces into the {a}x{b}x{c} box so that it is "
             f"completely full. {_COORDS} The box spans x 1-{a}, y 1-{b}, z 1-{c}. The pieces "
@@ -84,9 +91,9 @@ def instruction(state: BaseState) -> str:
             "Actions, one per turn:\n"
             "  place COLOUR (x,y,z) (x,y,z) ...  list every cell the piece will fill, e.g. "
             "place red (1,1,1) (2,1,1) (1,2,1)\n"
-            "  pickup COLOUR  take a placed piece back to the tray (it may not leave another "
-            "piece floating)\n"
-            "  finish  end the game when you are done\n"
+            f"{pickup}"
+            + (_CHAIN_ACTIONS if chain else "")
+            + "  finish  end the game when you are done\n"
             "Every turn costs one step, including a turn whose action fails."
         )
     assert isinstance(level.rules, PuzzleRules)
@@ -125,10 +132,20 @@ def instruction(state: BaseState) -> str:
     )
 
 
+_CHAIN_ACTIONS = (
+    "  state  show every piece's cells (changes nothing)\n"
+    "A piece may also be named by its CHAIN id (place 2 (1,1,1) ...), and an action may be "
+    'a CHAIN tool call: {"tool": "place", "piece_id": "2", "cells": [[1,1,1], [2,1,1]]}, '
+    '{"tool": "pickup", "piece_id": "2"}, {"tool": "state"}, {"tool": "finish"}. A refused '
+    "action is reported with CHAIN's error name.\n"
+)
+
+
 def color_table(state: BaseState) -> dict[str, str]:
-    """Colour name -> its hex colour and size, in the level's piece order."""
+    """Colour name -> its hex colour and size (and CHAIN's id), in the level's piece order."""
     return {
         p.name: f"{p.rgb}, {len(p.shape)} cube{'s' if len(p.shape) != 1 else ''}"
+        + ("" if p.chain_id is None else f", CHAIN id {p.chain_id}")
         for p in state.level.pieces
     }
 
@@ -145,41 +162,7 @@ def history_lines(state: BaseState, window: int = DEFAULT_HISTORY) -> list[str]:
 
 def state_text(state: BaseState) -> str:
     """Every piece's cells (1-based): where it is, or its shape in the tray."""
-    from chaingeo.envs.puzzle import PuzzleState
-    from chaingeo.envs.stacking import StackingState
-
-    if isinstance(state, StackingState):
-        a, b, c = state.box
-        lines = [f"Box {a}x{b}x{c}: {a * b * c - state.empty_cells()} of {a * b * c} cells filled."]
-        placed = state.placed
-        lines.append("In the box:" if placed else "In the box: nothing yet.")
-        for p in state.level.pieces:
-            if p.name in placed:
-                lines.append(f"  {p.name}: {cells_text(placed[p.name])}")
-        tray = state.tray
-        if tray:
-            lines.append("In the tray (the piece's own cells, counted from 1):")
-            for name in tray:
-                lines.append(f"  {name}: {cells_text(state.tables.shapes[name].normalized())}")
-        return "\n".join(lines)
-    assert isinstance(state, PuzzleState)
-    lines = []
-    parts = ordered_parts(state)
-    if len(parts) == 1:
-        lines.append(f"One part: {', '.join(sorted(parts[0]))}.")
-    else:
-        lines.append(f"{len(parts)} parts (pieces of different parts never touch again):")
-    for i, part in enumerate(parts, 1):
-        if len(parts) > 1:
-            label = "apart" if len(part) == 1 else "held together"
-            lines.append(f"  part {i} ({label}): {', '.join(sorted(part))}")
-        for name in sorted(part):
-            lines.append(f"    {name}: {cells_text(state.cells_of(name))}")
-    if state.mode == "assemble":
-        lines.append("Target (every piece in its place):")
-        for p in state.level.pieces:
-            lines.append(f"    {p.name}: {cells_text(p.shape)}")
-    return "\n".join(lines)
+    return text_state.state_text(state)
 
 
 def ordered_parts(state: BaseState) -> list[frozenset[str]]:
@@ -187,7 +170,7 @@ def ordered_parts(state: BaseState) -> list[frozenset[str]]:
     from chaingeo.envs.puzzle import PuzzleState
 
     assert isinstance(state, PuzzleState)
-    return sorted(state.assembly.parts, key=lambda p: (-len(p), sorted(p)))
+    return text_state.ordered_parts(state)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -8,6 +8,12 @@ the ``drop`` rule also lowerable from above). ``pickup`` takes a placed piece ba
 it may not leave another piece floating, and under ``drop`` nothing may rest on top of it.
 Success is the box exactly full, i.e. every piece placed.
 
+Under the ``chain`` rules profile the game is CHAIN's exactly: the same placement checks in
+the same order (unknown piece, already placed, cell count, shape, box, overlap, support), but a
+pickup of a placed piece is always allowed (CHAIN does not re-check the pieces left behind),
+and every refusal's reason starts with CHAIN's error name. On every stacking level a refusal
+carries that name as its ``code`` (None for our own rules that CHAIN lacks).
+
 Legal placements are enumerated once per level (every orientation at every offset inside the
 box) as bit masks over the box cells, so ``legal_actions`` is a few integer ``&`` per candidate;
 a test checks that it agrees with ``placement_problem`` exactly.
@@ -21,7 +27,7 @@ from typing import Any
 
 from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
 from chaingeo.core.level import Level
-from chaingeo.core.rules import StackingRules, placement_problem
+from chaingeo.core.rules import Rejection, StackingRules, placement_rejection
 from chaingeo.envs.actions import (
     Action,
     FinishAction,
@@ -31,6 +37,7 @@ from chaingeo.envs.actions import (
     rules_text,
 )
 from chaingeo.envs.state import BaseState
+from chaingeo.envs.text_state import label
 
 
 @dataclass(frozen=True)
@@ -190,32 +197,49 @@ class StackingState(BaseState):
         return out
 
     def _move_problem(self, action: Action) -> str | None:
-        if isinstance(action, PlaceAction):
-            return self._place_problem(action)
-        if isinstance(action, PickupAction):
-            if action.piece not in self.tables.shapes:
-                return f"unknown piece {action.piece!r}"
-            return self._pickup_problem(action.piece)
-        return "this is a stacking level: use place, pickup or finish"
+        why = self._move_rejection(action)
+        return None if why is None else why.reason
 
-    def _place_problem(self, action: PlaceAction) -> str | None:
+    def _move_rejection(self, action: Action) -> Rejection | None:
+        if isinstance(action, PlaceAction):
+            why = self._place_problem(action)
+        elif isinstance(action, PickupAction):
+            if action.piece not in self.tables.shapes:
+                why = Rejection(f"unknown piece {action.piece!r}", "PieceNotFound")
+            else:
+                why = self._pickup_problem(action.piece)
+        else:
+            why = Rejection("this is a stacking level: use place, pickup or finish")
+        return None if why is None else self.tables.rules.tag(why)
+
+    def _place_problem(self, action: PlaceAction) -> Rejection | None:
+        """CHAIN's checks in CHAIN's order (then our ``drop`` rule)."""
         name = action.piece
         if name not in self.tables.shapes:
-            return f"unknown piece {name!r}"
+            return Rejection(f"unknown piece {name!r}", "PieceNotFound")
         if name in self.placed:
-            return f"{name} is already in the box; pick it up first to put it elsewhere"
+            return Rejection(
+                f"{name} is already in the box; pick it up first to put it elsewhere",
+                "PieceAlreadyPlaced",
+            )
         size = len(self.tables.shapes[name])
         if len(action.cells) != size:
-            return f"{name} has {size} cubes but {len(action.cells)} cells were given"
+            return Rejection(
+                f"{name} has {size} cubes but {len(action.cells)} cells were given", "WrongCount"
+            )
         if Shape(action.cells).normalized().cells not in self.tables.orientations[name]:
-            return f"those cells are not the shape of {name} in any rotation"
-        why = placement_problem(Shape(action.cells), self.occupied(), self.box, self.tables.rules)
-        return None if why is None else rules_text(why)
+            return Rejection(
+                f"those cells are not the shape of {name} in any rotation", "ShapeMismatch"
+            )
+        why = placement_rejection(Shape(action.cells), self.occupied(), self.box, self.tables.rules)
+        return None if why is None else Rejection(rules_text(why.reason), why.code)
 
-    def _pickup_problem(self, name: str) -> str | None:
+    def _pickup_problem(self, name: str) -> Rejection | None:
         inside = self.placed
         if name not in inside:
-            return f"{name} is not in the box"
+            return Rejection(f"{name} is not in the box", "PieceNotFound")
+        if self.tables.rules.profile == "chain":
+            return None  # CHAIN takes any placed piece out, whatever it leaves behind
         cells = set(inside[name])
         occupied = self.occupied()
         if self.tables.rules.support == "drop":
@@ -223,13 +247,13 @@ class StackingState(BaseState):
                 for zz in range(z + 1, self.box[2]):
                     who = occupied.get((x, y, zz))
                     if who is not None and who != name:
-                        return f"{who} rests on top of it at {cell_text((x, y, zz))}"
+                        return Rejection(f"{who} rests on top of it at {cell_text((x, y, zz))}")
         rest = {c: n for c, n in occupied.items() if n != name}
         for other in sorted(inside):
             if other == name:
                 continue
             if not _supported(inside[other], rest, other):
-                return f"{other} would be left floating"
+                return Rejection(f"{other} would be left floating")
         return None
 
     def _after(self, action: Action) -> Any:
@@ -248,9 +272,9 @@ class StackingState(BaseState):
         k = len(self._pos.placed)
         progress = f"{k} of {n} pieces in the box, {self.empty_cells()} empty cells left."
         if isinstance(action, PlaceAction):
-            return f"OK: {action.piece} placed. {progress}"
+            return f"OK: {label(self.level.piece(action.piece))} placed. {progress}"
         if isinstance(action, PickupAction):
-            return f"OK: {action.piece} is back in the tray. {progress}"
+            return f"OK: {label(self.level.piece(action.piece))} is back in the tray. {progress}"
         if self.is_success():
             return "Finished: the box is full."
         return f"Finished without solving: {progress} Still in the tray: {', '.join(self.tray)}."

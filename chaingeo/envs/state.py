@@ -8,8 +8,15 @@ out changes nothing but still costs a step), ``push``/``pop``, the budget and ``
 
 A step is one agent turn. ``apply`` (and ``push``) count a step for a legal action;
 ``step_text`` counts one for every turn, legal or not. ``finish`` counts like any action and
-ends the game: afterwards every action is illegal. ``key()`` identifies the position only (not
-the steps used, not the history), so searches can use it for transpositions.
+ends the game: afterwards every action is illegal. ``state`` (:class:`StateAction`) is legal
+while the game is not finished, costs its step like any turn and changes nothing else; its
+feedback is the text state (:mod:`chaingeo.envs.text_state`). It is not in
+``legal_actions()``, so searches, baselines and the Gymnasium action mask never see it.
+``key()`` identifies the position only (not the steps used, not the history), so searches can
+use it for transpositions.
+
+A refusal is a :class:`chaingeo.core.rules.Rejection`: our reason and, on stacking levels,
+CHAIN's error name (``StepResult.code``, ``IllegalActionError.code``).
 """
 
 from __future__ import annotations
@@ -20,15 +27,26 @@ from dataclasses import dataclass
 from typing import Any, Protocol, TypeVar, runtime_checkable
 
 from chaingeo.core.level import Level
+from chaingeo.core.rules import Rejection
 from chaingeo.envs.action_list import ActionList
 from chaingeo.envs.action_text import parse_action
-from chaingeo.envs.actions import Action, ActionError, FinishAction, IllegalActionError, MoveRequest
+from chaingeo.envs.actions import (
+    Action,
+    ActionError,
+    FinishAction,
+    IllegalActionError,
+    MoveRequest,
+    StateAction,
+)
+from chaingeo.envs.text_state import state_text
 
 
 @dataclass(frozen=True)
 class StepResult:
     """What one agent turn did. ``error`` is None for a legal action, otherwise the kind of
-    failure: ``"unparseable"``, ``"illegal"`` or ``"ambiguous"``."""
+    failure: ``"unparseable"``, ``"illegal"`` or ``"ambiguous"``. ``code`` is CHAIN's error name
+    of an illegal stacking action (``"Collision"``, ...; see
+    :data:`chaingeo.core.rules.CHAIN_CODES`), else None."""
 
     action: Action | None
     legal: bool
@@ -36,6 +54,7 @@ class StepResult:
     feedback: str
     success: bool
     truncated: bool
+    code: str | None = None
 
 
 @dataclass(frozen=True)
@@ -65,6 +84,7 @@ class GameState(Protocol):
     def legal_actions(self) -> Sequence[Action]: ...
     def resolve(self, action: Action | MoveRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
+    def rejection(self, action: Action) -> Rejection | None: ...
     def apply(self, action: Action) -> None: ...
     def push(self, action: Action) -> None: ...
     def pop(self) -> Action: ...
@@ -112,6 +132,11 @@ class BaseState(ABC):
     @abstractmethod
     def _move_problem(self, action: Action) -> str | None:
         """Why a non-finish action is illegal here (agent text, 1-based), or None."""
+
+    def _move_rejection(self, action: Action) -> Rejection | None:
+        """:meth:`_move_problem` with CHAIN's error name; families that have them override."""
+        why = self._move_problem(action)
+        return None if why is None else Rejection(why)
 
     @abstractmethod
     def _after(self, action: Action) -> Any:
@@ -166,11 +191,16 @@ class BaseState(ABC):
         return ActionList([self._legal_moves(), [FinishAction()]])
 
     def problem(self, action: Action) -> str | None:
+        why = self.rejection(action)
+        return None if why is None else why.reason
+
+    def rejection(self, action: Action) -> Rejection | None:
+        """Why ``action`` is illegal here (our reason and CHAIN's error name), or None."""
         if self._finished:
-            return "the game is over: finish was already played"
-        if isinstance(action, FinishAction):
+            return Rejection("the game is over: finish was already played")
+        if isinstance(action, FinishAction | StateAction):
             return None
-        return self._move_problem(action)
+        return self._move_rejection(action)
 
     def apply(self, action: Action) -> None:
         """Carry out ``action`` (one step) or raise, leaving the state unchanged."""
@@ -178,13 +208,15 @@ class BaseState(ABC):
 
     def push(self, action: Action) -> None:
         resolved = self.resolve(action)
-        why = self.problem(resolved)
+        why = self.rejection(resolved)
         if why is not None:
-            raise IllegalActionError(why, action=resolved, state_key=self.key())
+            raise IllegalActionError(
+                why.reason, action=resolved, state_key=self.key(), code=why.code
+            )
         self._stack.append((resolved, self._position, self._steps_used, self._finished))
         if isinstance(resolved, FinishAction):
             self._finished = True
-        else:
+        elif not isinstance(resolved, StateAction):
             self._position = self._after(resolved)
         self._steps_used += 1
 
@@ -214,10 +246,13 @@ class BaseState(ABC):
             self._steps_used += 1
             self._history.append(Turn(self._steps_used, text, e.feedback, False))
             return StepResult(
-                None, False, e.kind, e.feedback, self.is_success(), self.is_truncated()
+                None, False, e.kind, e.feedback, self.is_success(), self.is_truncated(), e.code
             )
-        feedback = self.describe(action)
-        if self.is_success():
-            feedback += " Solved!"
+        if isinstance(action, StateAction):
+            feedback = f"OK: nothing changed. The state:\n{state_text(self)}"
+        else:
+            feedback = self.describe(action)
+            if self.is_success():
+                feedback += " Solved!"
         self._history.append(Turn(self._steps_used, text, feedback, True))
         return StepResult(action, True, None, feedback, self.is_success(), self.is_truncated())

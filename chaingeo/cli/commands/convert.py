@@ -1,34 +1,125 @@
-"""``chain convert``: move levels between our format and the original CHAIN stacking JSON."""
+"""``chain convert``: move levels between our format and the original CHAIN stacking JSON.
+
+``--from chain`` (or ``--to chain-level``) reads CHAIN's level file as CHAIN writes it: packed
+(the cells fill the box) or in tray form (each piece where it lies beside the box). A tray
+file is packed here with the exact-cover engine (``solvers.cover.first_solution``, the pieces
+as free shapes, rotations only as in CHAIN); the level keeps CHAIN's piece ids and is verified
+like any level file before it is written. ``--rules chain`` gives it CHAIN's rules profile.
+"""
 
 from __future__ import annotations
 
 import argparse
+import re
+import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # the command imports its work lazily, so `chain --help` stays fast
+    from chaingeo.core.formats.chain_json import ChainStacking
+    from chaingeo.core.geometry import Shape
+    from chaingeo.core.level import Level
+
+#: Exact-cover nodes allowed when packing a tray file (CHAIN's hardest levels need thousands).
+PACK_NODE_LIMIT = 50_000_000
+_DIFFICULTY_RE = re.compile(r"(?:^|[_\-.])(easy|mid|hard)(?:$|[_\-.])")
 
 
 def register(sub: Any) -> None:
     p = sub.add_parser("convert", help="import/export the original CHAIN stacking JSON format")
     p.add_argument("source", type=Path)
-    p.add_argument("target", type=Path)
     p.add_argument(
+        "target",
+        type=Path,
+        nargs="?",
+        help="the file to write (default: the level on standard output)",
+    )
+    direction = p.add_mutually_exclusive_group(required=True)
+    direction.add_argument(
         "--to",
         choices=("chain-level", "chain-json"),
-        required=True,
         help="chain-level: import an original file; chain-json: export one of ours",
     )
+    direction.add_argument(
+        "--from",
+        dest="source_format",
+        choices=("chain",),
+        help="chain: import CHAIN's level file, packed or in tray form (same as --to chain-level)",
+    )
     p.add_argument("--id", help="level id on import (default: the file name)")
-    p.add_argument("--difficulty", default="easy", choices=("easy", "mid", "hard"))
+    p.add_argument(
+        "--difficulty",
+        choices=("easy", "mid", "hard"),
+        help="on import (default: from the file name, as CHAIN names them, else easy)",
+    )
+    p.add_argument(
+        "--rules",
+        choices=("default", "chain"),
+        default="default",
+        help="on import: our stacking rules, or CHAIN's game exactly (rules profile 'chain')",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.core.formats.chain_json import read_chain_stacking, write_chain_stacking
-    from chaingeo.core.level import load_level, save_level
+    from chaingeo.core.formats.chain_json import write_chain_stacking
+    from chaingeo.core.level import level_bytes, load_level, save_level
 
-    if args.to == "chain-level":
-        save_level(read_chain_stacking(args.source, args.id, args.difficulty), args.target)
-    else:
+    if args.to == "chain-json":
+        if args.target is None:
+            raise ValueError("--to chain-json needs a target file")
         write_chain_stacking(load_level(args.source), args.target)
+        print(args.target)
+        return 0
+    level = import_chain_file(args.source, args.id, args.difficulty, args.rules)
+    if args.target is None:
+        sys.stdout.write(level_bytes(level).decode("utf-8"))
+        return 0
+    save_level(level, args.target)
     print(args.target)
     return 0
+
+
+def import_chain_file(
+    path: Path, level_id: str | None, difficulty: str | None, rules: str = "default"
+) -> Level:
+    """A verified level from CHAIN's file, packed or in tray form."""
+    from chaingeo.core.formats.chain_json import chain_level, load_chain_file
+    from chaingeo.core.rules import StackingRules
+
+    spec = load_chain_file(path)
+    if difficulty is None:
+        m = _DIFFICULTY_RE.search(path.stem.lower())
+        difficulty = m.group(1) if m else "easy"
+    placements = None if spec.packed else pack(spec, str(path))
+    return chain_level(
+        spec,
+        level_id or path.stem,
+        difficulty,
+        placements=placements,
+        rules=StackingRules(profile="chain" if rules == "chain" else "default"),
+        source=str(path),
+    )
+
+
+def pack(spec: ChainStacking, source: str) -> list[Shape]:
+    """A packing of the file's pieces into its box (piece ``i`` first at index ``i``)."""
+    from chaingeo.core.level import LevelError
+    from solvers.cover import CoverError, CoverLimitError, first_solution
+
+    volume = spec.box[0] * spec.box[1] * spec.box[2]
+    cubes = sum(len(s) for s in spec.pieces)
+    if cubes != volume:
+        raise LevelError(source, "pieces", f"{cubes} cubes in all cannot fill a {spec.box} box")
+    try:
+        solution = first_solution(spec.shapes, spec.box, node_limit=PACK_NODE_LIMIT)
+    except CoverLimitError:
+        raise LevelError(
+            source, "pieces", f"no packing found within {PACK_NODE_LIMIT} search nodes"
+        ) from None
+    except CoverError as e:
+        raise LevelError(source, "pieces", str(e)) from None
+    if solution is None:
+        raise LevelError(source, "pieces", "the pieces cannot fill the box in any way")
+    placed = dict(solution.placements)
+    return [placed[str(i)] for i in range(len(spec.pieces))]
