@@ -205,9 +205,9 @@ class CoverSearch:
         t0 = time.perf_counter()
         a = self._arr
         if isinstance(a, DLXArrays):
-            L, R, U, D, C, RW, S = self._links
+            HL, HR, U, D, TOP, RW, S = self._links
             n = dlx_run(
-                L, R, U, D, C, RW, S, a.kind, a.lo, a.hi, self._cnt, a.counters,
+                HL, HR, U, D, TOP, RW, S, a.kind, a.lo, a.hi, self._cnt, a.counters,
                 self._buf, self._nbuf, self._pos, self._aux, self._chosen,
                 self._regs, self._rng, self._shuffle,
                 out, max_store, stop_after, self.node_limit,
