@@ -9,7 +9,8 @@ first in scan order), or on an unused exact-once piece when that piece has at mo
 alive rows (pieces win ties, as in :mod:`solvers.dlx`). When every empty cell has 8 or more
 rows (near the root only) the counts are taken exactly, cell by cell. A cell with no alive row,
 an exact-once piece with no alive row, or a piece type with fewer alive rows than it still needs
-ends the branch at once.
+ends the branch at once; so does, in box targets of one word, a placement that cuts off an empty
+region no set of pieces can fill (:func:`solvers.bitboard._regions_ok`, same scan order).
 
 Targets over 64 cells use ``W = ceil(cells / 64)`` words per mask (:func:`mrv_wide_run`); the
 one-word kernel :func:`mrv_run` is the same algorithm on scalars. Piece types carry count ranges
@@ -25,6 +26,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from solvers.bitboard import _regions_ok, region_pruning
 from solvers.kernels import (
     DONE,
     FRESH,
@@ -106,14 +108,20 @@ def _expand(
     sat = _NONE
     tcount[:] = 0
     n = w
-    for i in range(a, b):  # branch-free: the keep test is unpredictable
+    cur = 0  # rows come grouped by type: count each type's run in a register
+    run = 0
+    for i in range(a, b):  # branch-free keep test: it is unpredictable
         j = src[i]
         m = mask[j]
         t = rtype[j]
+        if t != cur:
+            tcount[cur] += run
+            cur = t
+            run = 0
         keep = ((m & occ) == _NONE) & (cnt[t] < hi[t])
         live[n] = j
         n += keep
-        tcount[t] += keep
+        run += keep
         m &= _NONE - np.uint64(keep)
         c0 = b0 & m
         b0 ^= m
@@ -123,6 +131,7 @@ def _expand(
         b2 ^= c1
         sat |= b3 & c2
         b3 ^= c2
+    tcount[cur] += run
     empty = primary & ~occ
     if empty & ~(b0 | b1 | b2 | b3 | sat):
         return n, 0  # an empty cell no row can fill
@@ -164,6 +173,7 @@ def _expand(
 def mrv_run(
     mask: Any, rtype: Any, rid: Any, allrows: Any, primary: Any,
     lo: Any, hi: Any, cnt: Any, counters: Any, pieces: Any, table: Any,
+    nb: Any, region_gcd: int, region_min: int,
     live: Any, lstart: Any, occ: Any, tcount: Any, tally: Any,
     br: Any, nbr: Any, pos: Any, chosen: Any,
     regs: Any, rng: Any, shuffle: bool,
@@ -185,16 +195,16 @@ def mrv_run(
         k = 0
         occ[0] = _NONE
         lstart[0] = 0
-        end, nb = _expand(
+        end, n_br = _expand(
             allrows, 0, len(allrows), live, 0, _NONE, primary, mask, rtype, lo, hi, cnt,
             tcount, counters, pieces, table, tally, br[0],
         )  # fmt: skip
         updates += len(allrows)
         lstart[1] = end
-        nbr[0] = nb
+        nbr[0] = n_br
         pos[0] = 0
         if shuffle:
-            shuffle_prefix(br[0], nb, rng)
+            shuffle_prefix(br[0], n_br, rng)
     else:
         k = regs[REG_DEPTH]
     regs[REG_STATUS] = RUNNING
@@ -224,22 +234,27 @@ def mrv_run(
                     if (max_store > 0 and n_out == max_store) or found == stop_after:
                         break
                 continue
+            if region_min > 0 and not _regions_ok(
+                mask[r], primary & ~here, nb, region_gcd, region_min
+            ):
+                cnt[t] -= 1  # cuts off a region no set of pieces can fill
+                continue
             a, b = lstart[k], lstart[k + 1]
             updates += b - a
-            end, nb = _expand(
+            end, n_br = _expand(
                 live, a, b, live, b, here, primary, mask, rtype, lo, hi, cnt,
                 tcount, counters, pieces, table, tally, br[k + 1],
             )  # fmt: skip
-            if nb == 0:
+            if n_br == 0:
                 cnt[t] -= 1
                 continue
             k += 1
             occ[k] = here
             lstart[k + 1] = end
-            nbr[k] = nb
+            nbr[k] = n_br
             pos[k] = 0
             if shuffle:
-                shuffle_prefix(br[k], nb, rng)
+                shuffle_prefix(br[k], n_br, rng)
         else:
             if k == 0:
                 regs[REG_STATUS] = DONE
@@ -487,3 +502,7 @@ class MRVArrays:
         per_type = np.bincount(self.rtype, minlength=T) if T else np.zeros(1, np.int64)
         self.max_col = max(int(per_cell.max(initial=0)), int(per_type.max(initial=0)), 1)
         self.table = DEBRUIJN_TABLE
+        if W == 1:
+            self.nb, self.region_gcd, self.region_min = region_pruning(problem)
+        else:
+            self.nb, self.region_gcd, self.region_min = np.zeros(8, np.uint64), 1, 0

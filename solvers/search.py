@@ -70,10 +70,10 @@ def first_cell_wins(problem: CoverProblem) -> bool:
     one layer thick (a planar problem) or has at most :data:`FIRST_CELL_SMALL` cells; branch
     on the most constrained cell otherwise. In a layer the first empty cell sits on the edge of
     the filled part, so it already has few fits, and it is found with one bit scan; in thicker
-    targets that cell has many fits and counting (MRV) cuts the tree up to 13-fold (46.4 M to
-    3.4 M nodes on the 2x5x6 solid pentominoes). Measured raw counts, CPU seconds
-    (first / MRV): pentominoes 6x10 1.2 / 2.4, 5x12 0.69 / 1.6, Soma 0.054 / 0.078,
-    solid pentominoes 2x5x6 9.4 / 2.5.
+    targets that cell has many fits and counting (MRV) cuts the tree 13-fold (46.4 M to 3.4 M
+    nodes on the 2x5x6 solid pentominoes). Measured raw counts, best-of-3 CPU seconds
+    (first / MRV): pentominoes 6x10 1.18 / 1.37, 5x12 0.67 / 0.70, Soma 0.054 / 0.064, solid
+    pentominoes 2x5x6 9.2 / 1.96.
     """
     ext = problem.target.extent
     n = problem.n_cells
@@ -226,6 +226,7 @@ class CoverSearch:
             n = mrv_run(
                 a.mask, a.rtype, a.rid, a.allrows, a.primary[0],
                 a.lo, a.hi, self._cnt, a.counters, a.pieces, a.table,
+                a.nb, a.region_gcd, a.region_min,
                 self._live, self._lstart, self._occ[:, 0], self._tcount, self._tally,
                 self._buf, self._nbuf, self._pos, self._chosen,
                 self._regs, self._rng, self._shuffle,
