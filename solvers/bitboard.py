@@ -43,9 +43,9 @@ MAX_CELLS = 64
 MRV_DEPTH = 2
 
 _DEBRUIJN = np.uint64(0x03F79D71B4CB0A89)
-_DEBRUIJN_TABLE = np.zeros(64, dtype=np.int32)
+DEBRUIJN_TABLE = np.zeros(64, dtype=np.int32)
 for _i in range(64):
-    _DEBRUIJN_TABLE[(((1 << _i) * 0x03F79D71B4CB0A89) & 0xFFFFFFFFFFFFFFFF) >> 58] = _i
+    DEBRUIJN_TABLE[(((1 << _i) * 0x03F79D71B4CB0A89) & 0xFFFFFFFFFFFFFFFF) >> 58] = _i
 
 
 @njit(cache=True)
@@ -77,7 +77,7 @@ def _grow(x: np.uint64, nb: Any) -> Any:
 
 
 @njit(cache=True)
-def _regions_ok(placed: np.uint64, empty: np.uint64, nb: Any, gcd: int, smallest: int) -> bool:
+def regions_ok(placed: np.uint64, empty: np.uint64, nb: Any, gcd: int, smallest: int) -> bool:
     """Can every empty region touching the piece just placed still be filled?
 
     Each region is grown from a seed next to the piece; it must hold at least ``smallest``
@@ -215,11 +215,7 @@ def bitboard_run(
             if (m & here) != 0:
                 continue
             free = primary & ~(here | m)
-            if (
-                region_min > 0
-                and free != 0
-                and not _regions_ok(m, free, nb, region_gcd, region_min)
-            ):
+            if region_min > 0 and free != 0 and not regions_ok(m, free, nb, region_gcd, region_min):
                 continue
             row = r
             break
@@ -312,7 +308,7 @@ class BitboardArrays:
         pm = masks & primary
         keep = pm != 0  # rows entirely on optional cells are unreachable
         rows, masks, pm = rows[keep], masks[keep], pm[keep]
-        low = np.array([_lowest_bit(np.uint64(x), _DEBRUIJN_TABLE) for x in pm], dtype=np.int64)
+        low = np.array([_lowest_bit(np.uint64(x), DEBRUIJN_TABLE) for x in pm], dtype=np.int64)
         rtype = problem.row_type[rows].astype(np.int64)
         order = np.lexsort((rows, rtype, low))  # by lowest mandatory cell, type, row id
         self.mask = np.ascontiguousarray(masks[order])
@@ -348,7 +344,7 @@ class BitboardArrays:
         n_primary = problem.n_cells - len(problem.optional)
         self.max_depth = min(n_primary, int(self.hi.sum()))
         self.max_col = max(int(counts.max()), int(np.diff(self.type_ptr).max(initial=0)))
-        self.table = _DEBRUIJN_TABLE
+        self.table = DEBRUIJN_TABLE
         self.nb, self.region_gcd, self.region_min = region_pruning(problem)
 
 

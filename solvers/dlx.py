@@ -41,91 +41,116 @@ from solvers.problem import CoverProblem
 PRIMARY, SECONDARY, COUNTER = 0, 1, 2
 
 
-@njit(cache=True)
-def _cover(c: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any) -> int:
-    L[R[c]] = L[c]
-    R[L[c]] = R[c]
+# Node layout (as in Knuth's dlx1): nodes 0..n_cols are the column headers; then each row's
+# nodes lie contiguously, with a *spacer* before every row and after the last one. A spacer
+# has ``TOP <= 0``; its ``U`` is the first node of the row before it and its ``D`` the last
+# node of the row after it, so a row is walked by ``q += 1`` (or ``q -= 1``) with one jump at
+# the spacer and no left/right links. Only the primary column headers are linked
+# horizontally (``HL``/``HR``). Every kernel is compiled without bounds checks (numba's
+# default, spelled out): the wrapper builds the arrays consistently.
+
+
+@njit(cache=True, boundscheck=False)
+def _cover(c: int, HL: Any, HR: Any, U: Any, D: Any, TOP: Any, S: Any) -> int:
+    HL[HR[c]] = HL[c]
+    HR[HL[c]] = HR[c]
     upd = 0
     i = D[c]
     while i != c:
-        j = R[i]
-        while j != i:
-            U[D[j]] = U[j]
-            D[U[j]] = D[j]
-            S[C[j]] -= 1
+        q = i + 1
+        while q != i:
+            x = TOP[q]
+            if x <= 0:
+                q = U[q]
+                continue
+            u = U[q]
+            d = D[q]
+            D[u] = d
+            U[d] = u
+            S[x] -= 1
             upd += 1
-            j = R[j]
+            q += 1
         i = D[i]
     return upd
 
 
-@njit(cache=True)
-def _uncover(c: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any) -> None:
+@njit(cache=True, boundscheck=False)
+def _uncover(c: int, HL: Any, HR: Any, U: Any, D: Any, TOP: Any, S: Any) -> None:
     i = U[c]
     while i != c:
-        j = L[i]
-        while j != i:
-            S[C[j]] += 1
-            U[D[j]] = j
-            D[U[j]] = j
-            j = L[j]
+        q = i - 1
+        while q != i:
+            x = TOP[q]
+            if x <= 0:
+                q = D[q]
+                continue
+            S[x] += 1
+            U[D[q]] = q
+            D[U[q]] = q
+            q -= 1
         i = U[i]
-    L[R[c]] = c
-    R[L[c]] = c
+    HL[HR[c]] = c
+    HR[HL[c]] = c
 
 
-@njit(cache=True)
+@njit(cache=True, boundscheck=False)
 def _select(
-    r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any
+    r: int, HL: Any, HR: Any, U: Any, D: Any, TOP: Any, S: Any, kind: Any, hi: Any, cnt: Any
 ) -> int:
     upd = 0
-    j = R[r]
+    j = r + 1
     while j != r:
-        c = C[j]
+        c = TOP[j]
+        if c <= 0:
+            j = U[j]
+            continue
         if kind[c] == COUNTER:
             cnt[c] += 1
             if cnt[c] == hi[c]:
-                upd += _cover(c, L, R, U, D, C, S)
+                upd += _cover(c, HL, HR, U, D, TOP, S)
         else:
-            upd += _cover(c, L, R, U, D, C, S)
-        j = R[j]
+            upd += _cover(c, HL, HR, U, D, TOP, S)
+        j += 1
     return upd
 
 
-@njit(cache=True)
+@njit(cache=True, boundscheck=False)
 def _unselect(
-    r: int, L: Any, R: Any, U: Any, D: Any, C: Any, S: Any, kind: Any, hi: Any, cnt: Any
+    r: int, HL: Any, HR: Any, U: Any, D: Any, TOP: Any, S: Any, kind: Any, hi: Any, cnt: Any
 ) -> None:
-    j = L[r]
+    j = r - 1
     while j != r:
-        c = C[j]
+        c = TOP[j]
+        if c <= 0:
+            j = D[j]
+            continue
         if kind[c] == COUNTER:
             if cnt[c] == hi[c]:
-                _uncover(c, L, R, U, D, C, S)
+                _uncover(c, HL, HR, U, D, TOP, S)
             cnt[c] -= 1
         else:
-            _uncover(c, L, R, U, D, C, S)
-        j = L[j]
+            _uncover(c, HL, HR, U, D, TOP, S)
+        j -= 1
 
 
-@njit(cache=True)
-def _choose(R: Any, S: Any) -> int:
+@njit(cache=True, boundscheck=False)
+def _choose(HR: Any, S: Any) -> int:
     best = 0
     best_size = 1 << 30
-    c = R[0]
+    c = HR[0]
     while c != 0:
         if S[c] < best_size:
             best = c
             best_size = S[c]
             if best_size <= 1:
                 break
-        c = R[c]
+        c = HR[c]
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, boundscheck=False)
 def dlx_run(
-    L: Any, R: Any, U: Any, D: Any, C: Any, RW: Any, S: Any,
+    HL: Any, HR: Any, U: Any, D: Any, TOP: Any, RW: Any, S: Any,
     kind: Any, lo: Any, hi: Any, cnt: Any, counters: Any,
     buf: Any, nbuf: Any, pos: Any, lcol: Any, chosen: Any,
     regs: Any, rng: Any, shuffle: bool,
@@ -145,8 +170,8 @@ def dlx_run(
     found = 0
     n_out = 0
     if status == FRESH:
-        c = _choose(R, S)
-        updates += _cover(c, L, R, U, D, C, S)
+        c = _choose(HR, S)
+        updates += _cover(c, HL, HR, U, D, TOP, S)
         k = 0
         n = 0
         i = D[c]
@@ -170,9 +195,9 @@ def dlx_run(
             r = buf[k, pos[k]]
             pos[k] += 1
             nodes += 1
-            updates += _select(r, L, R, U, D, C, S, kind, hi, cnt)
+            updates += _select(r, HL, HR, U, D, TOP, S, kind, hi, cnt)
             chosen[k] = r
-            c = _choose(R, S)
+            c = _choose(HR, S)
             if c == 0:
                 ok = True
                 for q in counters:
@@ -183,15 +208,15 @@ def dlx_run(
                     found += 1
                     if max_store > 0:
                         n_out = store_solution(out, n_out, chosen, RW, k)
-                _unselect(r, L, R, U, D, C, S, kind, hi, cnt)
+                _unselect(r, HL, HR, U, D, TOP, S, kind, hi, cnt)
                 if ok and ((max_store > 0 and n_out == max_store) or found == stop_after):
                     break
                 continue
             if S[c] == 0:
-                _unselect(r, L, R, U, D, C, S, kind, hi, cnt)
+                _unselect(r, HL, HR, U, D, TOP, S, kind, hi, cnt)
                 continue
             k += 1
-            updates += _cover(c, L, R, U, D, C, S)
+            updates += _cover(c, HL, HR, U, D, TOP, S)
             n = 0
             i = D[c]
             while i != c:
@@ -204,12 +229,12 @@ def dlx_run(
             pos[k] = 0
             lcol[k] = c
         else:
-            _uncover(lcol[k], L, R, U, D, C, S)
+            _uncover(lcol[k], HL, HR, U, D, TOP, S)
             if k == 0:
                 regs[REG_STATUS] = DONE
                 break
             k -= 1
-            _unselect(chosen[k], L, R, U, D, C, S, kind, hi, cnt)
+            _unselect(chosen[k], HL, HR, U, D, TOP, S, kind, hi, cnt)
     regs[REG_DEPTH] = k
     regs[REG_NODES] = nodes
     regs[REG_UPDATES] = updates
@@ -247,43 +272,45 @@ class DLXArrays:
         if optional.any():
             keep = [not optional[flat[ptr[r] : ptr[r + 1]]].all() for r in rows]
             rows = rows[np.asarray(keep, dtype=bool)]
-        sizes = (ptr[rows + 1] - ptr[rows]).astype(np.int64) + 1
-        n_nodes = 1 + n_cols + int(sizes.sum())
+        sizes = (ptr[rows + 1] - ptr[rows]).astype(np.int64) + 1  # the type node + cells
+        # Row i's nodes are first[i] : first[i] + sizes[i]; spacer i sits just before them.
         first = np.zeros(len(rows) + 1, dtype=np.int64)
-        np.cumsum(sizes, out=first[1:])
-        first += 1 + n_cols
-        C = np.zeros(n_nodes, dtype=np.int32)
+        np.cumsum(sizes + 1, out=first[1:])
+        first += n_cols + 2
+        n_nodes = int(first[-1])  # the final spacer is n_nodes - 1
+        TOP = np.zeros(n_nodes, dtype=np.int32)
         RW = np.full(n_nodes, -1, dtype=np.int32)
-        L = np.arange(n_nodes, dtype=np.int32)
-        R = np.arange(n_nodes, dtype=np.int32)
-        for i, r in enumerate(rows):
-            a, b = int(first[i]), int(first[i + 1])
-            C[a] = problem.row_type[r] + 1
-            C[a + 1 : b] = flat[ptr[r] : ptr[r + 1]] + T + 1
-            RW[a:b] = r
-            idx = np.arange(a, b, dtype=np.int32)
-            R[a:b] = np.roll(idx, -1)
-            L[a:b] = np.roll(idx, 1)
-        C[: n_cols + 1] = np.arange(n_cols + 1, dtype=np.int32)
-        # Vertical lists: every column is header, then its nodes in row order, circular.
         U = np.arange(n_nodes, dtype=np.int32)
         D = np.arange(n_nodes, dtype=np.int32)
-        data = np.arange(n_cols + 1, n_nodes, dtype=np.int32)
-        order = data[np.argsort(C[data], kind="stable")]
-        col_sorted = C[order]
-        S = np.bincount(C[data], minlength=n_cols + 1).astype(np.int32)
-        starts = np.searchsorted(col_sorted, np.arange(1, n_cols + 1))
+        TOP[: n_cols + 1] = np.arange(n_cols + 1, dtype=np.int32)
+        for i, r in enumerate(rows):
+            a = int(first[i])
+            b = a + int(sizes[i])
+            TOP[a] = problem.row_type[r] + 1
+            TOP[a + 1 : b] = flat[ptr[r] : ptr[r + 1]] + T + 1
+            RW[a:b] = r
+            D[a - 1] = b - 1  # spacer before the row: its last node
+            U[b] = a  # spacer after the row: its first node
+        # Vertical lists: every column is header, then its nodes in row order, circular.
+        is_node = np.zeros(n_nodes, dtype=bool)
+        is_node[n_cols + 1 :] = TOP[n_cols + 1 :] > 0
+        data = np.flatnonzero(is_node).astype(np.int32)
+        order = data[np.argsort(TOP[data], kind="stable")]
+        S = np.bincount(TOP[data], minlength=n_cols + 1).astype(np.int32)
+        starts = np.searchsorted(TOP[order], np.arange(1, n_cols + 1))
         for h in range(1, n_cols + 1):
             seq = order[starts[h - 1] : starts[h - 1] + S[h]]
             chain = np.concatenate(([h], seq)).astype(np.int32)
             D[chain] = np.roll(chain, -1)
             U[chain] = np.roll(chain, 1)
         # Header list: primary columns only, in column order.
+        HL = np.arange(n_cols + 1, dtype=np.int32)
+        HR = np.arange(n_cols + 1, dtype=np.int32)
         prim = [0] + [h for h in range(1, n_cols + 1) if kind[h] == PRIMARY]
         pa = np.asarray(prim, dtype=np.int32)
-        R[pa] = np.roll(pa, -1)
-        L[pa] = np.roll(pa, 1)
-        self.arrays = (L, R, U, D, C, RW, S)
+        HR[pa] = np.roll(pa, -1)
+        HL[pa] = np.roll(pa, 1)
+        self.arrays = (HL, HR, U, D, TOP, RW, S)
         self.kind, self.lo, self.hi = kind, lo, hi
         self.counters = np.asarray(
             [h for h in range(1, n_cols + 1) if kind[h] == COUNTER and lo[h] > 0], dtype=np.int32
@@ -294,5 +321,5 @@ class DLXArrays:
 
     def fresh(self) -> tuple[np.ndarray, ...]:
         """Copies of the mutable arrays for one independent search."""
-        L, R, U, D, C, RW, S = self.arrays
-        return (L.copy(), R.copy(), U.copy(), D.copy(), C, RW, S.copy())
+        HL, HR, U, D, TOP, RW, S = self.arrays
+        return (HL.copy(), HR.copy(), U.copy(), D.copy(), TOP, RW, S.copy())

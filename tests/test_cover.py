@@ -186,7 +186,7 @@ def test_bad_input() -> None:
     with pytest.raises(CoverError):
         count_solutions([PieceSpec(DOMINO, "d", 2, 1)], (2, 1, 1))
     with pytest.raises(CoverError):
-        count_solutions([DOMINO], (9, 9, 1), engine="bitboard")
+        count_solutions([DOMINO], (9, 9, 1), engine="bitboard-first")
     with pytest.raises(CoverError):
         count_solutions({"a": DOMINO}, (2, 1, 1), node_limit=-1)
 

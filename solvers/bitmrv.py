@@ -1,0 +1,495 @@
+"""Bit-board exact cover that branches on the most constrained cell (any target size).
+
+Every node keeps the list of rows still *alive* (not overlapping the occupancy, type not used
+up), filtered from its parent's list in one pass. The same pass adds each alive row's cell mask
+into bit-sliced counters (four planes and a saturation plane), so at the end of it the number
+of alive rows through every empty cell is known up to 15 without a loop over cells. The search
+then branches on the empty mandatory cell with the fewest alive rows (ties: lowest bit, i.e.
+first in scan order), or on an unused exact-once piece when that piece has at most as many
+alive rows (pieces win ties, as in :mod:`solvers.dlx`). When every empty cell has 16 or more
+rows (near the root only: 21 thousand of 3.4 million nodes on the 2x5x6 solid pentominoes) the
+counts are taken exactly, cell by cell. A cell with no alive row,
+an exact-once piece with no alive row, or a piece type with fewer alive rows than it still needs
+ends the branch at once; so does, in box targets of one word, a placement that cuts off an empty
+region no set of pieces can fill (:func:`solvers.bitboard.regions_ok`, same scan order).
+
+Targets over 64 cells use ``W = ceil(cells / 64)`` words per mask (:func:`mrv_wide_run`); the
+one-word kernel :func:`mrv_run` is the same algorithm on scalars. Piece types carry count ranges
+exactly as in :mod:`solvers.dlx`. ``nodes`` counts rows placed (as in the DLX kernel: a row that
+completes a cover or ends in a dead end counts too); ``updates`` counts rows tested by the
+filter (the unit of work here).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numba import njit
+
+from solvers.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
+from solvers.kernels import (
+    DONE,
+    FRESH,
+    LIMIT,
+    REG_DEPTH,
+    REG_NODES,
+    REG_SOLUTIONS,
+    REG_STATUS,
+    REG_UPDATES,
+    RUNNING,
+    shuffle_prefix,
+    store_solution,
+)
+from solvers.placements import Int32Array
+from solvers.problem import CoverProblem
+
+_ONE = np.uint64(1)
+_NONE = np.uint64(0)
+
+_DEBRUIJN_MUL = np.uint64(0x03F79D71B4CB0A89)  # with bitboard.DEBRUIJN_TABLE
+
+#: Saturated count of the bit-sliced counters (counts 0..15 are exact).
+SATURATED = 16
+
+
+@njit(cache=True, inline="always")
+def _low(x: Any, table: Any) -> int:
+    """Index of the lowest set bit of a non-zero ``uint64``."""
+    return int(table[((x & (~x + _ONE)) * _DEBRUIJN_MUL) >> np.uint64(58)])
+
+
+@njit(cache=True, inline="always")
+def _with_count(v: int, b0: Any, b1: Any, b2: Any, b3: Any, sat: Any) -> Any:
+    """Bits whose bit-sliced count is exactly ``v`` (0 <= v < 16)."""
+    x = ~sat
+    x &= b0 if v & 1 else ~b0
+    x &= b1 if v & 2 else ~b1
+    x &= b2 if v & 4 else ~b2
+    x &= b3 if v & 8 else ~b3
+    return x
+
+
+@njit(cache=True)
+def _exact_min(live: Any, a: int, b: int, mask: Any, empty: Any, table: Any, tally: Any) -> Any:
+    """``(cell, count)`` of the empty cell with fewest rows of ``live[a:b]`` (lowest bit on
+    ties), counted one by one (used only when every count is saturated)."""
+    tally[:] = 0
+    for i in range(a, b):
+        m = mask[live[i]] & empty
+        while m != _NONE:
+            tally[_low(m, table)] += 1
+            m &= m - _ONE
+    best, best_n = -1, 1 << 30
+    e = empty
+    while e != _NONE:
+        c = _low(e, table)
+        if tally[c] < best_n:
+            best, best_n = c, tally[c]
+        e &= e - _ONE
+    return best, best_n
+
+
+@njit(cache=True)
+def _expand(
+    src: Any, a: int, b: int, live: Any, w: int, occ: Any, primary: Any,
+    mask: Any, rtype: Any, lo: Any, hi: Any, cnt: Any, tcount: Any, counters: Any,
+    pieces: Any, table: Any, tally: Any, br: Any,
+) -> tuple[int, int]:  # fmt: skip
+    """Filter ``src[a:b]`` to the rows alive under ``occ`` (written from ``live[w]``), pick the
+    branching cell or piece and write its rows to ``br``; returns ``(end of the alive list,
+    number of branches)`` with 0 branches for a dead end."""
+    b0 = _NONE
+    b1 = _NONE
+    b2 = _NONE
+    b3 = _NONE
+    sat = _NONE
+    tcount[:] = 0
+    n = w
+    cur = 0  # rows come grouped by type: count each type's run in a register
+    run = 0
+    for i in range(a, b):  # branch-free keep test: it is unpredictable
+        j = src[i]
+        m = mask[j]
+        t = rtype[j]
+        if t != cur:
+            tcount[cur] += run
+            cur = t
+            run = 0
+        keep = ((m & occ) == _NONE) & (cnt[t] < hi[t])
+        live[n] = j
+        n += keep
+        run += keep
+        m &= _NONE - np.uint64(keep)
+        c0 = b0 & m
+        b0 ^= m
+        c1 = b1 & c0
+        b1 ^= c0
+        c2 = b2 & c1
+        b2 ^= c1
+        sat |= b3 & c2
+        b3 ^= c2
+    tcount[cur] += run
+    empty = primary & ~occ
+    if empty & ~(b0 | b1 | b2 | b3 | sat):
+        return n, 0  # an empty cell no row can fill
+    for q in counters:
+        if cnt[q] + tcount[q] < lo[q]:
+            return n, 0  # not enough rows left for a piece still needed
+    best_t, best_n = -1, 1 << 30
+    for t in pieces:
+        if cnt[t] == 0 and tcount[t] < best_n:
+            best_t, best_n = t, tcount[t]
+    cell = -1
+    for v in range(1, min(best_n, SATURATED)):  # cells strictly below the best piece
+        x = empty & _with_count(v, b0, b1, b2, b3, sat)
+        if x != _NONE:
+            cell, best_n = _low(x, table), v
+            break
+    if cell < 0 and best_n > SATURATED:
+        c, cn = _exact_min(live, w, n, mask, empty, table, tally)
+        if cn < best_n:
+            cell, best_n = c, cn
+    k = 0
+    if cell >= 0:
+        bit = _ONE << np.uint64(cell)
+        for i in range(w, n):
+            j = live[i]
+            if mask[j] & bit:
+                br[k] = j
+                k += 1
+    else:
+        for i in range(w, n):
+            j = live[i]
+            if rtype[j] == best_t:
+                br[k] = j
+                k += 1
+    return n, k
+
+
+@njit(cache=True)
+def mrv_run(
+    mask: Any, rtype: Any, rid: Any, allrows: Any, primary: Any,
+    lo: Any, hi: Any, cnt: Any, counters: Any, pieces: Any, table: Any,
+    nb: Any, region_gcd: int, region_min: int,
+    live: Any, lstart: Any, occ: Any, tcount: Any, tally: Any,
+    br: Any, nbr: Any, pos: Any, chosen: Any,
+    regs: Any, rng: Any, shuffle: bool,
+    out: Any, max_store: int, stop_after: int, node_limit: int,
+) -> int:  # fmt: skip
+    """Run (or resume) the search; same contract as :func:`solvers.dlx.dlx_run`.
+
+    Level ``k`` has the alive rows ``live[lstart[k] : lstart[k + 1]]``, occupancy ``occ[k]``
+    and branches ``br[k, :nbr[k]]`` (tried up to ``pos[k]``).
+    """
+    status = regs[REG_STATUS]
+    if status == DONE:
+        return 0
+    nodes = regs[REG_NODES]
+    updates = regs[REG_UPDATES]
+    found = 0
+    n_out = 0
+    if status == FRESH:
+        k = 0
+        occ[0] = _NONE
+        lstart[0] = 0
+        end, n_br = _expand(
+            allrows, 0, len(allrows), live, 0, _NONE, primary, mask, rtype, lo, hi, cnt,
+            tcount, counters, pieces, table, tally, br[0],
+        )  # fmt: skip
+        updates += len(allrows)
+        lstart[1] = end
+        nbr[0] = n_br
+        pos[0] = 0
+        if shuffle:
+            shuffle_prefix(br[0], n_br, rng)
+    else:
+        k = regs[REG_DEPTH]
+    regs[REG_STATUS] = RUNNING
+    while True:
+        if pos[k] < nbr[k]:
+            if nodes >= node_limit:
+                regs[REG_STATUS] = LIMIT
+                break
+            r = br[k, pos[k]]
+            pos[k] += 1
+            nodes += 1
+            chosen[k] = r
+            here = occ[k] | mask[r]
+            t = rtype[r]
+            cnt[t] += 1
+            if (here & primary) == primary:  # every mandatory cell covered
+                ok = True
+                for q in counters:
+                    if cnt[q] < lo[q]:
+                        ok = False
+                        break
+                cnt[t] -= 1
+                if ok:
+                    found += 1
+                    if max_store > 0:
+                        n_out = store_solution(out, n_out, chosen, rid, k)
+                    if (max_store > 0 and n_out == max_store) or found == stop_after:
+                        break
+                continue
+            if region_min > 0 and not regions_ok(
+                mask[r], primary & ~here, nb, region_gcd, region_min
+            ):
+                cnt[t] -= 1  # cuts off a region no set of pieces can fill
+                continue
+            a, b = lstart[k], lstart[k + 1]
+            updates += b - a
+            end, n_br = _expand(
+                live, a, b, live, b, here, primary, mask, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, br[k + 1],
+            )  # fmt: skip
+            if n_br == 0:
+                cnt[t] -= 1
+                continue
+            k += 1
+            occ[k] = here
+            lstart[k + 1] = end
+            nbr[k] = n_br
+            pos[k] = 0
+            if shuffle:
+                shuffle_prefix(br[k], n_br, rng)
+        else:
+            if k == 0:
+                regs[REG_STATUS] = DONE
+                break
+            k -= 1
+            cnt[rtype[chosen[k]]] -= 1
+    regs[REG_DEPTH] = k
+    regs[REG_NODES] = nodes
+    regs[REG_UPDATES] = updates
+    regs[REG_SOLUTIONS] += found
+    return n_out
+
+
+@njit(cache=True)
+def _expand_wide(
+    src: Any, a: int, b: int, live: Any, w0: int, occ: Any, primary: Any,
+    masks: Any, rtype: Any, lo: Any, hi: Any, cnt: Any, tcount: Any, counters: Any,
+    pieces: Any, table: Any, tally: Any, planes: Any, empty: Any, br: Any,
+) -> tuple[int, int]:  # fmt: skip
+    """:func:`_expand` on masks of ``W`` words (``planes``: (5, W) scratch counters)."""
+    W = masks.shape[1]
+    planes[:] = _NONE
+    tcount[:] = 0
+    n = w0
+    for i in range(a, b):
+        j = src[i]
+        t = rtype[j]
+        hit = _NONE
+        for w in range(W):
+            hit |= masks[j, w] & occ[w]
+        if hit != _NONE or cnt[t] >= hi[t]:
+            continue
+        live[n] = j
+        n += 1
+        tcount[t] += 1
+        for w in range(W):
+            c = masks[j, w]
+            for p in range(4):
+                nxt = planes[p, w] & c
+                planes[p, w] ^= c
+                c = nxt
+            planes[4, w] |= c
+    for w in range(W):
+        empty[w] = primary[w] & ~occ[w]
+        seen = planes[0, w] | planes[1, w] | planes[2, w] | planes[3, w] | planes[4, w]
+        if empty[w] & ~seen:
+            return n, 0
+    for q in counters:
+        if cnt[q] + tcount[q] < lo[q]:
+            return n, 0
+    best_t, best_n = -1, 1 << 30
+    for t in pieces:
+        if cnt[t] == 0 and tcount[t] < best_n:
+            best_t, best_n = t, tcount[t]
+    cell = -1
+    for v in range(1, min(best_n, SATURATED)):  # cells strictly below the best piece
+        for w in range(W):
+            x = empty[w] & _with_count(
+                v, planes[0, w], planes[1, w], planes[2, w], planes[3, w], planes[4, w]
+            )
+            if x != _NONE:
+                cell = 64 * w + _low(x, table)
+                break
+        if cell >= 0:
+            best_n = v
+            break
+    if cell < 0 and best_n > SATURATED:
+        tally[:] = 0
+        for i in range(w0, n):
+            for w in range(W):
+                m = masks[live[i], w] & empty[w]
+                while m != _NONE:
+                    tally[64 * w + _low(m, table)] += 1
+                    m &= m - _ONE
+        for w in range(W):
+            e = empty[w]
+            while e != _NONE:
+                c = 64 * w + _low(e, table)
+                if tally[c] < best_n:
+                    cell, best_n = c, tally[c]
+                e &= e - _ONE
+    k = 0
+    if cell >= 0:
+        word, bit = cell // 64, _ONE << np.uint64(cell % 64)
+        for i in range(w0, n):
+            j = live[i]
+            if masks[j, word] & bit:
+                br[k] = j
+                k += 1
+    else:
+        for i in range(w0, n):
+            j = live[i]
+            if rtype[j] == best_t:
+                br[k] = j
+                k += 1
+    return n, k
+
+
+@njit(cache=True)
+def mrv_wide_run(
+    masks: Any, rtype: Any, rid: Any, allrows: Any, primary: Any,
+    lo: Any, hi: Any, cnt: Any, counters: Any, pieces: Any, table: Any,
+    live: Any, lstart: Any, occ: Any, tcount: Any, tally: Any, planes: Any, scratch: Any,
+    br: Any, nbr: Any, pos: Any, chosen: Any,
+    regs: Any, rng: Any, shuffle: bool,
+    out: Any, max_store: int, stop_after: int, node_limit: int,
+) -> int:  # fmt: skip
+    """:func:`mrv_run` on masks of ``W`` words: ``occ`` is (depth, W), ``scratch`` (2, W)."""
+    status = regs[REG_STATUS]
+    if status == DONE:
+        return 0
+    W = masks.shape[1]
+    nodes = regs[REG_NODES]
+    updates = regs[REG_UPDATES]
+    found = 0
+    n_out = 0
+    here = scratch[0]
+    if status == FRESH:
+        k = 0
+        occ[0, :] = _NONE
+        lstart[0] = 0
+        end, nb = _expand_wide(
+            allrows, 0, len(allrows), live, 0, occ[0], primary, masks, rtype, lo, hi, cnt,
+            tcount, counters, pieces, table, tally, planes, scratch[1], br[0],
+        )  # fmt: skip
+        updates += len(allrows)
+        lstart[1] = end
+        nbr[0] = nb
+        pos[0] = 0
+        if shuffle:
+            shuffle_prefix(br[0], nb, rng)
+    else:
+        k = regs[REG_DEPTH]
+    regs[REG_STATUS] = RUNNING
+    while True:
+        if pos[k] < nbr[k]:
+            if nodes >= node_limit:
+                regs[REG_STATUS] = LIMIT
+                break
+            r = br[k, pos[k]]
+            pos[k] += 1
+            nodes += 1
+            chosen[k] = r
+            full = True
+            for w in range(W):
+                here[w] = occ[k, w] | masks[r, w]
+                if (here[w] & primary[w]) != primary[w]:
+                    full = False
+            t = rtype[r]
+            cnt[t] += 1
+            if full:
+                ok = True
+                for q in counters:
+                    if cnt[q] < lo[q]:
+                        ok = False
+                        break
+                cnt[t] -= 1
+                if ok:
+                    found += 1
+                    if max_store > 0:
+                        n_out = store_solution(out, n_out, chosen, rid, k)
+                    if (max_store > 0 and n_out == max_store) or found == stop_after:
+                        break
+                continue
+            a, b = lstart[k], lstart[k + 1]
+            updates += b - a
+            end, nb = _expand_wide(
+                live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, planes, scratch[1], br[k + 1],
+            )  # fmt: skip
+            if nb == 0:
+                cnt[t] -= 1
+                continue
+            k += 1
+            occ[k, :] = here
+            lstart[k + 1] = end
+            nbr[k] = nb
+            pos[k] = 0
+            if shuffle:
+                shuffle_prefix(br[k], nb, rng)
+        else:
+            if k == 0:
+                regs[REG_STATUS] = DONE
+                break
+            k -= 1
+            cnt[rtype[chosen[k]]] -= 1
+    regs[REG_DEPTH] = k
+    regs[REG_NODES] = nodes
+    regs[REG_UPDATES] = updates
+    regs[REG_SOLUTIONS] += found
+    return n_out
+
+
+class MRVArrays:
+    """Row masks (``W`` words each) of a problem restricted to a subset of its rows."""
+
+    def __init__(self, problem: CoverProblem, rows: Int32Array) -> None:
+        n_cells = problem.n_cells
+        self.words = W = max(1, -(-n_cells // 64))
+        bit = scan_order(problem)  # the first-cell kernel's order: regions_ok relies on it
+        optional = np.zeros(n_cells, dtype=bool)
+        if problem.optional:
+            optional[sorted(problem.optional)] = True
+        rows = np.asarray(rows, dtype=np.int32)
+        ptr, flat = problem.row_ptr, problem.flat_cells
+        keep = [not optional[flat[ptr[r] : ptr[r + 1]]].all() for r in rows]
+        rows = rows[np.asarray(keep, dtype=bool)] if len(rows) else rows
+        masks = np.zeros((len(rows), W), dtype=np.uint64)
+        per_cell = np.zeros(n_cells, dtype=np.int64)
+        for i, r in enumerate(rows):
+            cells = flat[ptr[r] : ptr[r + 1]]
+            per_cell[cells] += 1
+            for b in bit[cells]:
+                masks[i, b // 64] |= np.uint64(1) << np.uint64(b % 64)
+        primary = np.zeros(W, dtype=np.uint64)
+        for c in range(n_cells):
+            if not optional[c]:
+                primary[bit[c] // 64] |= np.uint64(1) << np.uint64(bit[c] % 64)
+        self.rid = np.ascontiguousarray(rows)
+        self.rtype = np.ascontiguousarray(problem.row_type[rows]).astype(np.int32)
+        self.masks = masks
+        self.mask = np.ascontiguousarray(masks[:, 0])  # the one-word kernel's masks
+        self.primary = primary
+        self.allrows = np.arange(len(rows), dtype=np.int32)
+        T = len(problem.types)
+        self.lo = np.array([t.lo for t in problem.types], dtype=np.int32)
+        self.hi = np.array([t.hi for t in problem.types], dtype=np.int32)
+        self.counters = np.array([t for t in range(T) if self.lo[t] > 0], dtype=np.int32)
+        self.pieces = np.array(
+            [t for t, ty in enumerate(problem.types) if ty.lo == 1 and ty.hi == 1], dtype=np.int32
+        )
+        n_primary = n_cells - int(optional.sum())
+        self.max_depth = min(n_primary, int(self.hi.sum()))
+        per_type = np.bincount(self.rtype, minlength=T) if T else np.zeros(1, np.int64)
+        self.max_col = max(int(per_cell.max(initial=0)), int(per_type.max(initial=0)), 1)
+        self.table = DEBRUIJN_TABLE
+        if W == 1:
+            self.nb, self.region_gcd, self.region_min = region_pruning(problem)
+        else:
+            self.nb, self.region_gcd, self.region_min = np.zeros(8, np.uint64), 1, 0

@@ -1,0 +1,142 @@
+"""The exact-cover kernels agree: DLX, the first-cell bit-board and the MRV bit-board (one-word
+and multi-word masks) list the same solutions, and the automatic rule picks as documented."""
+
+from __future__ import annotations
+
+from math import comb
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from chaingeo.geometry import Shape, box_cells
+from chaingeo.piecesets import PENTOMINOES, SOMA
+from solvers.cover import CoverLimitError, CoverSearch, PieceSpec, count_solutions, cover_problem
+from solvers.problem import CoverProblem
+from solvers.search import choose_kernel
+from tests.strategies import polycubes
+from tests.test_cover import instances
+
+KERNELS = ("dlx", "bitboard-first", "bitboard-mrv")
+
+
+def _rod(n: int) -> Shape:
+    return Shape([(0, 0, z) for z in range(n)])
+
+
+def _solution_set(problem: CoverProblem, engine: str, limit: int | None = None) -> set[bytes]:
+    """Every solution as the bytes of its sorted row ids."""
+    search = CoverSearch(problem, engine=engine, node_limit=limit)  # type: ignore[arg-type]
+    out: set[bytes] = set()
+    for block in search.batches(4096):
+        for sol in block:
+            key = np.sort(sol[sol >= 0]).astype(np.int32).tobytes()
+            assert key not in out, engine  # each solution exactly once
+            out.add(key)
+    assert len(out) == search.found
+    return out
+
+
+@settings(max_examples=60, deadline=None)
+@given(instances(), st.booleans())
+def test_kernels_list_the_same_solutions(
+    inst: tuple[list[PieceSpec], tuple[int, int, int], Shape | None], reflections: bool
+) -> None:
+    specs, dims, optional = inst
+    problem = cover_problem(specs, dims, optional=optional, reflections=reflections)
+    if not problem.types:
+        return
+    sets = {k: _solution_set(problem, k) for k in KERNELS}
+    assert sets["dlx"] == sets["bitboard-first"] == sets["bitboard-mrv"]
+    for k in KERNELS:  # and with symmetry reduction
+        r = count_solutions(problem, engine=k)  # type: ignore[arg-type]
+        assert r.solutions == len(sets["dlx"]), k
+
+
+@st.composite
+def wide_instances(draw: st.DrawFn) -> tuple[list[PieceSpec], tuple[int, int, int]]:
+    """Thin boxes of 65..120 cells (two words) with pieces of four to six cells, each used a
+    fixed number of times: few packings, deep searches across the word boundary."""
+    a = draw(st.integers(1, 2))
+    b = draw(st.integers(2, 3))
+    c = draw(st.integers(-(-65 // (a * b)), 120 // (a * b)))
+    cells = a * b * c
+    specs: list[PieceSpec] = []
+    left = cells
+    while left > 0:
+        shape = draw(polycubes(min_size=min(4, left), max_size=min(6, left)))
+        copies = draw(st.integers(1, max(1, left // len(shape))))
+        specs.append(PieceSpec(shape, f"p{len(specs)}", copies, copies))
+        left -= copies * len(shape)
+    if left < 0:  # overshot: let the last piece be used fewer times
+        last = specs[-1]
+        specs[-1] = PieceSpec(last.shape, last.name, 0, last.max)
+    return specs, (a, b, c)
+
+
+@settings(max_examples=25, deadline=None)
+@given(wide_instances())
+def test_multiword_bitboard_matches_dlx(inst: tuple[list[PieceSpec], tuple[int, int, int]]) -> None:
+    specs, dims = inst
+    problem = cover_problem(specs, dims)
+    assert problem.n_cells > 64
+    try:
+        expected = _solution_set(problem, "dlx", limit=50_000)
+    except CoverLimitError:
+        return  # too big for a quick check
+    assert _solution_set(problem, "bitboard-mrv") == expected
+
+
+def test_rods_across_the_word_boundary() -> None:
+    # A line of 70 cells tiled by rods of 3 and 5 (any number): one tiling per composition.
+    expected = sum(comb(a + b, a) for a in range(24) for b in range(15) if 3 * a + 5 * b == 70)
+    specs = [PieceSpec(_rod(3), "r3", 0, 30), PieceSpec(_rod(5), "r5", 0, 20)]
+    for engine in ("auto", "dlx", "bitboard", "bitboard-mrv"):
+        r = count_solutions(specs, (1, 1, 70), engine=engine, distinct=False)  # type: ignore[arg-type]
+        assert r.solutions == expected == 63862, engine
+
+
+def test_optional_cells_beyond_64() -> None:
+    # Two rows of 34 filled by rods of 4 and 5; two far corners may stay empty.
+    opt = Shape([(0, 0, 0), (0, 1, 33)])
+    specs = [PieceSpec(_rod(4), "r4", 0, 17), PieceSpec(_rod(5), "r5", 0, 13)]
+    wide = cover_problem(specs, (1, 2, 34), optional=opt)
+    assert wide.n_cells == 68
+    sols = _solution_set(wide, "dlx")
+    assert len(sols) > 100 and _solution_set(wide, "bitboard-mrv") == sols
+
+
+@pytest.mark.parametrize("box", [(3, 3, 3), (6, 10, 1), (2, 5, 6), (4, 4, 5)])
+def test_automatic_rule(box: tuple[int, int, int]) -> None:
+    pieces = SOMA.pieces if box == (3, 3, 3) else PENTOMINOES.pieces
+    problem = cover_problem(pieces, box)
+    expected = {
+        (3, 3, 3): "bitboard-first",  # at most 32 cells
+        (6, 10, 1): "bitboard-first",  # one layer
+        (2, 5, 6): "bitboard-mrv",  # thick
+        (4, 4, 5): "bitboard-mrv",  # over 64 cells
+    }[box]
+    assert choose_kernel(problem, "auto") == choose_kernel(problem, "bitboard") == expected
+    assert choose_kernel(problem, "dlx") == "dlx"
+
+
+@pytest.mark.parametrize("engine", KERNELS)
+def test_random_order_is_a_permutation(engine: str) -> None:
+    problem = cover_problem([PieceSpec(_rod(2), "d", 0, 40)], box_cells((2, 3, 4)))
+    plain = _solution_set(problem, engine)
+    rng = np.random.default_rng(7)
+    search = CoverSearch(problem, engine=engine, rng=rng)  # type: ignore[arg-type]
+    shuffled = [np.sort(s[s >= 0]).astype(np.int32).tobytes() for b in search.batches(7) for s in b]
+    assert len(shuffled) == len(plain) and set(shuffled) == plain
+
+
+def test_mrv_visits_fewer_nodes_than_first_cell_in_thick_boxes() -> None:
+    problem = cover_problem(PENTOMINOES.pieces, (2, 5, 6))
+    nodes = {}
+    for k in ("bitboard-first", "bitboard-mrv"):
+        search = CoverSearch(problem, engine=k, node_limit=300_000)  # type: ignore[arg-type]
+        for _ in search.batches(1):
+            break  # nodes to the first packing
+        nodes[k] = search.stats.nodes
+    assert nodes["bitboard-mrv"] < nodes["bitboard-first"]
