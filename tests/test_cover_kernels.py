@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.geometry import Shape, box_cells
-from chaingeo.piecesets import PENTOMINOES, SOMA
+from chaingeo.core.geometry import Shape, box_cells
+from chaingeo.core.piecesets import PENTOMINOES, SOMA
 from solvers.cover import CoverLimitError, CoverSearch, PieceSpec, count_solutions, cover_problem
 from solvers.problem import CoverProblem
 from solvers.search import choose_kernel
@@ -93,7 +93,7 @@ def test_rods_across_the_word_boundary() -> None:
     expected = sum(comb(a + b, a) for a in range(24) for b in range(15) if 3 * a + 5 * b == 70)
     specs = [PieceSpec(_rod(3), "r3", 0, 30), PieceSpec(_rod(5), "r5", 0, 20)]
     for engine in ("auto", "dlx", "bitboard", "bitboard-mrv"):
-        r = count_solutions(specs, (1, 1, 70), engine=engine, distinct=False)  # type: ignore[arg-type]
+        r = count_solutions(specs, (1, 1, 70), engine=engine, distinct=False)
         assert r.solutions == expected == 63862, engine
 
 
@@ -135,7 +135,7 @@ def test_mrv_visits_fewer_nodes_than_first_cell_in_thick_boxes() -> None:
     problem = cover_problem(PENTOMINOES.pieces, (2, 5, 6))
     nodes = {}
     for k in ("bitboard-first", "bitboard-mrv"):
-        search = CoverSearch(problem, engine=k, node_limit=300_000)  # type: ignore[arg-type]
+        search = CoverSearch(problem, engine=k, node_limit=300_000)
         for _ in search.batches(1):
             break  # nodes to the first packing
         nodes[k] = search.stats.nodes
