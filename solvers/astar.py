@@ -16,8 +16,14 @@ different parts commute and act on nothing else, so any plan can be reordered to
 parts in that order with the same length (the next move of the active part in the given plan is
 legal now, as it depends on that part alone); the optimum is unchanged, and interleavings are
 never enumerated. A* pops by ``f = g + h`` (ties: deeper first, then older); with a
-consistent ``h`` the first goal popped is optimal and no state is expanded twice (the search
-still reopens a state reached more cheaply, and counts it: the tests check it never happens).
+consistent ``h`` the first goal popped is optimal and no state is reached again more cheaply
+after its expansion (the search would reopen it, and counts it: the tests check it never
+happens). *Partial expansion* (Yoshizumi et al.'s PEA*): expanding a state with value ``F``
+stores only the children with ``f == F`` and puts the state back with ``F`` = the smallest
+larger child ``f``; children that never reach the front (most of them) are never stored. A
+child is stored at the expansion whose ``F`` equals its ``f``, so every child is still
+considered in ``f`` order and the optimum is unchanged; ``expanded`` counts these partial
+expansions.
 
 **Heuristic.** For a subset ``S`` of a part ``P`` (a pair or a triple), ``g_S(X)`` is the fewest
 moves that take ``S`` apart when every other piece is gone, from the one-part state ``X`` with

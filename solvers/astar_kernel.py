@@ -123,7 +123,7 @@ def _heap_key(g: int, h: int) -> int:
 
 @njit(cache=True)
 def run_astar(
-    regs: I64, rows: I16, gv: I32, hv: I32, hact: I32, parent: I64, mmask: I64, mdir: I64,
+    regs: I64, rows: I16, gv: I32, hv: I32, hact: I32, fv: I32, parent: I64, mmask: I64, mdir: I64,
     mk: I64, closed: U8, table: I64, hkey: I64, hnode: I64,
     gvox: I64, gstarts: I64, glo: I64, ghi: I64, max_group: int, group_limit: int,
     fam: I64, n_fam: int, pkeys: I16, pvals: I32, ptable: I64, miss: I16,
@@ -148,9 +148,9 @@ def run_astar(
             node = hnode[0]
             regs[R_HEAP] = _pop(hkey, hnode, regs[R_HEAP])
             g = (1 << _GBITS) - 1 - (hk & ((1 << _GBITS) - 1))
-            if closed[node] or g != gv[node]:
-                continue  # stale heap entry
             f = hk >> _GBITS
+            if g != gv[node] or f != fv[node]:
+                continue  # stale heap entry
             if f > regs[R_BOUND]:
                 regs[R_BOUND] = f
             if hv[node] == 0:
@@ -207,6 +207,9 @@ def run_astar(
             return NEED_MOVES
         g1 = gv[cur] + 1
         hbase = hv[cur] - hact[cur]
+        big_f = fv[cur]  # this (partial) expansion stores the children with f == big_f
+        first = big_f == gv[cur] + hv[cur]
+        nxt = DEAD
         for r in range(nrows):
             lmask = np.uint64(moves_buf[r, 0])
             d = moves_buf[r, 1]
@@ -294,6 +297,12 @@ def run_astar(
                         if hc < 0:
                             return NEED_PDB
                     kk = 0
+                fc = g1 + h
+                if fc > big_f:  # left for a later expansion of cur
+                    nxt = min(nxt, fc)
+                    continue
+                if fc < big_f and not first:
+                    continue  # stored by an earlier expansion of cur
                 n_states = regs[R_STATES]
                 if n_states >= rows.shape[0] or 2 * (n_states + 1) > table.shape[0]:
                     return NEED_STATES
@@ -312,11 +321,19 @@ def run_astar(
                     closed[got] = 0
                     regs[R_REOPENED] += 1
                 gv[got] = g1
+                fv[got] = fc
                 parent[got] = cur
                 mmask[got] = gmask
                 mdir[got] = d
                 mk[got] = kk
                 regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(g1, hv[got]), got)
+        if nxt < DEAD:  # children with a larger f remain: come back at the next f
+            if regs[R_HEAP] + 1 >= hkey.shape[0]:
+                return NEED_HEAP
+            fv[cur] = nxt
+            regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(gv[cur], nxt - gv[cur]), cur)
+        else:
+            fv[cur] = -1
         closed[cur] = 1
         regs[R_EXPANDED] += 1
         regs[R_CUR] = -1
@@ -356,6 +373,7 @@ class Run:
         self.gv = np.zeros(cap, dtype=np.int32)
         self.hv = np.zeros(cap, dtype=np.int32)
         self.hact = np.zeros(cap, dtype=np.int32)
+        self.fv = np.zeros(cap, dtype=np.int32)
         self.parent = np.full(cap, -1, dtype=np.int64)
         self.mmask = np.zeros(cap, dtype=np.int64)
         self.mdir = np.zeros(cap, dtype=np.int64)
@@ -402,7 +420,7 @@ class Run:
             pdb.ensure(self.miss.tolist())
         if h >= DEAD:
             return False
-        self.hv[0] = self.hact[0] = self.start_h = h
+        self.hv[0] = self.hact[0] = self.fv[0] = self.start_h = h
         self.regs[R_STATES] = 1
         self.regs[R_HEAP] = _push(self.hkey, self.hnode, 0, _heap_key(0, h), 0)
         self.regs[R_CUR] = -1
@@ -420,7 +438,7 @@ class Run:
         new = min(2 * cap, self.limits.max_states)
         extra = new - cap
         self.rows = np.concatenate([self.rows, np.zeros((extra, self.rows.shape[1]), np.int16)])
-        for name in ("gv", "hv", "hact"):
+        for name in ("gv", "hv", "hact", "fv"):
             setattr(self, name, np.concatenate([getattr(self, name), np.zeros(extra, np.int32)]))
         self.parent = np.concatenate([self.parent, np.full(extra, -1, np.int64)])
         for name in ("mmask", "mdir", "mk"):
@@ -440,7 +458,7 @@ class Run:
         while True:
             self.deadline.check()
             status = run_astar(
-                self.regs, self.rows, self.gv, self.hv, self.hact, self.parent, self.mmask,
+                self.regs, self.rows, self.gv, self.hv, self.hact, self.fv, self.parent, self.mmask,
                 self.mdir, self.mk, self.closed, self.table, self.hkey, self.hnode,
                 self.gvox, self.gstarts, self.glo, self.ghi, self.max_group,
                 self.limits.group_limit, pdb.fam, pdb.n_family, pdb.keys, pdb.vals, pdb.hash,

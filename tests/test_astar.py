@@ -140,8 +140,9 @@ def test_alpackino_start_bound() -> None:
 @needs_files
 @pytest.mark.slow
 def test_alpackino_needs_at_least_16_moves() -> None:
-    """A* exhausts every state with g + h <= 15 within 4,000,000 stored states (about 25 s):
-    no plan of 15 moves or fewer takes AlPackino apart; the BurrTools-style plan has 17."""
+    """A* exhausts every state with g + h <= 15 within 600,000 (partial) expansions (about
+    30 s): no plan of 15 moves or fewer takes AlPackino apart; the BurrTools-style plan has
+    17."""
     import re
 
     from chaingeo.formats.burrtools import read_xmpuzzle
@@ -150,7 +151,7 @@ def test_alpackino_needs_at_least_16_moves() -> None:
     (asm,) = read_xmpuzzle(BT / "AlPackino.xmpuzzle").assemblies(0)
     shapes = {f"p{k:02d}": s for k, s in asm.items()}
     assert analyze(shapes, optimal=False).moves == 17
-    with pytest.raises(SearchLimitError, match="A\\* state cap") as err:
-        astar_optimal(shapes, limits=AStarLimits(max_states=4_000_000, seconds=None))
+    with pytest.raises(SearchLimitError, match="A\\* expansion cap") as err:
+        astar_optimal(shapes, limits=AStarLimits(max_expansions=600_000, seconds=None))
     found = re.search(r"lower bound (\d+)", str(err.value))
     assert found is not None and int(found.group(1)) >= 16
