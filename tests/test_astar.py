@@ -155,3 +155,18 @@ def test_alpackino_needs_at_least_16_moves() -> None:
         astar_optimal(shapes, limits=AStarLimits(max_expansions=600_000, seconds=None))
     found = re.search(r"lower bound (\d+)", str(err.value))
     assert found is not None and int(found.group(1)) >= 16
+
+
+@needs_files
+@pytest.mark.slow
+def test_alpackino_optimum_is_17() -> None:
+    """The full search (about 6,000,000 partial expansions, several minutes): o_i = 17, the
+    plan replays, and the heuristic never had to reopen a state."""
+    from chaingeo.formats.burrtools import read_xmpuzzle
+
+    assert BT is not None
+    (asm,) = read_xmpuzzle(BT / "AlPackino.xmpuzzle").assemblies(0)
+    shapes = {f"p{k:02d}": s for k, s in asm.items()}
+    found = astar_optimal(shapes, limits=AStarLimits(max_states=8_000_000, seconds=None))
+    assert found.optimal_steps == 17 == len(found.plan) and found.reopened == 0
+    assert replay_disassembly(shapes, found.plan).is_separated()
