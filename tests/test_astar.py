@@ -170,3 +170,14 @@ def test_alpackino_optimum_is_17() -> None:
     found = astar_optimal(shapes, limits=AStarLimits(max_states=8_000_000, seconds=None))
     assert found.optimal_steps == 17 == len(found.plan) and found.reopened == 0
     assert replay_disassembly(shapes, found.plan).is_separated()
+
+
+def test_bench_astar_quick(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from chaingeo.cli import main
+
+    assert main(["bench", "astar", "--quick"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert len(rows) == 3 and all(r["astar_o_i"] == r["bfs_o_i"] is not None for r in rows)
+    assert all(r["astar_expanded"] > 0 and r["bfs_states"] > 0 for r in rows)
