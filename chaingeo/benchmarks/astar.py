@@ -1,0 +1,128 @@
+"""``chain bench astar``: o_i by A* with pattern databases against the branch-and-bound search.
+
+Both searches run in this process on the same puzzle, one after the other (the machines are
+shared, so compare the ratios of one run, not seconds across runs). Instances: the shipped
+suite levels of at most 12 pieces (their own ``max_group``), AlPackino (problem 0 of
+``../shared/burrtools/AlPackino.xmpuzzle``, when present) and the first 36-piece tower of the
+suite played with multi-piece moves (``max_group`` None instead of the file's 1).
+
+Per instance and search: ``o_i`` (or the cap it stopped at), ``seconds``, and the states:
+``astar_expanded`` / ``astar_stored`` whole states, ``bfs_states`` the states the
+branch-and-bound search stored over all its part searches (:attr:`Analysis.states`), and
+``astar_bound``: A*'s proven lower bound when it stops at a cap. JIT compilation is excluded
+(a warm-up runs first). Caps: ``CHAIN_BENCH_ASTAR_STATES`` stored A* states (default
+2,000,000) and ``CHAIN_BENCH_ASTAR_SECONDS`` per search (default 60); ``CHAIN_BENCH_ASTAR_ONLY``:
+run only the instances whose name contains it. ``--quick``: three suite levels only.
+A* expands partially (:mod:`solvers.astar`), so ``astar_expanded`` counts partial expansions.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import time
+from collections.abc import Mapping
+from pathlib import Path
+
+from chaingeo.geometry import Shape
+from chaingeo.kinematics import SearchLimitError
+
+Instance = tuple[str, dict[str, Shape], int | None]
+
+
+def _instances(quick: bool) -> list[Instance]:
+    from chaingeo.level import load_levels
+    from chaingeo.rules import PuzzleRules
+
+    root = Path(__file__).resolve().parents[2]
+    suite = root / "levels" / "puzzle"
+    levels = load_levels(suite) if suite.is_dir() else []
+    out: list[Instance] = []
+    small = [lv for lv in levels if len(lv.shapes) <= 12]
+    for lv in small[:3] if quick else small:
+        mg = lv.rules.max_group if isinstance(lv.rules, PuzzleRules) else None
+        out.append((lv.id, lv.shapes, mg))
+    if quick:
+        return out
+    env = os.environ.get("CHAIN_BURRTOOLS_DIR")
+    bt = Path(env) if env else root.parent / "shared" / "burrtools"
+    if (bt / "AlPackino.xmpuzzle").is_file():
+        from chaingeo.formats.burrtools import read_xmpuzzle
+
+        (asm,) = read_xmpuzzle(bt / "AlPackino.xmpuzzle").assemblies(0)
+        out.append(("AlPackino", {f"p{k:02d}": s for k, s in asm.items()}, None))
+    towers = [lv for lv in levels if re.search(r"burr36", lv.id)]
+    if towers:
+        out.append((f"{towers[0].id} (max_group None)", towers[0].shapes, None))
+    return out
+
+
+def _astar(
+    shapes: Mapping[str, Shape], max_group: int | None, states: int, seconds: float
+) -> dict[str, object]:
+    from solvers.astar import AStarLimits, astar_optimal
+
+    t0 = time.perf_counter()
+    limits = AStarLimits(max_states=states, seconds=seconds)
+    try:
+        r = astar_optimal(shapes, max_group=max_group, limits=limits)
+    except SearchLimitError as e:
+        bound = re.search(r"lower bound (\d+)", str(e))
+        return {
+            "astar_o_i": None,
+            "astar_stopped": str(e).split(";")[0],
+            "astar_bound": int(bound.group(1)) if bound else None,
+            "astar_seconds": round(time.perf_counter() - t0, 3),
+        }
+    return {
+        "astar_o_i": r.optimal_steps,
+        "astar_expanded": r.expanded,
+        "astar_stored": r.states,
+        "astar_start_bound": r.start_bound,
+        "astar_pdb_states": r.pdb_states,
+        "astar_seconds": round(time.perf_counter() - t0, 3),
+    }
+
+
+def _bfs(shapes: Mapping[str, Shape], max_group: int | None, seconds: float) -> dict[str, object]:
+    from solvers.disassemble import analyze
+    from solvers.partsearch import SearchLimits
+
+    t0 = time.perf_counter()
+    try:
+        a = analyze(shapes, max_group=max_group, limits=SearchLimits(seconds=seconds))
+    except SearchLimitError as e:
+        return {
+            "bfs_o_i": None,
+            "bfs_stopped": str(e).split(";")[0],
+            "bfs_seconds": round(time.perf_counter() - t0, 3),
+        }
+    return {
+        "bfs_o_i": a.optimal_steps,
+        "bfs_states": a.states,
+        "bfs_seconds": round(time.perf_counter() - t0, 3),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    states = int(os.environ.get("CHAIN_BENCH_ASTAR_STATES", "2000000"))
+    seconds = float(os.environ.get("CHAIN_BENCH_ASTAR_SECONDS", "60"))
+    warm = {"a": Shape([(0, 0, 0), (1, 0, 0)]), "b": Shape([(0, 1, 0), (1, 1, 0)])}
+    _astar(warm, None, states, seconds)  # JIT warm-up, not timed
+    _bfs(warm, None, seconds)
+    only = os.environ.get("CHAIN_BENCH_ASTAR_ONLY", "")
+    for name, shapes, max_group in _instances(args.quick):
+        if only not in name:
+            continue
+        row: dict[str, object] = {"instance": name, "pieces": len(shapes), "max_group": max_group}
+        row.update(_astar(shapes, max_group, states, seconds))
+        row.update(_bfs(shapes, max_group, seconds))
+        a_s, b_s = row.get("astar_seconds"), row.get("bfs_seconds")
+        if row.get("astar_o_i") is not None and row.get("bfs_o_i") is not None:
+            row["seconds_ratio_bfs_over_astar"] = round(
+                float(str(b_s)) / max(float(str(a_s)), 1e-4), 2
+            )
+        print(json.dumps(row, sort_keys=True), flush=True)
+    return 0

@@ -1,0 +1,489 @@
+"""The numba side of :mod:`solvers.astar`: heuristic, heap, expansion, and the resumable loop.
+
+A whole state is one ``int16`` row of ``4 n``: ``row[i]`` is the label of piece ``i``'s part
+(its smallest piece index), ``row[n + 3 i + t]`` its offset relative to that piece. The loop
+(:func:`run_astar`) keeps everything in arrays owned by :class:`Run` and returns a status when
+a buffer is full, a pattern-database entry is missing, a batch is done (so Python can check
+the deadline) or the search ends; the next call resumes where it stopped (a node whose
+expansion was cut short is expanded again from scratch; its children already stored are found
+again with the same ``g`` and change nothing).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+
+from chaingeo.kinematics import SearchLimitError
+from solvers import movement as mv
+from solvers.pattern_db import DEAD, KEY_WIDTH, lookup
+
+if TYPE_CHECKING:
+    from solvers.astar import AStarLimits
+    from solvers.partsearch import Deadline, PieceTable
+    from solvers.pattern_db import PatternDB
+
+I64 = npt.NDArray[np.int64]
+I32 = npt.NDArray[np.int32]
+I16 = npt.NDArray[np.int16]
+U8 = npt.NDArray[np.uint8]
+U64 = npt.NDArray[np.uint64]
+
+FOUND, EXHAUSTED, NEED_STATES, NEED_HEAP, NEED_PDB, NEED_MOVES, YIELD, LIMIT, GROUPS = range(9)
+# Registers shared with Python.
+R_CUR, R_STATES, R_HEAP, R_EXPANDED, R_REOPENED, R_BOUND, R_GOAL = range(7)
+N_REGS = 7
+_GBITS = 20  # heap key: f << 20 | (2^20 - 1 - g): smaller f first, then larger g
+
+
+@njit(cache=True)
+def part_h(
+    row: I16, n: int, label: int, size: int, fam: I64, n_fam: int,
+    pkeys: I16, pvals: I32, ptable: I64, key: I16, miss: I16,
+) -> int:  # fmt: skip
+    """The term of one part (module docstring of :mod:`solvers.astar`); -1 when a pattern
+    database entry is missing (its key is written to ``miss``), ``DEAD`` when some subset can
+    never come apart."""
+    if size < 2:
+        return 0
+    h = size - 1
+    for f in range(n_fam):
+        a = fam[f, 0]
+        b = fam[f, 1]
+        c = fam[f, 2]
+        if row[a] != label or row[b] != label:
+            continue
+        m = 2
+        if c >= 0:
+            if row[c] != label:
+                continue
+            m = 3
+        key[0] = f
+        for t in range(3):
+            key[1 + t] = row[n + 3 * b + t] - row[n + 3 * a + t]
+            key[4 + t] = row[n + 3 * c + t] - row[n + 3 * a + t] if m == 3 else 0
+        idx = lookup(pkeys, ptable, key)
+        if idx < 0:
+            for t in range(KEY_WIDTH):
+                miss[t] = key[t]
+            return -1
+        g = pvals[idx]
+        if g >= DEAD:
+            return DEAD
+        v = g + size - m
+        if v > h:
+            h = v
+    return h
+
+
+@njit(cache=True)
+def _push(hkey: I64, hnode: I64, size: int, key: int, node: int) -> int:
+    i = size
+    hkey[i] = key
+    hnode[i] = node
+    while i > 0:
+        p = (i - 1) // 2
+        if hkey[p] < hkey[i] or (hkey[p] == hkey[i] and hnode[p] <= hnode[i]):
+            break
+        hkey[p], hkey[i] = hkey[i], hkey[p]
+        hnode[p], hnode[i] = hnode[i], hnode[p]
+        i = p
+    return size + 1
+
+
+@njit(cache=True)
+def _pop(hkey: I64, hnode: I64, size: int) -> int:
+    size -= 1
+    hkey[0] = hkey[size]
+    hnode[0] = hnode[size]
+    i = 0
+    while True:
+        lft = 2 * i + 1
+        if lft >= size:
+            break
+        c = lft
+        r = lft + 1
+        if r < size and (hkey[r] < hkey[lft] or (hkey[r] == hkey[lft] and hnode[r] < hnode[lft])):
+            c = r
+        if hkey[i] < hkey[c] or (hkey[i] == hkey[c] and hnode[i] <= hnode[c]):
+            break
+        hkey[c], hkey[i] = hkey[i], hkey[c]
+        hnode[c], hnode[i] = hnode[i], hnode[c]
+        i = c
+    return size
+
+
+@njit(cache=True)
+def _heap_key(g: int, h: int) -> int:
+    return ((g + h) << _GBITS) | ((1 << _GBITS) - 1 - g)
+
+
+@njit(cache=True)
+def run_astar(
+    regs: I64, rows: I16, gv: I32, hv: I32, hact: I32, fv: I32, parent: I64, mmask: I64, mdir: I64,
+    mk: I64, closed: U8, table: I64, hkey: I64, hnode: I64,
+    gvox: I64, gstarts: I64, glo: I64, ghi: I64, max_group: int, group_limit: int,
+    fam: I64, n_fam: int, pkeys: I16, pvals: I32, ptable: I64, miss: I16,
+    moves_buf: I64, groups_buf: U64, max_expansions: int, batch: int,
+) -> int:  # fmt: skip
+    """A* from the stored states until a status (module docstring); see :class:`Run`."""
+    n = glo.shape[0]
+    w = rows.shape[1]
+    child = np.empty(w, dtype=np.int16)
+    key = np.empty(KEY_WIDTH, dtype=np.int16)
+    cnt = np.zeros(n, dtype=np.int64)
+    members = np.empty(n, dtype=np.int64)
+    done = 0
+    while True:
+        cur = regs[R_CUR]
+        if cur < 0:
+            if done >= batch:
+                return YIELD
+            if regs[R_HEAP] == 0:
+                return EXHAUSTED
+            hk = hkey[0]
+            node = hnode[0]
+            regs[R_HEAP] = _pop(hkey, hnode, regs[R_HEAP])
+            g = (1 << _GBITS) - 1 - (hk & ((1 << _GBITS) - 1))
+            f = hk >> _GBITS
+            if g != gv[node] or f != fv[node]:
+                continue  # stale heap entry
+            if f > regs[R_BOUND]:
+                regs[R_BOUND] = f
+            if hv[node] == 0:
+                regs[R_GOAL] = node
+                return FOUND
+            if max_expansions >= 0 and regs[R_EXPANDED] >= max_expansions:
+                regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], hk, node)
+                return LIMIT
+            regs[R_CUR] = node
+            cur = node
+        # ---- expand cur: the active part only ---------------------------------------------
+        for i in range(n):
+            cnt[i] = 0
+        for i in range(n):
+            cnt[rows[cur, i]] += 1
+        act = -1
+        for i in range(n):
+            if cnt[i] >= 2:
+                act = i
+                break
+        m = 0
+        nvox = 0
+        for i in range(n):
+            if rows[cur, i] == act:
+                members[m] = i
+                m += 1
+                nvox += gstarts[i + 1] - gstarts[i]
+        vox = np.empty((3, nvox, 3), dtype=np.int64)
+        starts = np.empty(m + 1, dtype=np.int64)
+        lo = np.empty((m, 3), dtype=np.int64)
+        hi = np.empty((m, 3), dtype=np.int64)
+        off = np.empty((m, 3), dtype=np.int64)
+        gaps = np.empty((3, m, m), dtype=np.int64)
+        pos = 0
+        for p in range(m):
+            q = members[p]
+            starts[p] = pos
+            for v in range(gstarts[q], gstarts[q + 1]):
+                for a in range(3):
+                    for t in range(3):
+                        vox[a, pos, t] = gvox[a, v, t]
+                pos += 1
+            for t in range(3):
+                lo[p, t] = glo[q, t]
+                hi[p, t] = ghi[q, t]
+                off[p, t] = rows[cur, n + 3 * q + t]
+        starts[m] = pos
+        nrows = mv.node_moves(
+            vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
+        )
+        if nrows == -2:
+            return GROUPS
+        if nrows == -1:
+            return NEED_MOVES
+        g1 = gv[cur] + 1
+        hbase = hv[cur] - hact[cur]
+        big_f = fv[cur]  # this (partial) expansion stores the children with f == big_f
+        first = big_f == gv[cur] + hv[cur]
+        nxt = DEAD
+        for r in range(nrows):
+            lmask = np.uint64(moves_buf[r, 0])
+            d = moves_buf[r, 1]
+            kmax = moves_buf[r, 2]
+            gmask = np.int64(0)
+            for p in range(m):
+                if lmask & (np.uint64(1) << np.uint64(p)):
+                    gmask |= np.int64(1) << np.int64(members[p])
+            ax = d // 2
+            sign = 1 if d % 2 == 0 else -1
+            anchor_moves = (lmask & np.uint64(1)) != np.uint64(0)
+            last = kmax + 1 if moves_buf[r, 3] else kmax  # k = kmax + 1 stands for the removal
+            for k in range(1, last + 1):
+                for t in range(w):
+                    child[t] = rows[cur, t]
+                if k <= kmax:
+                    for p in range(m):
+                        q = members[p]
+                        inside = (gmask >> q) & 1
+                        if anchor_moves:
+                            if not inside:
+                                child[n + 3 * q + ax] -= sign * k
+                        elif inside:
+                            child[n + 3 * q + ax] += sign * k
+                    hp = part_h(child, n, act, m, fam, n_fam, pkeys, pvals, ptable, key, miss)
+                    if hp < 0:
+                        return NEED_PDB
+                    if hp >= DEAD:
+                        continue
+                    h = hbase + hp
+                    hc = hp
+                    kk = k
+                else:  # the removal: two parts, re-anchored at their smallest pieces
+                    la = -1
+                    lb = -1
+                    for p in range(m):
+                        q = members[p]
+                        if (gmask >> q) & 1:
+                            if la < 0:
+                                la = q
+                        elif lb < 0:
+                            lb = q
+                    sa = 0
+                    for p in range(m):
+                        q = members[p]
+                        lab = la if (gmask >> q) & 1 else lb
+                        sa += 1 if lab == la else 0
+                        child[q] = lab
+                        for t in range(3):
+                            child[n + 3 * q + t] = (
+                                rows[cur, n + 3 * q + t] - rows[cur, n + 3 * lab + t]
+                            )
+                    sb = m - sa
+                    ha = part_h(child, n, la, sa, fam, n_fam, pkeys, pvals, ptable, key, miss)
+                    if ha < 0:
+                        return NEED_PDB
+                    hb = part_h(child, n, lb, sb, fam, n_fam, pkeys, pvals, ptable, key, miss)
+                    if hb < 0:
+                        return NEED_PDB
+                    if ha >= DEAD or hb >= DEAD:
+                        continue
+                    h = hbase + ha + hb
+                    nact = -1
+                    for i in range(n):
+                        c = cnt[i]
+                        if i == act:
+                            c = 0
+                        if i == la:
+                            c = sa
+                        if i == lb:
+                            c = sb
+                        if c >= 2:
+                            nact = i
+                            break
+                    if nact < 0:
+                        hc = 0
+                    elif nact == la:
+                        hc = ha
+                    elif nact == lb:
+                        hc = hb
+                    else:
+                        hc = part_h(
+                            child, n, nact, cnt[nact], fam, n_fam, pkeys, pvals, ptable, key, miss
+                        )
+                        if hc < 0:
+                            return NEED_PDB
+                    kk = 0
+                fc = g1 + h
+                if fc > big_f:  # left for a later expansion of cur
+                    nxt = min(nxt, fc)
+                    continue
+                if fc < big_f and not first:
+                    continue  # stored by an earlier expansion of cur
+                n_states = regs[R_STATES]
+                if n_states >= rows.shape[0] or 2 * (n_states + 1) > table.shape[0]:
+                    return NEED_STATES
+                if regs[R_HEAP] + 1 >= hkey.shape[0]:
+                    return NEED_HEAP
+                got = mv.find_or_insert(rows, n_states, table, child)
+                if got < 0:
+                    got = -1 - got
+                    regs[R_STATES] = n_states + 1
+                    hv[got] = h
+                    hact[got] = hc
+                    closed[got] = 0
+                elif g1 >= gv[got]:
+                    continue
+                elif closed[got]:
+                    closed[got] = 0
+                    regs[R_REOPENED] += 1
+                gv[got] = g1
+                fv[got] = fc
+                parent[got] = cur
+                mmask[got] = gmask
+                mdir[got] = d
+                mk[got] = kk
+                regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(g1, hv[got]), got)
+        if nxt < DEAD:  # children with a larger f remain: come back at the next f
+            if regs[R_HEAP] + 1 >= hkey.shape[0]:
+                return NEED_HEAP
+            fv[cur] = nxt
+            regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(gv[cur], nxt - gv[cur]), cur)
+        else:
+            fv[cur] = -1
+        closed[cur] = 1
+        regs[R_EXPANDED] += 1
+        regs[R_CUR] = -1
+        done += 1
+
+
+class Run:
+    """One A* search's arrays, and the Python loop that serves the kernel's requests."""
+
+    def __init__(
+        self,
+        table: PieceTable,
+        pdb: PatternDB,
+        max_group: int,
+        limits: AStarLimits,
+        deadline: Deadline,
+    ) -> None:
+        n = len(table.names)
+        self.n = n
+        self.pdb = pdb
+        self.max_group = max_group
+        self.limits = limits
+        self.deadline = deadline
+        sizes = [len(v) for v in table.voxels]
+        self.gstarts = np.zeros(n + 1, dtype=np.int64)
+        self.gstarts[1:] = np.cumsum(sizes)
+        self.gvox = np.ascontiguousarray(
+            np.stack(
+                [np.concatenate([table.sorted_axes[i][a] for i in range(n)]) for a in range(3)]
+            )
+        )
+        self.glo = table.lo.copy()
+        self.ghi = table.hi.copy()
+        cap = max(2, min(4096, limits.max_states))
+        self.rows = np.zeros((cap, 4 * n), dtype=np.int16)
+        self.rows[0, :n] = 0  # the start: one part labelled 0, every offset zero
+        self.gv = np.zeros(cap, dtype=np.int32)
+        self.hv = np.zeros(cap, dtype=np.int32)
+        self.hact = np.zeros(cap, dtype=np.int32)
+        self.fv = np.zeros(cap, dtype=np.int32)
+        self.parent = np.full(cap, -1, dtype=np.int64)
+        self.mmask = np.zeros(cap, dtype=np.int64)
+        self.mdir = np.zeros(cap, dtype=np.int64)
+        self.mk = np.zeros(cap, dtype=np.int64)
+        self.closed = np.zeros(cap, dtype=np.uint8)
+        self.table = np.full(1 << (4 * cap - 1).bit_length(), -1, dtype=np.int64)
+        self.hkey = np.zeros(4 * cap, dtype=np.int64)
+        self.hnode = np.zeros(4 * cap, dtype=np.int64)
+        self.moves_buf = np.zeros((1024, 4), dtype=np.int64)
+        self.groups_buf = np.zeros(min(limits.group_limit, 1 << 16) + 1, dtype=np.uint64)
+        self.miss = np.zeros(KEY_WIDTH, dtype=np.int16)
+        self.regs = np.zeros(N_REGS, dtype=np.int64)
+        self.start_h = 0
+
+    # -- registers as attributes -------------------------------------------------------------
+    @property
+    def n_states(self) -> int:
+        return int(self.regs[R_STATES])
+
+    @property
+    def expanded(self) -> int:
+        return int(self.regs[R_EXPANDED])
+
+    @property
+    def reopened(self) -> int:
+        return int(self.regs[R_REOPENED])
+
+    @property
+    def bound(self) -> int:
+        return int(self.regs[R_BOUND])
+
+    def _start(self) -> bool:
+        """Store the start state with its ``h``; False when it can never come apart."""
+        mv.find_or_insert(self.rows, 0, self.table, self.rows[0].copy())
+        key = np.zeros(KEY_WIDTH, dtype=np.int16)
+        pdb = self.pdb
+        while True:
+            h = part_h(
+                self.rows[0], self.n, 0, self.n, pdb.fam, pdb.n_family,
+                pdb.keys, pdb.vals, pdb.hash, key, self.miss,
+            )  # fmt: skip
+            if h >= 0:
+                break
+            pdb.ensure(self.miss.tolist())
+        if h >= DEAD:
+            return False
+        self.hv[0] = self.hact[0] = self.fv[0] = self.start_h = h
+        self.regs[R_STATES] = 1
+        self.regs[R_HEAP] = _push(self.hkey, self.hnode, 0, _heap_key(0, h), 0)
+        self.regs[R_CUR] = -1
+        self.regs[R_BOUND] = h
+        return True
+
+    def _grow_states(self) -> None:
+        cap = self.rows.shape[0]
+        if cap >= self.limits.max_states:
+            raise SearchLimitError(
+                f"A* state cap of {self.limits.max_states} stored states reached after "
+                f"{self.expanded} expansions (lower bound {self.bound}); "
+                "raise AStarLimits(max_states=...)"
+            )
+        new = min(2 * cap, self.limits.max_states)
+        extra = new - cap
+        self.rows = np.concatenate([self.rows, np.zeros((extra, self.rows.shape[1]), np.int16)])
+        for name in ("gv", "hv", "hact", "fv"):
+            setattr(self, name, np.concatenate([getattr(self, name), np.zeros(extra, np.int32)]))
+        self.parent = np.concatenate([self.parent, np.full(extra, -1, np.int64)])
+        for name in ("mmask", "mdir", "mk"):
+            setattr(self, name, np.concatenate([getattr(self, name), np.zeros(extra, np.int64)]))
+        self.closed = np.concatenate([self.closed, np.zeros(extra, np.uint8)])
+        if self.table.shape[0] < 4 * new:
+            size = 1 << (4 * new - 1).bit_length()
+            self.table = np.full(size, -1, dtype=np.int64)
+            mv.rebuild_table(self.rows, self.n_states, self.table)
+
+    def search(self) -> int:
+        """Run to the end: the goal node, or -1 when the puzzle never comes apart."""
+        if not self._start():
+            return -1
+        pdb = self.pdb
+        max_exp = -1 if self.limits.max_expansions is None else self.limits.max_expansions
+        while True:
+            self.deadline.check()
+            status = run_astar(
+                self.regs, self.rows, self.gv, self.hv, self.hact, self.fv, self.parent, self.mmask,
+                self.mdir, self.mk, self.closed, self.table, self.hkey, self.hnode,
+                self.gvox, self.gstarts, self.glo, self.ghi, self.max_group,
+                self.limits.group_limit, pdb.fam, pdb.n_family, pdb.keys, pdb.vals, pdb.hash,
+                self.miss, self.moves_buf, self.groups_buf, max_exp, 20000,
+            )  # fmt: skip
+            if status == FOUND:
+                return int(self.regs[R_GOAL])
+            if status == EXHAUSTED:
+                return -1
+            if status == NEED_STATES:
+                self._grow_states()
+            elif status == NEED_HEAP:
+                self.hkey = np.concatenate([self.hkey, np.zeros_like(self.hkey)])
+                self.hnode = np.concatenate([self.hnode, np.zeros_like(self.hnode)])
+            elif status == NEED_PDB:
+                pdb.ensure(self.miss.tolist())
+            elif status == NEED_MOVES:
+                self.moves_buf = np.zeros((2 * self.moves_buf.shape[0], 4), dtype=np.int64)
+            elif status == LIMIT:
+                raise SearchLimitError(
+                    f"A* expansion cap of {self.limits.max_expansions} reached (lower bound "
+                    f"{self.bound}); raise AStarLimits(max_expansions=...)"
+                )
+            elif status == GROUPS:
+                raise SearchLimitError(
+                    f"more than {self.limits.group_limit} movable groups along one direction "
+                    "in one state; raise AStarLimits(group_limit=...)"
+                )
