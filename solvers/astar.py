@@ -1,7 +1,7 @@
 """A* over whole disassembly states: o_i, the fewest moves that take every piece apart.
 
 **The problem** (the quantity :func:`solvers.disassemble.analyze` computes with
-``optimal=True``; rules of :mod:`chaingeo.kinematics`). A state is a partition of the pieces
+``optimal=True``; rules of :mod:`chaingeo.core.kinematics`). A state is a partition of the pieces
 into *parts* plus, per part, its pieces' offsets relative to the part's first piece. A move
 translates a proper sub-group ``G`` of one part ``P`` along an axis by ``k >= 1`` (legal when
 no unit step meets ``P \\ G``) or to infinity; a move that clears ``P \\ G`` for good is a
@@ -76,27 +76,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import Assembly, Move
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import Assembly, Move
 from solvers import astar_kernel as ak
+from solvers.astar_kernel import AStarLimits
 from solvers.partsearch import DIRECTION_NAMES, Deadline, PieceTable
 from solvers.pattern_db import DEAD, KEY_WIDTH, PatternDB
 
 __all__ = ["AStarLimits", "AStarResult", "Heuristic", "astar_optimal", "default_family"]
-
-
-@dataclass(frozen=True)
-class AStarLimits:
-    """Caps; each raises :class:`SearchLimitError` naming itself. ``max_states``: whole states
-    stored by A*; ``max_expansions``: states expanded; ``pdb_states``: pattern database
-    entries; ``component_states``: states of one sub-puzzle search; ``seconds``: wall clock."""
-
-    max_states: int = 4_000_000
-    max_expansions: int | None = None
-    pdb_states: int = 20_000_000
-    component_states: int = 4_000_000
-    seconds: float | None = 300.0
-    group_limit: int = 4096
 
 
 @dataclass(frozen=True)

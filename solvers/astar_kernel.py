@@ -11,23 +11,39 @@ again with the same ``g`` and change nothing).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from chaingeo.kinematics import SearchLimitError
+from chaingeo.core.kinematics import SearchLimitError
 from solvers import movement as mv
 from solvers.pattern_db import DEAD, KEY_WIDTH, lookup
 
 if TYPE_CHECKING:
-    from solvers.astar import AStarLimits
     from solvers.partsearch import Deadline, PieceTable
     from solvers.pattern_db import PatternDB
 
 I64 = npt.NDArray[np.int64]
 I32 = npt.NDArray[np.int32]
+
+
+@dataclass(frozen=True)
+class AStarLimits:
+    """Caps; each raises :class:`SearchLimitError` naming itself. ``max_states``: whole states
+    stored by A*; ``max_expansions``: states expanded; ``pdb_states``: pattern database
+    entries; ``component_states``: states of one sub-puzzle search; ``seconds``: wall clock."""
+
+    max_states: int = 4_000_000
+    max_expansions: int | None = None
+    pdb_states: int = 20_000_000
+    component_states: int = 4_000_000
+    seconds: float | None = 300.0
+    group_limit: int = 4096
+
+
 I16 = npt.NDArray[np.int16]
 U8 = npt.NDArray[np.uint8]
 U64 = npt.NDArray[np.uint64]

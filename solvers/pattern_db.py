@@ -3,7 +3,7 @@
 For a subset ``S`` of the pieces (a pair or a triple) the *sub-puzzle* is ``S`` alone, the
 other pieces removed. Its *one-part states* are ``S``'s relative offsets with ``S`` still one
 part; ``g_S(X)`` is the fewest moves that take every piece of ``S`` apart from ``X`` under the
-rules of :mod:`chaingeo.kinematics` (same ``max_group``). :class:`PatternDB` holds ``g_S`` for
+rules of :mod:`chaingeo.core.kinematics` (same ``max_group``). :class:`PatternDB` holds ``g_S`` for
 every one-part state it has met, in one open-addressing table keyed by
 ``(subset id, offsets of S[1], S[2] relative to S[0])``; why these values bound the whole
 puzzle's distance is proven in :mod:`solvers.astar`.
@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 from numba import njit
 
-from chaingeo.kinematics import SearchLimitError
+from chaingeo.core.kinematics import SearchLimitError
 from solvers import movement as mv
 from solvers.partsearch import Deadline, PieceTable
 

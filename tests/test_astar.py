@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import (
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import (
     Assembly,
     SearchLimitError,
     legal_moves,
@@ -128,7 +128,7 @@ def test_stuck_and_single_piece() -> None:
 def test_alpackino_start_bound() -> None:
     """The heuristic at AlPackino's start is at least the 12 removals and at most the 17
     moves of the BurrTools-style plan."""
-    from chaingeo.formats.burrtools import read_xmpuzzle
+    from chaingeo.core.formats.burrtools import read_xmpuzzle
 
     assert BT is not None
     (asm,) = read_xmpuzzle(BT / "AlPackino.xmpuzzle").assemblies(0)
@@ -145,7 +145,7 @@ def test_alpackino_needs_at_least_16_moves() -> None:
     17."""
     import re
 
-    from chaingeo.formats.burrtools import read_xmpuzzle
+    from chaingeo.core.formats.burrtools import read_xmpuzzle
 
     assert BT is not None
     (asm,) = read_xmpuzzle(BT / "AlPackino.xmpuzzle").assemblies(0)
@@ -162,7 +162,7 @@ def test_alpackino_needs_at_least_16_moves() -> None:
 def test_alpackino_optimum_is_17() -> None:
     """The full search (about 6,000,000 partial expansions, several minutes): o_i = 17, the
     plan replays, and the heuristic never had to reopen a state."""
-    from chaingeo.formats.burrtools import read_xmpuzzle
+    from chaingeo.core.formats.burrtools import read_xmpuzzle
 
     assert BT is not None
     (asm,) = read_xmpuzzle(BT / "AlPackino.xmpuzzle").assemblies(0)
@@ -175,7 +175,7 @@ def test_alpackino_optimum_is_17() -> None:
 def test_bench_astar_quick(capsys: pytest.CaptureFixture[str]) -> None:
     import json
 
-    from chaingeo.cli import main
+    from chaingeo.cli.main import main
 
     assert main(["bench", "astar", "--quick"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]

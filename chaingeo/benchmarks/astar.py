@@ -26,15 +26,15 @@ import time
 from collections.abc import Mapping
 from pathlib import Path
 
-from chaingeo.geometry import Shape
-from chaingeo.kinematics import SearchLimitError
+from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import SearchLimitError
 
 Instance = tuple[str, dict[str, Shape], int | None]
 
 
 def _instances(quick: bool) -> list[Instance]:
-    from chaingeo.level import load_levels
-    from chaingeo.rules import PuzzleRules
+    from chaingeo.core.level import load_levels
+    from chaingeo.core.rules import PuzzleRules
 
     root = Path(__file__).resolve().parents[2]
     suite = root / "levels" / "puzzle"
@@ -49,7 +49,7 @@ def _instances(quick: bool) -> list[Instance]:
     env = os.environ.get("CHAIN_BURRTOOLS_DIR")
     bt = Path(env) if env else root.parent / "shared" / "burrtools"
     if (bt / "AlPackino.xmpuzzle").is_file():
-        from chaingeo.formats.burrtools import read_xmpuzzle
+        from chaingeo.core.formats.burrtools import read_xmpuzzle
 
         (asm,) = read_xmpuzzle(bt / "AlPackino.xmpuzzle").assemblies(0)
         out.append(("AlPackino", {f"p{k:02d}": s for k, s in asm.items()}, None))
