@@ -36,6 +36,7 @@ from generator.deep import TOWERS, maze_candidate, tower_candidate
 from generator.layouts import get_layout
 from generator.maze import parse_maze_shape
 from generator.result import Rejection
+from generator.standard_burr import STANDARD_DEFAULTS, STANDARD_SHAPES, standard_burr_search
 from solvers.blockbound import analyze_by_blocks
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
@@ -47,9 +48,11 @@ VERSION = "1"
 @dataclass(frozen=True)
 class PuzzleConfig:
     """What to make. ``shape``: a layout name (burr3, plate3, burr6, burr12, burr18, burr24,
-    burr36), ``cubeN`` with ``pieces``, or ``mazeN`` (a maze burr on an N x N grid, the best
-    of ``hill_steps`` walks); ``min_level``: moves until the first part comes free. Towers
-    (burr12..burr36) with ``max_group=1`` are built unit by unit (:mod:`generator.deep`)."""
+    burr36), ``burr6x8`` / ``burr6x8u`` (Cutler's standard six-piece burr, 2x2x8 holey sticks;
+    ``u``: unique assembly, :mod:`generator.standard_burr`), ``cubeN`` with ``pieces``, or
+    ``mazeN`` (a maze burr on an N x N grid, the best of ``hill_steps`` walks); ``min_level``:
+    moves until the first part comes free. Towers (burr12..burr36) with ``max_group=1`` are
+    built unit by unit (:mod:`generator.deep`)."""
 
     shape: str = "burr6"
     min_level: int = 1
@@ -63,9 +66,23 @@ class PuzzleConfig:
     max_states: int = 500_000  # state cap per part in the final search
     max_total_states: int = 3_000_000  # state cap of the whole optimal-plan search
     probe_states: int = 20_000  # state cap of each evaluation while climbing (over: rejected)
+    restarts: int = 4  # standard burrs (burr6x8): annealing runs of hill_steps changes each
+    unique: bool = False  # standard burrs: keep only designs that assemble in exactly one way
+
+    def __post_init__(self) -> None:
+        # Standard burrs need many more holes and steps than the generic defaults: the CLI
+        # passes --hole-rate / --hill-steps only when given, so a generic default here means
+        # "not asked for" and becomes the family's own (generator.standard_burr.DEFAULTS).
+        if self.shape in STANDARD_SHAPES:
+            for name, value in STANDARD_DEFAULTS.items():
+                if getattr(self, name) == _GENERIC_DEFAULTS[name]:
+                    object.__setattr__(self, name, value)
 
     def to_json(self) -> dict[str, object]:
         return asdict(self)
+
+
+_GENERIC_DEFAULTS: dict[str, object] = {"hole_rate": 0.1, "hill_steps": 300}
 
 
 def _broken(shapes: Sequence[Shape]) -> int:
@@ -219,7 +236,12 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
     blocks: list[list[int]] | None = None
-    if config.shape.startswith("cube"):
+    extra: dict[str, object] = {"shape": config.shape}
+    if config.shape in STANDARD_SHAPES:
+        outcome = standard_burr_search(config, rng)
+        best = None if outcome is None else outcome.candidate
+        extra.update({} if outcome is None else outcome.stats())
+    elif config.shape.startswith("cube"):
         try:
             n = int(config.shape[4:])
         except ValueError:
@@ -237,6 +259,8 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
         if config.shape.startswith("cube"):
             target = interlocking_target(config.min_level)
             return Rejection(f"no cube design comes apart at level {target} or more", seed, index)
+        if config.shape in STANDARD_SHAPES and (config.unique or config.shape.endswith("u")):
+            return Rejection("no design that comes apart and assembles uniquely", seed, index)
         return Rejection("no design that comes apart", seed, index)
     if best.score[0] < config.min_level:
         return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)
@@ -255,7 +279,7 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
             limits=limits,
             seed=seed,
             index=index,
-            extra_stats={"shape": config.shape},
+            extra_stats=extra,
             blocks=blocks,
         )
     except SearchLimitError as e:
