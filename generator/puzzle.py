@@ -66,7 +66,7 @@ class PuzzleConfig:
     max_states: int = 500_000  # state cap per part in the final search
     max_total_states: int = 3_000_000  # state cap of the whole optimal-plan search
     probe_states: int = 20_000  # state cap of each evaluation while climbing (over: rejected)
-    restarts: int = 4  # standard burrs (burr6x8): annealing runs of hill_steps changes each
+    restarts: int = 2  # standard burrs (burr6x8): annealing runs of hill_steps changes each
     unique: bool = False  # standard burrs: keep only designs that assemble in exactly one way
 
     def __post_init__(self) -> None:
