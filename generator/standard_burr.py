@@ -399,6 +399,55 @@ START_TRIES = 60
 #: about one design of the walk in 25 assembles uniquely (27 sampled from one walk: 1), and a
 #: check that stops at the second solution takes about 0.2 s.
 UNIQUE_CANDIDATES = 200
+#: Designs checked for uniqueness differ from one another in at least this many cells: what
+#: makes a design assemble twice (a piece that fits another slot) survives small changes, so
+#: the 200 best designs, neighbours of one another, all failed together (seed 2026, item 0).
+UNIQUE_SPREAD = 4
+
+
+def _unique_climb(
+    found: SearchOutcome,
+    evaluator: _Evaluator,
+    config: PuzzleConfig,
+    limits: SearchLimits,
+    rng: np.random.Generator,
+) -> SearchOutcome:
+    """Hill climb from a uniquely assembling design, keeping a single-cube change when the
+    design still comes apart, its (level, moves) does not drop and it still assembles uniquely
+    (checked only for changes that pass the first two tests, as that check is ~50 times the
+    cost of an evaluation). ``hill_steps / 3`` changes."""
+    best = found
+    design = list(found.design)
+    memo: dict[Design, tuple[int, int]] = {}
+    for _ in range(config.hill_steps // 3):
+        i, old = _mutate(design, config.hole_rate, rng)
+        verdict = evaluator(design)
+        a = None if verdict is None else verdict.analysis
+        if a is None or (a.first_level or 0, a.moves or 0) < best.candidate.score:
+            design[i] = old
+            continue
+        trial = SearchOutcome(Candidate(design_pieces(design), a), tuple(design), 0)
+        if trial.design not in memo:
+            try:
+                memo[trial.design] = assembly_counts(
+                    trial.candidate.shapes, limits, 2, config.max_group
+                )
+            except SearchLimitError:
+                memo[trial.design] = (0, 0)  # undecided within the caps: not proven unique
+        counts = memo[trial.design]
+        if counts[1] != 1:
+            design[i] = old
+            continue
+        trial.assemblies, trial.solutions = counts
+        best = trial
+    best.evaluations = len(evaluator.memo)
+    return best
+
+
+def _outcome(design: Design, evaluator: _Evaluator, evaluations: int) -> SearchOutcome:
+    verdict = evaluator(design)
+    assert verdict is not None and verdict.analysis is not None
+    return SearchOutcome(Candidate(design_pieces(design), verdict.analysis), design, evaluations)
 
 
 def standard_burr_search(config: PuzzleConfig, rng: np.random.Generator) -> SearchOutcome | None:
@@ -424,15 +473,18 @@ def standard_burr_search(config: PuzzleConfig, rng: np.random.Generator) -> Sear
         return None
     ranked = sorted(pool.items(), key=lambda kv: (-kv[1][0], -kv[1][1], kv[0]))
     evaluations = len(evaluator.memo)
-    unique = config.unique or config.shape.endswith("u")
-    for kept, _ in ranked[: UNIQUE_CANDIDATES if unique else 1]:
-        verdict = evaluator(kept)
-        assert verdict is not None and verdict.analysis is not None
-        candidate = Candidate(design_pieces(kept), verdict.analysis)
-        outcome = SearchOutcome(candidate, kept, evaluations)
-        if not unique:
-            return outcome
-        limits = SearchLimits(max_states=config.probe_states, seconds=config.seconds)
+    if not (config.unique or config.shape.endswith("u")):
+        return _outcome(ranked[0][0], evaluator, evaluations)
+    limits = SearchLimits(max_states=config.probe_states, seconds=config.seconds)
+    checked: list[np.ndarray] = []
+    for kept, _ in ranked:
+        if len(checked) >= UNIQUE_CANDIDATES:
+            break
+        row = np.array(kept, dtype=np.int8)
+        if any(int(np.count_nonzero(row != c)) < UNIQUE_SPREAD for c in checked):
+            continue  # too close to a design already found not unique
+        checked.append(row)
+        outcome = _outcome(kept, evaluator, evaluations)
         try:
             outcome.assemblies, outcome.solutions = assembly_counts(
                 outcome.candidate.shapes, limits, stop_at=2, max_group=config.max_group
@@ -440,5 +492,5 @@ def standard_burr_search(config: PuzzleConfig, rng: np.random.Generator) -> Sear
         except SearchLimitError:
             continue  # some assembly could not be decided within the caps: not proven unique
         if outcome.solutions == 1:
-            return outcome
+            return _unique_climb(outcome, evaluator, config, limits, rng)
     return None

@@ -9,7 +9,7 @@ the items per row.
 
 A second section makes standard six-piece burrs (``--shape burr6x8``, min level 1 so every item
 that comes apart counts) and prints the histogram of their levels and the seconds per item
-(o_i included). One item is tens of seconds, so the default run makes 4 (2 with ``--quick``);
+(o_i included). One item is 20 to 50 s, so the default run makes 3 (1 with ``--quick``);
 ``CHAIN_BENCH_BURR_ITEMS=100`` gives the histogram per 100 items.
 """
 
@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
             rows.append(row)
             print(f"{row['box']:<7} {mode:<5} {accepted:>6} {items:>5} {per:>8.3f} "
                   f"{rate:>13.2f} {row['reference_ratio']!s:>17}")  # fmt: skip
-    burrs = _standard_burrs(int(os.environ.get("CHAIN_BENCH_BURR_ITEMS", 2 if args.quick else 4)))
+    burrs = _standard_burrs(int(os.environ.get("CHAIN_BENCH_BURR_ITEMS", 1 if args.quick else 3)))
     print(
         json.dumps(
             {
