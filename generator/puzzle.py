@@ -30,12 +30,13 @@ from chaingeo.core.level import (
 )
 from chaingeo.core.rules import PuzzleRules
 from generator.candidate import Candidate, evaluate
-from generator.config import PuzzleConfig
+from generator.config import STANDARD_SHAPES, PuzzleConfig
 from generator.cubes import cube_search, interlocking_target
 from generator.deep import TOWERS, maze_candidate, tower_candidate
 from generator.layouts import get_layout
 from generator.maze import parse_maze_shape
 from generator.result import Rejection
+from generator.standard_burr import standard_burr_search
 from solvers.analysis import BLOCKS_KEY, analyze_puzzle
 from solvers.partsearch import SearchLimits
 
@@ -175,7 +176,12 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
     blocks: list[list[int]] | None = None
-    if config.shape.startswith("cube"):
+    extra: dict[str, object] = {"shape": config.shape}
+    if config.shape in STANDARD_SHAPES:
+        outcome = standard_burr_search(config, rng)
+        best = None if outcome is None else outcome.candidate
+        extra.update({} if outcome is None else outcome.stats())
+    elif config.shape.startswith("cube"):
         try:
             n = int(config.shape[4:])
         except ValueError:
@@ -193,6 +199,8 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
         if config.shape.startswith("cube"):
             target = interlocking_target(config.min_level)
             return Rejection(f"no cube design comes apart at level {target} or more", seed, index)
+        if config.shape in STANDARD_SHAPES and (config.unique or config.shape.endswith("u")):
+            return Rejection("no design that comes apart and assembles uniquely", seed, index)
         return Rejection("no design that comes apart", seed, index)
     if best.score[0] < config.min_level:
         return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)
@@ -211,7 +219,7 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
             limits=limits,
             seed=seed,
             index=index,
-            extra_stats={"shape": config.shape},
+            extra_stats=extra,
             blocks=blocks,
         )
     except SearchLimitError as e:

@@ -6,6 +6,11 @@ The reference, timed in the same run, is the exact-cover engine counting all 115
 of the Soma cube: each row also says how many such counts one level costs, which travels
 between machines better than seconds. Environment: ``CHAIN_BENCH_GENERATE_ITEMS`` overrides
 the items per row.
+
+A second section makes standard six-piece burrs (``--shape burr6x8``, min level 1 so every item
+that comes apart counts) and prints the histogram of their levels and the seconds per item
+(o_i included). One item is 20 to 50 s, so the default run makes 3 (1 with ``--quick``);
+``CHAIN_BENCH_BURR_ITEMS=100`` gives the histogram per 100 items.
 """
 
 from __future__ import annotations
@@ -77,5 +82,44 @@ def run(args: argparse.Namespace) -> int:
             rows.append(row)
             print(f"{row['box']:<7} {mode:<5} {accepted:>6} {items:>5} {per:>8.3f} "
                   f"{rate:>13.2f} {row['reference_ratio']!s:>17}")  # fmt: skip
-    print(json.dumps({"benchmark": "generate", "reference_seconds": round(ref, 5), "rows": rows}))
+    burrs = _standard_burrs(int(os.environ.get("CHAIN_BENCH_BURR_ITEMS", 1 if args.quick else 3)))
+    print(
+        json.dumps(
+            {
+                "benchmark": "generate",
+                "reference_seconds": round(ref, 5),
+                "rows": rows,
+                "standard_burrs": burrs,
+            }
+        )
+    )
     return 0
+
+
+def _standard_burrs(items: int) -> dict[str, Any]:
+    """Items 0..items-1 of :data:`SEED` with ``--shape burr6x8``: level histogram, s / item."""
+    from generator.config import PuzzleConfig
+    from generator.puzzle import make
+
+    make(PuzzleConfig(shape="burr6x8", hill_steps=50), SEED, 10_000)  # compile the kernels
+    cfg = PuzzleConfig(shape="burr6x8", min_level=1)
+    histogram: dict[str, int] = {}
+    seconds: list[float] = []
+    for i in range(items):
+        t0 = time.perf_counter()
+        item = make(cfg, SEED, i)
+        seconds.append(time.perf_counter() - t0)
+        stats = getattr(item, "stats", None)
+        key = str(stats["first_level"]) if stats is not None else "rejected"
+        histogram[key] = histogram.get(key, 0) + 1
+    order = sorted(histogram, key=lambda k: (k == "rejected", int(k) if k.isdigit() else 0))
+    per = sum(seconds) / max(1, items)
+    print(f"standard burrs (burr6x8, seed {SEED}): {items} items, {per:.1f} s / item, levels:")
+    print("  " + "  ".join(f"{k}: {histogram[k]}" for k in order))
+    return {
+        "shape": "burr6x8",
+        "items": items,
+        "seconds_per_item": round(per, 2),
+        "max_seconds": round(max(seconds, default=0.0), 2),
+        "levels": {k: histogram[k] for k in order},
+    }
