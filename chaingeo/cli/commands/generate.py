@@ -161,7 +161,8 @@ def _register_puzzle(fam: Any) -> None:
         "--shape",
         default="burr6",
         help=(
-            "burr3, plate3, burr6, burr12, burr18, burr24, burr36 (towers; with --max-group 1 "
+            "burr3, plate3, burr6, burr6x8 / burr6x8u (Cutler's standard six-piece burr; u: "
+            "unique assembly), burr12, burr18, burr24, burr36 (towers; with --max-group 1 "
             "built and proven unit by unit), cubeN or mazeN (maze burr: level grows with N); "
             "default burr6"
         ),
@@ -173,6 +174,10 @@ def _register_puzzle(fam: Any) -> None:
     p.add_argument("--goal", choices=("disassemble", "assemble"), default="disassemble")
     p.add_argument("--max-group", type=int, help="most pieces one move may carry")
     p.add_argument("--seconds", type=float, help="time limit of the optimal-plan search")
+    p.add_argument("--restarts", type=int, help="annealing runs (burr6x8; default 2)")
+    p.add_argument(
+        "--unique", action="store_true", help="only designs that assemble in one way (burr6x8)"
+    )
     add_run_options(p)
     p.set_defaults(func=_run_puzzle)
 
@@ -187,8 +192,9 @@ def _run_puzzle(args: argparse.Namespace) -> int:
         "pieces": args.pieces,
         "goal": args.goal,
         "max_group": args.max_group,
+        "unique": args.unique,
     }
-    for opt in ("hole_rate", "hill_steps", "seconds"):
+    for opt in ("hole_rate", "hill_steps", "seconds", "restarts"):
         if getattr(args, opt) is not None:
             fields[opt] = getattr(args, opt)
     return run_job(args, "puzzle", make, PuzzleConfig(**fields))
