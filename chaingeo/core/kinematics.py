@@ -30,8 +30,8 @@ from chaingeo.core.turns import (
     TurnMove,
     centre_inside,
     centres_within,
+    lateral,
     swept_by,
-    turn_hits,
     turn_pose,
 )
 
@@ -139,21 +139,26 @@ class Assembly:
     ``parts`` lists the sub-puzzles still to take apart (and finished singletons); pieces of
     different parts never interact again. ``rotations`` holds the pieces a turn has left in
     another orientation (index into :data:`chaingeo.core.geometry.ROTATIONS`; absent: 0, as
-    assembled).
+    assembled). ``rods``: cells of a piece (assembled frame) that are round rods along an axis
+    (0, 1, 2); a rod lying on a turn's axis line spins in place (see :meth:`turn_sweep`).
     """
 
     shapes: Mapping[str, Shape]
     offsets: Mapping[str, Cell]
     parts: tuple[frozenset[str], ...]
     rotations: Mapping[str, int] = field(default_factory=dict)
+    rods: Mapping[str, Mapping[Cell, int]] = field(default_factory=dict)
 
     @staticmethod
-    def assembled(shapes: Mapping[str, Shape]) -> Assembly:
+    def assembled(
+        shapes: Mapping[str, Shape], rods: Mapping[str, Mapping[Cell, int]] | None = None
+    ) -> Assembly:
         names = sorted(shapes)
         return Assembly(
             shapes=dict(shapes),
             offsets={n: (0, 0, 0) for n in names},
             parts=(frozenset(names),),
+            rods={n: dict(r) for n, r in (rods or {}).items() if r},
         )
 
     def rotation_of(self, name: str) -> int:
@@ -232,17 +237,49 @@ class Assembly:
         elif free is not None and free < move.distance:
             raise MoveError(move, f"blocked after {free} unit(s), {move.distance} asked")
 
+    def spinning(self, names: Iterable[str], axis: int, centre2: Sequence[int]) -> set[Cell]:
+        """The cells of these pieces' round rods that lie along ``axis`` on the line through
+        ``centre2``: turning about that line they spin in place, sweeping only their own cell
+        (a rod is a cylinder of diameter 1 in its cell; in every other test it counts as a
+        full cube, which never allows a move the rod could not make)."""
+        u, v = lateral(axis)
+        out: set[Cell] = set()
+        for n in names:
+            rods = self.rods.get(n)
+            if not rods:
+                continue
+            r = ROTATIONS[self.rotation_of(n)]
+            ox, oy, oz = self.offsets[n]
+            for cell, a in rods.items():
+                if r[axis, a] == 0:
+                    continue  # this rod now lies across the axis
+                w = r @ np.asarray(cell, dtype=np.int64) + (ox, oy, oz)
+                if 2 * w[u] == centre2[u] and 2 * w[v] == centre2[v]:
+                    out.add(_cell(w))
+        return out
+
+    def turn_sweep(
+        self, names: Sequence[str], axis: int, quarter: int, centre2: Sequence[int]
+    ) -> set[Cell]:
+        """Every cell the pieces sweep through turning together (exact: see
+        :func:`chaingeo.core.turns.swept_by`; rods on the axis line spin in place)."""
+        spin = self.spinning(names, axis, centre2)
+        cells = [c for n in names for c in self.cells_of(n) if c not in spin]
+        return swept_by(cells, axis, quarter, centre2) | spin
+
     def turn_problem(self, move: TurnMove) -> str | None:
         """Why the (well-formed, one-part) turn is illegal here, or None: its centre must lie in
-        the group's bounding box, and the turning group must sweep through no other piece."""
+        the group's bounding box, and the turning group must sweep through no other piece (a
+        rod of another piece spinning on the axis line is passed by, never hit)."""
+        a = move.axis_index
         group = [c for n in move.pieces for c in self.cells_of(n)]
-        if not centre_inside(group, move.axis_index, move.centre2):
+        if not centre_inside(group, a, move.centre2):
             return "the axis must pass through the group's bounding box"
+        swept = self.turn_sweep(move.pieces, a, move.quarter, move.centre2)
         part = self.part_of(move.pieces[0])
         for other in sorted(part - set(move.pieces)):
-            hit = turn_hits(
-                group, self.cells_of(other), move.axis_index, move.quarter, move.centre2
-            )
+            fixed = self.cells_of(other) - self.spinning([other], a, move.centre2)
+            hit = sorted(swept & fixed)
             if hit:
                 return f"it would sweep through {other} at {hit[0]}"
         return None
@@ -285,7 +322,7 @@ class Assembly:
             r, offsets[n] = turn_pose(ROTATIONS[self.rotation_of(n)], offsets[n], move)
             rotations[n] = rotation_index(r)
         rotations = {n: r for n, r in rotations.items() if r != 0}
-        return Assembly(self.shapes, offsets, self.parts, rotations)
+        return Assembly(self.shapes, offsets, self.parts, rotations, self.rods)
 
 
 class SearchLimitError(RuntimeError):
@@ -362,18 +399,6 @@ def legal_moves(state: Assembly, max_group: int | None = None) -> list[Move]:
     return sorted(moves, key=lambda m: (m.pieces, m.direction, m.distance is None, m.distance or 0))
 
 
-def turn_hit_relation(
-    state: Assembly, part: frozenset[str], axis: int, quarter: int, centre2: Cell
-) -> dict[str, frozenset[str]]:
-    """``name -> the pieces of its part it would sweep through`` turning alone that way."""
-    cells = {n: state.cells_of(n) for n in sorted(part)}
-    out: dict[str, frozenset[str]] = {}
-    for n in sorted(part):
-        swept = swept_by(cells[n], axis, quarter, centre2)
-        out[n] = frozenset(o for o in cells if o != n and not swept.isdisjoint(cells[o]))
-    return out
-
-
 def legal_turns(state: Assembly, max_group: int | None = None) -> list[TurnMove]:
     """Every legal turn, sorted: each proper group of a part (every subset, tried one by one:
     this is the reference), each axis and sense, each centre in the group's bounding box."""
@@ -384,12 +409,13 @@ def legal_turns(state: Assembly, max_group: int | None = None) -> list[TurnMove]
         for size in range(1, top + 1):
             for group in combinations(names, size):
                 cells = [c for n in group for c in state.cells_of(n)]
-                rest = [c for n in names if n not in group for c in state.cells_of(n)]
+                others = [n for n in names if n not in group]
+                rest = {c for n in others for c in state.cells_of(n)}
                 for a, axis in enumerate(AXES):
                     for centre in centres_within(cells, a):
+                        fixed = rest - state.spinning(others, a, centre)
                         for q in (1, -1):
-                            swept = swept_by(cells, a, q, centre)
-                            if swept.isdisjoint(rest):
+                            if state.turn_sweep(group, a, q, centre).isdisjoint(fixed):
                                 out.append(TurnMove(group, axis, q, centre))
     return sorted(out)
 
@@ -416,9 +442,13 @@ def _sorted_parts(parts: Iterable[frozenset[str]]) -> tuple[frozenset[str], ...]
     return tuple(sorted(parts, key=lambda p: sorted(p)))
 
 
-def replay_disassembly(shapes: Mapping[str, Shape], moves: Sequence[Move | TurnMove]) -> Assembly:
+def replay_disassembly(
+    shapes: Mapping[str, Shape],
+    moves: Sequence[Move | TurnMove],
+    rods: Mapping[str, Mapping[Cell, int]] | None = None,
+) -> Assembly:
     """Apply ``moves`` from the assembled state; raise :class:`MoveError` at the first bad one."""
-    state = Assembly.assembled(shapes)
+    state = Assembly.assembled(shapes, rods)
     for m in moves:
         state = state.apply(m)
     return state
@@ -509,11 +539,12 @@ def reference_first_level(
     max_group: int | None = None,
     max_states: int = 200_000,
     turns: bool = False,
+    rods: Mapping[str, Mapping[Cell, int]] | None = None,
 ) -> int | None:
     """Fewest moves until some group leaves the assembled puzzle (the removal counts): the first
     number of BurrTools' level, by plain breadth-first search; None if nothing ever leaves.
     Raises :class:`SearchLimitError` past ``max_states`` states. For tests."""
-    start = Assembly.assembled(shapes)
+    start = Assembly.assembled(shapes, rods)
     seen = {state_key(start)}
     frontier = [start]
     depth = 0
@@ -540,10 +571,11 @@ def reference_optimal_disassembly(
     max_group: int | None = None,
     max_states: int = 200_000,
     turns: bool = False,
+    rods: Mapping[str, Mapping[Cell, int]] | None = None,
 ) -> list[Move | TurnMove] | None:
     """Fewest moves taking every piece apart, by plain breadth-first search over whole states
     (all parts at once); None if impossible. Exponential: for small puzzles and tests only."""
-    start = Assembly.assembled(shapes)
+    start = Assembly.assembled(shapes, rods)
     if start.is_separated():
         return []
     seen: dict[object, tuple[object, Move | TurnMove | None]] = {state_key(start): (None, None)}

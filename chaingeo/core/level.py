@@ -28,6 +28,7 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
 )
 from chaingeo.core.rules import SUPPORT_RULES, PuzzleRules, StackingRules, placement_order_problem
+from chaingeo.core.turns import TurnMove, turn_from_json
 
 FORMAT: Final = "chain-level/1"
 FAMILIES: Final = ("stacking", "puzzle")
@@ -67,7 +68,7 @@ class StackingSolution:
 
 @dataclass(frozen=True)
 class PuzzleSolution:
-    moves: tuple[Move, ...]
+    moves: tuple[Move | TurnMove, ...]
 
 
 @dataclass(frozen=True)
@@ -295,10 +296,16 @@ def parse_level(data: Any, source: str = "<level>") -> Level:
         support = r.string(rules_obj.get("support", "contact"), "rules.support", SUPPORT_RULES)
         rules = StackingRules(support=support)  # type: ignore[arg-type]
     else:
-        _only_keys(r, rules_obj, {"max_group"}, "rules")
+        _only_keys(r, rules_obj, {"max_group", "turns"}, "rules")
         mg = rules_obj.get("max_group")
+        turns = rules_obj.get("turns", False)
+        if turns is not True and "turns" in rules_obj:  # written only when true
+            raise r.fail("rules.turns", f"expected true or no field, got {_short(turns)}")
         rules = PuzzleRules(
-            max_group=None if mg is None else r.integer(mg, "rules.max_group", 1, limits.MAX_PIECES)
+            max_group=None
+            if mg is None
+            else r.integer(mg, "rules.max_group", 1, limits.MAX_PIECES),
+            turns=turns,
         )
 
     max_steps = r.integer(
@@ -464,10 +471,26 @@ def _parse_puzzle_solution(
     if len(raw_moves) > limits.MAX_STEPS:
         raise r.fail("solution.moves", f"{len(raw_moves)} moves; at most {limits.MAX_STEPS}")
     names = {p.name for p in pieces}
-    moves: list[Move] = []
+    moves: list[Move | TurnMove] = []
     for i, m in enumerate(raw_moves):
         f = f"solution.moves[{i}]"
         obj = r.obj(m, f)
+        if "axis" in obj:  # a turn
+            if not rules.turns:
+                raise r.fail(f, "a turn, but the rules do not allow turns")
+            _only_keys(r, obj, {"pieces", "axis", "angle", "about"}, f)
+            try:
+                turn = turn_from_json(obj)
+            except ValueError as e:
+                raise r.fail(f, str(e)) from None
+            if set(turn.pieces) - names:
+                raise r.fail(f"{f}.pieces", f"unknown piece(s) {sorted(set(turn.pieces) - names)}")
+            if rules.max_group is not None and len(turn.pieces) > rules.max_group:
+                raise r.fail(
+                    f"{f}.pieces", f"turns {len(turn.pieces)} pieces; at most {rules.max_group}"
+                )
+            moves.append(turn)
+            continue
         group = [
             r.string(n, f"{f}.pieces")
             for n in r.lst(r.get(obj, "pieces", f"{f}.pieces"), f"{f}.pieces")

@@ -29,12 +29,18 @@ class StackingRules:
 
 @dataclass(frozen=True)
 class PuzzleRules:
-    """``max_group``: the most pieces one move may carry (None: any group that moves together)."""
+    """``max_group``: the most pieces one move may carry (None: any group that moves together).
+    ``turns``: groups may also turn 90 degrees (:mod:`chaingeo.core.turns`); written to a file
+    only when true, so every level without turns keeps its bytes."""
 
     max_group: int | None = None
+    turns: bool = False
 
     def to_json(self) -> dict[str, object]:
-        return asdict(self)
+        out: dict[str, object] = {"max_group": self.max_group}
+        if self.turns:
+            out["turns"] = True
+        return out
 
 
 def placement_problem(

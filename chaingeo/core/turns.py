@@ -30,10 +30,10 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Final
+from typing import Any, Final
 
 import numpy as np
 
@@ -144,6 +144,33 @@ class TurnMove:
 
     def matrix(self) -> IntArray:
         return quarter_matrix(self.axis_index, self.quarter)
+
+
+def turn_from_json(obj: Mapping[str, Any]) -> TurnMove:
+    """The inverse of :meth:`TurnMove.to_json` (pieces checked by the caller); ValueError
+    naming the field otherwise."""
+    pieces = obj.get("pieces")
+    if not isinstance(pieces, list) or not all(isinstance(n, str) for n in pieces):
+        raise ValueError("pieces: expected a list of piece names")
+    axis = obj.get("axis")
+    if axis not in AXES:
+        raise ValueError(f"axis: expected 'x', 'y' or 'z', got {axis!r}")
+    angle = obj.get("angle")
+    if isinstance(angle, bool) or angle not in (90, -90):
+        raise ValueError(f"angle: expected 90 or -90, got {angle!r}")
+    about = obj.get("about")
+    if not isinstance(about, list) or len(about) != 3:
+        raise ValueError("about: expected three numbers (whole or ending in .5)")
+    centre2: list[int] = []
+    for v in about:
+        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+            raise ValueError(f"about: expected numbers, got {v!r}")
+        if abs(v) > 1e6 or 2 * v != int(2 * v):
+            raise ValueError(f"about: {v!r} is not a whole number or a half")
+        centre2.append(int(2 * v))
+    return TurnMove(
+        tuple(pieces), axis, 1 if angle == 90 else -1, (centre2[0], centre2[1], centre2[2])
+    )
 
 
 def turn_cells(
