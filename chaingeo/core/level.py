@@ -19,7 +19,7 @@ from typing import Any, Final, Literal
 
 from chaingeo.core import canonical_json, limits
 from chaingeo.core.files import atomic_write
-from chaingeo.core.geometry import Shape, box_cells, puzzle_signature
+from chaingeo.core.geometry import Cell, Shape, box_cells, puzzle_signature
 from chaingeo.core.kinematics import (
     DIRECTIONS,
     Move,
@@ -28,7 +28,7 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
 )
 from chaingeo.core.rules import SUPPORT_RULES, PuzzleRules, StackingRules, placement_order_problem
-from chaingeo.core.turns import TurnMove, turn_from_json
+from chaingeo.core.turns import AXES, TurnMove, turn_from_json
 
 FORMAT: Final = "chain-level/1"
 FAMILIES: Final = ("stacking", "puzzle")
@@ -58,6 +58,9 @@ class Piece:
     name: str
     rgb: str
     shape: Shape  # stacking: as handed to the agent; puzzle: assembled position
+    #: puzzle cells that are round rods along an axis (0, 1, 2), which spin in place when they
+    #: turn about their own axis (:mod:`chaingeo.core.turns`); written only when there are any
+    rods: Mapping[Cell, int] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -105,6 +108,11 @@ class Level:
     def shapes(self) -> dict[str, Shape]:
         return {p.name: p.shape for p in self.pieces}
 
+    @property
+    def rods(self) -> dict[str, dict[Cell, int]]:
+        """The round rods of the pieces that have any (see :class:`Piece`)."""
+        return {p.name: dict(p.rods) for p in self.pieces if p.rods}
+
     def to_json(self) -> dict[str, Any]:
         sol: dict[str, Any]
         if isinstance(self.solution, StackingSolution):
@@ -124,10 +132,7 @@ class Level:
             "difficulty": self.difficulty,
             "goal": self.goal,
             "box": list(self.box) if self.box is not None else None,
-            "pieces": [
-                {"name": p.name, "rgb": p.rgb, "voxels": [list(c) for c in p.shape.cells]}
-                for p in self.pieces
-            ],
+            "pieces": [_piece_json(p) for p in self.pieces],
             "solution": sol,
             "optimal_steps": self.optimal_steps,
             "max_steps": self.max_steps,
@@ -141,6 +146,14 @@ class Level:
             },
             "stats": dict(self.stats),
         }
+
+
+def _piece_json(p: Piece) -> dict[str, Any]:
+    out: dict[str, Any] = {"name": p.name, "rgb": p.rgb, "voxels": [list(c) for c in p.shape.cells]}
+    if p.rods:
+        out["rods"] = {AXES[a]: sorted(list(c) for c, b in p.rods.items() if b == a) for a in
+                       sorted(set(p.rods.values()))}  # fmt: skip
+    return out
 
 
 # ---------------------------------------------------------------------------------------------
@@ -404,7 +417,8 @@ def _parse_pieces(
             raise r.fail(f"{f}.voxels", f"piece {name} is not face-connected")
         seen_names.add(name)
         seen_rgb[rgb] = name
-        pieces.append(Piece(name, rgb, shape))
+        rods = _parse_rods(r, obj.get("rods"), shape, f"{f}.rods", family)
+        pieces.append(Piece(name, rgb, shape, rods))
     if family == "stacking":
         assert box is not None
         total = sum(len(p.shape) for p in pieces)
@@ -418,6 +432,25 @@ def _parse_pieces(
                     raise r.fail("pieces", f"pieces {owner[c]} and {p.name} overlap at {list(c)}")
                 owner[c] = p.name
     return pieces
+
+
+def _parse_rods(r: _Reader, raw: Any, shape: Shape, fld: str, family: str) -> dict[Cell, int]:
+    """``{"y": [[x, y, z], ...]}``: cells of the piece that are round rods along that axis."""
+    if raw is None:
+        return {}
+    if family != "puzzle":
+        raise r.fail(fld, "only puzzle pieces have rods")
+    out: dict[Cell, int] = {}
+    for axis, cells in sorted(r.obj(raw, fld).items()):
+        if axis not in AXES:
+            raise r.fail(fld, f"{axis!r} is not an axis (x, y or z)")
+        for c in r.voxels(cells, f"{fld}.{axis}").cells:
+            if c not in shape.cell_set:
+                raise r.fail(f"{fld}.{axis}", f"{list(c)} is not a cell of the piece")
+            if c in out:
+                raise r.fail(fld, f"{list(c)} is a rod along two axes")
+            out[c] = AXES.index(axis)
+    return out
 
 
 def _parse_stacking_solution(
@@ -516,7 +549,7 @@ def _parse_puzzle_solution(
     shapes = {p.name: p.shape for p in pieces}
     disassembly = moves if goal == "disassemble" else disassembly_of_assembly_plan(moves)
     try:
-        final = replay_disassembly(shapes, disassembly)
+        final = replay_disassembly(shapes, disassembly, {p.name: p.rods for p in pieces})
     except MoveError as e:
         raise r.fail("solution.moves", f"does not replay: {e}") from None
     if not final.is_separated():

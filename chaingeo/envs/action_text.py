@@ -15,6 +15,7 @@ from typing import Final, Protocol
 from chaingeo.core import limits
 from chaingeo.core.kinematics import Move
 from chaingeo.core.level import Level
+from chaingeo.core.turns import TurnMove
 from chaingeo.envs.actions import (
     Action,
     AmbiguousActionError,
@@ -25,9 +26,12 @@ from chaingeo.envs.actions import (
     MoveRequest,
     PickupAction,
     PlaceAction,
+    TurnAction,
+    TurnRequest,
     UnparseableActionError,
     cell_from_agent,
 )
+from chaingeo.envs.turn_text import TurnTextError, is_turn_text, parse_turn
 
 GRAMMAR: Final[dict[str, str]] = {
     "stacking": "expected 'place COLOUR (x,y,z) (x,y,z) ...' listing every cell the piece "
@@ -103,7 +107,17 @@ def _tokenise(s: str) -> list[Token]:
     return tokens
 
 
-def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
+def _turn_text(text: str, normalised: str) -> TurnRequest:
+    """A turn (:mod:`chaingeo.envs.turn_text`), its errors as the parser's own."""
+    try:
+        return parse_turn(normalised)
+    except TurnTextError as e:
+        if e.meaningless:
+            raise IllegalActionError(e.hint, text=text) from None
+        raise UnparseableActionError(text, f"{e.hint}") from None
+
+
+def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest | TurnRequest:
     """Parse agent text without a state: an action, or a move whose distance or (in assembly)
     destination is left open. :class:`UnparseableActionError` if it is not in the grammar.
 
@@ -117,6 +131,8 @@ def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
             f"the text has {len(text)} characters; an action has at most "
             f"{limits.MAX_TEXT_CHARS}; {hint_all}",
         )
+    if is_turn_text(_normalise(text)):
+        return _turn_text(text, _normalise(text))
     try:
         tokens = _tokenise(_normalise(text))
         if not tokens:
@@ -301,7 +317,7 @@ class ResolvingState(Protocol):
     level: Level
 
     def key(self) -> Hashable: ...
-    def resolve(self, action: Action | MoveRequest) -> Action: ...
+    def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
 
 
@@ -336,6 +352,8 @@ def parse_action(text: str, state: ResolvingState) -> Action:
             names = [parsed.piece]
         elif isinstance(parsed, MoveRequest):
             names = [*parsed.pieces, *(parsed.into or ())]
+        elif isinstance(parsed, TurnRequest):
+            names = list(parsed.pieces)
         _known(names, state)
         action = state.resolve(parsed)
         reason = state.problem(action)
@@ -351,8 +369,13 @@ def parse_action(text: str, state: ResolvingState) -> Action:
 
 
 def action_from_text(text: str) -> Action:
-    """Parse the canonical text of an action without a state (moves must give a distance)."""
+    """Parse the canonical text of an action without a state (moves must give a distance,
+    turns their centre)."""
     parsed = parse_text(text, "assemble")
+    if isinstance(parsed, TurnRequest):
+        if parsed.centre2 is None:
+            raise UnparseableActionError(text, "a stand-alone turn needs its centre")
+        return TurnAction(TurnMove(parsed.pieces, parsed.axis, parsed.quarter, parsed.centre2))
     if isinstance(parsed, MoveRequest):
         if not parsed.distance_given:
             raise UnparseableActionError(text, "a stand-alone move needs its distance")

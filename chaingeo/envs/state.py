@@ -22,7 +22,14 @@ from typing import Any, Protocol, TypeVar, runtime_checkable
 from chaingeo.core.level import Level
 from chaingeo.envs.action_list import ActionList
 from chaingeo.envs.action_text import parse_action
-from chaingeo.envs.actions import Action, ActionError, FinishAction, IllegalActionError, MoveRequest
+from chaingeo.envs.actions import (
+    Action,
+    ActionError,
+    FinishAction,
+    IllegalActionError,
+    MoveRequest,
+    TurnRequest,
+)
 
 
 @dataclass(frozen=True)
@@ -63,7 +70,7 @@ class GameState(Protocol):
     @property
     def history(self) -> list[Turn]: ...
     def legal_actions(self) -> Sequence[Action]: ...
-    def resolve(self, action: Action | MoveRequest) -> Action: ...
+    def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
     def apply(self, action: Action) -> None: ...
     def push(self, action: Action) -> None: ...
@@ -124,9 +131,9 @@ class BaseState(ABC):
     def describe(self, action: Action) -> str:
         """Feedback for a legal action just applied (agent text)."""
 
-    def resolve(self, action: Action | MoveRequest) -> Action:
+    def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action:
         """Fill in what the agent left open, or raise Ambiguous/IllegalActionError."""
-        if isinstance(action, MoveRequest):
+        if isinstance(action, MoveRequest | TurnRequest):
             raise IllegalActionError("moves belong to puzzle levels; use place or pickup")
         return action
 

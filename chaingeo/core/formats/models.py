@@ -59,6 +59,7 @@ from chaingeo.core.level import (
     revalidate,
 )
 from chaingeo.core.rules import PuzzleRules, StackingRules, find_placing_order
+from chaingeo.core.turns import TurnMove
 
 __all__ = [
     "ImportedModel",
@@ -465,7 +466,7 @@ def provenance_generator(model: str) -> str:
 
 def model_puzzle_level(
     model: ImportedModel,
-    disassembly: Sequence[Move],
+    disassembly: Sequence[Move | TurnMove],
     *,
     goal: Literal["disassemble", "assemble"] = "disassemble",
     difficulty: Difficulty,
