@@ -172,10 +172,9 @@ class Assembly:
     def moved(
         self, offsets: Mapping[str, Cell], parts: tuple[frozenset[str], ...] | None = None
     ) -> Assembly:
-        """The same pieces and orientations at ``offsets`` (and ``parts``)."""
-        return Assembly(
-            self.shapes, offsets, self.parts if parts is None else parts, self.rotations
-        )
+        """The same pieces, orientations and rods at ``offsets`` (and ``parts``)."""
+        parts = self.parts if parts is None else parts
+        return Assembly(self.shapes, offsets, parts, self.rotations, self.rods)
 
     def part_of(self, name: str) -> frozenset[str]:
         for p in self.parts:

@@ -126,8 +126,10 @@ def parse_turn(normalised: str) -> TurnRequest:
                 raise TurnTextError(f"unexpected {value!r} in the centre")
         if len(values) != 3:
             raise TurnTextError("the centre needs three coordinates (x,y,z)")
-        centre = centre_from_agent(values)
+        c = list(centre_from_agent(values))
         a = _AXES.index(axis)
+        c[a] = 0  # the line's position along itself does not matter
+        centre = (c[0], c[1], c[2])
         u, v = (a + 1) % 3, (a + 2) % 3
         if (centre[u] - centre[v]) % 2:
             raise TurnTextError(
