@@ -221,13 +221,24 @@ def _walk(state: PuzzleState, choices: list[int]) -> None:
         state.apply(legal[c % len(legal)])
 
 
-@settings(max_examples=15, deadline=None)
-@given(st.sampled_from(["disassemble", "assemble"]), st.lists(st.integers(0, 10**6), max_size=3))
-def test_fast_action_lists_match_reference(goal: str, choices: list[int]) -> None:
+def _lists_match(goal: str, choices: list[int]) -> None:
     state = PuzzleState(luban_level(goal))
     _walk(state, choices)
     want = reference_actions(state.assembly, goal, None, turns=True)
     assert list(state.legal_actions()) == want
+
+
+@settings(max_examples=5, deadline=None)
+@given(st.sampled_from(["disassemble", "assemble"]), st.lists(st.integers(0, 10**6), max_size=3))
+def test_fast_action_lists_match_reference(goal: str, choices: list[int]) -> None:
+    _lists_match(goal, choices)
+
+
+@pytest.mark.slow
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(["disassemble", "assemble"]), st.lists(st.integers(0, 10**6), max_size=5))
+def test_fast_action_lists_match_reference_long_walks(goal: str, choices: list[int]) -> None:
+    _lists_match(goal, choices)
 
 
 def test_assembly_plays_the_plan_backwards() -> None:

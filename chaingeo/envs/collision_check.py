@@ -157,3 +157,16 @@ def move_is_legal(
         return True
     travel = sweep_to_clear(moving, rest, direction) if distance is None else float(distance)
     return not swept_collision(moving, rest, direction, travel)
+
+
+def turn_is_legal(
+    pieces: Mapping[str, Shape], group: Sequence[str], axis: int, quarter: int, centre2: Cell
+) -> bool:
+    """FCL's verdict on turning ``group`` (pieces where they stand) by ``quarter`` about the
+    line parallel to ``axis`` through ``centre2`` (see :func:`turning_collision`)."""
+    unknown = sorted(set(group) - set(pieces))
+    if unknown:
+        raise ValueError(f"unknown piece(s) {unknown}")
+    moving = [pieces[n] for n in sorted(set(group))]
+    rest = [pieces[n] for n in sorted(set(pieces) - set(group))]
+    return not turning_collision(moving, rest, axis, quarter, centre2)
