@@ -30,7 +30,7 @@ from chaingeo.core.turns import (
     TurnMove,
     centre_inside,
     centres_within,
-    lateral,
+    spinning_rods,
     swept_by,
     turn_pose,
 )
@@ -237,25 +237,16 @@ class Assembly:
             raise MoveError(move, f"blocked after {free} unit(s), {move.distance} asked")
 
     def spinning(self, names: Iterable[str], axis: int, centre2: Sequence[int]) -> set[Cell]:
-        """The cells of these pieces' round rods that lie along ``axis`` on the line through
-        ``centre2``: turning about that line they spin in place, sweeping only their own cell
-        (a rod is a cylinder of diameter 1 in its cell; in every other test it counts as a
-        full cube, which never allows a move the rod could not make)."""
-        u, v = lateral(axis)
-        out: set[Cell] = set()
-        for n in names:
-            rods = self.rods.get(n)
-            if not rods:
-                continue
-            r = ROTATIONS[self.rotation_of(n)]
-            ox, oy, oz = self.offsets[n]
-            for cell, a in rods.items():
-                if r[axis, a] == 0:
-                    continue  # this rod now lies across the axis
-                w = r @ np.asarray(cell, dtype=np.int64) + (ox, oy, oz)
-                if 2 * w[u] == centre2[u] and 2 * w[v] == centre2[v]:
-                    out.add(_cell(w))
-        return out
+        """The cells of these pieces' round rods on the turn's line: they spin in place
+        (:func:`chaingeo.core.turns.spinning_rods`)."""
+        return {
+            c
+            for n in names
+            if self.rods.get(n)
+            for c in spinning_rods(
+                self.rods[n], ROTATIONS[self.rotation_of(n)], self.offsets[n], axis, centre2
+            )
+        }
 
     def turn_sweep(
         self, names: Sequence[str], axis: int, quarter: int, centre2: Sequence[int]

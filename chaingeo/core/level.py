@@ -27,6 +27,9 @@ from chaingeo.core.kinematics import (
     disassembly_of_assembly_plan,
     replay_disassembly,
 )
+from chaingeo.core.level_reader import LevelError as LevelError
+from chaingeo.core.level_reader import Reader as _Reader
+from chaingeo.core.level_reader import short as _short
 from chaingeo.core.rules import SUPPORT_RULES, PuzzleRules, StackingRules, placement_order_problem
 from chaingeo.core.turns import AXES, TurnMove, turn_from_json
 
@@ -41,16 +44,6 @@ _HEX_RE: Final = re.compile(r"^#[0-9a-f]{6}$")
 Family = Literal["stacking", "puzzle"]
 Difficulty = Literal["easy", "mid", "hard"]
 Goal = Literal["pack", "disassemble", "assemble"]
-
-
-class LevelError(ValueError):
-    """A level that cannot be loaded or is not valid: which file, which field, and why."""
-
-    def __init__(self, source: str, field: str, reason: str) -> None:
-        super().__init__(f"{source}: {field}: {reason}")
-        self.source = source
-        self.field = field
-        self.reason = reason
 
 
 @dataclass(frozen=True)
@@ -190,86 +183,6 @@ def default_step_budget(optimal_steps: int) -> int:
 # ---------------------------------------------------------------------------------------------
 # Loading and validation
 # ---------------------------------------------------------------------------------------------
-
-
-class _Reader:
-    """Typed field access that turns every problem into a LevelError for one source."""
-
-    def __init__(self, source: str) -> None:
-        self.source = source
-
-    def fail(self, fld: str, reason: str) -> LevelError:
-        return LevelError(self.source, fld, reason)
-
-    def get(self, obj: Mapping[str, Any], key: str, fld: str) -> Any:
-        if key not in obj:
-            raise self.fail(fld, "missing field")
-        return obj[key]
-
-    def obj(self, value: Any, fld: str) -> Mapping[str, Any]:
-        if not isinstance(value, dict):
-            raise self.fail(fld, f"expected an object, got {_kind(value)}")
-        return value
-
-    def lst(self, value: Any, fld: str) -> list[Any]:
-        if not isinstance(value, list):
-            raise self.fail(fld, f"expected a list, got {_kind(value)}")
-        return value
-
-    def string(self, value: Any, fld: str, choices: Sequence[str] | None = None) -> str:
-        if not isinstance(value, str):
-            raise self.fail(fld, f"expected a string, got {_kind(value)}")
-        if choices is not None and value not in choices:
-            raise self.fail(fld, f"{value!r} is not one of {list(choices)}")
-        return value
-
-    def integer(
-        self, value: Any, fld: str, minimum: int | None = None, maximum: int | None = None
-    ) -> int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise self.fail(fld, f"expected an integer, got {_kind(value)}")
-        if minimum is not None and value < minimum:
-            raise self.fail(fld, f"must be >= {minimum}, got {value}")
-        if maximum is not None and value > maximum:
-            raise self.fail(fld, f"must be <= {maximum}, got {value}")
-        return value
-
-    def coord(self, value: Any, fld: str) -> int:
-        return self.integer(value, fld, -limits.MAX_COORD, limits.MAX_COORD)
-
-    def opt_integer(self, value: Any, fld: str) -> int | None:
-        return None if value is None else self.integer(value, fld)
-
-    def voxels(self, value: Any, fld: str) -> Shape:
-        cells = self.lst(value, fld)
-        if not cells:
-            raise self.fail(fld, "a piece needs at least one voxel")
-        if len(cells) > limits.MAX_PIECE_VOXELS:
-            raise self.fail(
-                fld, f"{len(cells)} voxels; a piece has at most {limits.MAX_PIECE_VOXELS}"
-            )
-        out: list[tuple[int, int, int]] = []
-        seen: set[tuple[int, int, int]] = set()
-        for i, c in enumerate(cells):
-            f = f"{fld}[{i}]"
-            if not (isinstance(c, list) and len(c) == 3):
-                raise self.fail(f, f"a voxel is a list of three integers, got {_short(c)}")
-            cell = (self.coord(c[0], f), self.coord(c[1], f), self.coord(c[2], f))
-            if cell in seen:
-                raise self.fail(fld, f"voxel {list(cell)} is listed twice")
-            seen.add(cell)
-            out.append(cell)
-        return Shape(out)
-
-
-def _kind(value: Any) -> str:
-    return "null" if value is None else type(value).__name__
-
-
-def _short(value: Any) -> str:
-    """``repr`` cut to a line, so an error message never echoes a huge value."""
-    text = repr(value)
-    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def parse_level(data: Any, source: str = "<level>") -> Level:

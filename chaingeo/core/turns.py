@@ -477,12 +477,27 @@ def swept_by(cells: Iterable[Cell], axis: int, quarter: int, centre2: Sequence[i
     return out
 
 
-def turn_hits(
-    moving: Iterable[Cell], fixed: Iterable[Cell], axis: int, quarter: int, centre2: Sequence[int]
-) -> list[Cell]:
-    """The cells of ``fixed`` that ``moving`` would pass through in that turn, sorted."""
-    swept = swept_by(moving, axis, quarter, centre2)
-    return sorted(c for c in set(fixed) if c in swept)
+def spinning_rods(
+    rods: Mapping[Cell, int],
+    rotation: IntArray,
+    offset: Sequence[int],
+    axis: int,
+    centre2: Sequence[int],
+) -> set[Cell]:
+    """The cells (where they stand) of a piece's round rods (cell of the piece's own frame ->
+    the rod's axis) that lie along ``axis`` on the line through ``centre2``, the piece at pose
+    ``(rotation, offset)``: turning about that line they spin in place, sweeping only their own
+    cell. (A rod is a cylinder of diameter 1 filling its cell; in every other test it counts as
+    a full cube, which never allows a move the rod could not make.)"""
+    u, v = lateral(axis)
+    out: set[Cell] = set()
+    for cell, a in rods.items():
+        if rotation[axis, a] == 0:
+            continue  # this rod now lies across the axis
+        w = rotation @ np.asarray(cell, dtype=np.int64) + np.asarray(offset, dtype=np.int64)
+        if 2 * w[u] == centre2[u] and 2 * w[v] == centre2[v]:
+            out.add((int(w[0]), int(w[1]), int(w[2])))
+    return out
 
 
 def centres_within(cells: Iterable[Cell], axis: int) -> list[Cell]:

@@ -48,16 +48,14 @@ from typing import Any
 
 import numpy as np
 
-from chaingeo.core.geometry import ROTATIONS, Cell, Shape, rotation_index
+from chaingeo.core.geometry import Cell
 from chaingeo.core.kinematics import (
     DIRECTIONS,
     OPPOSITE,
     Assembly,
     Move,
-    disassembly_of_assembly_plan,
 )
-from chaingeo.core.level import Level, PuzzleSolution
-from chaingeo.core.rules import PuzzleRules
+from chaingeo.core.level import Level
 from chaingeo.envs.action_list import ActionList
 from chaingeo.envs.actions import (
     Action,
@@ -79,43 +77,17 @@ from chaingeo.envs.puzzle_actions import (
     shifts,
     turn_actions,
 )
+from chaingeo.envs.puzzle_tables import PositionKey as PositionKey
+from chaingeo.envs.puzzle_tables import PuzzleTables as PuzzleTables
+from chaingeo.envs.puzzle_tables import normal_key as normal_key
 from chaingeo.envs.puzzle_turns import describe_turn, resolve_turn, turn_problem
 from chaingeo.envs.state import BaseState
-from solvers.partsearch import PieceTable
-from solvers.turnmoves import TurnTable
 
 _ByGroup = dict[tuple[tuple[str, ...], str], MoveRange]
 #: a position (kept alive so its id stays its own), its moves by (group, direction), its turns,
 #: its actions
 _Listed = tuple[Assembly, _ByGroup, list[TurnAction], ActionList]
 _CACHED_POSITIONS = 8
-
-PartKey = tuple[tuple[str, Cell] | tuple[str, Cell, int], ...]
-PositionKey = tuple[PartKey, ...]
-
-
-def normal_key(asm: Assembly) -> PositionKey:
-    """Each part as (name, offset relative to the part's first piece), parts sorted. Where
-    turns left pieces turned, the part is seen from its first piece's pose (turned back so
-    that piece is as assembled) and each entry adds the relative orientation when not 0."""
-    parts: list[PartKey] = []
-    for part in asm.parts:
-        names = sorted(part)
-        bx, by, bz = asm.offsets[names[0]]
-        rel = {n: (asm.offsets[n][0] - bx, asm.offsets[n][1] - by, asm.offsets[n][2] - bz)
-               for n in names}  # fmt: skip
-        base = asm.rotation_of(names[0])
-        if not base and not any(asm.rotation_of(n) for n in names):
-            parts.append(tuple((n, rel[n]) for n in names))
-            continue
-        back = ROTATIONS[base].T
-        entries: list[tuple[str, Cell] | tuple[str, Cell, int]] = []
-        for n in names:
-            x, y, z = (int(v) for v in back @ rel[n])
-            r = rotation_index(back @ ROTATIONS[asm.rotation_of(n)])
-            entries.append((n, (x, y, z), r) if r else (n, (x, y, z)))
-        parts.append(tuple(entries))
-    return tuple(sorted(parts))
 
 
 def group_text(names: Iterable[str]) -> str:
@@ -126,40 +98,6 @@ def _axis(direction: str) -> tuple[int, int]:
     d = DIRECTIONS[direction]
     axis = next(i for i in range(3) if d[i])
     return axis, d[axis]
-
-
-class PuzzleTables:
-    """Per-level data shared by every state of that level."""
-
-    def __init__(self, level: Level) -> None:
-        if not isinstance(level.rules, PuzzleRules) or not isinstance(
-            level.solution, PuzzleSolution
-        ):
-            raise ValueError(f"level {level.id} is not a puzzle level")
-        self.mode: str = level.goal
-        self.shapes: dict[str, Shape] = {p.name: p.shape for p in level.pieces}
-        self.names: tuple[str, ...] = tuple(sorted(self.shapes))
-        self.max_group: int | None = level.rules.max_group
-        self.turns: bool = level.rules.turns
-        self.rods = level.rods
-        self.target_key: PositionKey = normal_key(Assembly.assembled(self.shapes, self.rods))
-        self.piece_table = PieceTable(self.shapes)
-        self.turn_table = TurnTable(self.shapes, self.rods) if self.turns else None
-        #: translation tables of the pieces as turned, by orientations (see oriented_table)
-        self.oriented: dict[object, PieceTable] = {}
-        #: assembly only: normalised states on the recorded plan -> how far along they are.
-        self.path: dict[PositionKey, int] = {}
-        #: assembly only: the orientations the plan leaves the pieces in (where they start)
-        self.start_rotations: dict[str, int] = {}
-        if self.mode == "assemble":
-            forward = disassembly_of_assembly_plan(level.solution.moves)
-            states = [Assembly.assembled(self.shapes, self.rods)]
-            for m in forward:
-                states.append(states[-1].apply(m))
-            n = len(states) - 1
-            for i, s in enumerate(states):
-                self.path.setdefault(normal_key(s), n - i)
-            self.start_rotations = dict(states[-1].rotations)
 
 
 @dataclass(frozen=True)

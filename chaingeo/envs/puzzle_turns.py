@@ -11,6 +11,9 @@ from __future__ import annotations
 
 from collections.abc import Hashable, Sequence
 
+import numpy as np
+
+from chaingeo.core.geometry import ROTATIONS, Cell, rotation_index
 from chaingeo.core.kinematics import Assembly
 from chaingeo.core.turns import AXES, TurnMove, lateral
 from chaingeo.envs.actions import (
@@ -22,6 +25,23 @@ from chaingeo.envs.actions import (
 )
 
 NO_TURNS = "this level does not allow turns; use move or finish"
+
+#: A part in a position key: each piece's name and offset relative to the part's first piece,
+#: and its relative orientation where not 0 (:func:`chaingeo.envs.puzzle.normal_key`).
+PartKey = tuple[tuple[str, Cell] | tuple[str, Cell, int], ...]
+
+
+def turned_part_key(asm: Assembly, names: Sequence[str]) -> PartKey:
+    """A part with turned pieces, seen from its first piece's pose (the whole part turned back
+    so that piece stands as assembled): relative offsets and, where not 0, orientations."""
+    back = ROTATIONS[asm.rotation_of(names[0])].T
+    base = np.asarray(asm.offsets[names[0]], dtype=np.int64)
+    out: list[tuple[str, Cell] | tuple[str, Cell, int]] = []
+    for n in names:
+        x, y, z = (int(v) for v in back @ (np.asarray(asm.offsets[n], dtype=np.int64) - base))
+        r = rotation_index(back @ ROTATIONS[asm.rotation_of(n)])
+        out.append((n, (x, y, z), r) if r else (n, (x, y, z)))
+    return tuple(out)
 
 
 def turn_problem(
