@@ -17,7 +17,7 @@ from chaingeo.core.kinematics import Move, SearchLimitError
 from generator.candidate import Candidate, evaluate
 from generator.config import PuzzleConfig
 from generator.maze import maze_search, runs, with_exit
-from solvers.disassemble import analyze
+from solvers.disassemble import analyze, translations
 
 #: Towers of burr units; with single-piece moves (max_group=1) they are built unit by unit and
 #: their o_i is proven with the block bound (:mod:`solvers.blockbound`), one block per unit.
@@ -65,7 +65,7 @@ def tower_candidate(
                 continue
             named = {f"p{i}": s for i, s in enumerate(unit.shapes)}
             try:
-                plan = analyze(named, max_group=1, optimal=True).plan
+                plan = translations(analyze(named, max_group=1, optimal=True).plan)
             except SearchLimitError:
                 continue
             down = any(m.direction == "-z" for m in plan)

@@ -20,7 +20,7 @@ from chaingeo.core.level import Level
 from chaingeo.core.rules import PuzzleRules
 from solvers.assemble import count_solutions
 from solvers.blockbound import analyze_by_blocks
-from solvers.disassemble import Analysis, analyze
+from solvers.disassemble import Analysis, Rods, analyze
 from solvers.partsearch import SearchLimits
 from solvers.problem import PieceSpec
 
@@ -55,15 +55,22 @@ def analyze_puzzle(
     max_group: int | None,
     limits: SearchLimits | None = None,
     blocks: Sequence[Sequence[str]] | None = None,
+    turns: bool = False,
+    rods: Rods | None = None,
 ) -> Analysis:
     """Level, moves, o_i and an optimal plan of an assembled puzzle. With ``blocks`` (single-piece
     moves only) o_i is proven by the block bound instead of searched, and a
-    :class:`SearchLimitError` says when no quick plan meets it."""
+    :class:`SearchLimitError` says when no quick plan meets it. With ``turns`` groups may also
+    turn (``rods``: the pieces' round rods)."""
     if blocks is not None:
-        if max_group != 1:
+        if max_group != 1 or turns:
             raise ValueError("blocks prove o_i for single-piece moves (max_group=1) only")
         return analyze_by_blocks(shapes, blocks, limits=limits, stacked=True, search=False)
-    return analyze(shapes, max_group=max_group, limits=limits, optimal=True)
+    return analyze(shapes, max_group=max_group, limits=limits, optimal=True, turns=turns, rods=rods)
+
+
+def level_turns(level: Level) -> bool:
+    return isinstance(level.rules, PuzzleRules) and level.rules.turns
 
 
 def analyze_level(level: Level, limits: SearchLimits | None = None) -> Analysis:
@@ -71,7 +78,12 @@ def analyze_level(level: Level, limits: SearchLimits | None = None) -> Analysis:
     if level.family != "puzzle":
         raise ValueError(f"{level.id}: a {level.family} level; only puzzles are analysed")
     return analyze_puzzle(
-        level.shapes, max_group=level_max_group(level), limits=limits, blocks=level_blocks(level)
+        level.shapes,
+        max_group=level_max_group(level),
+        limits=limits,
+        blocks=level_blocks(level),
+        turns=level_turns(level),
+        rods=level.rods,
     )
 
 
@@ -82,16 +94,20 @@ def disassembly_figures(
     limits: SearchLimits,
     optimal: bool,
     blocks: Sequence[Sequence[str]] | None = None,
+    turns: bool = False,
+    rods: Rods | None = None,
 ) -> dict[str, Any]:
     """``level``, ``moves`` and ``optimal_steps`` of one assembly (None where unknown); if the
     optimal search hits a cap, ``optimal_error`` says which (the level is still reported)."""
     out: dict[str, Any] = {}
-    first = analyze(shapes, max_group=max_group, limits=limits, optimal=False)
+    first = analyze(
+        shapes, max_group=max_group, limits=limits, optimal=False, turns=turns, rods=rods
+    )
     out.update(level=first.level, moves=first.moves, optimal_steps=None)
     if optimal and first.disassemblable:
         try:
             out["optimal_steps"] = analyze_puzzle(
-                shapes, max_group=max_group, limits=limits, blocks=blocks
+                shapes, max_group=max_group, limits=limits, blocks=blocks, turns=turns, rods=rods
             ).optimal_steps
         except SearchLimitError as e:
             out["optimal_error"] = str(e)
@@ -122,6 +138,8 @@ def level_figures(
             limits=limits,
             optimal=optimal,
             blocks=level_blocks(level),
+            turns=level_turns(level),
+            rods=level.rods,
         )
     )
     return out

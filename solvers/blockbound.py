@@ -41,7 +41,7 @@ from collections.abc import Mapping, Sequence
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, Move, MoveError, SearchLimitError
-from solvers.disassemble import Analysis, analyze
+from solvers.disassemble import Analysis, analyze, translations
 from solvers.partsearch import SearchLimits
 
 
@@ -80,7 +80,7 @@ def _block_plans(
         result = analyze(part, max_group=1, limits=limits, optimal=True)
         if result.optimal_steps is None:
             raise ValueError(f"block {sorted(block)} cannot be taken apart on its own")
-        plans.append(list(result.plan))
+        plans.append(translations(result.plan))
     return plans
 
 
@@ -177,7 +177,7 @@ def analyze_by_blocks(
     quick = analyze(shapes, max_group=1, limits=limits, optimal=False)
     if not quick.disassemblable:
         return quick
-    if quick.moves == bound and (not stacked or removals_touch(shapes, quick.plan)):
+    if quick.moves == bound and (not stacked or removals_touch(shapes, translations(quick.plan))):
         return dataclasses.replace(quick, optimal_steps=quick.moves)
     if stacked:
         plan = end_first_plan(shapes, blocks, plans)

@@ -16,15 +16,18 @@ Semantics are those of :mod:`chaingeo.core.kinematics` (the reference); the sear
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from chaingeo.core.geometry import Shape
+from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
+from chaingeo.core.turns import TurnMove
 from solvers import movement as mv
 from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
+from solvers.turnmoves import TurnTable
+from solvers.turnsearch import TurnPartSearch
 
 __all__ = [
     "Analysis",
@@ -43,7 +46,7 @@ class Separation:
     """One node of a disassembly tree: ``moves`` (ending with the removal) split a part into
     ``removed`` and ``left`` (None where that side is a single piece)."""
 
-    moves: tuple[Move, ...]
+    moves: tuple[Move | TurnMove, ...]
     removed: Separation | None = None
     left: Separation | None = None
 
@@ -70,10 +73,10 @@ class Separation:
                 text += "." + sub.level_text()
         return text
 
-    def all_moves(self) -> list[Move]:
+    def all_moves(self) -> list[Move | TurnMove]:
         """The whole tree as one move sequence: this part, then the left part, then the
         removed one (parts are independent, so any interleaving is as good)."""
-        out = list(self.moves)
+        out: list[Move | TurnMove] = list(self.moves)
         if self.left is not None:
             out.extend(self.left.all_moves())
         if self.removed is not None:
@@ -89,7 +92,7 @@ class Analysis:
     level: str | None  # BurrTools notation, None when it cannot be taken apart
     moves: int | None  # total moves of that (BurrTools-style) disassembly
     optimal_steps: int | None  # o_i, the fewest moves of any full disassembly
-    plan: tuple[Move, ...] = ()  # one optimal full disassembly
+    plan: tuple[Move | TurnMove, ...] = ()  # one optimal full disassembly
     tree: Separation | None = None
     states: int = 0  # states visited, over every search
     first_level: int | None = field(default=None)  # moves until the first part comes free
@@ -98,31 +101,55 @@ class Analysis:
 PartKey = tuple[tuple[int, ...], bytes]
 
 
+#: Round rods of each piece: cell (assembled frame) -> the rod's axis (0, 1, 2).
+Rods = Mapping[str, Mapping[Cell, int]]
+
+
 class _Solver:
-    """Searches of one puzzle, sharing the piece table, the caps, the deadline and memos."""
+    """Searches of one puzzle, sharing the piece table, the caps, the deadline and memos.
+
+    With ``turns`` a part's configuration is ``(n, 4)`` poses (offset, rotation index) in real
+    coordinates, searched by :class:`solvers.turnsearch.TurnPartSearch`; plans then name turn
+    centres in real coordinates, so memo keys keep the absolute poses."""
 
     def __init__(
-        self, shapes: Mapping[str, Shape], max_group: int | None, limits: SearchLimits
+        self,
+        shapes: Mapping[str, Shape],
+        max_group: int | None,
+        limits: SearchLimits,
+        turns: bool = False,
+        rods: Rods | None = None,
     ) -> None:
         self.table = PieceTable(shapes)
+        self.turn_table = TurnTable(shapes, rods or {}) if turns else None
         self.max_group = max_group
         self.limits = limits
         self.deadline = Deadline(limits.seconds)
         self.greedy_memo: dict[PartKey, Separation | None] = {}
-        self.opt_memo: dict[PartKey, tuple[int, bool, list[Move]]] = {}
+        self.opt_memo: dict[PartKey, tuple[int, bool, list[Move | TurnMove]]] = {}
         self.states = 0
 
-    @staticmethod
-    def key(members: tuple[int, ...], offsets: np.ndarray) -> PartKey:
+    def key(self, members: tuple[int, ...], offsets: np.ndarray) -> PartKey:
+        if self.turn_table is not None:
+            return members, np.asarray(offsets, dtype=np.int16).tobytes()
         rel = np.asarray(offsets, dtype=np.int64) - np.asarray(offsets[0], dtype=np.int64)
         return members, rel.astype(np.int16).tobytes()
 
-    def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch:
+    def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch | TurnPartSearch:
         cap = self.limits.max_total_states
         if cap is not None and self.states > cap:
             raise SearchLimitError(
                 f"total state cap of {cap} reached over all searches; "
                 "raise SearchLimits(max_total_states=...)"
+            )
+        if self.turn_table is not None:
+            return TurnPartSearch(
+                self.turn_table,
+                members,
+                offsets,
+                max_group=self.max_group,
+                limits=self.limits,
+                deadline=self.deadline,
             )
         return PartSearch(
             self.table,
@@ -153,7 +180,7 @@ class _Solver:
                 if len(lm) > 1 and left is None:
                     continue
                 r = sp.removal
-                moves = (*s.path_to(r.node), s.local_move(r.mask, r.direction, None))
+                moves = (*s.path_to(r.node), s.removal_move(r))
                 result = Separation(moves, removed, left)
                 break
         self.states += s.n_states
@@ -163,7 +190,7 @@ class _Solver:
     # -- optimal full disassembly --------------------------------------------------------------
     def optimal(
         self, members: tuple[int, ...], offsets: np.ndarray, budget: int, floor: int = 0
-    ) -> tuple[int, list[Move] | None]:
+    ) -> tuple[int, list[Move | TurnMove] | None]:
         """``(f, plan)`` with ``f`` the fewest moves to take the part apart if that is below
         ``budget``; otherwise ``(lower bound >= budget, None)``. ``floor`` is a proven lower
         bound on ``f`` from the caller: the search stops as soon as a plan meets it."""
@@ -200,7 +227,7 @@ class _Solver:
                 best = base + fa + fb
                 best_plan = [
                     *s.path_to(r.node),
-                    s.local_move(r.mask, r.direction, None),
+                    s.removal_move(r),
                     *pb,
                     *pa,
                 ]
@@ -222,15 +249,19 @@ def analyze(
     limits: SearchLimits | None = None,
     optimal: bool = True,
     lower_bound: int | None = None,
+    turns: bool = False,
+    rods: Rods | None = None,
 ) -> Analysis:
     """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
     state (every piece at offset zero, one part). ``lower_bound``: a *proven* lower bound on
     o_i (e.g. :func:`solvers.blockbound.block_lower_bound`); the search stops at a plan that
-    meets it, and a plan below it raises ``ValueError`` (the bound was not a bound)."""
-    solver = _Solver(shapes, max_group, limits or SearchLimits())
+    meets it, and a plan below it raises ``ValueError`` (the bound was not a bound). With
+    ``turns`` groups may also turn (:mod:`solvers.turnsearch`; ``rods``: the round rods of each
+    piece, which spin in place)."""
+    solver = _Solver(shapes, max_group, limits or SearchLimits(), turns, rods)
     n = len(solver.table.names)
     members = tuple(range(n))
-    offsets = np.zeros((n, 3), dtype=np.int64)
+    offsets = np.zeros((n, 4 if turns else 3), dtype=np.int64)
     if n == 1:
         return Analysis(True, "0", 0, 0)
     tree = solver.greedy(members, offsets)
@@ -258,6 +289,15 @@ def analyze(
         states=solver.states,
         first_level=len(tree.moves),
     )
+
+
+def translations(plan: Sequence[Move | TurnMove]) -> list[Move]:
+    """A plan known to hold translations only (no turns: the rules did not allow them);
+    ``ValueError`` otherwise."""
+    out = [m for m in plan if isinstance(m, Move)]
+    if len(out) != len(plan):
+        raise ValueError("the plan turns pieces; expected translations only")
+    return out
 
 
 # -------------------------------------------------------------------------------------------

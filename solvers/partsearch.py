@@ -239,6 +239,10 @@ class PartSearch:
         pieces = tuple(names[self.members[i]] for i in range(self.n) if mask >> i & 1)
         return Move(pieces, DIRECTION_NAMES[direction], distance)
 
+    def removal_move(self, removal: Removal) -> Move:
+        """The removal as a move (to infinity)."""
+        return self.local_move(removal.mask, removal.direction, None)
+
     def path_to(self, node: int) -> list[Move]:
         """The moves from the start state to ``node`` (shortest, as found)."""
         out: list[Move] = []

@@ -22,6 +22,7 @@ from chaingeo.envs.actions import (
     MoveRequest,
     PickupAction,
     PlaceAction,
+    TurnRequest,
     UnparseableActionError,
     action_from_json,
     action_to_json,
@@ -122,7 +123,7 @@ FORGIVING = [
 @pytest.mark.parametrize(("text", "canonical"), FORGIVING)
 def test_parser_is_forgiving_in_syntax(text: str, canonical: str) -> None:
     parsed = parse_text(text, "assemble")
-    shown = parsed.text() if isinstance(parsed, MoveRequest) else parsed.to_text()
+    shown = parsed.text() if isinstance(parsed, MoveRequest | TurnRequest) else parsed.to_text()
     assert shown == canonical
 
 

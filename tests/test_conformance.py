@@ -14,7 +14,7 @@ import pytest
 
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution, load_levels
 from chaingeo.envs.action_text import parse_action
-from chaingeo.envs.actions import Action, MoveAction, PlaceAction
+from chaingeo.envs.actions import Action, PlaceAction, action_of_move
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.state import BaseState
 from tests.env_levels import puzzle_levels, stacking_levels
@@ -39,7 +39,7 @@ def oracle_actions(level: Level) -> list[Action]:
     if isinstance(sol, StackingSolution):
         return [PlaceAction(n, sol.placements[n].cells) for n in sol.order]
     assert isinstance(sol, PuzzleSolution)
-    return [MoveAction(m) for m in sol.moves]
+    return [action_of_move(m) for m in sol.moves]
 
 
 def same_as_a_legal_action(state: BaseState, action: Action) -> bool:

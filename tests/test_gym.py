@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from chaingeo.envs.actions import MoveAction, PlaceAction
+from chaingeo.envs.actions import PlaceAction, action_of_move
 from chaingeo.envs.gym import CHARSET, PuzzleEnv, StackingEnv
 from tests.env_levels import drop_level, puzzle_levels, soma_level, tiny_level
 
@@ -102,5 +102,5 @@ def test_finish_terminates_the_puzzle_episode_and_lists_moves() -> None:
     env.reset(options={"level": "lock3-assemble"})
     lock3 = next(lv for lv in puzzle_levels() if lv.id == "lock3-assemble")
     for move in lock3.solution.moves:  # type: ignore[union-attr]
-        _, reward, terminated, truncated, info = env.step(MoveAction(move).to_text())
+        _, reward, terminated, truncated, info = env.step(action_of_move(move).to_text())
     assert terminated and reward == 1.0 and info["steps_used"] == 2

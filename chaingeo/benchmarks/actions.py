@@ -24,7 +24,7 @@ import numpy as np
 from chaingeo.core.kinematics import Assembly
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.suite import shipped_levels
-from chaingeo.envs.actions import MoveAction
+from chaingeo.envs.actions import action_of_move
 from chaingeo.envs.puzzle import PuzzleState
 from chaingeo.envs.puzzle_actions import reference_actions
 
@@ -37,7 +37,7 @@ def _states(level: Level, walk: int, seed: int) -> list[PuzzleState]:
     state = PuzzleState(level)
     out = [state.clone()]
     for move in level.solution.moves:  # type: ignore[union-attr]
-        state.apply(state.resolve(MoveAction(move)))
+        state.apply(state.resolve(action_of_move(move)))
         out.append(state.clone())
     rng = np.random.default_rng(np.random.SeedSequence([seed, len(level.pieces)]))
     state = PuzzleState(level)

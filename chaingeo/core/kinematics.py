@@ -5,15 +5,35 @@ a group of pieces of one part along an axis by ``k >= 1`` units, or to infinity;
 when no unit step on the way makes a voxel of the group meet a voxel of the rest of the part.
 A move to infinity splits the part in two; the disassembly is done when every part is one piece.
 Each move is one step whatever its distance (BurrTools' convention).
+
+Where a level's rules allow turns, a :class:`~chaingeo.core.turns.TurnMove` turns a group of one
+part by 90 degrees about a line parallel to x, y or z through cell centres or cell corners (the
+convention of :mod:`chaingeo.core.turns`), its centre within the group's bounding box; it is legal
+when the continuous turn sweeps through no other piece of the part (decided exactly there).
+A turned piece changes orientation: a piece's pose is a rotation (index into
+:data:`chaingeo.core.geometry.ROTATIONS`, 0 the identity) and an offset, its cells ``R v + offset``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
-from typing import Final
+from dataclasses import dataclass, field
+from functools import lru_cache
+from itertools import combinations
+from typing import Any, Final
 
-from chaingeo.core.geometry import Cell, Shape
+import numpy as np
+
+from chaingeo.core.geometry import ROTATIONS, Cell, Shape, rotation_index
+from chaingeo.core.turns import (
+    AXES,
+    TurnMove,
+    centre_inside,
+    centres_within,
+    spinning_rods,
+    swept_by,
+    turn_pose,
+)
 
 DIRECTIONS: Final[dict[str, Cell]] = {
     "+x": (1, 0, 0),
@@ -36,7 +56,7 @@ OPPOSITE: Final[dict[str, str]] = {
 class MoveError(ValueError):
     """A move that the kinematics forbids; ``reason`` says why in words a user can act on."""
 
-    def __init__(self, move: Move, reason: str) -> None:
+    def __init__(self, move: Move | TurnMove, reason: str) -> None:
         super().__init__(f"{move.describe()}: {reason}")
         self.move = move
         self.reason = reason
@@ -102,30 +122,59 @@ def _max_free_run(group: frozenset[Cell], rest: frozenset[Cell], d: Cell) -> int
     return None if first is None else first - 1
 
 
+#: A translation or a turn.
+AnyMove = Move | TurnMove
+
+
+@lru_cache(maxsize=4096)
+def oriented(shape: Shape, rotation: int) -> Shape:
+    """``shape`` turned by ``ROTATIONS[rotation]`` about the origin (cells ``R v``)."""
+    return shape if rotation == 0 else shape.rotate(ROTATIONS[rotation])
+
+
 @dataclass(frozen=True)
 class Assembly:
     """Pieces (in their assembled position) with integer offsets, grouped into parts.
 
     ``parts`` lists the sub-puzzles still to take apart (and finished singletons); pieces of
-    different parts never interact again.
+    different parts never interact again. ``rotations`` holds the pieces a turn has left in
+    another orientation (index into :data:`chaingeo.core.geometry.ROTATIONS`; absent: 0, as
+    assembled). ``rods``: cells of a piece (assembled frame) that are round rods along an axis
+    (0, 1, 2); a rod lying on a turn's axis line spins in place (see :meth:`turn_sweep`).
     """
 
     shapes: Mapping[str, Shape]
     offsets: Mapping[str, Cell]
     parts: tuple[frozenset[str], ...]
+    rotations: Mapping[str, int] = field(default_factory=dict)
+    rods: Mapping[str, Mapping[Cell, int]] = field(default_factory=dict)
 
     @staticmethod
-    def assembled(shapes: Mapping[str, Shape]) -> Assembly:
+    def assembled(
+        shapes: Mapping[str, Shape], rods: Mapping[str, Mapping[Cell, int]] | None = None
+    ) -> Assembly:
         names = sorted(shapes)
         return Assembly(
             shapes=dict(shapes),
             offsets={n: (0, 0, 0) for n in names},
             parts=(frozenset(names),),
+            rods={n: dict(r) for n, r in (rods or {}).items() if r},
         )
+
+    def rotation_of(self, name: str) -> int:
+        return self.rotations.get(name, 0)
 
     def cells_of(self, name: str) -> frozenset[Cell]:
         ox, oy, oz = self.offsets[name]
-        return frozenset((x + ox, y + oy, z + oz) for x, y, z in self.shapes[name])
+        shape = oriented(self.shapes[name], self.rotation_of(name))
+        return frozenset((x + ox, y + oy, z + oz) for x, y, z in shape)
+
+    def moved(
+        self, offsets: Mapping[str, Cell], parts: tuple[frozenset[str], ...] | None = None
+    ) -> Assembly:
+        """The same pieces, orientations and rods at ``offsets`` (and ``parts``)."""
+        parts = self.parts if parts is None else parts
+        return Assembly(self.shapes, offsets, parts, self.rotations, self.rods)
 
     def part_of(self, name: str) -> frozenset[str]:
         for p in self.parts:
@@ -165,7 +214,7 @@ class Assembly:
             if not moved.isdisjoint(self.cells_of(other))
         ]
 
-    def check(self, move: Move) -> None:
+    def check(self, move: Move | TurnMove) -> None:
         """Raise :class:`MoveError` unless ``move`` is legal here."""
         unknown = [n for n in move.pieces if n not in self.shapes]
         if unknown:
@@ -175,6 +224,11 @@ class Assembly:
             raise MoveError(move, "the pieces belong to different, already separated parts")
         if set(move.pieces) == part:
             raise MoveError(move, "the group is a whole part: nothing to move it against")
+        if isinstance(move, TurnMove):
+            why = self.turn_problem(move)
+            if why is not None:
+                raise MoveError(move, why)
+            return
         free = self.free_distance(move.pieces, move.direction)
         if move.distance is None:
             if free is not None:
@@ -182,23 +236,65 @@ class Assembly:
         elif free is not None and free < move.distance:
             raise MoveError(move, f"blocked after {free} unit(s), {move.distance} asked")
 
-    def removes(self, move: Move) -> bool:
+    def spinning(self, names: Iterable[str], axis: int, centre2: Sequence[int]) -> set[Cell]:
+        """The cells of these pieces' round rods on the turn's line: they spin in place
+        (:func:`chaingeo.core.turns.spinning_rods`)."""
+        return {
+            c
+            for n in names
+            if self.rods.get(n)
+            for c in spinning_rods(
+                self.rods[n], ROTATIONS[self.rotation_of(n)], self.offsets[n], axis, centre2
+            )
+        }
+
+    def turn_sweep(
+        self, names: Sequence[str], axis: int, quarter: int, centre2: Sequence[int]
+    ) -> set[Cell]:
+        """Every cell the pieces sweep through turning together (exact: see
+        :func:`chaingeo.core.turns.swept_by`; rods on the axis line spin in place)."""
+        spin = self.spinning(names, axis, centre2)
+        cells = [c for n in names for c in self.cells_of(n) if c not in spin]
+        return swept_by(cells, axis, quarter, centre2) | spin
+
+    def turn_problem(self, move: TurnMove) -> str | None:
+        """Why the (well-formed, one-part) turn is illegal here, or None: its centre must lie in
+        the group's bounding box, and the turning group must sweep through no other piece (a
+        rod of another piece spinning on the axis line is passed by, never hit)."""
+        a = move.axis_index
+        group = [c for n in move.pieces for c in self.cells_of(n)]
+        if not centre_inside(group, a, move.centre2):
+            return "the axis must pass through the group's bounding box"
+        swept = self.turn_sweep(move.pieces, a, move.quarter, move.centre2)
+        part = self.part_of(move.pieces[0])
+        for other in sorted(part - set(move.pieces)):
+            fixed = self.cells_of(other) - self.spinning([other], a, move.centre2)
+            hit = sorted(swept & fixed)
+            if hit:
+                return f"it would sweep through {other} at {hit[0]}"
+        return None
+
+    def removes(self, move: Move | TurnMove) -> bool:
         """Does this (legal) move take its group out of the part? True for distance None and for
-        a finite move long enough to clear the rest for good."""
+        a finite move long enough to clear the rest for good; never for a turn."""
+        if isinstance(move, TurnMove):
+            return False
         if move.distance is None:
             return True
         if self.free_distance(move.pieces, move.direction) is not None:
             return False
         return move.distance >= self.clearance(move.pieces, move.direction)
 
-    def apply(self, move: Move) -> Assembly:
+    def apply(self, move: Move | TurnMove) -> Assembly:
         """The assembly after ``move`` (checked); this object is left unchanged."""
         self.check(move)
+        if isinstance(move, TurnMove):
+            return self.turned(move)
         group = frozenset(move.pieces)
         if self.removes(move):
             part = self.part_of(move.pieces[0])
             parts = (*tuple(p for p in self.parts if p != part), group, part - group)
-            return Assembly(self.shapes, self.offsets, _sorted_parts(parts))
+            return self.moved(self.offsets, _sorted_parts(parts))
         d = DIRECTIONS[move.direction]
         k = move.distance
         assert k is not None  # distance None always removes
@@ -206,7 +302,17 @@ class Assembly:
         for n in move.pieces:
             x, y, z = offsets[n]
             offsets[n] = (x + d[0] * k, y + d[1] * k, z + d[2] * k)
-        return Assembly(self.shapes, offsets, self.parts)
+        return self.moved(offsets)
+
+    def turned(self, move: TurnMove) -> Assembly:
+        """The group of ``move`` turned (not checked): new orientations and offsets."""
+        offsets = dict(self.offsets)
+        rotations = dict(self.rotations)
+        for n in move.pieces:
+            r, offsets[n] = turn_pose(ROTATIONS[self.rotation_of(n)], offsets[n], move)
+            rotations[n] = rotation_index(r)
+        rotations = {n: r for n, r in rotations.items() if r != 0}
+        return Assembly(self.shapes, offsets, self.parts, rotations, self.rods)
 
 
 class SearchLimitError(RuntimeError):
@@ -283,19 +389,62 @@ def legal_moves(state: Assembly, max_group: int | None = None) -> list[Move]:
     return sorted(moves, key=lambda m: (m.pieces, m.direction, m.distance is None, m.distance or 0))
 
 
+def legal_turns(state: Assembly, max_group: int | None = None) -> list[TurnMove]:
+    """Every legal turn, sorted: each proper group of a part (every subset, tried one by one:
+    this is the reference), each axis and sense, each centre in the group's bounding box."""
+    out: list[TurnMove] = []
+    for part in state.parts:
+        names = sorted(part)
+        top = len(names) - 1 if max_group is None else min(max_group, len(names) - 1)
+        for size in range(1, top + 1):
+            for group in combinations(names, size):
+                cells = [c for n in group for c in state.cells_of(n)]
+                others = [n for n in names if n not in group]
+                rest = {c for n in others for c in state.cells_of(n)}
+                for a, axis in enumerate(AXES):
+                    for centre in centres_within(cells, a):
+                        fixed = rest - state.spinning(others, a, centre)
+                        for q in (1, -1):
+                            if state.turn_sweep(group, a, q, centre).isdisjoint(fixed):
+                                out.append(TurnMove(group, axis, q, centre))
+    return sorted(out)
+
+
+def move_sort_key(m: Move | TurnMove) -> tuple[Any, ...]:
+    """One order for translations and turns: by group, then translations (as
+    :func:`legal_moves` sorts them), then turns by axis, sense and centre."""
+    if isinstance(m, TurnMove):
+        return (m.pieces, "rotate", m.axis, m.quarter, m.centre2)
+    return (m.pieces, m.direction, m.distance is None, m.distance or 0)
+
+
+def legal_steps(
+    state: Assembly, max_group: int | None = None, turns: bool = False
+) -> list[Move | TurnMove]:
+    """:func:`legal_moves`, and with ``turns`` :func:`legal_turns` too, in one sorted list."""
+    steps: list[Move | TurnMove] = [*legal_moves(state, max_group)]
+    if turns:
+        steps.extend(legal_turns(state, max_group))
+    return sorted(steps, key=move_sort_key)
+
+
 def _sorted_parts(parts: Iterable[frozenset[str]]) -> tuple[frozenset[str], ...]:
     return tuple(sorted(parts, key=lambda p: sorted(p)))
 
 
-def replay_disassembly(shapes: Mapping[str, Shape], moves: Sequence[Move]) -> Assembly:
+def replay_disassembly(
+    shapes: Mapping[str, Shape],
+    moves: Sequence[Move | TurnMove],
+    rods: Mapping[str, Mapping[Cell, int]] | None = None,
+) -> Assembly:
     """Apply ``moves`` from the assembled state; raise :class:`MoveError` at the first bad one."""
-    state = Assembly.assembled(shapes)
+    state = Assembly.assembled(shapes, rods)
     for m in moves:
         state = state.apply(m)
     return state
 
 
-def disassembly_of_assembly_plan(moves: Sequence[Move]) -> list[Move]:
+def disassembly_of_assembly_plan(moves: Sequence[Move | TurnMove]) -> list[Move | TurnMove]:
     """An assembly plan is a disassembly played backwards: reverse it and invert each move."""
     return [m.inverse() for m in reversed(moves)]
 
@@ -337,16 +486,29 @@ def insertion_shifts(moving: Iterable[Cell], fixed: Iterable[Cell], direction: s
 # ---------------------------------------------------------------------------------------------
 
 
-def state_key(state: Assembly) -> tuple[tuple[tuple[str, ...], tuple[Cell, ...]], ...]:
+def state_key(state: Assembly) -> tuple[tuple[Any, ...], ...]:
     """Hashable identity of a state: each part with its offsets relative to its first piece
-    (positions are relative: moving a group one way equals moving the rest the other way)."""
-    out = []
+    (positions are relative: moving a group one way equals moving the rest the other way).
+    Where turns left pieces of a part in different orientations, the part is seen from its
+    first piece's pose (the whole part turned back so that piece is as assembled) and the
+    relative orientations follow the offsets."""
+    out: list[tuple[Any, ...]] = []
     for part in state.parts:
         names = sorted(part)
+        base = state.rotation_of(names[0])
         bx, by, bz = state.offsets[names[0]]
         rel = tuple((x - bx, y - by, z - bz) for x, y, z in (state.offsets[n] for n in names))
-        out.append((tuple(names), rel))
+        rots = tuple(state.rotation_of(n) for n in names)
+        if base:  # see the part from its first piece: turn it all back to that piece's pose
+            back = ROTATIONS[base].T
+            rel = tuple(_cell(back @ np.asarray(v, dtype=np.int64)) for v in rel)
+            rots = tuple(rotation_index(back @ ROTATIONS[r]) for r in rots)
+        out.append((tuple(names), rel) if not any(rots) else (tuple(names), rel, rots))
     return tuple(sorted(out))
+
+
+def _cell(v: Any) -> Cell:
+    return (int(v[0]), int(v[1]), int(v[2]))
 
 
 def blocking_matrix(state: Assembly, direction: str) -> dict[tuple[str, str], int | None]:
@@ -363,12 +525,16 @@ def blocking_matrix(state: Assembly, direction: str) -> dict[tuple[str, str], in
 
 
 def reference_first_level(
-    shapes: Mapping[str, Shape], max_group: int | None = None, max_states: int = 200_000
+    shapes: Mapping[str, Shape],
+    max_group: int | None = None,
+    max_states: int = 200_000,
+    turns: bool = False,
+    rods: Mapping[str, Mapping[Cell, int]] | None = None,
 ) -> int | None:
     """Fewest moves until some group leaves the assembled puzzle (the removal counts): the first
     number of BurrTools' level, by plain breadth-first search; None if nothing ever leaves.
     Raises :class:`SearchLimitError` past ``max_states`` states. For tests."""
-    start = Assembly.assembled(shapes)
+    start = Assembly.assembled(shapes, rods)
     seen = {state_key(start)}
     frontier = [start]
     depth = 0
@@ -376,7 +542,7 @@ def reference_first_level(
         depth += 1
         nxt: list[Assembly] = []
         for state in frontier:
-            for move in legal_moves(state, max_group):
+            for move in legal_steps(state, max_group, turns):
                 if state.removes(move):
                     return depth
                 child = state.apply(move)
@@ -391,26 +557,30 @@ def reference_first_level(
 
 
 def reference_optimal_disassembly(
-    shapes: Mapping[str, Shape], max_group: int | None = None, max_states: int = 200_000
-) -> list[Move] | None:
+    shapes: Mapping[str, Shape],
+    max_group: int | None = None,
+    max_states: int = 200_000,
+    turns: bool = False,
+    rods: Mapping[str, Mapping[Cell, int]] | None = None,
+) -> list[Move | TurnMove] | None:
     """Fewest moves taking every piece apart, by plain breadth-first search over whole states
     (all parts at once); None if impossible. Exponential: for small puzzles and tests only."""
-    start = Assembly.assembled(shapes)
+    start = Assembly.assembled(shapes, rods)
     if start.is_separated():
         return []
-    seen: dict[object, tuple[object, Move | None]] = {state_key(start): (None, None)}
+    seen: dict[object, tuple[object, Move | TurnMove | None]] = {state_key(start): (None, None)}
     frontier = [start]
     while frontier:
         nxt: list[Assembly] = []
         for state in frontier:
-            for move in legal_moves(state, max_group):
+            for move in legal_steps(state, max_group, turns):
                 child = state.apply(move)
                 key = state_key(child)
                 if key in seen:
                     continue
                 seen[key] = (state_key(state), move)
                 if child.is_separated():
-                    plan: list[Move] = []
+                    plan: list[Move | TurnMove] = []
                     k: object = key
                     while True:
                         prev, m = seen[k]

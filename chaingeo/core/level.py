@@ -19,7 +19,7 @@ from typing import Any, Final, Literal
 
 from chaingeo.core import canonical_json, limits
 from chaingeo.core.files import atomic_write
-from chaingeo.core.geometry import Shape, box_cells, puzzle_signature
+from chaingeo.core.geometry import Cell, Shape, box_cells, puzzle_signature
 from chaingeo.core.kinematics import (
     DIRECTIONS,
     Move,
@@ -36,6 +36,7 @@ from chaingeo.core.rules import (
     StackingRules,
     placement_order_problem,
 )
+from chaingeo.core.turns import AXES, TurnMove, turn_from_json
 
 FORMAT: Final = "chain-level/1"
 FAMILIES: Final = ("stacking", "puzzle")
@@ -60,6 +61,9 @@ class Piece:
     #: CHAIN's id of the piece (its index in CHAIN's level file, ``"0"``, ``"1"``, ...) when
     #: the level came from CHAIN: agents may name the piece by it. All pieces or none have one.
     chain_id: str | None = None
+    #: puzzle cells that are round rods along an axis (0, 1, 2), which spin in place when they
+    #: turn about their own axis (:mod:`chaingeo.core.turns`); written only when there are any
+    rods: Mapping[Cell, int] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -70,7 +74,7 @@ class StackingSolution:
 
 @dataclass(frozen=True)
 class PuzzleSolution:
-    moves: tuple[Move, ...]
+    moves: tuple[Move | TurnMove, ...]
 
 
 @dataclass(frozen=True)
@@ -106,6 +110,11 @@ class Level:
     @property
     def shapes(self) -> dict[str, Shape]:
         return {p.name: p.shape for p in self.pieces}
+
+    @property
+    def rods(self) -> dict[str, dict[Cell, int]]:
+        """The round rods of the pieces that have any (see :class:`Piece`)."""
+        return {p.name: dict(p.rods) for p in self.pieces if p.rods}
 
     def to_json(self) -> dict[str, Any]:
         sol: dict[str, Any]
@@ -146,6 +155,9 @@ def _piece_json(p: Piece) -> dict[str, Any]:
     out: dict[str, Any] = {"name": p.name, "rgb": p.rgb, "voxels": [list(c) for c in p.shape.cells]}
     if p.chain_id is not None:
         out["chain_id"] = p.chain_id
+    if p.rods:
+        out["rods"] = {AXES[a]: sorted(list(c) for c, b in p.rods.items() if b == a) for a in
+                       sorted(set(p.rods.values()))}  # fmt: skip
     return out
 
 
@@ -228,10 +240,16 @@ def parse_level(data: Any, source: str = "<level>") -> Level:
             raise r.fail("rules.support", "the chain profile has contact support only")
         rules = StackingRules(support=support, profile=profile)  # type: ignore[arg-type]
     else:
-        only_keys(r, rules_obj, {"max_group"}, "rules")
+        only_keys(r, rules_obj, {"max_group", "turns"}, "rules")
         mg = rules_obj.get("max_group")
+        turns = rules_obj.get("turns", False)
+        if turns is not True and "turns" in rules_obj:  # written only when true
+            raise r.fail("rules.turns", f"expected true or no field, got {short(turns)}")
         rules = PuzzleRules(
-            max_group=None if mg is None else r.integer(mg, "rules.max_group", 1, limits.MAX_PIECES)
+            max_group=None
+            if mg is None
+            else r.integer(mg, "rules.max_group", 1, limits.MAX_PIECES),
+            turns=turns,
         )
 
     max_steps = r.integer(
@@ -317,7 +335,7 @@ def _parse_pieces(
         if rgb in seen_rgb:
             raise r.fail(f"{f}.rgb", f"duplicate colour {rgb} (also {seen_rgb[rgb]})")
         shape = r.voxels(r.get(obj, "voxels", f"{f}.voxels"), f"{f}.voxels")
-        only_keys(r, obj, {"name", "rgb", "voxels", "chain_id"}, f, "field")
+        only_keys(r, obj, {"name", "rgb", "voxels", "chain_id", "rods"}, f, "field")
         chain_id = None
         if "chain_id" in obj:
             chain_id = r.string(obj["chain_id"], f"{f}.chain_id")
@@ -330,7 +348,8 @@ def _parse_pieces(
             raise r.fail(f"{f}.voxels", f"piece {name} is not face-connected")
         seen_names.add(name)
         seen_rgb[rgb] = name
-        pieces.append(Piece(name, rgb, shape, chain_id))
+        rods = _parse_rods(r, obj.get("rods"), shape, f"{f}.rods", family)
+        pieces.append(Piece(name, rgb, shape, chain_id, rods))
     ids = [p.chain_id for p in pieces]
     if any(i is not None for i in ids):
         if None in ids:
@@ -351,6 +370,25 @@ def _parse_pieces(
                     raise r.fail("pieces", f"pieces {owner[c]} and {p.name} overlap at {list(c)}")
                 owner[c] = p.name
     return pieces
+
+
+def _parse_rods(r: Reader, raw: Any, shape: Shape, fld: str, family: str) -> dict[Cell, int]:
+    """``{"y": [[x, y, z], ...]}``: cells of the piece that are round rods along that axis."""
+    if raw is None:
+        return {}
+    if family != "puzzle":
+        raise r.fail(fld, "only puzzle pieces have rods")
+    out: dict[Cell, int] = {}
+    for axis, cells in sorted(r.obj(raw, fld).items()):
+        if axis not in AXES:
+            raise r.fail(fld, f"{axis!r} is not an axis (x, y or z)")
+        for c in r.voxels(cells, f"{fld}.{axis}").cells:
+            if c not in shape.cell_set:
+                raise r.fail(f"{fld}.{axis}", f"{list(c)} is not a cell of the piece")
+            if c in out:
+                raise r.fail(fld, f"{list(c)} is a rod along two axes")
+            out[c] = AXES.index(axis)
+    return out
 
 
 def _parse_stacking_solution(
@@ -404,10 +442,26 @@ def _parse_puzzle_solution(
     if len(raw_moves) > limits.MAX_STEPS:
         raise r.fail("solution.moves", f"{len(raw_moves)} moves; at most {limits.MAX_STEPS}")
     names = {p.name for p in pieces}
-    moves: list[Move] = []
+    moves: list[Move | TurnMove] = []
     for i, m in enumerate(raw_moves):
         f = f"solution.moves[{i}]"
         obj = r.obj(m, f)
+        if "axis" in obj:  # a turn
+            if not rules.turns:
+                raise r.fail(f, "a turn, but the rules do not allow turns")
+            only_keys(r, obj, {"pieces", "axis", "angle", "about"}, f)
+            try:
+                turn = turn_from_json(obj)
+            except ValueError as e:
+                raise r.fail(f, str(e)) from None
+            if set(turn.pieces) - names:
+                raise r.fail(f"{f}.pieces", f"unknown piece(s) {sorted(set(turn.pieces) - names)}")
+            if rules.max_group is not None and len(turn.pieces) > rules.max_group:
+                raise r.fail(
+                    f"{f}.pieces", f"turns {len(turn.pieces)} pieces; at most {rules.max_group}"
+                )
+            moves.append(turn)
+            continue
         group = [
             r.string(n, f"{f}.pieces")
             for n in r.lst(r.get(obj, "pieces", f"{f}.pieces"), f"{f}.pieces")
@@ -433,7 +487,7 @@ def _parse_puzzle_solution(
     shapes = {p.name: p.shape for p in pieces}
     disassembly = moves if goal == "disassemble" else disassembly_of_assembly_plan(moves)
     try:
-        final = replay_disassembly(shapes, disassembly)
+        final = replay_disassembly(shapes, disassembly, {p.name: p.rods for p in pieces})
     except MoveError as e:
         raise r.fail("solution.moves", f"does not replay: {e}") from None
     if not final.is_separated():

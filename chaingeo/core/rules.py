@@ -7,7 +7,7 @@ level's ``optimal_steps`` means the same thing everywhere.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Final, Literal
 
 from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
@@ -88,12 +88,18 @@ class StackingRules:
 
 @dataclass(frozen=True)
 class PuzzleRules:
-    """``max_group``: the most pieces one move may carry (None: any group that moves together)."""
+    """``max_group``: the most pieces one move may carry (None: any group that moves together).
+    ``turns``: groups may also turn 90 degrees (:mod:`chaingeo.core.turns`); written to a file
+    only when true, so every level without turns keeps its bytes."""
 
     max_group: int | None = None
+    turns: bool = False
 
     def to_json(self) -> dict[str, object]:
-        return asdict(self)
+        out: dict[str, object] = {"max_group": self.max_group}
+        if self.turns:
+            out["turns"] = True
+        return out
 
 
 def placement_problem(

@@ -21,6 +21,7 @@ from chaingeo.core import limits
 from chaingeo.core.kinematics import Move
 from chaingeo.core.level import Level
 from chaingeo.core.rules import Rejection, StackingRules
+from chaingeo.core.turns import TurnMove
 from chaingeo.envs import chain_dialect
 from chaingeo.envs.actions import (
     Action,
@@ -33,10 +34,13 @@ from chaingeo.envs.actions import (
     PickupAction,
     PlaceAction,
     StateAction,
+    TurnAction,
+    TurnRequest,
     UnparseableActionError,
     cell_from_agent,
 )
 from chaingeo.envs.chain_dialect import PlacementCellsError
+from chaingeo.envs.turn_text import TurnTextError, is_turn_text, parse_turn
 
 GRAMMAR: Final[dict[str, str]] = {
     "stacking": "expected 'place COLOUR (x,y,z) (x,y,z) ...' listing every cell the piece "
@@ -113,7 +117,17 @@ def _tokenise(s: str) -> list[Token]:
     return tokens
 
 
-def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
+def _turn_text(text: str, normalised: str) -> TurnRequest:
+    """A turn (:mod:`chaingeo.envs.turn_text`), its errors as the parser's own."""
+    try:
+        return parse_turn(normalised)
+    except TurnTextError as e:
+        if e.meaningless:
+            raise IllegalActionError(e.hint, text=text) from None
+        raise UnparseableActionError(text, f"{e.hint}") from None
+
+
+def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest | TurnRequest:
     """Parse agent text without a state: an action, or a move whose distance or (in assembly)
     destination is left open. :class:`UnparseableActionError` if it is not in the grammar.
 
@@ -130,6 +144,8 @@ def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest:
     body = chain_dialect.unwrap(text)
     if chain_dialect.is_tool_call(body):
         return chain_dialect.parse_tool_call(text, body)
+    if is_turn_text(_normalise(text)):
+        return _turn_text(text, _normalise(text))
     try:
         tokens = _tokenise(_normalise(body))
         if not tokens:
@@ -326,7 +342,7 @@ class ResolvingState(Protocol):
     level: Level
 
     def key(self) -> Hashable: ...
-    def resolve(self, action: Action | MoveRequest) -> Action: ...
+    def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
     def rejection(self, action: Action) -> Rejection | None: ...
 
@@ -376,6 +392,8 @@ def parse_action(text: str, state: ResolvingState) -> Action:
             names = [parsed.piece]
         elif isinstance(parsed, MoveRequest):
             names = [*parsed.pieces, *(parsed.into or ())]
+        elif isinstance(parsed, TurnRequest):
+            names = list(parsed.pieces)
         _known(names, state)
         action = state.resolve(parsed)
         why = state.rejection(action)
@@ -406,8 +424,13 @@ def _cells_error(e: PlacementCellsError, text: str, state: ResolvingState) -> Il
 
 
 def action_from_text(text: str) -> Action:
-    """Parse the canonical text of an action without a state (moves must give a distance)."""
+    """Parse the canonical text of an action without a state (moves must give a distance,
+    turns their centre)."""
     parsed = parse_text(text, "assemble")
+    if isinstance(parsed, TurnRequest):
+        if parsed.centre2 is None:
+            raise UnparseableActionError(text, "a stand-alone turn needs its centre")
+        return TurnAction(TurnMove(parsed.pieces, parsed.axis, parsed.quarter, parsed.centre2))
     if isinstance(parsed, MoveRequest):
         if not parsed.distance_given:
             raise UnparseableActionError(text, "a stand-alone move needs its distance")

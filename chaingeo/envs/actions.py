@@ -22,6 +22,9 @@ Grammar (``GROUP`` is colour names joined by ``+``; ``DIR`` is ``+x -x +y -y +z 
     move GROUP DIR K | inf                slide a group K units, or out to infinity
     move GROUP DIR inf into GROUP offset (dx,dy,dz)   assembly: the part it joins, and how
                                           far from its place in the target it lands
+    rotate GROUP AXIS +90|-90 [about (x,y,z)]   levels with turns: turn a group a quarter turn
+                                          (right hand about +AXIS) about the line parallel to
+                                          AXIS through that point (see :class:`TurnAction`)
     finish                                declare the task done (ends the episode)
     state                                 show every piece's cells (changes nothing; a step)
 """
@@ -37,6 +40,7 @@ from typing import Any, ClassVar, Final
 
 from chaingeo.core.kinematics import Move
 from chaingeo.core.rules import ChainCode
+from chaingeo.core.turns import ANGLES, TurnMove, half_text, turn_from_json
 
 Cell = tuple[int, int, int]
 
@@ -58,6 +62,19 @@ def cell_from_agent(values: Sequence[int]) -> Cell:
     """A 1-based cell an agent wrote, in code coordinates."""
     x, y, z = values
     return (x - 1, y - 1, z - 1)
+
+
+def centre_text(centre2: Sequence[int]) -> str:
+    """A turn centre (doubled, 0-based cell units) as the agent reads it, 1-based in cell
+    units: the centre of cell (1,1,1) is ``(1,1,1)``, the corner between cells 3 and 4 along x
+    is 3.5: ``(6, 0, 0)`` -> ``"(4,1,1)"``, ``(5, 7, 0)`` -> ``"(3.5,4.5,1)"``."""
+    return "(" + ",".join(half_text(int(v) + 2) for v in centre2) + ")"
+
+
+def centre_from_agent(values2: Sequence[int]) -> Cell:
+    """A centre an agent wrote (1-based cell units, doubled: 3.5 -> 7), in code units."""
+    x, y, z = values2
+    return (x - 2, y - 2, z - 2)
 
 
 def vector_text(vec: Sequence[int]) -> str:
@@ -201,10 +218,37 @@ class MoveAction(_Ordered):
 
 
 @dataclass(frozen=True, eq=True)
+class TurnAction(_Ordered):
+    """A puzzle turn (:class:`chaingeo.core.turns.TurnMove`, levels whose rules allow turns):
+    the group turns by 90 degrees, right hand about the positive axis for ``+90``, about the
+    line parallel to the axis through the centre. Text ``rotate GROUP AXIS +90|-90 about
+    (x,y,z)``: the centre in 1-based cell units (:func:`centre_text`), its coordinate along the
+    axis irrelevant and written as 1."""
+
+    turn: TurnMove
+    RANK: ClassVar[int] = 3
+
+    @property
+    def pieces(self) -> tuple[str, ...]:
+        return self.turn.pieces
+
+    def sort_key(self) -> tuple[Any, ...]:
+        t = self.turn
+        return (t.pieces, t.axis, -t.quarter, t.centre2)
+
+    def to_text(self) -> str:
+        t = self.turn
+        return (
+            f"rotate {'+'.join(t.pieces)} {t.axis} {ANGLES[t.quarter]} "
+            f"about {centre_text(t.centre2)}"
+        )
+
+
+@dataclass(frozen=True, eq=True)
 class FinishAction(_Ordered):
     """Declare the task done; the episode ends (solved or not)."""
 
-    RANK: ClassVar[int] = 3
+    RANK: ClassVar[int] = 4
 
     def sort_key(self) -> tuple[Any, ...]:
         return ()
@@ -219,7 +263,7 @@ class StateAction(_Ordered):
     not finished, costs a step and changes nothing else. Not listed by ``legal_actions()``
     (it never advances a game, so searches and baselines have no use for it)."""
 
-    RANK: ClassVar[int] = 4
+    RANK: ClassVar[int] = 5
 
     def sort_key(self) -> tuple[Any, ...]:
         return ()
@@ -228,7 +272,12 @@ class StateAction(_Ordered):
         return "state"
 
 
-Action = PlaceAction | PickupAction | MoveAction | FinishAction | StateAction
+Action = PlaceAction | PickupAction | MoveAction | TurnAction | FinishAction | StateAction
+
+
+def action_of_move(move: Move | TurnMove) -> MoveAction | TurnAction:
+    """The action that plays a move of a plan."""
+    return TurnAction(move) if isinstance(move, TurnMove) else MoveAction(move)
 
 
 @dataclass(frozen=True)
@@ -255,6 +304,22 @@ class MoveRequest:
         return out
 
 
+@dataclass(frozen=True)
+class TurnRequest:
+    """A turn as written, before the state resolves its centre (``centre2`` None: left open)."""
+
+    pieces: tuple[str, ...]
+    axis: str
+    quarter: int
+    centre2: Cell | None = None
+
+    def text(self) -> str:
+        out = f"rotate {'+'.join(self.pieces)} {self.axis} {ANGLES[self.quarter]}"
+        if self.centre2 is not None:
+            out += f" about {centre_text(self.centre2)}"
+        return out
+
+
 # ---------------------------------------------------------------------------------------------
 # JSON form (0-based cells, as in files)
 # ---------------------------------------------------------------------------------------------
@@ -278,6 +343,8 @@ def action_to_json(action: Action) -> dict[str, Any]:
         return out
     if isinstance(action, StateAction):
         return {"type": "state"}
+    if isinstance(action, TurnAction):
+        return {"type": "rotate", **action.turn.to_json()}
     return {"type": "finish"}
 
 
@@ -307,6 +374,7 @@ _JSON_KEYS: Final[dict[str, set[str]]] = {
     "place": {"type", "piece", "cells"},
     "pickup": {"type", "piece"},
     "move": {"type", "pieces", "direction", "distance", "into", "offset"},
+    "rotate": {"type", "pieces", "axis", "angle", "about"},
     "finish": {"type"},
     "state": {"type"},
 }
@@ -353,6 +421,8 @@ def action_from_json(obj: Any) -> Action:
             )
         if kind == "state":
             return StateAction()
+        if kind == "rotate":
+            return TurnAction(turn_from_json(obj))
         return FinishAction()
     except ActionFormatError:
         raise
@@ -456,12 +526,17 @@ __all__ = [
     "PickupAction",
     "PlaceAction",
     "StateAction",
+    "TurnAction",
+    "TurnRequest",
     "UnparseableActionError",
     "action_from_json",
+    "action_of_move",
     "action_to_json",
     "cell_from_agent",
     "cell_text",
     "cells_text",
+    "centre_from_agent",
+    "centre_text",
     "rules_text",
     "vector_text",
 ]

@@ -42,6 +42,7 @@ from chaingeo.envs.actions import (
     PickupAction,
     PlaceAction,
     StateAction,
+    TurnRequest,
     UnparseableActionError,
     cell_from_agent,
     cell_text,
@@ -273,7 +274,9 @@ def resolve_id(name: str, level: Level) -> str:
     return name
 
 
-def resolve_ids(action: Action | MoveRequest, level: Level) -> Action | MoveRequest:
+def resolve_ids(
+    action: Action | MoveRequest | TurnRequest, level: Level
+) -> Action | MoveRequest | TurnRequest:
     """A parsed place or pickup with a CHAIN id replaced by the colour name (else as is)."""
     if isinstance(action, PlaceAction):
         name = resolve_id(action.piece, level)

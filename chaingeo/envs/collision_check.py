@@ -3,6 +3,8 @@
 A test oracle that ships with the package on purpose: the property tests compare every move the
 voxel engine allows with this verdict, and anyone who imports levels or adds a kind of move
 (turns, other lattices) can run the same comparison on their own data without our test tree.
+Turns (:func:`turn_is_legal`) are checked the same way, the motion being FCL's screw motion
+about the turn's axis line, sampled every :data:`TURN_SAMPLES`-th of the quarter turn.
 
 :mod:`chaingeo.core.kinematics` decides a move by testing every unit step on voxel sets. Here the
 same question is put to a different engine on different data: the pieces are watertight
@@ -96,6 +98,41 @@ def swept_collision(
     return bool(result.is_collide)
 
 
+#: Samples of a quarter turn (every 0.1 degree): a turning unit square that overlaps a fixed one
+#: does so over an interval of angles, and on this lattice (small scenes) that interval is far
+#: wider than a tenth of a degree.
+TURN_SAMPLES: Final = 900
+
+
+def turning_collision(
+    group: Sequence[Shape], rest: Sequence[Shape], axis: int, quarter: int, centre2: Cell
+) -> bool:
+    """Does ``group``, turned continuously by 90 degrees (``quarter`` +1 or -1, right hand
+    about the positive ``axis``) about the line through ``centre2`` (doubled cell units, cell
+    centres at whole numbers: :mod:`chaingeo.core.turns`), ever meet ``rest``?"""
+    if not rest:
+        return False
+    moving = fcl.CollisionObject(_bvh(group, GROUP_EPS), fcl.Transform())
+    fixed = fcl.CollisionObject(_bvh(rest, REST_EPS), fcl.Transform())
+    # mesh coordinates put cell (i, j, k) at [i, i+1] x ..., its centre at i + 1/2
+    point = np.asarray(centre2, dtype=np.float64) / 2 + 0.5
+    angle = quarter * math.pi / 2
+    c, s = math.cos(angle), math.sin(angle)
+    u, v = (axis + 1) % 3, (axis + 2) % 3
+    rot = np.eye(3)
+    rot[u, u], rot[u, v], rot[v, u], rot[v, v] = c, -s, s, c
+    end = fcl.Transform(rot, point - rot @ point)
+    request = fcl.ContinuousCollisionRequest(
+        num_max_iterations=TURN_SAMPLES,
+        toc_err=1.0 / (4 * TURN_SAMPLES),
+        ccd_motion_type=fcl.CCDMotionType.CCDM_SCREW,
+        ccd_solver_type=fcl.CCDSolverType.CCDC_NAIVE,
+    )
+    result = fcl.ContinuousCollisionResult()
+    fcl.continuousCollide(moving, end, fixed, fcl.Transform(), request, result)
+    return bool(result.is_collide)
+
+
 def sweep_to_clear(group: Sequence[Shape], rest: Sequence[Shape], direction: Cell) -> float:
     """A travel after which the group lies wholly past the rest along the axis (from bounding
     boxes of the cells, not from the kinematics), plus one unit of margin."""
@@ -120,3 +157,16 @@ def move_is_legal(
         return True
     travel = sweep_to_clear(moving, rest, direction) if distance is None else float(distance)
     return not swept_collision(moving, rest, direction, travel)
+
+
+def turn_is_legal(
+    pieces: Mapping[str, Shape], group: Sequence[str], axis: int, quarter: int, centre2: Cell
+) -> bool:
+    """FCL's verdict on turning ``group`` (pieces where they stand) by ``quarter`` about the
+    line parallel to ``axis`` through ``centre2`` (see :func:`turning_collision`)."""
+    unknown = sorted(set(group) - set(pieces))
+    if unknown:
+        raise ValueError(f"unknown piece(s) {unknown}")
+    moving = [pieces[n] for n in sorted(set(group))]
+    rest = [pieces[n] for n in sorted(set(pieces) - set(group))]
+    return not turning_collision(moving, rest, axis, quarter, centre2)

@@ -32,6 +32,12 @@ oracle replays the stored moves as they are and ``optimal_steps`` is the plan le
 
 Parts apart never interact, so ``key()`` records each part's offsets relative to its first
 piece (by name): where a separated part happens to lie does not matter.
+
+**Turns** (levels whose rules allow them, :mod:`chaingeo.envs.puzzle_turns`): a proper group of a
+part turns 90 degrees about a line parallel to an axis (``rotate red z +90 about (2,3,1)``). A
+turned piece keeps its orientation; keys then see each part from its first piece's pose. When
+assembling, the pieces start apart in the orientations the level's plan leaves them in (so the
+plan, reversed, plays as it is).
 """
 
 from __future__ import annotations
@@ -42,16 +48,14 @@ from typing import Any
 
 import numpy as np
 
-from chaingeo.core.geometry import Cell, Shape
+from chaingeo.core.geometry import Cell
 from chaingeo.core.kinematics import (
     DIRECTIONS,
     OPPOSITE,
     Assembly,
     Move,
-    disassembly_of_assembly_plan,
 )
-from chaingeo.core.level import Level, PuzzleSolution
-from chaingeo.core.rules import PuzzleRules
+from chaingeo.core.level import Level
 from chaingeo.envs.action_list import ActionList
 from chaingeo.envs.actions import (
     Action,
@@ -59,6 +63,8 @@ from chaingeo.envs.actions import (
     IllegalActionError,
     MoveAction,
     MoveRequest,
+    TurnAction,
+    TurnRequest,
     cell_text,
     vector_text,
 )
@@ -66,33 +72,22 @@ from chaingeo.envs.puzzle_actions import (
     MoveRange,
     assembly_actions,
     disassembly_actions,
+    oriented_table,
     part_cells,
     shifts,
+    turn_actions,
 )
+from chaingeo.envs.puzzle_tables import PositionKey as PositionKey
+from chaingeo.envs.puzzle_tables import PuzzleTables as PuzzleTables
+from chaingeo.envs.puzzle_tables import normal_key as normal_key
+from chaingeo.envs.puzzle_turns import describe_turn, resolve_turn, turn_problem
 from chaingeo.envs.state import BaseState
-from solvers.partsearch import PieceTable
 
-#: a position (kept alive so its id stays its own), its moves by (group, direction), its actions
-_Listed = tuple[Assembly, dict[tuple[tuple[str, ...], str], MoveRange], ActionList]
+_ByGroup = dict[tuple[tuple[str, ...], str], MoveRange]
+#: a position (kept alive so its id stays its own), its moves by (group, direction), its turns,
+#: its actions
+_Listed = tuple[Assembly, _ByGroup, list[TurnAction], ActionList]
 _CACHED_POSITIONS = 8
-
-PartKey = tuple[tuple[str, Cell], ...]
-PositionKey = tuple[PartKey, ...]
-
-
-def normal_key(asm: Assembly) -> PositionKey:
-    """Each part as (name, offset relative to the part's first piece), parts sorted."""
-    parts: list[PartKey] = []
-    for part in asm.parts:
-        names = sorted(part)
-        bx, by, bz = asm.offsets[names[0]]
-        parts.append(
-            tuple(
-                (n, (asm.offsets[n][0] - bx, asm.offsets[n][1] - by, asm.offsets[n][2] - bz))
-                for n in names
-            )
-        )
-    return tuple(sorted(parts))
 
 
 def group_text(names: Iterable[str]) -> str:
@@ -103,32 +98,6 @@ def _axis(direction: str) -> tuple[int, int]:
     d = DIRECTIONS[direction]
     axis = next(i for i in range(3) if d[i])
     return axis, d[axis]
-
-
-class PuzzleTables:
-    """Per-level data shared by every state of that level."""
-
-    def __init__(self, level: Level) -> None:
-        if not isinstance(level.rules, PuzzleRules) or not isinstance(
-            level.solution, PuzzleSolution
-        ):
-            raise ValueError(f"level {level.id} is not a puzzle level")
-        self.mode: str = level.goal
-        self.shapes: dict[str, Shape] = {p.name: p.shape for p in level.pieces}
-        self.names: tuple[str, ...] = tuple(sorted(self.shapes))
-        self.max_group: int | None = level.rules.max_group
-        self.target_key: PositionKey = normal_key(Assembly.assembled(self.shapes))
-        self.piece_table = PieceTable(self.shapes)
-        #: assembly only: normalised states on the recorded plan -> how far along they are.
-        self.path: dict[PositionKey, int] = {}
-        if self.mode == "assemble":
-            forward = disassembly_of_assembly_plan(level.solution.moves)
-            states = [Assembly.assembled(self.shapes)]
-            for m in forward:
-                states.append(states[-1].apply(m))
-            n = len(states) - 1
-            for i, s in enumerate(states):
-                self.path.setdefault(normal_key(s), n - i)
 
 
 @dataclass(frozen=True)
@@ -152,9 +121,11 @@ class PuzzleState(BaseState):
                 shapes=dict(self.tables.shapes),
                 offsets={n: (0, 0, 0) for n in self.tables.names},
                 parts=tuple(frozenset([n]) for n in self.tables.names),
+                rotations=dict(self.tables.start_rotations),
+                rods=self.tables.rods,
             )
         else:
-            self._asm = Assembly.assembled(self.tables.shapes)
+            self._asm = Assembly.assembled(self.tables.shapes, self.tables.rods)
         #: legal actions of recent positions by id(assembly), shared with clones (an agent's
         #: clone and the state it came from look at the same position)
         self._legal_cache: dict[int, _Listed] = {}
@@ -191,25 +162,30 @@ class PuzzleState(BaseState):
 
     # -- legal actions ------------------------------------------------------------------------
     def _legal_moves(self) -> Sequence[Action]:
-        return self._actions()[1]
+        return self._actions()[2]
 
-    def _actions(self) -> tuple[dict[tuple[tuple[str, ...], str], MoveRange], ActionList]:
-        """(the moves of groups within a part by (group, direction), every legal action) of
-        this position, computed once per position. Disassembling, the first are every move."""
+    def _actions(self) -> tuple[_ByGroup, list[TurnAction], ActionList]:
+        """(the moves of groups within a part by (group, direction), the legal turns, every
+        legal action) of this position, computed once per position. Disassembling, the first
+        are every move."""
         cached = self._legal_cache.get(id(self._asm))
         if cached is not None and cached[0] is self._asm:
-            return cached[1], cached[2]
-        table, mg = self.tables.piece_table, self.tables.max_group
+            return cached[1], cached[2], cached[3]
+        mg = self.tables.max_group
+        table = oriented_table(self._asm, self.tables.piece_table, self.tables.oriented)
+        tt = self.tables.turn_table
+        turns = [] if tt is None else turn_actions(self._asm, mg, tt)
         if self.mode == "disassemble":
             ranges = disassembly_actions(self._asm, mg, table)
-            actions = ActionList(ranges)
+            actions = ActionList([*ranges, turns])
         else:
-            ranges, actions = assembly_actions(self._asm, mg, table)
+            ranges, listed = assembly_actions(self._asm, mg, table)
+            actions = ActionList([listed, turns])
         by_group = {(r.pieces, r.direction): r for r in ranges}
         if len(self._legal_cache) >= _CACHED_POSITIONS:
             del self._legal_cache[next(iter(self._legal_cache))]
-        self._legal_cache[id(self._asm)] = (self._asm, by_group, actions)
-        return by_group, actions
+        self._legal_cache[id(self._asm)] = (self._asm, by_group, turns, actions)
+        return by_group, turns, actions
 
     def _slides(self, pieces: Sequence[str], direction: str) -> list[Action]:
         """The moves of one group along one direction (assembling: its slides)."""
@@ -272,7 +248,12 @@ class PuzzleState(BaseState):
         )
 
     # -- resolving what the text leaves open --------------------------------------------------
-    def resolve(self, action: Action | MoveRequest) -> Action:
+    def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action:
+        if isinstance(action, TurnRequest):
+            t = self.tables
+            return resolve_turn(
+                action, self._actions()[1], self._asm, t.turns, t.max_group, self.key()
+            )
         if isinstance(action, MoveRequest):
             return self._resolve_request(action)
         if (
@@ -393,7 +374,7 @@ class PuzzleState(BaseState):
             offsets[n] = (x + dx, y + dy, z + dz)
         merged = ins.part | ins.into
         parts = [p for p in asm.parts if p != ins.part and p != ins.into] + [merged]
-        return Assembly(asm.shapes, offsets, tuple(sorted(parts, key=lambda p: sorted(p))))
+        return asm.moved(offsets, tuple(sorted(parts, key=lambda p: sorted(p))))
 
     @staticmethod
     def _at_home(asm: Assembly, part: frozenset[str]) -> bool:
@@ -401,6 +382,10 @@ class PuzzleState(BaseState):
 
     # -- legality -----------------------------------------------------------------------------
     def _move_problem(self, action: Action) -> str | None:
+        if isinstance(action, TurnAction):
+            if action in self._actions()[1]:
+                return None
+            return turn_problem(self._asm, action, self.tables.turns, self.tables.max_group)
         if not isinstance(action, MoveAction):
             return "this is a puzzle level: use move or finish"
         move = action.move
@@ -532,6 +517,8 @@ class PuzzleState(BaseState):
 
     # -- applying -----------------------------------------------------------------------------
     def _after(self, action: Action) -> Any:
+        if isinstance(action, TurnAction):
+            return self._asm.apply(action.turn)
         assert isinstance(action, MoveAction)
         if self.mode == "disassemble":
             return self._asm.apply(action.move)
@@ -547,9 +534,11 @@ class PuzzleState(BaseState):
         for n in move.pieces:
             x, y, z = offsets[n]
             offsets[n] = (x + dx * k, y + dy * k, z + dz * k)
-        return Assembly(self._asm.shapes, offsets, self._asm.parts)
+        return self._asm.moved(offsets)
 
     def describe(self, action: Action) -> str:
+        if isinstance(action, TurnAction):
+            return describe_turn(action)
         if not isinstance(action, MoveAction):
             return "Finished: solved." if self.is_success() else "Finished without solving."
         grp = group_text(action.move.pieces)

@@ -10,7 +10,13 @@ an agent looks at a few. So they come in sorted lazy blocks inside an
   tested equal to the reference :func:`chaingeo.core.kinematics.legal_moves`);
 * :class:`InsertionBlock`: one part coming in along one direction into another part, every
   landing place, from a numba kernel equal to the reference
-  :func:`chaingeo.core.kinematics.insertion_shifts`.
+  :func:`chaingeo.core.kinematics.insertion_shifts`;
+* where the rules allow turns, one sorted list of :class:`~chaingeo.envs.actions.TurnAction`
+  from the numba turn kernel (:func:`solvers.turnsearch.turn_rows`, tested equal to the
+  reference :func:`chaingeo.core.kinematics.legal_turns`), after every move.
+
+Pieces a turn left in another orientation are read through :func:`oriented_table` (the
+translation kernels see each piece as it stands now).
 """
 
 from __future__ import annotations
@@ -21,7 +27,7 @@ from typing import overload
 import numpy as np
 from numba import njit
 
-from chaingeo.core.geometry import Cell, Shape
+from chaingeo.core.geometry import Cell
 from chaingeo.core.kinematics import (
     DIRECTIONS,
     OPPOSITE,
@@ -29,12 +35,17 @@ from chaingeo.core.kinematics import (
     Move,
     insertion_shifts,
     legal_moves,
+    legal_turns,
     movable_groups,
+    oriented,
 )
+from chaingeo.core.turns import AXES, TurnMove
 from chaingeo.envs.action_list import ActionList
-from chaingeo.envs.actions import Action, FinishAction, MoveAction
+from chaingeo.envs.actions import Action, FinishAction, MoveAction, TurnAction
 from solvers.disassemble import move_rows
 from solvers.partsearch import PieceTable
+from solvers.turnmoves import TurnTable
+from solvers.turnsearch import turn_rows
 
 #: Movable groups along one direction before a state's action list gives up with a
 #: SearchLimitError (a loose part of n pieces has up to 2**n - 2).
@@ -107,11 +118,39 @@ def shifts(moving: np.ndarray, fixed: np.ndarray, direction: str) -> np.ndarray:
 
 def part_cells(asm: Assembly, part: frozenset[str]) -> np.ndarray:
     """The cells a part fills now, as an int64 array (pieces by name)."""
-    return np.concatenate([_placed(asm.shapes[n], asm.offsets[n]) for n in sorted(part)])
+    return np.concatenate([_placed(asm, n) for n in sorted(part)])
 
 
-def _placed(shape: Shape, offset: Cell) -> np.ndarray:
-    return np.asarray(shape.voxels, dtype=np.int64) + np.asarray(offset, dtype=np.int64)
+def _placed(asm: Assembly, name: str) -> np.ndarray:
+    shape = oriented(asm.shapes[name], asm.rotation_of(name))
+    return np.asarray(shape.voxels, dtype=np.int64) + np.asarray(asm.offsets[name], np.int64)
+
+
+def oriented_table(asm: Assembly, table: PieceTable, cache: dict[object, PieceTable]) -> PieceTable:
+    """``table`` when no piece is turned, else a table of the pieces as they stand now (kept
+    in ``cache`` by orientations); the offsets of ``asm`` apply to it unchanged."""
+    if not asm.rotations:
+        return table
+    key = tuple(sorted(asm.rotations.items()))
+    hit = cache.get(key)
+    if hit is None:
+        if len(cache) > 64:
+            cache.clear()
+        hit = cache[key] = PieceTable(
+            {n: oriented(s, asm.rotation_of(n)) for n, s in asm.shapes.items()}
+        )
+    return hit
+
+
+def turn_actions(asm: Assembly, max_group: int | None, table: TurnTable) -> list[TurnAction]:
+    """Every legal turn, sorted (the fast kernel; equal to the reference
+    :func:`chaingeo.core.kinematics.legal_turns`)."""
+    out: list[TurnAction] = []
+    for names, rows in turn_rows(asm, max_group, table, GROUP_LIMIT):
+        for mask, axis, sense, c0, c1, c2 in rows.tolist():
+            pieces = tuple(names[i] for i in range(len(names)) if mask >> i & 1)
+            out.append(TurnAction(TurnMove(pieces, AXES[axis], 1 - 2 * sense, (c0, c1, c2))))
+    return sorted(out)
 
 
 class _Lazy(Sequence[MoveAction]):
@@ -305,8 +344,8 @@ def assembly_slides(asm: Assembly, max_group: int | None, table: PieceTable) -> 
     """The finite moves of a group within its part while assembling (see :func:`_slide_rows`)."""
     out: list[MoveRange] = []
     for names, rows in _ranges(asm, max_group, table):
-        lo = np.array([asm.shapes[p].voxels.min(axis=0) + asm.offsets[p] for p in names])
-        hi = np.array([asm.shapes[p].voxels.max(axis=0) + asm.offsets[p] for p in names])
+        lo = np.array([_placed(asm, p).min(axis=0) for p in names])
+        hi = np.array([_placed(asm, p).max(axis=0) for p in names])
         kept = rows[_slide_rows(rows, lo, hi)]
         groups = _groups(names, kept[:, 0])
         out.extend(MoveRange(groups[m], _DIRS[d], k, False) for m, d, k, _ in kept.tolist())
@@ -323,13 +362,17 @@ def assembly_actions(
     return slides, ActionList(blocks)
 
 
-def reference_actions(asm: Assembly, mode: str, max_group: int | None) -> list[Action]:
+def reference_actions(
+    asm: Assembly, mode: str, max_group: int | None, turns: bool = False
+) -> list[Action]:
     """Every legal action, built one by one from the pure-Python reference kinematics
     (:mod:`chaingeo.core.kinematics`): what the fast lazy lists must equal, in the same order. Slow;
     for tests and ``chain bench actions``."""
+    spins: list[Action] = [TurnAction(t) for t in legal_turns(asm, max_group)] if turns else []
     if mode == "disassemble":
-        return [*(MoveAction(m) for m in legal_moves(asm, max_group)), FinishAction()]
-    out: list[Action] = []
+        moves = [MoveAction(m) for m in legal_moves(asm, max_group)]
+        return [*moves, *sorted(spins), FinishAction()]
+    out: list[Action] = [*spins]
     for d in DIRECTIONS:
         for group in movable_groups(asm, d):
             if max_group is not None and len(group) > max_group:

@@ -37,6 +37,7 @@ from chaingeo.envs.actions import (
     IllegalActionError,
     MoveRequest,
     StateAction,
+    TurnRequest,
 )
 from chaingeo.envs.text_state import state_text
 
@@ -82,7 +83,7 @@ class GameState(Protocol):
     @property
     def history(self) -> list[Turn]: ...
     def legal_actions(self) -> Sequence[Action]: ...
-    def resolve(self, action: Action | MoveRequest) -> Action: ...
+    def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
     def rejection(self, action: Action) -> Rejection | None: ...
     def apply(self, action: Action) -> None: ...
@@ -149,9 +150,9 @@ class BaseState(ABC):
     def describe(self, action: Action) -> str:
         """Feedback for a legal action just applied (agent text)."""
 
-    def resolve(self, action: Action | MoveRequest) -> Action:
+    def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action:
         """Fill in what the agent left open, or raise Ambiguous/IllegalActionError."""
-        if isinstance(action, MoveRequest):
+        if isinstance(action, MoveRequest | TurnRequest):
             raise IllegalActionError("moves belong to puzzle levels; use place or pickup")
         return action
 

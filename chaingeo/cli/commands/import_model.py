@@ -39,6 +39,8 @@ def register(sub: Any) -> None:
     p.add_argument("--goal", choices=("disassemble", "assemble"), default="disassemble")
     p.add_argument("--kind", choices=("auto", "puzzle", "stacking"), default="auto")
     p.add_argument("--max-group", type=int, default=None, help="most pieces one move may carry")
+    p.add_argument("--turns", action="store_true", help="allow 90-degree turns of groups "
+                   "(rules turns=true; the model's round rods spin in place)")  # fmt: skip
     p.add_argument("--max-states", type=int, default=500_000, help="state cap per part search")
     p.add_argument("--max-total-states", type=int, default=3_000_000)
     p.add_argument("--seconds", type=float, default=120.0, help="time cap of each analysis")
@@ -120,12 +122,16 @@ def build_level(model: ImportedModel, args: argparse.Namespace) -> tuple[Level, 
             model, dict(sol.placements), difficulty=stacking_difficulty(model)
         )
         return level, None
-    a = analyze_puzzle(model.shapes, max_group=args.max_group, limits=limits_of(args))
+    a = analyze_puzzle(
+        model.shapes,
+        max_group=args.max_group,
+        limits=limits_of(args),
+        turns=args.turns,
+        rods=model.rods,
+    )
     if not a.disassemblable or a.optimal_steps is None:
-        raise CommandError(
-            f"{model.model}: does not come apart by translations alone (a rotation may be "
-            "needed); no level written"
-        )
+        how = "translations and turns" if args.turns else "translations alone (try --turns)"
+        raise CommandError(f"{model.model}: does not come apart by {how}; no level written")
     stats = {
         "level": a.level,
         "first_level": a.first_level,
@@ -140,6 +146,7 @@ def build_level(model: ImportedModel, args: argparse.Namespace) -> tuple[Level, 
         goal=args.goal,
         difficulty=difficulty_of(a.first_level or 0, a.optimal_steps, len(model.parts)),
         max_group=args.max_group,
+        turns=args.turns,
         stats=stats,
     )
     return level, a
@@ -158,10 +165,17 @@ def report_model(folder: Path, args: argparse.Namespace) -> ModelReport:
     if model.kind != "puzzle":
         return ModelReport(folder.name, model)
     try:
-        a = analyze_puzzle(model.shapes, max_group=args.max_group, limits=limits_of(args))
+        a = analyze_puzzle(
+            model.shapes,
+            max_group=args.max_group,
+            limits=limits_of(args),
+            turns=args.turns,
+            rods=model.rods,
+        )
     except SearchLimitError as e:
         return ModelReport(folder.name, model, note=f"analysis stopped: {e}")
-    note = None if a.disassemblable else "does not come apart by translations (needs a rotation?)"
+    how = "translations and turns" if args.turns else "translations (needs a turn? try --turns)"
+    note = None if a.disassemblable else f"does not come apart by {how}"
     return ModelReport(folder.name, model, analysis=a, note=note)
 
 

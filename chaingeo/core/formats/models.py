@@ -46,6 +46,7 @@ from chaingeo.core.formats.mesh_lattice import (
     load_model_parts,
     voxelize,
 )
+from chaingeo.core.formats.rods import round_rods
 from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape, puzzle_signature
 from chaingeo.core.kinematics import Move
 from chaingeo.core.level import (
@@ -59,6 +60,7 @@ from chaingeo.core.level import (
     revalidate,
 )
 from chaingeo.core.rules import PuzzleRules, StackingRules, find_placing_order
+from chaingeo.core.turns import TurnMove
 
 __all__ = [
     "ImportedModel",
@@ -98,6 +100,7 @@ class ImportedPart:
     shape: Shape
     moved: tuple[float, float, float]
     decided: tuple[tuple[Cell, float], ...] = ()
+    rods: tuple[tuple[Cell, int], ...] = ()  # round rods and their axes (formats.rods)
 
     @property
     def name(self) -> str:
@@ -120,6 +123,11 @@ class ImportedModel:
     @property
     def shapes(self) -> dict[str, Shape]:
         return {p.name: p.shape for p in self.parts}
+
+    @property
+    def rods(self) -> dict[str, dict[Cell, int]]:
+        """The round rods of the pieces that have any (:mod:`chaingeo.core.formats.rods`)."""
+        return {p.name: dict(p.rods) for p in self.parts if p.rods}
 
     def moved_parts(self, at_least: float = 0.05) -> dict[str, tuple[float, float, float]]:
         """Parts displaced by ``at_least`` units or more along some axis, by source part name."""
@@ -144,6 +152,11 @@ class ImportedModel:
             "decided_cells": {
                 p.name: [[*c, s] for c, s in p.decided] for p in self.parts if p.decided
             },
+            **(
+                {"round_rods": {p.name: [[*c, a] for c, a in p.rods] for p in self.parts if p.rods}}
+                if any(p.rods for p in self.parts)
+                else {}
+            ),
             **({"box": list(self.box)} if self.box is not None else {}),
             **({"container": self.container} if self.container is not None else {}),
             **(
@@ -387,9 +400,11 @@ def import_model(model_dir: str | Path, kind: Kind | Literal["auto"] = "auto") -
         return ImportedModel(
             folder.name, "stacking", fit, share, out, box, parts[container].name, box_residual
         )
-    return ImportedModel(
-        folder.name, "puzzle", fit, share, _assemble(source, parts, pieces, voxels, phases, colors)
-    )
+    rods = [
+        round_rods(parts[i], planes[i], fit, v.cells) for i, v in zip(pieces, voxels, strict=True)
+    ]
+    assembled = _assemble(source, parts, pieces, voxels, phases, colors, rods)
+    return ImportedModel(folder.name, "puzzle", fit, share, assembled)
 
 
 def _assemble(
@@ -399,6 +414,7 @@ def _assemble(
     voxels: Sequence[PartVoxels],
     phases: Sequence[tuple[float, float, float]],
     colors: Sequence[NamedColor],
+    rods: Sequence[Mapping[Cell, int]],
 ) -> tuple[ImportedPart, ...]:
     """Snap the parts, settle partly filled cells on the outside, refuse anything else."""
     shifts, (overlap, _) = snap_parts([v.cells for v in voxels], phases)
@@ -411,8 +427,8 @@ def _assemble(
     lo, hi = allc.min(axis=0).tolist(), allc.max(axis=0).tolist()
     taken = {c for s in placed for c in s}
     result: list[ImportedPart] = []
-    for i, v, s, ph, shape, color in zip(
-        pieces, voxels, shifts, phases, placed, colors, strict=True
+    for i, v, s, ph, shape, color, rod in zip(
+        pieces, voxels, shifts, phases, placed, colors, rods, strict=True
     ):
         shifted = [((c[0] + s[0], c[1] + s[1], c[2] + s[2]), f) for c, f in v.ambiguous]
         if any(not _exterior(c, shape.cell_set, lo, hi) for c, _ in shifted):
@@ -423,11 +439,15 @@ def _assemble(
         if not shape.is_connected():
             raise ModelImportError(source, f"parts.{v.name}", "its cells are not face-connected")
         moved = tuple(round(sh - p, 6) for sh, p in zip(s, ph, strict=True))
+        rod_cells = tuple(
+            sorted(((c[0] + s[0], c[1] + s[1], c[2] + s[2]), a) for c, a in rod.items())
+        )
         result.append(
             ImportedPart(
-                parts[i].name, color, shape, (moved[0], moved[1], moved[2]), tuple(shifted)
+                parts[i].name, color, shape, (moved[0], moved[1], moved[2]), tuple(shifted),
+                rod_cells,
             )
-        )
+        )  # fmt: skip
     base = np.min(np.concatenate([p.shape.voxels for p in result]), axis=0)
     b = (int(base[0]), int(base[1]), int(base[2]))
     return tuple(
@@ -437,6 +457,7 @@ def _assemble(
             p.shape.translate(-base),
             p.moved,
             tuple(((c[0] - b[0], c[1] - b[1], c[2] - b[2]), f) for c, f in p.decided),
+            tuple(((c[0] - b[0], c[1] - b[1], c[2] - b[2]), a) for c, a in p.rods),
         )
         for p in result
     )
@@ -465,17 +486,20 @@ def provenance_generator(model: str) -> str:
 
 def model_puzzle_level(
     model: ImportedModel,
-    disassembly: Sequence[Move],
+    disassembly: Sequence[Move | TurnMove],
     *,
     goal: Literal["disassemble", "assemble"] = "disassemble",
     difficulty: Difficulty,
     max_group: int | None = None,
+    turns: bool = False,
     stats: Mapping[str, Any] | None = None,
     level_id: str | None = None,
 ) -> Level:
     """A verified puzzle level from an imported model and an optimal disassembly plan found by
     the caller (o_i = its length); for 'assemble' the plan is reversed with each move inverted,
-    as :func:`generator.puzzle.puzzle_level` does."""
+    as :func:`generator.puzzle.puzzle_level` does. With ``turns`` the rules allow turns and the
+    pieces carry their round rods (a level without turns carries none: they change nothing
+    there)."""
     if model.kind != "puzzle":
         raise ValueError(f"{model.model} is a {model.kind} model, not a puzzle")
     moves = list(disassembly) if goal == "disassemble" else [m.inverse() for m in disassembly[::-1]]
@@ -487,11 +511,14 @@ def model_puzzle_level(
         difficulty=difficulty,
         goal=goal,
         box=None,
-        pieces=tuple(Piece(p.name, p.color.hex, p.shape) for p in model.parts),
+        pieces=tuple(
+            Piece(p.name, p.color.hex, p.shape, rods=dict(p.rods) if turns else {})
+            for p in model.parts
+        ),
         solution=PuzzleSolution(tuple(moves)),
         optimal_steps=steps,
         max_steps=max(default_step_budget(steps), 2 * steps),
-        rules=PuzzleRules(max_group=max_group),
+        rules=PuzzleRules(max_group=max_group, turns=turns),
         provenance=Provenance(
             provenance_generator(model.model), VERSION, None, None, puzzle_signature(shapes)
         ),

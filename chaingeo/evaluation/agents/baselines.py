@@ -24,7 +24,13 @@ from typing import Any
 import numpy as np
 
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
-from chaingeo.envs.actions import FinishAction, MoveAction, PickupAction, PlaceAction
+from chaingeo.envs.actions import (
+    FinishAction,
+    MoveAction,
+    PickupAction,
+    PlaceAction,
+    action_of_move,
+)
 from chaingeo.evaluation.agents.base import Agent, AgentError, Reply, StateLike, Turn
 
 
@@ -34,7 +40,7 @@ def oracle_plan(level: Level) -> list[str]:
     if isinstance(sol, StackingSolution):
         return [PlaceAction(n, tuple(sol.placements[n].cells)).to_text() for n in sol.order]
     assert isinstance(sol, PuzzleSolution)
-    return [MoveAction(m).to_text() for m in sol.moves]
+    return [action_of_move(m).to_text() for m in sol.moves]
 
 
 class OracleAgent(Agent):

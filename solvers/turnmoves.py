@@ -1,0 +1,457 @@
+"""Turn moves on flat integer arrays (numba): which groups can turn 90 degrees about which line.
+
+The semantics are :mod:`chaingeo.core.turns` and :func:`chaingeo.core.kinematics.legal_turns` (the
+reference): a group turns about a line parallel to axis ``a`` through cell centres or cell corners
+(``centre2``, doubled cell units, the two coordinates across ``a`` of one parity) inside the
+group's bounding box, legal when it sweeps through no other piece of its part.
+
+As for translations (:mod:`solvers.movement`), the legal groups of one turn (axis, sense, centre)
+are the sets closed under a relation between pieces, here "turning alone, ``j`` would sweep through
+``i``": a group sweeps through nothing outside it exactly when it holds everyone its members
+sweep through. The relation comes from the exact swept-cell *stencils* of
+:func:`chaingeo.core.turns.swept_squares` (computed once per relative position in Python, looked
+up here) and an occupancy grid of the state; the closed sets come from
+:func:`solvers.movement.closed_groups`, never from trying subsets.
+
+A part's pieces may stand in any of the 24 orientations, so every piece is pre-rotated: slot
+``24 p + r`` holds piece ``p`` turned by ``ROTATIONS[r]`` (cells ``R v``), sorted per axis for
+the gap kernel. A state is one ``int16`` row of ``3 n`` offsets then ``n`` rotation indices.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+
+from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
+from chaingeo.core.turns import quarter_index, swept_squares
+from solvers import movement as mv
+
+I64 = npt.NDArray[np.int64]
+U64 = npt.NDArray[np.uint64]
+N_ROT = 24
+#: Extra status of :func:`node_turns` and the search kernel: a stencil lies beyond the table.
+NEED_STENCIL = 5
+#: Move kinds in the search's move rows: 0..5 translations (``DIRECTIONS`` order), then turns
+#: ``TURN_BASE + 2 axis + (0 for +90, 1 for -90)``.
+TURN_BASE = 6
+
+#: ``COMPOSE[q, r]``: index of ``ROTATIONS[q] @ ROTATIONS[r]``.
+COMPOSE = np.array(
+    [[rotation_index(ROTATIONS[q] @ ROTATIONS[r]) for r in range(N_ROT)] for q in range(N_ROT)],
+    dtype=np.int64,
+)
+#: The 24 rotation matrices, (24, 3, 3).
+MATRICES = np.ascontiguousarray(np.stack(ROTATIONS), dtype=np.int64)
+#: ``QUARTERS[axis, 0 | 1]``: rotation index of the +90 / -90 degree turn about that axis.
+QUARTERS = np.array([[quarter_index(a, 1), quarter_index(a, -1)] for a in range(3)], np.int64)
+
+
+class Stencils:
+    """Swept-square stencils for every relative position ``s`` (doubled units, both
+    coordinates within ``bound``) and both senses, flattened for numba:
+    ``cells[start[k, i, j]:end[k, i, j]]`` are the squares (relative to the axis) that square
+    ``s = (i - bound, j - bound)`` sweeps turning +90 (``k = 0``) or -90 (``k = 1``)."""
+
+    def __init__(self, bound: int) -> None:
+        self.bound = bound
+        w = 2 * bound + 1
+        self.start = np.zeros((2, w, w), dtype=np.int64)
+        self.end = np.zeros((2, w, w), dtype=np.int64)
+        chunks: list[tuple[tuple[int, int], ...]] = []
+        total = 0
+        for k, quarter in enumerate((1, -1)):
+            for i in range(w):
+                for j in range(w):
+                    s = (i - bound, j - bound)
+                    if (s[0] - s[1]) % 2:
+                        continue  # not a square of either lattice
+                    sq = swept_squares(s, quarter)
+                    self.start[k, i, j] = total
+                    total += len(sq)
+                    self.end[k, i, j] = total
+                    chunks.append(sq)
+        self.cells = np.array([c for sq in chunks for c in sq], dtype=np.int64).reshape(-1, 2)
+
+
+_STENCILS: dict[int, Stencils] = {}
+
+
+def stencils(bound: int) -> Stencils:
+    """The stencil table reaching at least ``bound`` (shared; grown by doubling)."""
+    have = max(_STENCILS, default=0)
+    if have >= bound:
+        return _STENCILS[have]
+    size = max(bound, 2 * have, 16)
+    _STENCILS.clear()
+    _STENCILS[size] = Stencils(size)
+    return _STENCILS[size]
+
+
+class TurnTable:
+    """Every piece in every orientation: sorted voxels, bounding boxes, rod flags.
+
+    ``rods[name]`` maps a cell of the piece (assembled frame) to the axis (0, 1, 2) of a round
+    rod filling it: such a cell turning about its own axis line sweeps nothing but itself."""
+
+    def __init__(
+        self, shapes: Mapping[str, Shape], rods: Mapping[str, Mapping[tuple[int, int, int], int]]
+    ) -> None:
+        self.names: tuple[str, ...] = tuple(sorted(shapes))
+        self.shapes = {n: shapes[n] for n in self.names}
+        self.rods = {n: dict(rods.get(n, {})) for n in self.names}
+
+    def part_arrays(self, members: Sequence[int]) -> tuple[I64, I64, I64, I64, I64]:
+        """``(vox, starts, lo, hi, rod)`` for the pieces ``members`` (indices into ``names``),
+        slot ``24 i + r`` for the ``i``-th member turned by ``ROTATIONS[r]``: ``vox[a]`` sorted
+        by (the two other axes, then ``a``), ``rod`` aligned with ``vox[0]`` (-1: no rod)."""
+        per_axis: list[list[I64]] = [[], [], []]
+        rod_rows: list[I64] = []
+        sizes: list[int] = []
+        lo = np.zeros((len(members) * N_ROT, 3), dtype=np.int64)
+        hi = np.zeros((len(members) * N_ROT, 3), dtype=np.int64)
+        for i, m in enumerate(members):
+            name = self.names[m]
+            base = np.asarray(self.shapes[name].voxels, dtype=np.int64)
+            rod_axis = np.array(
+                [self.rods[name].get((int(x), int(y), int(z)), -1) for x, y, z in base],
+                dtype=np.int64,
+            )
+            for r in range(N_ROT):
+                v = base @ MATRICES[r].T
+                axes = np.full(len(v), -1, dtype=np.int64)
+                for k, a in enumerate(rod_axis.tolist()):
+                    if a >= 0:
+                        axes[k] = int(np.flatnonzero(MATRICES[r][:, a])[0])
+                for a in range(3):
+                    u, w = (a + 1) % 3, (a + 2) % 3
+                    order = np.lexsort((v[:, a], v[:, w], v[:, u]))
+                    per_axis[a].append(v[order])
+                    if a == 0:
+                        rod_rows.append(axes[order])
+                lo[i * N_ROT + r] = v.min(axis=0)
+                hi[i * N_ROT + r] = v.max(axis=0)
+                sizes.append(len(v))
+        starts = np.zeros(len(sizes) + 1, dtype=np.int64)
+        starts[1:] = np.cumsum(sizes)
+        vox = np.empty((3, int(starts[-1]), 3), dtype=np.int64)
+        for a in range(3):
+            vox[a] = np.concatenate(per_axis[a])
+        return vox, starts, lo, hi, np.concatenate(rod_rows)
+
+
+@njit(cache=True)
+def gather(
+    vox_all: I64, starts_all: I64, lo_all: I64, hi_all: I64, rod_all: I64, rot: I64
+) -> tuple[I64, I64, I64, I64, I64]:
+    """The per-piece arrays of one state (piece ``i`` in orientation ``rot[i]``), in the layout
+    of :func:`solvers.movement.node_moves`, and the rod axes aligned with ``vox[0]``."""
+    n = rot.shape[0]
+    starts = np.zeros(n + 1, dtype=np.int64)
+    for i in range(n):
+        s = i * 24 + rot[i]
+        starts[i + 1] = starts[i] + starts_all[s + 1] - starts_all[s]
+    vox = np.empty((3, starts[n], 3), dtype=np.int64)
+    rod = np.empty(starts[n], dtype=np.int64)
+    lo = np.empty((n, 3), dtype=np.int64)
+    hi = np.empty((n, 3), dtype=np.int64)
+    for i in range(n):
+        s = i * 24 + rot[i]
+        a0 = starts_all[s]
+        for k in range(starts[i + 1] - starts[i]):
+            for a in range(3):
+                for t in range(3):
+                    vox[a, starts[i] + k, t] = vox_all[a, a0 + k, t]
+            rod[starts[i] + k] = rod_all[a0 + k]
+        for t in range(3):
+            lo[i, t] = lo_all[s, t]
+            hi[i, t] = hi_all[s, t]
+    return vox, starts, lo, hi, rod
+
+
+@njit(cache=True)
+def node_turns(
+    vox: I64,
+    starts: I64,
+    lo: I64,
+    hi: I64,
+    rod: I64,
+    off: I64,
+    st_start: I64,
+    st_end: I64,
+    st_cells: I64,
+    bound: int,
+    max_group: int,
+    group_limit: int,
+    groups: U64,
+    out: I64,
+) -> int:
+    """List the legal turns of one state into ``out`` rows ``(mask, axis, sense, c0, c1,
+    c2)`` (sense 0: +90, 1: -90; ``c`` the doubled centre, its axis component 0). Returns the
+    row count; -1 if ``out`` is too small, -2 past ``group_limit`` groups of one turn, and
+    ``-3 - b`` when a stencil beyond the table (``b`` > ``bound``) is needed."""
+    n = starts.shape[0] - 1
+    full = (np.uint64(1) << np.uint64(n)) - np.uint64(1)
+    total = starts[n]
+    cells = np.empty((total, 3), dtype=np.int64)
+    owner = np.empty(total, dtype=np.int64)
+    for i in range(n):
+        for k in range(starts[i], starts[i + 1]):
+            owner[k] = i
+            for t in range(3):
+                cells[k, t] = vox[0, k, t] + off[i, t]
+    glo = np.empty(3, dtype=np.int64)
+    ghi = np.empty(3, dtype=np.int64)
+    for t in range(3):
+        glo[t] = cells[:, t].min()
+        ghi[t] = cells[:, t].max()
+    dims = ghi - glo + 1
+    grid = np.full((dims[0], dims[1], dims[2]), -1, dtype=np.int64)
+    rods = np.full((dims[0], dims[1], dims[2]), -1, dtype=np.int64)
+    for k in range(total):
+        grid[cells[k, 0] - glo[0], cells[k, 1] - glo[1], cells[k, 2] - glo[2]] = owner[k]
+        rods[cells[k, 0] - glo[0], cells[k, 1] - glo[1], cells[k, 2] - glo[2]] = rod[k]
+    # each piece's bounding box now, for the "centre inside the group's box" rule
+    plo = np.empty((n, 3), dtype=np.int64)
+    phi = np.empty((n, 3), dtype=np.int64)
+    for i in range(n):
+        for t in range(3):
+            plo[i, t] = lo[i, t] + off[i, t]
+            phi[i, t] = hi[i, t] + off[i, t]
+    hits = np.zeros(n, dtype=np.uint64)
+    c = np.empty(3, dtype=np.int64)
+    hit_cell = np.empty(3, dtype=np.int64)
+    rows = 0
+    for a in range(3):
+        u = (a + 1) % 3
+        v = (a + 2) % 3
+        for cu in range(2 * glo[u] - 1, 2 * ghi[u] + 2):
+            for cv in range(2 * glo[v] - 1, 2 * ghi[v] + 2):
+                if (cu - cv) % 2 != 0:
+                    continue
+                for sense in range(2):
+                    for i in range(n):
+                        hits[i] = np.uint64(1) << np.uint64(i)
+                    for k in range(total):
+                        i = owner[k]
+                        su = 2 * cells[k, u] - cu
+                        sv = 2 * cells[k, v] - cv
+                        if su == 0 and sv == 0 and rod[k] == a:
+                            continue  # a round rod spinning about its own axis
+                        need = max(abs(su), abs(sv))
+                        if need > bound:
+                            return int(-3 - need)
+                        for e in range(st_start[sense, su + bound, sv + bound],
+                                       st_end[sense, su + bound, sv + bound]):  # fmt: skip
+                            hit_cell[a] = cells[k, a]
+                            hit_cell[u] = (st_cells[e, 0] + cu) // 2
+                            hit_cell[v] = (st_cells[e, 1] + cv) // 2
+                            x = hit_cell[0] - glo[0]
+                            y = hit_cell[1] - glo[1]
+                            z = hit_cell[2] - glo[2]
+                            if 0 <= x < dims[0] and 0 <= y < dims[1] and 0 <= z < dims[2]:
+                                o = grid[x, y, z]
+                                if o >= 0 and not (
+                                    rods[x, y, z] == a
+                                    and 2 * hit_cell[u] == cu
+                                    and 2 * hit_cell[v] == cv
+                                ):  # (a rod spinning on the axis line is passed by)
+                                    hits[i] |= np.uint64(1) << np.uint64(o)
+                    # close "must come along" (Warshall on bit rows)
+                    for m in range(n):
+                        bm = np.uint64(1) << np.uint64(m)
+                        for i in range(n):
+                            if hits[i] & bm:
+                                hits[i] |= hits[m]
+                    ng = mv.closed_groups(hits, n, group_limit, groups, max_group)
+                    if ng < 0:
+                        return -2
+                    for gi in range(ng):
+                        g = groups[gi]
+                        if g == full:
+                            continue
+                        size = 0
+                        blo_u = 1 << 40
+                        bhi_u = -(1 << 40)
+                        blo_v = 1 << 40
+                        bhi_v = -(1 << 40)
+                        for i in range(n):
+                            if g & (np.uint64(1) << np.uint64(i)):
+                                size += 1
+                                blo_u = min(blo_u, plo[i, u])
+                                bhi_u = max(bhi_u, phi[i, u])
+                                blo_v = min(blo_v, plo[i, v])
+                                bhi_v = max(bhi_v, phi[i, v])
+                        if max_group >= 0 and size > max_group:
+                            continue
+                        if not (
+                            2 * blo_u - 1 <= cu <= 2 * bhi_u + 1
+                            and 2 * blo_v - 1 <= cv <= 2 * bhi_v + 1
+                        ):
+                            continue
+                        if rows >= out.shape[0]:
+                            return -1
+                        c[a] = 0
+                        c[u] = cu
+                        c[v] = cv
+                        out[rows, 0] = np.int64(g)
+                        out[rows, 1] = a
+                        out[rows, 2] = sense
+                        out[rows, 3] = c[0]
+                        out[rows, 4] = c[1]
+                        out[rows, 5] = c[2]
+                        rows += 1
+    return rows
+
+
+@njit(cache=True)
+def turn_pose(rot: int, off: I64, q: int, c: I64, out: I64) -> int:
+    """Pose ``(rot, off)`` turned by rotation ``q`` about doubled centre ``c``: writes the
+    new offset into ``out`` and returns the new rotation index."""
+    for t in range(3):
+        acc = 0
+        for s in range(3):
+            acc += MATRICES[q, t, s] * (2 * off[s] - c[s])
+        out[t] = (acc + c[t]) // 2
+    return int(COMPOSE[q, rot])
+
+
+#: Status of :func:`expand_turns` besides those of :func:`solvers.movement.expand`.
+NEED_TURNS = 6
+
+
+@njit(cache=True)
+def expand_turns(
+    states: npt.NDArray[np.int16],
+    n_states: int,
+    parent: I64,
+    move: I64,
+    table: I64,
+    node_start: int,
+    node_end: int,
+    vox_all: I64,
+    starts_all: I64,
+    lo_all: I64,
+    hi_all: I64,
+    rod_all: I64,
+    st_start: I64,
+    st_end: I64,
+    st_cells: I64,
+    bound: int,
+    max_group: int,
+    group_limit: int,
+    seps: I64,
+    n_seps: int,
+    moves_buf: I64,
+    turns_buf: I64,
+    groups_buf: U64,
+) -> tuple[int, int, int, int, int]:
+    """Expand nodes ``node_start..node_end-1`` of a breadth-first search with translations and
+    turns (rows: ``3 n`` offsets, then ``n`` rotation indices; piece 0 never moves: when it
+    belongs to the moving group, the rest moves the opposite way instead).
+
+    ``move`` rows: ``(mask, kind, p0, p1, p2)``, kind ``0..5`` a translation by ``p0`` along
+    that direction, ``TURN_BASE + 2 axis + sense`` a turn about doubled centre ``(p0, p1, p2)``;
+    ``mask`` is the group that moves (as a move of the reference it names those pieces).
+    Returns ``(status, next node, n_states, n_seps, extra)``; ``extra`` is the stencil bound
+    needed on ``NEED_STENCIL``. On a status other than DONE the caller grows that buffer and
+    calls again from the next node (re-expanded from scratch)."""
+    n = starts_all.shape[0] // 24
+    w = 4 * n
+    gaps = np.empty((3, n, n), dtype=np.int64)
+    off = np.empty((n, 3), dtype=np.int64)
+    rot = np.empty(n, dtype=np.int64)
+    child = np.empty(w, dtype=np.int16)
+    c = np.empty(3, dtype=np.int64)
+    new_off = np.empty(3, dtype=np.int64)
+    while n_seps > 0 and seps[n_seps - 1, 0] >= node_start:
+        n_seps -= 1
+    for node in range(node_start, node_end):
+        for p in range(n):
+            for t in range(3):
+                off[p, t] = states[node, 3 * p + t]
+            rot[p] = states[node, 3 * n + p]
+        vox, starts, lo, hi, rod = gather(vox_all, starts_all, lo_all, hi_all, rod_all, rot)
+        rows = mv.node_moves(
+            vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
+        )
+        if rows == -2:
+            return mv.TOO_MANY_GROUPS, node, n_states, n_seps, 0
+        if rows == -1:
+            return mv.NEED_MOVES, node, n_states, n_seps, 0
+        nt = node_turns(
+            vox, starts, lo, hi, rod, off, st_start, st_end, st_cells, bound,
+            max_group, group_limit, groups_buf, turns_buf,
+        )  # fmt: skip
+        if nt == -1:
+            return NEED_TURNS, node, n_states, n_seps, 0
+        if nt == -2:
+            return mv.TOO_MANY_GROUPS, node, n_states, n_seps, 0
+        if nt <= -3:
+            return NEED_STENCIL, node, n_states, n_seps, -3 - nt
+        for r in range(rows):
+            mask = np.uint64(moves_buf[r, 0])
+            d = moves_buf[r, 1]
+            kmax = moves_buf[r, 2]
+            if moves_buf[r, 3]:
+                if n_seps >= seps.shape[0]:
+                    return mv.NEED_SEPS, node, n_states, n_seps, 0
+                seps[n_seps, 0] = node
+                seps[n_seps, 1] = np.int64(mask)
+                seps[n_seps, 2] = d
+                n_seps += 1
+            a = d // 2
+            sign = 1 if d % 2 == 0 else -1
+            anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
+            for k in range(1, kmax + 1):
+                if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
+                    return mv.NEED_STATES, node, n_states, n_seps, 0
+                for t in range(w):
+                    child[t] = states[node, t]
+                for p in range(n):
+                    inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
+                    if anchor_moves:
+                        if not inside:
+                            child[3 * p + a] -= sign * k
+                    elif inside:
+                        child[3 * p + a] += sign * k
+                got = mv.find_or_insert(states, n_states, table, child)
+                if got < 0:
+                    parent[n_states] = node
+                    move[n_states, 0] = np.int64(mask)
+                    move[n_states, 1] = d
+                    move[n_states, 2] = k
+                    move[n_states, 3] = 0
+                    move[n_states, 4] = 0
+                    n_states += 1
+        for r in range(nt):
+            mask = np.uint64(turns_buf[r, 0])
+            a = turns_buf[r, 1]
+            sense = turns_buf[r, 2]
+            for t in range(3):
+                c[t] = turns_buf[r, 3 + t]
+            anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
+            q = QUARTERS[a, 1 - sense] if anchor_moves else QUARTERS[a, sense]
+            if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
+                return mv.NEED_STATES, node, n_states, n_seps, 0
+            for t in range(w):
+                child[t] = states[node, t]
+            for p in range(n):
+                inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
+                if inside != anchor_moves:
+                    child[3 * n + p] = turn_pose(rot[p], off[p], q, c, new_off)
+                    for t in range(3):
+                        child[3 * p + t] = new_off[t]
+            got = mv.find_or_insert(states, n_states, table, child)
+            if got < 0:
+                parent[n_states] = node
+                move[n_states, 0] = np.int64(mask)
+                move[n_states, 1] = TURN_BASE + 2 * a + sense
+                move[n_states, 2] = c[0]
+                move[n_states, 3] = c[1]
+                move[n_states, 4] = c[2]
+                n_states += 1
+    return mv.DONE, node_end, n_states, n_seps, 0
