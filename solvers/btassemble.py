@@ -83,31 +83,38 @@ class Anchor:
 
 
 def choose_anchor(packing: Packing) -> Anchor | None:
-    """One placement per rotation orbit of a piece used exactly once (the one cut most), else
-    of the rows through a fixed cell (under the rotations fixing it); None without symmetry."""
+    """One placement per rotation orbit of a piece used exactly once, else of the rows through
+    a fixed cell (under the rotations fixing it); None without symmetry. Among pieces, as the
+    engine does (:func:`solvers.cover.anchor_plan`): the fewest orientations first (the most
+    symmetric piece, Knuth's choice for pentominoes), then the fewest representatives per
+    placement, then the fewest representatives."""
     maps = packing.row_maps(False)
     if len(maps) == 1 or packing.n_rows == 0:
         return None
     starts = packing.problem.row_start
-    best: tuple[float, str, Int32Array, Int32Array] | None = None
+    best: tuple[tuple[int, float, int], str, Int32Array, Int32Array] | None = None
     for t, info in enumerate(packing.types):
         a, b = int(starts[t]), int(starts[t + 1])
         if info.lo != 1 or info.hi != 1 or a == b:
             continue
         rows = np.arange(a, b, dtype=np.int32)
         reps = np.unique(maps[:, rows].min(axis=0)).astype(np.int32)
-        factor = len(rows) / len(reps)
-        if best is None or factor > best[0]:
-            best = (factor, info.name, rows, reps)
-    if best is None:
-        best = _cell_anchor(packing, maps)
-    if best is None or best[0] <= 1.0:
+        score = (len(info.piece.orientations()), len(reps) / len(rows), len(reps))
+        if best is None or score < best[0]:
+            best = (score, info.name, rows, reps)
+    if best is not None:
+        _, label, anchored, reps = best
+    else:
+        cell = _cell_anchor(packing, maps)
+        if cell is None:
+            return None
+        _, label, anchored, reps = cell
+    if len(reps) == len(anchored):
         return None
-    factor, label, anchored, reps = best
     keep = np.ones(packing.n_rows, dtype=bool)
     keep[anchored] = False
     keep[reps] = True
-    return Anchor(label, np.flatnonzero(keep).astype(np.int32), factor)
+    return Anchor(label, np.flatnonzero(keep).astype(np.int32), len(anchored) / len(reps))
 
 
 def _cell_anchor(

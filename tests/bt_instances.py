@@ -18,6 +18,7 @@ from chaingeo.core.geometry import SYMMETRIES, Shape
 from tests.bt_reference import Cell, RefPart, Voxel
 
 BOXES = ((2, 2, 2), (2, 2, 3), (2, 3, 3), (1, 3, 4))
+SMALL_BOXES = ((2, 2, 2), (2, 2, 3), (1, 3, 4))
 NEIGHBOURS = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
 
 
@@ -25,7 +26,9 @@ def random_partition(
     box: tuple[int, int, int], k: int, rng: np.random.Generator
 ) -> list[list[Cell]]:
     """``k`` connected pieces covering the box, grown from random seeds."""
-    cells = list(itertools.product(*(range(n) for n in box)))
+    cells: list[Cell] = [
+        (x, y, z) for x, y, z in itertools.product(range(box[0]), range(box[1]), range(box[2]))
+    ]
     seeds = rng.choice(len(cells), size=k, replace=False)
     owner = {cells[int(s)]: i for i, s in enumerate(seeds)}
     while len(owner) < len(cells):
@@ -40,13 +43,14 @@ def random_partition(
     return [sorted(c for c, o in owner.items() if o == i) for i in range(k)]
 
 
-def random_puzzle(seed: int) -> BTPuzzle:
+def random_puzzle(seed: int, small: bool = False) -> BTPuzzle:
     """One problem: a box cut into 3-5 pieces; maybe one piece's cells made variable (that
     piece optional), colours on some voxels with the pairs the cut needs plus random ones,
-    a range on one piece, a hole cap."""
+    a range on one piece, a hole cap. ``small``: boxes of at most 12 cells, at most 4 pieces."""
     rng = np.random.default_rng(seed)
-    box = BOXES[int(rng.integers(len(BOXES)))]
-    k = int(rng.integers(3, 6))
+    boxes = SMALL_BOXES if small else BOXES
+    box = boxes[int(rng.integers(len(boxes)))]
+    k = int(rng.integers(3, 5 if small else 6))
     pieces = random_partition(box, k, rng)
     n_colors = int(rng.integers(0, 4))
     result_color: dict[Cell, int] = {}

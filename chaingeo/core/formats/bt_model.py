@@ -145,11 +145,12 @@ class BTPlacement:
 @dataclass(frozen=True)
 class BTSolution:
     """One stored solution: a placement per piece of the problem (None: piece unused), the
-    solution's attributes and its separation tree as XML text (kept as read, not interpreted)."""
+    solution's attributes, and its other elements (the separation tree, ``<separationInfo>``)
+    as XML text, kept as read and not interpreted."""
 
     placements: tuple[BTPlacement | None, ...]
     attributes: tuple[tuple[str, str], ...] = ()
-    separation: str | None = None
+    extra: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

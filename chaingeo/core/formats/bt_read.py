@@ -4,7 +4,7 @@ Everything that changes what a problem means is read: colours (``<colors>``, and
 ``+N`` after a voxel), variable voxels, hotspots and weights, each problem's parts
 (``count``, or a ``min``/``max`` range, default 1; ``group=`` or nested ``<group group count>``
 tags), result, colour rules (``<bitmap>`` pairs, 0-based colour numbers in the file), hole cap
-(``maxHoles``) and stored solutions (placements; the separation tree kept as XML text).
+(``maxHoles``) and stored solutions (placements; the separation trees kept as XML text).
 
 Hostile input meets a typed error before it costs anything: the sizes in
 :mod:`chaingeo.core.limits` bound the decompressed XML, the grids, the shapes, problems and
@@ -230,9 +230,8 @@ def _parse_problem(
             continue
         w = f"{where}.solutions[{si}]"
         placements = _parse_assembly(src, w, asm.text or "", slots, len(shapes))
-        sep = sol.find("separation")
-        sep_text = None if sep is None else _compact_xml(sep)
-        sols.append(BTSolution(placements, tuple(sorted(sol.attrib.items())), sep_text))
+        extra = tuple(_compact_xml(e) for e in sol if e.tag != "assembly")
+        sols.append(BTSolution(placements, tuple(sorted(sol.attrib.items())), extra))
     state = _int(src, f"{where}.state", prob.get("state", "0"), 0, 2)
     recorded = {
         k: _int(src, f"{where}.{k}", prob.get(k), 0)

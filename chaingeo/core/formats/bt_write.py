@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import gzip
 import os
+import re
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
@@ -25,6 +26,8 @@ from chaingeo.core.formats.bt_model import (
 )
 from chaingeo.core.geometry import Shape
 
+_EMPTY_TAG = re.compile(rb'(<[A-Za-z]+(?:\s+[A-Za-z]+="[^"]*")*) />')
+
 
 def voxel_string(shape: BTShape) -> str:
     """``#``/``+``/``_`` per grid cell, x fastest, each coloured voxel followed by its colour."""
@@ -39,14 +42,15 @@ def voxel_string(shape: BTShape) -> str:
 
 
 def _shape_node(parent: ET.Element, s: BTShape) -> None:
-    attrs = {"x": str(s.size[0]), "y": str(s.size[1]), "z": str(s.size[2]), "type": "0"}
-    if s.name:
-        attrs["name"] = s.name
-    if s.weight != 1:
-        attrs["weight"] = str(s.weight)
+    attrs = {"x": str(s.size[0]), "y": str(s.size[1]), "z": str(s.size[2])}
     for axis, h in zip("xyz", s.hotspot, strict=True):
         if h:
             attrs[f"h{axis}"] = str(h)
+    if s.weight != 1:
+        attrs["weight"] = str(s.weight)
+    if s.name:
+        attrs["name"] = s.name
+    attrs["type"] = "0"
     ET.SubElement(parent, "voxel", attrs).text = voxel_string(s)
 
 
@@ -96,8 +100,8 @@ def _problem_node(parent: ET.Element, p: BTProblem) -> None:
             node = ET.SubElement(sols, "solution", dict(sol.attributes))
             text = " ".join(_placement_text(pl) for pl in sol.placements)
             ET.SubElement(node, "assembly").text = text
-            if sol.separation is not None:
-                node.append(ET.fromstring(sol.separation))
+            for extra in sol.extra:
+                node.append(ET.fromstring(extra))
 
 
 def xmpuzzle_xml(puzzle: BTPuzzle) -> bytes:
@@ -118,6 +122,7 @@ def xmpuzzle_xml(puzzle: BTPuzzle) -> bytes:
         node.text = puzzle.comment or None
     ET.indent(root)
     body: bytes = ET.tostring(root, encoding="utf-8")
+    body = _EMPTY_TAG.sub(rb"\1/>", body)  # <a x="1"/> as BurrTools writes it, not <a x="1" />
     return b'<?xml version="1.0"?>\n' + body
 
 
