@@ -161,25 +161,35 @@ def problem_figures(
     out: dict[str, Any] = {"problem": index, "name": prob.name}
     out.update(assemblies=None, solutions=None)
     found: tuple[dict[str, Shape], PieceGroups] | None = None
+    first: Analysis | None = None
     if assemble:
         packing = compile_packing(bt_packing_spec(puzzle, index))
         rep = count_bt(packing, mirrors=mirrors, limits=limits)
         out.update(assemblies=rep.assemblies, solutions=rep.solutions)
         if rep.first_solution is not None:
-            found = rep.first_solution, piece_groups(packing)
+            found, first = (rep.first_solution, piece_groups(packing)), rep.first_analysis
     else:
         found = _stored_assembly(puzzle, index)
     if found is None:
         out.update(level=None, moves=None, optimal_steps=None)
         return out
     shapes, groups = found
-    if not groups.any():
+    if groups.any():
+        result = first or analyze_grouped(shapes, groups, limits=limits)
+        out.update(level=result.level, moves=result.moves, optimal_steps=None)
+        if optimal and result.disassemblable:
+            out["optimal_error"] = "o_i is not searched for problems with piece groups"
+    elif first is None:
         out.update(disassembly_figures(shapes, max_group=None, limits=limits, optimal=optimal))
-        return out
-    result = analyze_grouped(shapes, groups, limits=limits)
-    out.update(level=result.level, moves=result.moves, optimal_steps=None)
-    if optimal and result.disassemblable:
-        out["optimal_error"] = "o_i is not searched for problems with piece groups"
+    else:  # the level is known: the assembler's disassembler found it
+        out.update(level=first.level, moves=first.moves, optimal_steps=None)
+        if optimal:
+            try:
+                out["optimal_steps"] = analyze_puzzle(
+                    shapes, max_group=None, limits=limits
+                ).optimal_steps
+            except SearchLimitError as e:
+                out["optimal_error"] = str(e)
     return out
 
 

@@ -142,14 +142,20 @@ def _cell_anchor(
 
 
 def iter_classes(
-    packing: Packing, *, mirrors: Mirrors = "keep", node_limit: int | None = None
+    packing: Packing,
+    *,
+    mirrors: Mirrors = "keep",
+    node_limit: int | None = None,
+    anchor: Anchor | Literal["auto"] | None = "auto",
 ) -> Iterator[Int32Array]:
-    """One assembly per class (its rows, sorted), in the search's fixed order."""
+    """One assembly per class (its rows, sorted), in the search's fixed order. ``anchor``:
+    the symmetry cut (:func:`choose_anchor` by default; None searches every row)."""
     if mirrors not in ("keep", "drop"):
         raise ValueError(f"mirrors: 'keep' or 'drop', got {mirrors!r}")
     if packing.n_rows == 0:
         return
-    anchor = choose_anchor(packing)
+    if anchor == "auto":
+        anchor = choose_anchor(packing)
     rot = packing.row_maps(False)
     full = packing.row_maps(True) if mirrors == "drop" else None
     search = CoverSearch(
@@ -245,7 +251,8 @@ def count_bt(
     n_asm = n_sol = 0
     first: dict[str, Shape] | None = None
     first_an: Analysis | None = None
-    for rows in iter_classes(packing, mirrors=mirrors, node_limit=node_limit):
+    anchor = choose_anchor(packing) if packing.n_rows else None
+    for rows in iter_classes(packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor):
         n_asm += 1
         asm = named_assembly(packing, rows)
         result = disassemble(packing, asm, max_group=max_group, limits=limits)
@@ -253,6 +260,5 @@ def count_bt(
             n_sol += 1
             if first is None:
                 first, first_an = asm, result
-    anchor = choose_anchor(packing)
     label = None if anchor is None else anchor.label
     return BTReport(n_asm, n_sol, first, first_an, time.perf_counter() - start, label)

@@ -3,7 +3,10 @@
 On top of the plain engine's problem (:mod:`solvers.problem`): voxels carry colours and a
 placement is a row only when every coloured piece voxel may sit on the result voxel under it
 (:class:`ColorRules`, BurrTools' ``<bitmap>``); result cells may be *variable* (covered at most
-once, the secondary columns of the engine). A piece is a coloured voxel set, so a piece whose
+once, the secondary columns of the engine; when a piece fits wholly on variable cells, where
+the kernels never branch, variable cells become fixed ones covered by a piece or a *hole*,
+see :func:`compile_packing`). Parts of the same coloured shape (and groups) are merged into
+one type whose copies are interchangeable. A piece is a coloured voxel set, so a piece whose
 shape is symmetric but whose colouring is not has more orientations than its shape; rows are
 ``(type, coloured placement)`` and two rows may cover the same cells.
 
@@ -23,15 +26,8 @@ from functools import cached_property
 
 import numpy as np
 
-from chaingeo.core.geometry import ROTATIONS, Shape
-from solvers.placements import (
-    Int32Array,
-    IntArray,
-    Placements,
-    cell_permutation,
-    target_index,
-    target_symmetries,
-)
+from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
+from solvers.placements import Int32Array, IntArray, Placements, target_index
 from solvers.problem import CoverError, CoverProblem, PieceType
 
 Cell = tuple[int, int, int]
@@ -58,27 +54,66 @@ class ColoredPiece:
     def shape(self) -> Shape:
         return Shape(self.voxels)
 
+    @cached_property
+    def _keys(self) -> tuple[IntArray, int]:
+        """Per rotation (:data:`ROTATION_STACK` order): the normalised voxels as sorted codes
+        ``((x * base + y) * base + z) * COLOR_BASE + colour``, and ``base``."""
+        vox = np.asarray(self.voxels, dtype=np.int64).reshape(-1, 3)
+        rot = np.einsum("rij,nj->rni", ROTATION_STACK, vox)
+        rot -= rot.min(axis=1, keepdims=True)
+        base = int(rot.max()) + 1 if len(vox) else 1
+        keys = (rot[..., 0] * base + rot[..., 1]) * base + rot[..., 2]
+        keys = keys * COLOR_BASE + np.asarray(self.colors, dtype=np.int64)[None, :]
+        keys.sort(axis=1)
+        return keys, base
+
+    @staticmethod
+    def _decode(row: IntArray, base: int) -> ColoredPiece:
+        k = row // COLOR_BASE
+        x, y, z = k // (base * base), (k // base) % base, k % base
+        cells = tuple(zip(x.tolist(), y.tolist(), z.tolist(), strict=True))
+        return ColoredPiece(cells, tuple((row % COLOR_BASE).tolist()))
+
     def transformed(self, m: IntArray) -> ColoredPiece:
         """Image under the matrix ``m``, normalised to the origin."""
-        v = np.asarray(self.voxels, dtype=np.int64) @ np.asarray(m).T
+        v = np.asarray(self.voxels, dtype=np.int64).reshape(-1, 3) @ np.asarray(m).T
         v -= v.min(axis=0)
-        order = np.lexsort((v[:, 2], v[:, 1], v[:, 0]))
-        cols = np.asarray(self.colors)[order]
-        cells = tuple((int(a), int(b), int(c)) for a, b, c in v[order].tolist())
-        return ColoredPiece(cells, tuple(int(k) for k in cols))
+        base = int(v.max()) + 1 if len(v) else 1
+        row = ((v[:, 0] * base + v[:, 1]) * base + v[:, 2]) * COLOR_BASE
+        return ColoredPiece._decode(np.sort(row + np.asarray(self.colors, dtype=np.int64)), base)
+
+    @cached_property
+    def _orientations(self) -> tuple[ColoredPiece, ...]:
+        keys, base = self._keys
+        seen: set[bytes] = set()
+        out = []
+        for row in keys:
+            b = row.tobytes()
+            if b not in seen:
+                seen.add(b)
+                out.append(ColoredPiece._decode(row, base))
+        return tuple(out)
 
     def orientations(self) -> tuple[ColoredPiece, ...]:
         """The distinct coloured orientations, in :data:`ROTATIONS` order."""
-        seen: dict[ColoredPiece, None] = {}
-        for m in ROTATIONS:
-            seen.setdefault(self.transformed(m), None)
-        return tuple(seen)
+        return self._orientations
+
+    @cached_property
+    def _canonical(self) -> ColoredPiece:
+        keys, base = self._keys
+        return ColoredPiece._decode(keys[int(np.lexsort(keys.T[::-1])[0])], base)
 
     def canonical(self) -> ColoredPiece:
-        return min(self.orientations(), key=lambda p: (p.voxels, p.colors))
+        """One orientation standing for all: equal for two pieces exactly when one is a
+        rotation of the other (colours included)."""
+        return self._canonical
 
     def mirrored(self) -> ColoredPiece:
         return self.transformed(_MIRROR)
+
+    @cached_property
+    def mirror_canonical(self) -> ColoredPiece:
+        return self.mirrored().canonical()
 
 
 @dataclass(frozen=True)
@@ -243,20 +278,28 @@ def _merge(parts: Sequence[PartSpec]) -> list[TypeInfo]:
 
 
 def _result_symmetries(spec: PackingSpec, target: Shape) -> tuple[Symmetry, ...]:
-    """The result's symmetries keeping colours and variable marks."""
+    """The result's symmetries keeping colours and variable marks (identity first, rotations
+    before reflections)."""
     idx = target_index(target)
     colors = np.zeros(len(target), dtype=np.int64)
     colors[idx.index_of(np.asarray(spec.result.voxels))] = spec.result.colors
     var = np.zeros(len(target), dtype=bool)
     if spec.variable:
         var[idx.index_of(np.asarray(sorted(spec.variable)))] = True
+    ext = np.asarray(target.extent)
     out = []
-    for m, t in target_symmetries(target, reflections=True):
-        perm = cell_permutation(target, m, t)
+    for m in SYMMETRIES:
+        if not np.array_equal(np.abs(m) @ ext, ext):
+            continue  # the bounding box would not map onto itself
+        img = target.voxels @ np.asarray(m).T
+        shift = target.min_corner - img.min(axis=0)
+        perm = idx.index_of(img + shift)
+        if np.any(perm < 0):
+            continue
         if np.array_equal(colors[perm], colors) and np.array_equal(var[perm], var):
             proper = round(float(np.linalg.det(m))) > 0
-            out.append(Symmetry(np.asarray(m), np.asarray(t), perm, proper))
-    out.sort(key=lambda s: not s.proper)  # stable: identity stays first
+            out.append(Symmetry(np.asarray(m), shift, perm, proper))
+    out.sort(key=lambda s: not s.proper)  # stable: the identity stays first
     return tuple(out)
 
 
@@ -361,7 +404,7 @@ def compile_packing(spec: PackingSpec) -> Packing:
             tuple(info.name if i == 0 else f"{info.name}_{i + 1}" for i in range(info.hi)),
             info.lo,
             info.hi,
-            info.piece != info.piece.mirrored().canonical(),
+            info.piece != info.piece.mirror_canonical,
         )
         for info in infos
     )
@@ -374,7 +417,7 @@ def compile_packing(spec: PackingSpec) -> Packing:
             by_piece.setdefault(info.piece, i)
     mirror = []
     for i, info in enumerate(infos):
-        m = info.piece.mirrored().canonical()
+        m = info.piece.mirror_canonical
         mirror.append(i if i == hole_type else by_key.get((m, info.groups), by_piece.get(m, -1)))
     syms = _result_symmetries(spec, target)
     return Packing(spec, problem, tuple(infos), tuple(codes), syms, tuple(mirror), hole_type)

@@ -237,3 +237,14 @@ def test_chain_analyze_with_groups_says_why_there_is_no_o_i(
     out = json.loads(capsys.readouterr().out)
     assert (out["assemblies"], out["solutions"], out["level"], out["moves"]) == (2, 2, "17", 17)
     assert out["optimal_steps"] is None and "piece groups" in out["optimal_error"]
+
+
+def test_bench_burrtools_quick(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bench", "burrtools", "--quick", "--repeat", "1"]) == 0
+    summary = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    rows = {r["instance"]: r for r in summary["rows"]}
+    assert set(rows) == {"linked_rings", "ring_maze", "deep_maze", "soma_problems#2"}
+    assert rows["deep_maze"]["ours"]["level"] == "51"
+    assert rows["ring_maze"]["ours"]["solutions"] == 2
+    assert rows["ring_maze"]["previous"]["assemblies"] == 0  # the ring lies on variable cells
+    assert all(r["speedup"] is not None for r in rows.values())
