@@ -78,7 +78,7 @@ def _instances(quick: bool) -> list[Instance]:
 # -- the previous engine ----------------------------------------------------------------------
 
 
-def _previous_plain(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> dict[str, Any]:
+def previous_plain(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> dict[str, Any]:
     """The old ``chain analyze`` on a ``.xmpuzzle`` problem: colours, groups and hole caps
     unknown to it."""
     from solvers.analysis import disassembly_figures
@@ -135,7 +135,7 @@ def _colour_variants(
     return sorted(out, key=sorted)
 
 
-def _previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> dict[str, Any]:
+def previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> dict[str, Any]:
     """Colour rules the slow way: every uncoloured packing, filtered voxel by voxel."""
     import itertools
 
@@ -234,7 +234,7 @@ def _warm_up() -> None:
 
     puzzle = linked_rings()
     problem_figures(puzzle, 0, SearchLimits(), True, True)
-    _previous_plain(puzzle, 0, SearchLimits(max_states=1000), "keep")
+    previous_plain(puzzle, 0, SearchLimits(max_states=1000), "keep")
     CoverSearch(compile_packing(bt_packing_spec(puzzle, 0)).problem, engine="dlx").count()
 
 
@@ -254,7 +254,7 @@ def run(args: argparse.Namespace) -> int:
             partial(problem_figures, puzzle, index, limits, True, True, mode), args.repeat
         )
         colours = bool(puzzle.colors and puzzle.problems[index].color_pairs)
-        previous = _previous_colours if colours else _previous_plain
+        previous = previous_colours if colours else previous_plain
         prev_s, prev = _timed(partial(previous, puzzle, index, limits, mirrors), args.repeat)
         row: dict[str, Any] = {
             "instance": name,
