@@ -270,3 +270,44 @@ def test_any_puzzle_read_back_is_the_same_puzzle(puzzle: BTPuzzle) -> None:
     )
     assert back == normal
     assert xmpuzzle_bytes(back) == data
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.data())
+def test_damaged_files_raise_only_burrtools_errors(data: st.DataObject) -> None:
+    """Bytes cut, dropped or replaced anywhere in a real file: read, or BurrToolsError."""
+    xml = bytearray(xmpuzzle_xml(EXAMPLES[data.draw(st.sampled_from(sorted(EXAMPLES)))]()))
+    for _ in range(data.draw(st.integers(1, 4))):
+        i = data.draw(st.integers(0, len(xml) - 1))
+        op = data.draw(st.sampled_from(["cut", "drop", "put"]))
+        if op == "cut":
+            del xml[i:]
+        elif op == "drop":
+            del xml[i : i + data.draw(st.integers(1, 20))]
+        else:
+            xml[i : i + 1] = data.draw(st.sampled_from([b"9", b"-", b"#7", b"+", b"x", b"<", b'"']))
+        if not xml:
+            break
+    try:
+        puzzle = parse_xmpuzzle(bytes(xml))
+    except BurrToolsError:
+        return
+    assert parse_xmpuzzle(xmpuzzle_bytes(puzzle)) is not None
+
+
+@settings(max_examples=40, deadline=None)
+@given(_puzzles())
+def test_any_readable_problem_is_analysed_or_refused_with_a_value_error(puzzle: BTPuzzle) -> None:
+    """Whatever a readable file's problems say (empty pieces, variable voxels in a piece, no
+    parts, colours), the analysis answers or raises a ValueError saying why."""
+    from chaingeo.core.kinematics import SearchLimitError
+    from solvers.analysis import problem_figures
+    from solvers.partsearch import SearchLimits
+
+    back = parse_xmpuzzle(xmpuzzle_bytes(puzzle))
+    for i in range(len(back.problems)):
+        try:
+            out = problem_figures(back, i, SearchLimits(max_states=2000, seconds=5), True, True)
+        except (ValueError, SearchLimitError):
+            continue
+        assert out["assemblies"] is not None and out["assemblies"] >= out["solutions"] >= 0
