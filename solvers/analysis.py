@@ -13,14 +13,17 @@ import os
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from chaingeo.core.formats.burrtools import read_xmpuzzle
+from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.level import Level
 from chaingeo.core.rules import PuzzleRules
 from solvers.assemble import count_solutions
 from solvers.blockbound import analyze_by_blocks
+from solvers.btassemble import Mirrors, bt_packing_spec, count_bt, piece_groups
+from solvers.constrained import compile_packing
 from solvers.disassemble import Analysis, Rods, analyze
+from solvers.groups import PieceGroups, analyze_grouped
 from solvers.partsearch import SearchLimits
 from solvers.problem import PieceSpec
 
@@ -115,9 +118,10 @@ def disassembly_figures(
 
 
 def level_figures(
-    level: Level, limits: SearchLimits, optimal: bool, assemble: bool
+    level: Level, limits: SearchLimits, optimal: bool, assemble: bool, mirrors: Mirrors = "keep"
 ) -> dict[str, Any]:
-    """What ``chain analyze`` prints for one of our puzzle levels."""
+    """What ``chain analyze`` prints for one of our puzzle levels (``mirrors="drop"`` also
+    identifies an assembly with its mirror image when the piece set maps to itself)."""
     if level.family != "puzzle":
         raise ValueError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
     max_group = level_max_group(level)
@@ -127,6 +131,7 @@ def level_figures(
         rep = count_solutions(
             [PieceSpec(p.shape.normalized(), p.name) for p in level.pieces],
             target,
+            mirror_distinct=mirrors == "keep",
             max_group=max_group,
             limits=limits,
         )
@@ -145,28 +150,83 @@ def level_figures(
     return out
 
 
-def xmpuzzle_figures(
-    path: str | os.PathLike[str], problem: int, limits: SearchLimits, optimal: bool, assemble: bool
+def _stored_assembly(puzzle: BTPuzzle, index: int) -> tuple[dict[str, Shape], PieceGroups] | None:
+    """The first stored assembly of a problem (pieces ``p<slot>``) and its pieces' groups."""
+    stored = puzzle.assemblies(index)
+    if not stored:
+        return None
+    prob = puzzle.problem(index)
+    part_of = [k for k, p in enumerate(prob.parts) for _ in range(p.max)]
+    shapes = {f"p{slot}": s for slot, s in stored[0].items()}
+    shape_of = {n: f"part{part_of[int(n[1:])]}" for n in shapes}
+    groups_of = {n: prob.parts[part_of[int(n[1:])]].groups for n in shapes}
+    return shapes, PieceGroups(shape_of, groups_of)
+
+
+def problem_figures(
+    puzzle: BTPuzzle,
+    index: int,
+    limits: SearchLimits,
+    optimal: bool,
+    assemble: bool,
+    mirrors: Mirrors = "keep",
 ) -> dict[str, Any]:
-    """What ``chain analyze`` prints for one problem of a BurrTools file."""
-    puzzle = read_xmpuzzle(path)
-    prob = puzzle.problem(problem)
-    out: dict[str, Any] = {"assemblies": None, "solutions": None}
-    shapes: dict[str, Shape] | None = None
+    """What ``chain analyze`` prints for one problem of a BurrTools puzzle: BurrTools'
+    assemblies and solutions (``mirrors``: see :mod:`solvers.btassemble`), then level, moves
+    and o_i of the first solution (with ``assemble`` off: of the first stored assembly). With
+    piece groups o_i is not searched (``optimal_error`` says so)."""
+    prob = puzzle.problem(index)
+    out: dict[str, Any] = {"problem": index, "name": prob.name}
+    out.update(assemblies=None, solutions=None)
+    found: tuple[dict[str, Shape], PieceGroups] | None = None
+    first: Analysis | None = None
     if assemble:
-        result = puzzle.shapes[prob.result]
-        pieces = [
-            PieceSpec(puzzle.shapes[sid].filled, f"s{sid}", lo, hi) for sid, lo, hi in prob.pieces
-        ]
-        rep = count_solutions(pieces, result.cells, optional=result.variable, limits=limits)
+        packing = compile_packing(bt_packing_spec(puzzle, index))
+        rep = count_bt(packing, mirrors=mirrors, limits=limits)
         out.update(assemblies=rep.assemblies, solutions=rep.solutions)
-        shapes = rep.first_solution
+        if rep.first_solution is not None:
+            found, first = (rep.first_solution, piece_groups(packing)), rep.first_analysis
     else:
-        stored = puzzle.assemblies(problem)
-        if stored:
-            shapes = {f"p{slot}": s for slot, s in stored[0].items()}
-    if shapes is None:
+        found = _stored_assembly(puzzle, index)
+    if found is None:
         out.update(level=None, moves=None, optimal_steps=None)
-    else:
+        return out
+    shapes, groups = found
+    if groups.any():
+        result = first or analyze_grouped(shapes, groups, limits=limits)
+        out.update(level=result.level, moves=result.moves, optimal_steps=None)
+        if optimal and result.disassemblable:
+            out["optimal_error"] = "o_i is not searched for problems with piece groups"
+    elif first is None:
         out.update(disassembly_figures(shapes, max_group=None, limits=limits, optimal=optimal))
+    else:  # the level is known: the assembler's disassembler found it
+        out.update(level=first.level, moves=first.moves, optimal_steps=None)
+        if optimal:
+            try:
+                out["optimal_steps"] = analyze_puzzle(
+                    shapes, max_group=None, limits=limits
+                ).optimal_steps
+            except SearchLimitError as e:
+                out["optimal_error"] = str(e)
     return out
+
+
+def xmpuzzle_figures(
+    path: str | os.PathLike[str],
+    problem: int | None,
+    limits: SearchLimits,
+    optimal: bool,
+    assemble: bool,
+    mirrors: Mirrors = "keep",
+) -> dict[str, Any]:
+    """What ``chain analyze`` prints for a BurrTools file: the figures of problem ``problem``,
+    or with None those of its only problem, or ``{"problems": [...]}`` listing every one."""
+    puzzle = read_xmpuzzle(path)
+    if problem is not None or len(puzzle.problems) == 1:
+        return problem_figures(puzzle, problem or 0, limits, optimal, assemble, mirrors)
+    return {
+        "problems": [
+            problem_figures(puzzle, i, limits, optimal, assemble, mirrors)
+            for i in range(len(puzzle.problems))
+        ]
+    }

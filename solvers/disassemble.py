@@ -172,12 +172,11 @@ class _Solver:
             # Like BurrTools, prefer taking out single pieces (then smaller groups) first.
             found = sorted(s.expand_layer(), key=lambda r: (r.mask.bit_count(), r.node))
             for sp in s.unique_splits(found):
-                rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
-                removed = self.greedy(rm, roff) if len(rm) > 1 else None
-                if len(rm) > 1 and removed is None:
+                done, removed = self.subpart(sp.removed, sp.removed_offsets)
+                if not done:
                     continue
-                left = self.greedy(lm, loff) if len(lm) > 1 else None
-                if len(lm) > 1 and left is None:
+                done, left = self.subpart(sp.left, sp.left_offsets)
+                if not done:
                     continue
                 r = sp.removal
                 moves = (*s.path_to(r.node), s.removal_move(r))
@@ -186,6 +185,16 @@ class _Solver:
         self.states += s.n_states
         self.greedy_memo[k] = result
         return result
+
+    def subpart(
+        self, members: tuple[int, ...], offsets: np.ndarray
+    ) -> tuple[bool, Separation | None]:
+        """Whether a part a separation leaves can be taken apart, and its tree (None: nothing
+        left to do). The hook :mod:`solvers.groups` overrides for BurrTools' piece groups."""
+        if len(members) == 1:
+            return True, None
+        tree = self.greedy(members, offsets)
+        return tree is not None, tree
 
     # -- optimal full disassembly --------------------------------------------------------------
     def optimal(

@@ -42,6 +42,15 @@ MAX_TEXT_CHARS: Final = 4096
 MAX_AGENT_NUMBER: Final = 100_000
 MAX_AGENT_DIGITS: Final = len(str(MAX_AGENT_NUMBER))
 
+#: BurrTools ``.xmpuzzle`` files: the XML once decompressed (a gzip bomb stops here), the cells
+#: of one voxel grid (``x * y * z``), shapes and problems per file, and the pieces of one
+#: problem (the sum of the parts' ``max``; also :data:`MAX_PIECES`). BurrTools' own examples
+#: stay far below (160 KB of XML, 6x6x6 grids, 27 shapes, 150 pieces).
+MAX_XMPUZZLE_XML_BYTES: Final = 32 * 1024 * 1024
+MAX_BT_GRID_CELLS: Final = 1_000_000
+MAX_BT_SHAPES: Final = 4096
+MAX_BT_PROBLEMS: Final = 1024
+
 #: The ``optimal_steps`` re-check of ``chain validate``: a search capped at this many states
 #: (the same cap the tests use); larger puzzles are reported as not re-checked.
 RECHECK_MAX_STATES: Final = 200_000

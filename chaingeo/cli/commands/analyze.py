@@ -1,5 +1,12 @@
-"""``chain analyze FILE [--problem N]``: assemblies, solutions, level, moves and o_i of a puzzle
-(one of our level files or a BurrTools ``.xmpuzzle``), printed as one JSON object."""
+"""``chain analyze FILE [--problem N] [--mirrors keep|drop]``: assemblies, solutions, level, moves
+and o_i of a puzzle (one of our level files or a BurrTools ``.xmpuzzle``), printed as one JSON
+object. A ``.xmpuzzle`` with several problems and no ``--problem`` gives
+``{"problems": [...], "seconds": ...}``, one object per problem.
+
+``--mirrors keep`` (default) counts mirror images apart: BurrTools' stored figures (e.g. 1063
+assemblies / 314 solutions on its SolidSixPieceBurrs example); ``--mirrors drop`` identifies an
+assembly with its mirror image when that is an assembly too: what BurrTools' command-line
+solver prints (588 / 179 there)."""
 
 from __future__ import annotations
 
@@ -17,7 +24,19 @@ def register(sub: Any) -> None:
         "analyze", help="assemblies, solutions, level and optimal steps of a puzzle file"
     )
     p.add_argument("file", type=Path, help="a chain-level/1 puzzle file or a .xmpuzzle file")
-    p.add_argument("--problem", type=int, default=0, help="problem index in a .xmpuzzle file")
+    p.add_argument(
+        "--problem",
+        type=int,
+        default=None,
+        help="problem index in a .xmpuzzle file (default: every problem)",
+    )
+    p.add_argument(
+        "--mirrors",
+        choices=("keep", "drop"),
+        default="keep",
+        help="keep mirror-image assemblies apart (BurrTools' stored counts) or drop them "
+        "(BurrTools' command-line solver)",
+    )
     p.add_argument("--seconds", type=float, default=120.0, help="time limit of each search")
     p.add_argument("--max-states", type=int, default=2_000_000, help="state cap per part")
     p.add_argument("--no-optimal", action="store_true", help="skip the optimal-plan search")
@@ -38,11 +57,18 @@ def run(args: argparse.Namespace) -> int:
     try:
         if args.file.suffix == ".xmpuzzle":
             out = xmpuzzle_figures(
-                args.file, args.problem, limits, not args.no_optimal, not args.no_assemble
+                args.file,
+                args.problem,
+                limits,
+                not args.no_optimal,
+                not args.no_assemble,
+                args.mirrors,
             )
         else:
             level = load_level(args.file)
-            out = level_figures(level, limits, not args.no_optimal, not args.no_assemble)
+            out = level_figures(
+                level, limits, not args.no_optimal, not args.no_assemble, args.mirrors
+            )
     except SearchLimitError as e:
         raise CommandError(str(e)) from None
     except (IndexError, RuntimeError) as e:
