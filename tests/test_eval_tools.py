@@ -13,6 +13,8 @@ import pytest
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, stacking_level
 from chaingeo.core.rules import PuzzleRules
+from chaingeo.envs.action_text import parse_text
+from chaingeo.envs.actions import TurnRequest
 from chaingeo.evaluation.agents.base import Agent, AgentSpec, Reply, ToolCall, Turn
 from chaingeo.evaluation.agents.openai_chat import OpenAIAgent, provider_fields, tools_setting
 from chaingeo.evaluation.agents.registry import AGENTS
@@ -57,7 +59,7 @@ def test_the_functions_offered_follow_the_level() -> None:
     assert "into" not in dis[0]["function"]["parameters"]["properties"]
     asm = tool_specs(_puzzle("assemble"))
     assert {"into", "offset"} <= set(asm[0]["function"]["parameters"]["properties"])
-    # No rules allow turns today; a rules field `turns` that is exactly True offers rotate.
+    # A rules field `turns` that is exactly True offers rotate.
     assert not turns_allowed(_puzzle("disassemble"))
     turning = _puzzle("disassemble", _TurningRules())
     assert turns_allowed(turning)
@@ -99,7 +101,8 @@ def _cells(*cells: Any) -> str:
         ("move", _mv(distance=2), ASM, "move red +x 2"),
         ("move", _mv(distance="inf", into=["blue", "green"], offset=[0, -1, 0]), ASM,
          "move red +x inf into blue+green offset (0,-1,0)"),
-        ("rotate", _rot(pieces=["red", "blue"]), ASM, "rotate red+blue z 90"),
+        ("rotate", _rot(pieces=["red", "blue"]), ASM, "rotate red+blue z +90"),
+        ("rotate", _rot(angle=-90), ASM, "rotate red z -90"),
     ],
 )  # fmt: skip
 def test_calls_become_canonical_action_text(
@@ -138,7 +141,8 @@ def test_calls_become_canonical_action_text(
         ("move", _mv(distance="INF"), ASM, "distance must be"),
         ("move", _mv(distance="2"), ASM, "distance must be"),
         ("move", _mv(distance="inf", offset=[0, 0]), ASM, "offset must be"),
-        ("rotate", _rot(angle=45), ASM, "angle must be one of 90, 180, 270"),
+        ("rotate", _rot(angle=45), ASM, "angle must be one of 90, -90"),
+        ("rotate", _rot(angle=180), ASM, "angle must be one of 90, -90"),
         ("rotate", _rot(angle="90"), ASM, "angle must be one of"),
         ("rotate", _rot(angle=90.0), ASM, "angle must be one of"),
         ("rotate", _rot(axis="w"), ASM, "axis must be one of x, y, z"),
@@ -296,3 +300,14 @@ def test_several_actions_a_turn_stop_at_the_first_rejected(
     assert index == 1 and previous is not None and previous.text == "turn 0"
     assert legal == [True, False]
     assert agent.seen[0][1:] == (None, [])
+
+
+def test_rotate_calls_become_turns_the_parser_reads() -> None:
+    """Levels whose rules allow turns offer ``rotate``; its calls read as the turn grammar."""
+    offered = tool_specs(_puzzle("disassemble", PuzzleRules(turns=True)))
+    assert "rotate" in _names(offered)
+    for angle, quarter in ((90, 1), (-90, -1)):
+        text = translate("rotate", json.dumps(_rot(angle=angle)), offered).action
+        request = parse_text(text, "disassemble")
+        assert isinstance(request, TurnRequest) and request.quarter == quarter
+        assert request.axis == "z" and request.pieces == ("red",)

@@ -24,7 +24,8 @@ from chaingeo.core.level import Level
 
 DIRECTIONS: Final = ("+x", "-x", "+y", "-y", "+z", "-z")
 AXES: Final = ("x", "y", "z")
-ANGLES: Final = (90, 180, 270)
+#: Quarter turns either way (right hand about +axis), as ``rotate GROUP AXIS +90|-90`` reads.
+ANGLES: Final = (90, -90)
 #: Fields of a level's rules that, when exactly ``True``, allow turning pieces.
 TURN_FIELDS: Final = ("turns", "rotations")
 #: What a malformed call's action text starts with: a character no action grammar accepts.
@@ -124,7 +125,8 @@ MOVE_ASSEMBLE: Final = _function(
 )
 ROTATE: Final = _function(
     "rotate",
-    "Turn a group of pieces about an axis by a quarter, half or three-quarter turn.",
+    "Turn a group of pieces a quarter turn about a line parallel to an axis (right hand about "
+    "+axis for 90, the other way for -90); the engine finds the turn centre when only one fits.",
     {
         "pieces": _group_schema("the colour names of the pieces turning together"),
         "axis": {"type": "string", "enum": list(AXES)},
@@ -142,7 +144,7 @@ FINISH: Final = _function("finish", "Declare the task done; the episode ends.", 
 
 def turns_allowed(level: Level) -> bool:
     """Whether the level's rules allow turning pieces (a rules field such as ``turns`` that is
-    exactly ``True``; no rules have one yet, so ``rotate`` is not offered today)."""
+    exactly ``True``: :class:`chaingeo.core.rules.PuzzleRules` ``turns``)."""
     return any(getattr(level.rules, f, False) is True for f in TURN_FIELDS)
 
 
@@ -238,7 +240,7 @@ def _text(name: str, args: Mapping[str, Any]) -> str:
     if name == "rotate":
         return (
             f"rotate {_group(args['pieces'], 'pieces')} {_choice(args['axis'], AXES, 'axis')}"
-            f" {_choice(args['angle'], ANGLES, 'angle')}"
+            f" {int(_choice(args['angle'], ANGLES, 'angle')):+d}"
         )
     if name in ("state", "finish"):
         return name
