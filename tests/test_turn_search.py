@@ -4,12 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import (
     Assembly,
+    SearchLimitError,
     legal_steps,
     legal_turns,
     reference_first_level,
@@ -155,10 +156,16 @@ def test_luban_lock_needs_its_rod_to_spin() -> None:
 
 
 @pytest.mark.slow
-@settings(max_examples=60)
+@settings(max_examples=30)
 @given(small_scenes(max_pieces=4))
 def test_optimal_with_turns_matches_reference_bfs_four_pieces(shapes: dict[str, Shape]) -> None:
-    ref = reference_optimal_disassembly(shapes, turns=True, max_states=50_000)
+    """Loose four-piece scenes: the reference searches whole states and may pass its cap
+    (turns multiply the states); those examples are skipped."""
+    try:
+        ref = reference_optimal_disassembly(shapes, turns=True, max_states=20_000)
+    except SearchLimitError:
+        assume(False)
+        return
     a = analyze(shapes, turns=True, limits=SearchLimits(seconds=None))
     assert a.optimal_steps == (None if ref is None else len(ref))
     if ref is not None:

@@ -16,6 +16,7 @@ from typing import Final
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.rules import PuzzleRules, StackingRules
 from chaingeo.envs import text_state
+from chaingeo.envs.actions import cells_text
 from chaingeo.envs.state import BaseState
 
 #: The views rendered for every state (the tray and the target are added where they apply).
@@ -105,6 +106,30 @@ def instruction(state: BaseState) -> str:
         f"another piece. Every move is one step, whatever its distance.{group_rule} "
         f"{_COORDS}\n"
     )
+    turns = (
+        "  rotate GROUP AXIS ANGLE about (x,y,z)  turn a group of one part a quarter turn, "
+        "e.g. rotate red z +90 about (2,3,1): AXIS is x, y or z, ANGLE +90 or -90 (right hand "
+        "about the positive axis), and the turn is about the line parallel to AXIS through the "
+        "point given in cell units (a cell's own coordinates for its centre, .5 for the corner "
+        "between cells; the coordinate along AXIS does not matter; it must lie within the "
+        "group's bounding box). Legal only if the turning group sweeps through no other piece; "
+        "one step. Leave out 'about' and the engine takes the only centre that works, or asks.\n"
+        if level.rules.turns
+        else ""
+    )
+    rods = level.rods if level.rules.turns else {}
+    if rods:
+        turns += (
+            "  Round rods (cells of the assembled puzzle; a rod spins in place about its axis): "
+            + (
+                "; ".join(
+                    f"{n} {cells_text(sorted(c for c, b in r.items() if b == a))} along {'xyz'[a]}"
+                    for n, r in sorted(rods.items())
+                    for a in sorted(set(r.values()))
+                )
+                + ".\n"
+            )
+        )
     if level.goal == "disassemble":
         return (
             "Take the interlocking puzzle apart until every piece stands alone. "
@@ -112,8 +137,7 @@ def instruction(state: BaseState) -> str:
             + "Actions, one per turn:\n"
             "  move GROUP DIRECTION DISTANCE  e.g. move red +x 2, move red+blue -z inf "
             "(GROUP joins colour names with +; DIRECTION is one of +x -x +y -y +z -z; inf takes "
-            "the group out of the puzzle)\n"
-            "  finish  end the game when you are done\n"
+            "the group out of the puzzle)\n" + turns + "  finish  end the game when you are done\n"
             "Every turn costs one step, including a turn whose action fails."
         )
     return (
@@ -126,7 +150,8 @@ def instruction(state: BaseState) -> str:
         "in the target ((0,0,0) is exactly there); left out, the engine takes the only fit, or "
         "the target place, or asks you to choose.\n"
         "  move GROUP DIRECTION DISTANCE  slide pieces within a part, e.g. move red -x 2\n"
-        "  finish  end the game when you are done\n"
+        + turns
+        + "  finish  end the game when you are done\n"
         "Nothing leaves a part once it has joined. Every turn costs one step, including a turn "
         "whose action fails."
     )

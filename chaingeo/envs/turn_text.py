@@ -107,7 +107,7 @@ def parse_turn(normalised: str) -> TurnRequest:
         i += 1
     if i >= len(tokens) or tokens[i][0] != "num":
         raise TurnTextError("a turn needs its angle: +90 or -90")
-    if tokens[i][1] not in ("90", "90.0"):
+    if len(tokens[i][1]) > 12 or float(tokens[i][1]) != 90:
         raise TurnTextError(f"a turn is a quarter turn, +90 or -90, not {tokens[i][1]}", True)
     i += 1
     centre: tuple[int, int, int] | None = None
