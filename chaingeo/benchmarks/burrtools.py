@@ -4,8 +4,9 @@ Instances: every example of :mod:`generator.bt_examples` (one per problem featur
 rules, piece groups with variable cells, ranges and several problems, mirror images, a level-51
 maze, the solid burr catalogue), plus BurrTools' own example files when present
 (``../shared/burrtools`` or ``CHAIN_BURRTOOLS_DIR``). For each problem, ``ours`` is what
-``chain analyze`` does (:func:`solvers.analysis.problem_figures`: BurrTools' assemblies and
-solutions, then level, moves and o_i of the first solution) and ``previous`` the engine before
+``chain analyze --no-optimal`` does (:func:`solvers.analysis.problem_figures`: BurrTools'
+assemblies and solutions, then level and moves of the first solution; o_i is left out, being
+no BurrTools figure and the same code in both engines) and ``previous`` the engine before
 BurrTools' semantics, timed in the same run:
 
 * on a problem with colour rules, ``previous`` counts without them and filters after: every
@@ -14,11 +15,14 @@ BurrTools' semantics, timed in the same run:
   coloured result's symmetries, then the disassembler on those classes only (the same figures
   as ours, reached the slow way);
 * elsewhere ``previous`` is the old ``chain analyze`` (:func:`solvers.assemble.count_solutions`
-  on the uncoloured, ungrouped problem): its figures differ where groups or hole caps matter,
-  and on the ring maze it meets its time limit (the grouped pieces never come apart).
+  on the uncoloured, ungrouped problem): its figures differ where groups, hole caps or pieces
+  lying wholly on variable cells matter (the ring maze: 0 assemblies, the ring is never
+  placed; the linked rings: no solution, the rings never come apart).
 
 ``speedup`` is previous / ours (wall clock; the best of ``--repeat`` runs, a run over 10 s not
-repeated). JIT compilation is excluded: both engines run a small problem first. ``--quick``:
+repeated; ``agree`` says whether the previous engine's figures are ours). Every run builds
+its problem from scratch (the engines' placement caches are cleared first); JIT compilation is
+excluded: both engines run a small problem first. ``--quick``:
 four small instances, previous engine capped at 5 s. ``CHAIN_BENCH_BT_SECONDS`` sets the time
 limit of each search (default 120, as ``chain analyze``).
 """
@@ -102,7 +106,7 @@ def previous_plain(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> d
     out: dict[str, Any] = {"assemblies": rep.assemblies, "solutions": rep.solutions}
     if rep.first_solution is not None:
         figures = disassembly_figures(
-            rep.first_solution, max_group=None, limits=limits, optimal=True
+            rep.first_solution, max_group=None, limits=limits, optimal=False
         )
         out.update(level=figures["level"], moves=figures["moves"])
     return out
@@ -195,7 +199,7 @@ def previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) ->
             out["solutions"] += 1
             first = first or shapes
     if first is not None:
-        figures = disassembly_figures(first, max_group=None, limits=limits, optimal=True)
+        figures = disassembly_figures(first, max_group=None, limits=limits, optimal=False)
         out.update(level=figures["level"], moves=figures["moves"])
     return out
 
@@ -208,9 +212,19 @@ def _image(m: np.ndarray, t: np.ndarray, c: tuple[int, int, int]) -> tuple[int, 
 # -- timing -----------------------------------------------------------------------------------
 
 
+def _from_scratch() -> None:
+    """Forget the placements and problems the engines cache, so every run builds its own."""
+    from solvers.placements import _placements, target_index
+    from solvers.problem import _cover_problem
+
+    for cached in (_placements, target_index, _cover_problem):
+        cached.cache_clear()
+
+
 def _timed(fn: Callable[[], dict[str, Any]], repeat: int) -> tuple[float, dict[str, Any]]:
     best, out = float("inf"), {}
     for _ in range(max(repeat, 1)):
+        _from_scratch()
         t0 = time.perf_counter()
         try:
             out = fn()
@@ -247,11 +261,11 @@ def run(args: argparse.Namespace) -> int:
     limits = SearchLimits(seconds=seconds)
     _warm_up()
     rows = []
-    keys = ("assemblies", "solutions", "level", "moves", "optimal_steps", "error")
+    keys = ("assemblies", "solutions", "level", "moves", "error")
     for name, puzzle, index, mirrors in _instances(args.quick):
         mode: Mirrors = "drop" if mirrors == "drop" else "keep"
         ours_s, ours = _timed(
-            partial(problem_figures, puzzle, index, limits, True, True, mode), args.repeat
+            partial(problem_figures, puzzle, index, limits, False, True, mode), args.repeat
         )
         colours = bool(puzzle.colors and puzzle.problems[index].color_pairs)
         previous = previous_colours if colours else previous_plain
@@ -267,6 +281,7 @@ def run(args: argparse.Namespace) -> int:
             "previous_engine": "filter after an uncoloured count"
             if colours
             else "old chain analyze",
+            "agree": all(prev.get(k) == ours.get(k) for k in ("assemblies", "solutions", "level")),
             "speedup": round(prev_s / ours_s, 2) if ours_s > 0 else None,
         }
         known = BURRTOOLS_FIGURES.get((name, index, mirrors))
