@@ -282,27 +282,44 @@ def hash_row(row: I16) -> np.uint64:
 
 
 @njit(cache=True)
-def find_or_insert(states: I16, n_states: int, table: I64, row: I16) -> int:
-    """Index of ``row`` in ``states`` (via the open-addressing ``table``); if absent, store it
-    at ``n_states`` and return ``-1 - n_states``."""
+def _slot(states: I16, table: I64, row: I16) -> int:
+    """The slot of ``row`` in the open-addressing ``table`` over ``states``: where it is
+    stored, or the empty slot where it would go (linear probing on :func:`hash_row`)."""
     mask = np.uint64(table.shape[0] - 1)
     h = hash_row(row) & mask
     w = row.shape[0]
     while True:
         idx = int(table[h])
         if idx < 0:
-            table[h] = n_states
-            for t in range(w):
-                states[n_states, t] = row[t]
-            return -1 - n_states
+            return int(h)
         same = True
         for t in range(w):
             if states[idx, t] != row[t]:
                 same = False
                 break
         if same:
-            return idx
+            return int(h)
         h = (h + np.uint64(1)) & mask
+
+
+@njit(cache=True)
+def find_row(states: I16, table: I64, row: I16) -> int:
+    """Index of ``row`` in ``states`` (via the open-addressing ``table``), or -1."""
+    return int(table[_slot(states, table, row)])
+
+
+@njit(cache=True)
+def find_or_insert(states: I16, n_states: int, table: I64, row: I16) -> int:
+    """Index of ``row`` in ``states`` (via the open-addressing ``table``); if absent, store it
+    at ``n_states`` and return ``-1 - n_states``."""
+    slot = _slot(states, table, row)
+    idx = int(table[slot])
+    if idx >= 0:
+        return idx
+    table[slot] = n_states
+    for t in range(row.shape[0]):
+        states[n_states, t] = row[t]
+    return -1 - n_states
 
 
 @njit(cache=True)

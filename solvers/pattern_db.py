@@ -42,25 +42,8 @@ KEY_WIDTH = 7
 SUB_DONE, SUB_NEED_STATES, SUB_NEED_EDGES, SUB_NEED_MOVES, SUB_TOO_MANY_GROUPS = 0, 1, 2, 3, 4
 
 
-@njit(cache=True)
-def lookup(rows: I16, table: I64, row: I16) -> int:
-    """Index of ``row`` in ``rows`` via the open-addressing ``table`` (hash of
-    :func:`solvers.movement.hash_row`), or -1."""
-    mask = np.uint64(table.shape[0] - 1)
-    h = mv.hash_row(row) & mask
-    w = row.shape[0]
-    while True:
-        idx = int(table[h])
-        if idx < 0:
-            return -1
-        same = True
-        for t in range(w):
-            if rows[idx, t] != row[t]:
-                same = False
-                break
-        if same:
-            return idx
-        h = (h + np.uint64(1)) & mask
+#: Index of a key row in the database (-1 when absent): the shared open-addressing lookup.
+lookup = mv.find_row
 
 
 @njit(cache=True)
