@@ -11,7 +11,7 @@ from chaingeo.cli.main import main
 from chaingeo.core.geometry import Shape
 from solvers.assemble import count_solutions, iter_assemblies
 from solvers.problem import PieceSpec
-from tests.test_burrtools import BT, needs_files
+from tests.shared_files import BT, needs_files
 
 
 def test_small_assemblies_and_solutions() -> None:

@@ -20,7 +20,7 @@ from chaingeo.core.kinematics import (
 from solvers.astar import AStarLimits, Heuristic, astar_optimal
 from solvers.disassemble import analyze
 from tests.puzzle_strategies import random_partition, small_scenes
-from tests.test_burrtools import BT, needs_files
+from tests.shared_files import BT, needs_files
 from tests.test_disassemble import SCENE, random_walk
 
 

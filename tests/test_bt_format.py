@@ -27,7 +27,7 @@ from chaingeo.core.formats.burrtools import (
 )
 from chaingeo.core.geometry import Shape
 from generator.bt_examples import EXAMPLES
-from tests.test_burrtools import BT, needs_files
+from tests.shared_files import BT, needs_files
 
 DATA = Path(__file__).parent / "data" / "burrtools"
 

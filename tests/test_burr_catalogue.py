@@ -14,7 +14,7 @@ from chaingeo.core.piecesets.burrs import (
 )
 from solvers.assemble import count_solutions, solid_burr_codes
 from solvers.problem import PieceSpec
-from tests.test_burrtools import BT, needs_files
+from tests.shared_files import BT, needs_files
 
 
 def test_family_sizes() -> None:

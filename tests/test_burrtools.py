@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import gzip
 import json
-import os
 from pathlib import Path
 
 import pytest
@@ -21,16 +20,7 @@ from chaingeo.core.formats.burrtools import (
 from chaingeo.core.geometry import ROTATIONS, Shape
 from chaingeo.core.piecesets.burrs import six_piece_family, solid_knot
 from solvers.disassemble import analyze
-
-
-def burrtools_dir() -> Path | None:
-    env = os.environ.get("CHAIN_BURRTOOLS_DIR")
-    path = Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "burrtools"
-    return path if path.is_dir() else None
-
-
-BT = burrtools_dir()
-needs_files = pytest.mark.skipif(BT is None, reason="../shared/burrtools is not present")
+from tests.shared_files import BT, needs_files
 
 
 def test_transform_table_is_the_cube_group() -> None:

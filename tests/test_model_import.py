@@ -4,7 +4,6 @@ plus small synthetic models written here, which pin the refusals and the snappin
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import pytest
@@ -25,16 +24,7 @@ from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
 from solvers.cover import first_solution
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
-
-
-def models_dir() -> Path | None:
-    env = os.environ.get("CHAIN_MODELS_DIR")
-    path = Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "chain-models"
-    return path if path.is_dir() else None
-
-
-MODELS = models_dir()
-needs_models = pytest.mark.skipif(MODELS is None, reason="../shared/chain-models is not present")
+from tests.shared_files import MODELS, needs_models
 
 #: What each model must give: kind and cells per part (in part order), or the refusal.
 EXPECTED: dict[str, tuple[str, list[int]] | str] = {

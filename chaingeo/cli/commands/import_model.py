@@ -1,9 +1,9 @@
 """``chain import``: a CHAIN puzzle model (URDF + OBJ parts) as a ``chain-level/1`` file.
 
-The importer (:mod:`chaingeo.core.formats.models`) puts the parts on the lattice; this command adds
-what needs the solvers: a puzzle's level and optimal plan (``solvers.disassemble.analyze``, with
-caps) or a stacking model's packing (``solvers.cover``). A model that is not on a lattice, or a
-puzzle that does not come apart by translations, is an error and nothing is written.
+The importer (:mod:`chaingeo.core.formats.models`) puts the parts on the lattice;
+:mod:`generator.imported` adds what needs the solvers: a puzzle's level and optimal plan (with
+caps) or a stacking model's packing. A model that is not on a lattice, or a puzzle that does
+not come apart, is an error and nothing is written.
 
 ``chain import --report ROOT`` imports every model folder under ROOT and prints one table row
 per model (imported or refused, unit, fit residual, pieces, cells per piece, whether and how it
@@ -22,7 +22,7 @@ from chaingeo.cli.errors import CommandError
 
 if TYPE_CHECKING:
     from chaingeo.core.formats.models import ImportedModel
-    from chaingeo.core.level import Difficulty, Level
+    from chaingeo.core.level import Level
     from solvers.disassemble import Analysis
     from solvers.partsearch import SearchLimits
 
@@ -96,60 +96,17 @@ def limits_of(args: argparse.Namespace) -> SearchLimits:
     )
 
 
-def stacking_difficulty(model: ImportedModel) -> Difficulty:
-    """As the stacking generator's modes: cuboids easy, flat pieces mid, free shapes hard."""
-    shapes = [p.shape for p in model.parts]
-    if all(s.is_cuboid() for s in shapes):
-        return "easy"
-    if all(min(s.extent) == 1 for s in shapes):
-        return "mid"
-    return "hard"
-
-
-def build_level(model: ImportedModel, args: argparse.Namespace) -> tuple[Level, Analysis | None]:
-    """The verified level of an imported model (solvers find the plan or the packing)."""
-    from chaingeo.core.formats.models import model_puzzle_level, model_stacking_level
-    from generator.puzzle import difficulty_of
-    from solvers.analysis import analyze_puzzle
-    from solvers.cover import first_solution
+def build_level(model: ImportedModel, args: argparse.Namespace) -> Level:
+    """The verified level of an imported model (:mod:`generator.imported`: solvers find the
+    plan or the packing)."""
+    from generator.imported import imported_puzzle_level, imported_stacking_level
 
     if model.kind == "stacking":
-        assert model.box is not None
-        sol = first_solution(model.shapes, model.box, reflections=False)
-        if sol is None:
-            raise CommandError(f"{model.model}: the pieces do not pack the {list(model.box)} box")
-        level = model_stacking_level(
-            model, dict(sol.placements), difficulty=stacking_difficulty(model)
-        )
-        return level, None
-    a = analyze_puzzle(
-        model.shapes,
-        max_group=args.max_group,
-        limits=limits_of(args),
-        turns=args.turns,
-        rods=model.rods,
+        return imported_stacking_level(model)
+    level, _ = imported_puzzle_level(
+        model, goal=args.goal, turns=args.turns, max_group=args.max_group, limits=limits_of(args)
     )
-    if not a.disassemblable or a.optimal_steps is None:
-        how = "translations and turns" if args.turns else "translations alone (try --turns)"
-        raise CommandError(f"{model.model}: does not come apart by {how}; no level written")
-    stats = {
-        "level": a.level,
-        "first_level": a.first_level,
-        "moves": a.moves,
-        "pieces": len(model.parts),
-        "voxels": sum(len(p.shape) for p in model.parts),
-        "states": a.states,
-    }
-    level = model_puzzle_level(
-        model,
-        a.plan,
-        goal=args.goal,
-        difficulty=difficulty_of(a.first_level or 0, a.optimal_steps, len(model.parts)),
-        max_group=args.max_group,
-        turns=args.turns,
-        stats=stats,
-    )
-    return level, a
+    return level
 
 
 def report_model(folder: Path, args: argparse.Namespace) -> ModelReport:
@@ -218,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     model = import_model(args.model, args.kind)
     try:
-        level, _ = build_level(model, args)
+        level = build_level(model, args)
     except SearchLimitError as e:
         raise CommandError(f"{model.model}: optimal plan not found within the caps: {e}") from None
     if args.out is None:
