@@ -97,11 +97,13 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> Candidate 
 
 
 def difficulty_of(first_level: int, optimal_steps: int, pieces: int) -> Difficulty:
-    """The suite's thresholds (README, 'Puzzle suite'): *hard* when the first part needs 4 or
-    more moves, or the optimal plan 14 or more, or there are 12 or more pieces; *easy* when the
-    first part needs at most 2 moves, the plan at most 8 and there are at most 6 pieces; *mid*
-    otherwise."""
-    if first_level >= 4 or optimal_steps >= 14 or pieces >= 12:
+    """The suite's tiers (README, 'The puzzle suite'), in the paper's sense: *easy* is few
+    pieces and weak interlocking (at most 6 pieces, the first part free within 2 moves, a plan
+    of at most 8); *hard* is strong interlocking (5 or more moves before any part comes free),
+    a long plan (20 or more moves), or many pieces that interlock (12 or more pieces and a
+    first part needing 3 or more moves); *mid* is everything else, such as many loosely held
+    pieces."""
+    if first_level >= 5 or optimal_steps >= 20 or (pieces >= 12 and first_level >= 3):
         return "hard"
     if first_level <= 2 and optimal_steps <= 8 and pieces <= 6:
         return "easy"

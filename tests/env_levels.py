@@ -221,3 +221,12 @@ def puzzle_levels() -> tuple[Level, ...]:
         for goal in ("disassemble", "assemble"):
             levels.append(puzzle_level(f"{name}-{goal}", shapes, plan, goal, mg))
     return tuple(levels)
+
+
+def design_of(level: Level) -> str:
+    """What a shipped puzzle level is made of: the generator's shape (``burr6``, ``cube4``, ...)
+    or, for a level imported from CHAIN's models, ``chain/`` and the model's name."""
+    source = level.stats.get("source")
+    if isinstance(source, dict):
+        return f"chain/{source['model']}"
+    return str(level.stats["shape"])

@@ -42,7 +42,7 @@ from tests.test_eval_runner import _levels as _fake_levels
 LEVELS = (
     "stacking/stacking-2x2x2-easy-s101-000000.json",
     "stacking/stacking-2x2x2-mid-s102-000000.json",
-    "puzzle/puzzle-easy-04-burr3.json",
+    "puzzle/puzzle-easy-04-burr6.json",
 )
 HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)> & <b>bold</b>'
 

@@ -131,7 +131,7 @@ def test_far_offset_is_illegal_not_slow() -> None:
 
 
 def _base(family: str) -> dict[str, Any]:
-    name = "puzzle-easy-04-burr3.json" if family == "puzzle" else ""
+    name = "puzzle-easy-04-burr6.json" if family == "puzzle" else ""
     folder = shipped_levels(family)
     path = folder / name if name else sorted(folder.glob("*.json"))[0]
     data: dict[str, Any] = json.loads(path.read_text())
@@ -223,8 +223,8 @@ def test_validate_flags_a_stored_optimum_that_is_not(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     data = _base("puzzle")
-    state = new_state(load_level(shipped_levels("puzzle") / "puzzle-easy-04-burr3.json"))
-    assert isinstance(state, PuzzleState) and data["optimal_steps"] == 3
+    state = new_state(load_level(shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"))
+    assert isinstance(state, PuzzleState) and data["optimal_steps"] == 7
     # a detour: one slide and back, then the stored optimal plan (still a valid plan)
     slide = next(
         a
@@ -235,13 +235,13 @@ def test_validate_flags_a_stored_optimum_that_is_not(
     there = {"pieces": list(move.pieces), "direction": move.direction, "distance": 1}
     back = {**there, "direction": OPPOSITE[move.direction]}
     data["solution"]["moves"] = [there, back, *data["solution"]["moves"]]
-    data["optimal_steps"] = 5
-    data["max_steps"] = max(data["max_steps"], 5)
+    data["optimal_steps"] = 9
+    data["max_steps"] = max(data["max_steps"], 9)
     path = tmp_path / "bad.json"
     path.write_text(json.dumps(data))
-    load_level(path)  # a valid file: only the search can tell the optimum is 3
+    load_level(path)  # a valid file: only the search can tell the optimum is 7
     assert main(["validate", str(path)]) == 2
     row = json.loads(capsys.readouterr().out.splitlines()[0])
-    assert "optimum is 3" in row["error"]
-    good = shipped_levels("puzzle") / "puzzle-easy-04-burr3.json"
+    assert "optimum is 7" in row["error"]
+    good = shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"
     assert main(["validate", str(good)]) == 0

@@ -21,7 +21,7 @@ from chaingeo.envs.action_list import ActionList
 from chaingeo.envs.actions import FinishAction, MoveAction
 from chaingeo.envs.puzzle import PuzzleState
 from chaingeo.envs.puzzle_actions import reference_actions, shifts
-from tests.env_levels import puzzle_levels
+from tests.env_levels import design_of, puzzle_levels
 from tests.strategies import polycubes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
@@ -48,7 +48,7 @@ def small_levels() -> list[Level]:
     picked: dict[tuple[str, str], Level] = {}
     for lv in load_levels(SUITE):
         if len(lv.pieces) <= 6:
-            picked.setdefault((str(lv.stats["shape"]), lv.goal), lv)
+            picked.setdefault((design_of(lv), lv.goal), lv)
     return [*puzzle_levels(), *(picked[k] for k in sorted(picked))]
 
 
@@ -57,7 +57,7 @@ def large_assembly_levels() -> list[Level]:
     picked: dict[str, Level] = {}
     for lv in sorted(load_levels(SUITE), key=lambda lv: (-len(lv.pieces), lv.id)):
         if lv.goal == "assemble":
-            picked.setdefault(str(lv.stats["shape"]), lv)
+            picked.setdefault(design_of(lv), lv)
     return [lv for lv in picked.values() if len(lv.pieces) >= 12]
 
 
@@ -67,7 +67,8 @@ def test_legal_actions_are_the_reference_along_random_walks(lv: Level) -> None:
     state = PuzzleState(lv)
     for _ in range(6):
         legal = state.legal_actions()
-        assert legal == reference_actions(state.assembly, state.mode, state.tables.max_group)
+        turns = lv.rules.turns  # type: ignore[union-attr]
+        assert legal == reference_actions(state.assembly, state.mode, state.tables.max_group, turns)
         moves = len(legal) - 1
         if moves == 0 or state.is_success():
             break

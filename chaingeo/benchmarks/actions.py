@@ -81,8 +81,9 @@ def run(args: argparse.Namespace) -> int:
     for level in levels:
         states = _states(level, walk, 0)[: 3 if args.quick else None]
         mg = level.rules.max_group  # type: ignore[union-attr]
+        turns = level.rules.turns  # type: ignore[union-attr]
         first = states[0]
-        if list(first.legal_actions()) != reference_actions(first.assembly, first.mode, mg):
+        if list(first.legal_actions()) != reference_actions(first.assembly, first.mode, mg, turns):
             raise AssertionError(f"{level.id}: fast and reference action lists differ")
         ours = ref = 0.0
         counts = []
@@ -94,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
             ours += best
             counts.append(n)
             t0 = time.perf_counter()
-            reference_actions(s.assembly, s.mode, mg)
+            reference_actions(s.assembly, s.mode, mg, turns)
             ref += time.perf_counter() - t0
         ours_total += ours
         ref_total += ref

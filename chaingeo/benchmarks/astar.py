@@ -40,7 +40,12 @@ def _instances(quick: bool) -> list[Instance]:
     suite = root / "levels" / "puzzle"
     levels = load_levels(suite) if suite.is_dir() else []
     out: list[Instance] = []
-    small = [lv for lv in levels if len(lv.shapes) <= 12]
+    # translations only: A* does not search turns
+    small = [
+        lv
+        for lv in levels
+        if len(lv.shapes) <= 12 and not (isinstance(lv.rules, PuzzleRules) and lv.rules.turns)
+    ]
     for lv in small[:3] if quick else small:
         mg = lv.rules.max_group if isinstance(lv.rules, PuzzleRules) else None
         out.append((lv.id, lv.shapes, mg))

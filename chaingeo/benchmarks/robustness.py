@@ -33,7 +33,7 @@ SEED = 20261124
 #: The shipped levels fuzzed (stacking, puzzle disassembly, puzzle assembly).
 LEVEL_FILES = (
     ("stacking", "stacking-2x3x3-hard-s109-000000.json"),
-    ("puzzle", "puzzle-mid-09-cube4.json"),
+    ("puzzle", "puzzle-easy-04-burr6.json"),
     ("puzzle", "puzzle-mid-11-cube4.json"),
 )
 

@@ -203,6 +203,8 @@ def _run_puzzle(args: argparse.Namespace) -> int:
 def _register_puzzle_suite(fam: Any) -> None:
     p = fam.add_parser("puzzle-suite", help="rebuild the shipped 32-level puzzle suite")
     p.add_argument("--out", type=Path, default=Path("levels") / "puzzle", help="target folder")
+    p.add_argument("--models", type=Path, required=True,
+                   help="CHAIN's puzzle models (e.g. ../shared/chain-models)")  # fmt: skip
     p.add_argument("--jobs", type=int, default=1, help="suite entries built in parallel")
     p.set_defaults(func=_run_puzzle_suite)
 
@@ -214,7 +216,10 @@ def _run_puzzle_suite(args: argparse.Namespace) -> int:
 
     try:
         levels = build_puzzle_suite(
-            args.out, jobs=args.jobs, log=lambda s: print(s, file=sys.stderr, flush=True)
+            args.out,
+            args.models,
+            jobs=args.jobs,
+            log=lambda s: print(s, file=sys.stderr, flush=True),
         )
     except RuntimeError as e:
         raise CommandError(str(e)) from None
