@@ -220,9 +220,11 @@ def disassemble(
     *,
     max_group: int | None = None,
     limits: SearchLimits | None = None,
+    groups: PieceGroups | None = None,
 ) -> Analysis:
-    """The disassembler's verdict on one assembly (level and moves), groups honoured."""
-    groups = piece_groups(packing)
+    """The disassembler's verdict on one assembly (level and moves), groups honoured
+    (``groups``: :func:`piece_groups` of the packing, when the caller has it already)."""
+    groups = piece_groups(packing) if groups is None else groups
     if groups.any():
         return analyze_grouped(assembly, groups, max_group=max_group, limits=limits)
     return analyze(assembly, max_group=max_group, limits=limits, optimal=False)
@@ -252,10 +254,11 @@ def count_bt(
     first: dict[str, Shape] | None = None
     first_an: Analysis | None = None
     anchor = choose_anchor(packing) if packing.n_rows else None
+    groups = piece_groups(packing)
     for rows in iter_classes(packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor):
         n_asm += 1
         asm = named_assembly(packing, rows)
-        result = disassemble(packing, asm, max_group=max_group, limits=limits)
+        result = disassemble(packing, asm, max_group=max_group, limits=limits, groups=groups)
         if result.disassemblable:
             n_sol += 1
             if first is None:
