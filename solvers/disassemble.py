@@ -170,7 +170,7 @@ class _Solver:
         result: Separation | None = None
         while result is None and not s.exhausted:
             # Like BurrTools, prefer taking out single pieces (then smaller groups) first.
-            found = sorted(s.expand_layer(), key=lambda r: (r.mask.bit_count(), r.node))
+            found = sorted(s.expand_layers(), key=lambda r: (r.mask.bit_count(), r.node))
             for sp in s.unique_splits(found):
                 done, removed = self.subpart(sp.removed, sp.removed_offsets)
                 if not done:
@@ -219,7 +219,7 @@ class _Solver:
         s = self.search(members, offsets)
         best, best_plan = budget, None
         while not s.exhausted and s.depth + 1 + (n - 2) < best and best > floor:
-            for sp in s.unique_splits(s.expand_layer()):
+            for sp in s.unique_splits(s.expand_layers(best - n)):
                 if best <= floor:
                     break
                 r = sp.removal
