@@ -100,6 +100,35 @@ def pair_gaps(vox: I64, starts: I64, lo: I64, hi: I64, off: I64, out: I64) -> No
 
 
 @njit(cache=True)
+def sort_axes(every: I64, starts: I64) -> I64:
+    """The voxel order :func:`pair_gaps` merges in: ``out[a]`` holds every piece's voxels
+    (piece ``p`` in rows ``starts[p]:starts[p + 1]`` of ``every``), each piece sorted by the
+    two other axes, then ``a``. Coordinates must span less than 2**20 per axis."""
+    m = every.shape[0]
+    mn = np.empty(3, dtype=np.int64)
+    span = 1
+    for t in range(3):
+        mn[t] = every[:, t].min()
+        span = max(span, every[:, t].max() - mn[t] + 1)
+    out = np.empty((3, m, 3), dtype=np.int64)
+    key = np.empty(m, dtype=np.int64)
+    for a in range(3):
+        u = (a + 1) % 3
+        w = (a + 2) % 3
+        for r in range(m):
+            key[r] = (
+                ((every[r, u] - mn[u]) * span + every[r, w] - mn[w]) * span + every[r, a] - mn[a]
+            )
+        for p in range(starts.shape[0] - 1):
+            first = starts[p]
+            order = np.argsort(key[first : starts[p + 1]])
+            for i in range(order.shape[0]):
+                for t in range(3):
+                    out[a, first + i, t] = every[first + order[i], t]
+    return out
+
+
+@njit(cache=True)
 def closures(gaps: I64, a: int, n: int) -> U64:
     """``c[i]``: the pieces that must come along when ``i`` steps along ``+a`` (with ``i``)."""
     c = np.zeros(n, dtype=np.uint64)

@@ -9,7 +9,7 @@ it, and collects every removal (a move that splits the part) seen on the way.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,8 +54,8 @@ class Deadline:
 class PieceTable:
     """Every piece's voxels (assembled position), pre-sorted per axis for the gap kernel.
 
-    Built once per analysis with one sort per axis over all pieces (``vox[a]``: piece by
-    piece, each sorted by the two other axes, then ``a``); a part's arrays are a gather."""
+    Built once per analysis in one kernel call (``vox[a]``: piece by piece, each sorted by the
+    two other axes, then ``a``); a part's arrays are a gather."""
 
     def __init__(self, shapes: Mapping[str, Shape]) -> None:
         self.names: tuple[str, ...] = tuple(sorted(shapes))
@@ -68,11 +68,6 @@ class PieceTable:
         self.starts = np.zeros(len(sizes) + 1, dtype=np.int64)
         self.starts[1:] = np.cumsum(sizes)
         every = np.concatenate(self.voxels)
-        owner = np.repeat(np.arange(len(sizes)), sizes)
-        self.vox = np.empty((3, len(every), 3), dtype=np.int64)
-        for a in range(3):
-            u, w = (a + 1) % 3, (a + 2) % 3
-            self.vox[a] = every[np.lexsort((every[:, a], every[:, w], every[:, u], owner))]
         self.lo = np.minimum.reduceat(every, self.starts[:-1], axis=0)
         self.hi = np.maximum.reduceat(every, self.starts[:-1], axis=0)
         # Relative offsets stay within the sum of the extents plus the assembled span.
@@ -81,6 +76,8 @@ class PieceTable:
         )
         if bound > 30000:
             raise ValueError(f"puzzle too large for 16-bit offsets (bound {bound})")
+        self.vox = mv.sort_axes(every, self.starts)
+        self.owner = np.repeat(np.arange(len(sizes)), sizes)  # the piece of each row of vox[a]
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -95,9 +92,13 @@ class PieceTable:
         starts[1:] = np.cumsum(sizes)
         if sel == list(range(len(self.names))):
             vox = self.vox  # the kernels only read it
+        elif sel == sorted(sel):
+            keep = np.zeros(len(self.names), dtype=bool)
+            keep[sel] = True
+            vox = np.ascontiguousarray(self.vox[:, keep[self.owner]])
         else:
             rows = np.concatenate([np.arange(self.starts[m], self.starts[m + 1]) for m in sel])
-            vox = self.vox[:, rows]
+            vox = np.ascontiguousarray(self.vox[:, rows])
         return vox, starts, self.lo[sel], self.hi[sel]
 
 
@@ -258,15 +259,18 @@ class PartSearch:
             node = int(self.parent[node])
         return out[::-1]
 
-    def unique_splits(self, removals: Sequence[Removal]) -> list[Split]:
+    def unique_splits(self, removals: Sequence[Removal]) -> Iterator[Split]:
         """The removals that lead to different sub-problems (which pieces go, and the
-        configurations of both sides), first occurrence kept, in the given order."""
+        configurations of both sides), first occurrence kept, in the given order; each split
+        is made when asked for (the level search mostly stops at the first)."""
         if not removals:
-            return []
+            return
         nodes = np.array([r.node for r in removals], dtype=np.int64)
         masks = np.array([r.mask for r in removals], dtype=np.int64)
         keep = mv.unique_removals(self.states, nodes, masks, self.n)
-        return [Split(r, *self.split(r)) for r, k in zip(removals, keep.tolist(), strict=True) if k]
+        for r, k in zip(removals, keep.tolist(), strict=True):
+            if k:
+                yield Split(r, *self.split(r))
 
     def split(
         self, removal: Removal
