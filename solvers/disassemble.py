@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,8 +27,10 @@ from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitErro
 from chaingeo.core.turns import TurnMove
 from solvers import movement as mv
 from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
-from solvers.turnmoves import TurnTable
-from solvers.turnsearch import TurnPartSearch
+
+if TYPE_CHECKING:  # imported when a puzzle turns: most never do
+    from solvers.turnmoves import TurnTable
+    from solvers.turnsearch import TurnPartSearch
 
 __all__ = [
     "Analysis",
@@ -121,7 +124,11 @@ class _Solver:
         rods: Rods | None = None,
     ) -> None:
         self.table = PieceTable(shapes)
-        self.turn_table = TurnTable(shapes, rods or {}) if turns else None
+        self.turn_table: TurnTable | None = None
+        if turns:
+            from solvers.turnmoves import TurnTable
+
+            self.turn_table = TurnTable(shapes, rods or {})
         self.max_group = max_group
         self.limits = limits
         self.deadline = Deadline(limits.seconds)
@@ -143,6 +150,8 @@ class _Solver:
                 "raise SearchLimits(max_total_states=...)"
             )
         if self.turn_table is not None:
+            from solvers.turnsearch import TurnPartSearch
+
             return TurnPartSearch(
                 self.turn_table,
                 members,

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 
 import chaingeo.cli.commands
 from chaingeo.cli.errors import CommandError
-from chaingeo.core.level import LevelError
+from chaingeo.core.level_reader import LevelError
 
 # At exit, the interpreter's last collections walk every object numba and numpy created (about
 # 0.15 s of a 1 s ``chain analyze``); the process ends anyway, so freeze them instead.
