@@ -20,6 +20,7 @@ from numba import njit
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]
+I32 = npt.NDArray[np.int32]
 U64 = npt.NDArray[np.uint64]
 
 #: "Never meets": larger than any real gap.
@@ -144,6 +145,45 @@ def closures(gaps: I64, a: int, n: int) -> U64:
             if c[i] & bk:
                 c[i] |= c[k]
     return c
+
+
+@njit(cache=True)
+def stuck(pos: I64, box: I64, row_ptr: I64, cells: I32, rows: I32) -> bool:
+    """True when no group of the placed rows can take one step at all: a sure "cannot come
+    apart", decided before any search is built (most of an assembler's assemblies are such).
+
+    Row ``r`` covers target cells ``cells[row_ptr[r]:row_ptr[r + 1]]``, cell ``c`` at index
+    ``pos[c]`` of the target's bounding box ``box`` (x major). Along each axis the smallest
+    group that must come along with each piece (as :func:`closures`) must be every piece;
+    then nothing moves along ``+a``, nor along ``-a`` (the rest would move along ``+a``)."""
+    n = rows.shape[0]
+    if n < 2 or n > MAX_PIECES:
+        return False  # nothing to take apart, or a part the search refuses: let it decide
+    grid = np.full(box[0] * box[1] * box[2], -1, dtype=np.int64)
+    for k in range(n):
+        for p in range(row_ptr[rows[k]], row_ptr[rows[k] + 1]):
+            grid[pos[cells[p]]] = k
+    full = (np.uint64(1) << np.uint64(n)) - np.uint64(1)
+    c = np.empty(n, dtype=np.uint64)
+    for a in range(3):
+        stride = box[1] * box[2] if a == 0 else (box[2] if a == 1 else 1)
+        for i in range(n):
+            c[i] = np.uint64(1) << np.uint64(i)
+        for q in range(grid.shape[0]):
+            i = grid[q]
+            if i >= 0 and (q // stride) % box[a] < box[a] - 1:
+                j = grid[q + stride]
+                if j >= 0:
+                    c[i] |= np.uint64(1) << np.uint64(j)
+        for k in range(n):  # Warshall on bit rows
+            bk = np.uint64(1) << np.uint64(k)
+            for i in range(n):
+                if c[i] & bk:
+                    c[i] |= c[k]
+        for i in range(n):
+            if c[i] != full:
+                return False
+    return True
 
 
 @njit(cache=True)
