@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from numba import njit
 
 from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
 from solvers.placements import Int32Array, IntArray, Placements, target_index
@@ -437,23 +438,46 @@ def _hole_rows(target: Shape, cells: list[int]) -> Placements:
     )
 
 
-def canonical_keys(maps: Int32Array, solutions: Int32Array, chunk: int = 2048) -> Int32Array:
+def canonical_keys(maps: Int32Array, solutions: Int32Array) -> Int32Array:
     """Per solution (rows, -1 padded), the least sorted row set among its images under the
     group of ``maps`` (images through a -1 are skipped: not assemblies of this problem)."""
-    big = np.int32(np.iinfo(np.int32).max)
     out = np.empty(solutions.shape, dtype=np.int32)
-    for s in range(0, len(solutions), chunk):
-        sol = solutions[s : s + chunk]
-        real = sol >= 0
-        imgs = maps[:, np.maximum(sol, 0)]  # (G, n, k)
-        bad = np.any((imgs < 0) & real[None], axis=2)
-        imgs = np.where(real[None], imgs, big)
-        imgs[bad] = big
-        imgs.sort(axis=2)
-        alive = ~bad
-        for p in range(imgs.shape[2]):
-            col = np.where(alive, imgs[:, :, p], big)
-            low = col.min(axis=0)
-            alive &= imgs[:, :, p] == low[None, :]
-            out[s : s + chunk, p] = low
-    return np.where(out == big, -1, out)
+    _least_images(np.ascontiguousarray(maps), np.ascontiguousarray(solutions), out)
+    return out
+
+
+@njit(cache=True)
+def _least_images(maps: Int32Array, solutions: Int32Array, out: Int32Array) -> None:
+    """:func:`canonical_keys` in one pass per solution (numpy's version built every image of
+    every solution in memory first: 0.05 s of SolidSixPieceBurrs' 4199 raw assemblies)."""
+    big = np.int32(np.iinfo(np.int32).max)
+    k = solutions.shape[1]
+    img = np.empty(k, dtype=np.int32)
+    best = np.empty(k, dtype=np.int32)
+    for s in range(solutions.shape[0]):
+        have = False
+        for g in range(maps.shape[0]):
+            ok = True
+            for p in range(k):
+                r = solutions[s, p]
+                if r < 0:
+                    img[p] = big
+                elif maps[g, r] < 0:
+                    ok = False
+                    break
+                else:
+                    img[p] = maps[g, r]
+            if not ok:
+                continue
+            img.sort()
+            if not have:
+                best[:] = img
+                have = True
+                continue
+            for p in range(k):
+                if img[p] != best[p]:
+                    if img[p] < best[p]:
+                        best[:] = img
+                    break
+        for p in range(k):
+            out[s, p] = -1 if not have or best[p] == big else best[p]
