@@ -215,24 +215,31 @@ class Packing:
         (-1: its image is a piece the problem does not have)."""
         hit = self._maps.get(reflections)
         if hit is None:
-            hit = np.stack([self._row_map(self.symmetries[g]) for g in self.group(reflections)])
+            hit = self._row_maps([self.symmetries[g] for g in self.group(reflections)])
             self._maps[reflections] = hit
         return hit
 
-    def _row_map(self, sym: Symmetry) -> Int32Array:
-        out = np.full(self.n_rows, -1, dtype=np.int32)
+    def _row_maps(self, syms: list[Symmetry]) -> Int32Array:
+        """Every symmetry at once, type by type (one lookup per type and handedness, not one
+        per symmetry and type: 0.05 s on SolidSixPieceBurrs' 12 rotations and 25 pieces)."""
+        out = np.full((len(syms), self.n_rows), -1, dtype=np.int32)
         starts = self.problem.row_start
+        perms = np.stack([sym.perm for sym in syms]).astype(np.int64)
+        proper = np.array([sym.proper for sym in syms])
         for t, codes in enumerate(self.codes):
-            dest = t if sym.proper else self.mirror_type[t]
-            if dest < 0 or len(codes) == 0:
+            if len(codes) == 0:
                 continue
-            img = sym.perm[codes // COLOR_BASE].astype(np.int64) * COLOR_BASE + codes % COLOR_BASE
-            img.sort(axis=1)
-            rows = _lookup_rows(self.codes[dest], img)
-            if sym.proper and np.any(rows < 0):
-                raise AssertionError("a rotation of the result mapped a row outside the rows")
-            rows = np.where(rows >= 0, rows + int(starts[dest]), -1)
-            out[int(starts[t]) : int(starts[t + 1])] = rows
+            img = perms[:, codes // COLOR_BASE] * COLOR_BASE + codes % COLOR_BASE
+            img.sort(axis=2)
+            a, b = int(starts[t]), int(starts[t + 1])
+            for dest, chosen in ((t, proper), (self.mirror_type[t], ~proper)):
+                if dest < 0 or not chosen.any():
+                    continue
+                queries = img[chosen].reshape(-1, codes.shape[1])
+                rows = _lookup_rows(self.codes[dest], queries).reshape(-1, b - a)
+                if dest == t and chosen is proper and np.any(rows < 0):
+                    raise AssertionError("a rotation of the result mapped a row outside the rows")
+                out[np.flatnonzero(chosen), a:b] = np.where(rows >= 0, rows + int(starts[dest]), -1)
         return out
 
     def row_type(self, row: int) -> int:
@@ -244,14 +251,40 @@ class Packing:
 
 def _lookup_rows(table: IntArray, queries: IntArray) -> Int32Array:
     """Index of each query row in ``table`` (rows of equal width), or -1."""
-    if len(table) == 0:
-        return np.full(len(queries), -1, dtype=np.int32)
-    both = np.concatenate([table, queries])
-    _, inverse = np.unique(both, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    where = np.full(int(inverse.max()) + 1, -1, dtype=np.int32)
-    where[inverse[: len(table)]] = np.arange(len(table), dtype=np.int32)
-    return where[inverse[len(table) :]]
+    out = np.full(len(queries), -1, dtype=np.int32)
+    if len(table) and len(queries):
+        _hash_lookup(np.ascontiguousarray(table), np.ascontiguousarray(queries), out)
+    return out
+
+
+@njit(cache=True)
+def _row_hash(rows: IntArray, i: int) -> np.uint64:
+    h = np.uint64(14695981039346656037)
+    for v in rows[i]:
+        h = (h ^ np.uint64(v)) * np.uint64(1099511628211)
+    return h
+
+
+@njit(cache=True)
+def _hash_lookup(table: IntArray, queries: IntArray, out: Int32Array) -> None:
+    """:func:`_lookup_rows` by open addressing (equal rows of ``table``: the last one)."""
+    size = 1
+    while size < 2 * table.shape[0]:
+        size *= 2
+    mask = np.uint64(size - 1)
+    slots = np.full(size, -1, dtype=np.int64)
+    for i in range(table.shape[0]):
+        h = _row_hash(table, i) & mask
+        while slots[h] >= 0 and not np.array_equal(table[slots[h]], table[i]):
+            h = (h + np.uint64(1)) & mask
+        slots[h] = i
+    for q in range(queries.shape[0]):
+        h = _row_hash(queries, q) & mask
+        while slots[h] >= 0:
+            if np.array_equal(table[slots[h]], queries[q]):
+                out[q] = slots[h]
+                break
+            h = (h + np.uint64(1)) & mask
 
 
 def _merge(parts: Sequence[PartSpec]) -> list[TypeInfo]:
