@@ -69,11 +69,15 @@ class ColoredPiece:
         return keys, base
 
     @staticmethod
-    def _decode(row: IntArray, base: int) -> ColoredPiece:
-        k = row // COLOR_BASE
-        x, y, z = k // (base * base), (k // base) % base, k % base
-        cells = tuple(zip(x.tolist(), y.tolist(), z.tolist(), strict=True))
-        return ColoredPiece(cells, tuple((row % COLOR_BASE).tolist()))
+    def _decode(rows: IntArray, base: int) -> list[ColoredPiece]:
+        """The pieces of rows of codes, decoded together (one at a time took 0.02 s for the
+        orientations of SolidSixPieceBurrs' 25 pieces)."""
+        k = rows // COLOR_BASE
+        coded = np.stack([k // (base * base), (k // base) % base, k % base, rows % COLOR_BASE], -1)
+        return [
+            ColoredPiece(tuple((x, y, z) for x, y, z, _ in r), tuple(c for *_, c in r))
+            for r in coded.tolist()
+        ]
 
     def transformed(self, m: IntArray) -> ColoredPiece:
         """Image under the matrix ``m``, normalised to the origin."""
@@ -81,19 +85,21 @@ class ColoredPiece:
         v -= v.min(axis=0)
         base = int(v.max()) + 1 if len(v) else 1
         row = ((v[:, 0] * base + v[:, 1]) * base + v[:, 2]) * COLOR_BASE
-        return ColoredPiece._decode(np.sort(row + np.asarray(self.colors, dtype=np.int64)), base)
+        return ColoredPiece._decode(
+            np.sort(row + np.asarray(self.colors, dtype=np.int64))[None], base
+        )[0]
 
     @cached_property
     def _orientations(self) -> tuple[ColoredPiece, ...]:
         keys, base = self._keys
         seen: set[bytes] = set()
-        out = []
-        for row in keys:
+        first = []
+        for i, row in enumerate(keys):
             b = row.tobytes()
             if b not in seen:
                 seen.add(b)
-                out.append(ColoredPiece._decode(row, base))
-        return tuple(out)
+                first.append(i)
+        return tuple(ColoredPiece._decode(keys[first], base))
 
     def orientations(self) -> tuple[ColoredPiece, ...]:
         """The distinct coloured orientations, in :data:`ROTATIONS` order."""
@@ -102,7 +108,7 @@ class ColoredPiece:
     @cached_property
     def _canonical(self) -> ColoredPiece:
         keys, base = self._keys
-        return ColoredPiece._decode(keys[int(np.lexsort(keys.T[::-1])[0])], base)
+        return ColoredPiece._decode(keys[[int(np.lexsort(keys.T[::-1])[0])]], base)[0]
 
     def canonical(self) -> ColoredPiece:
         """One orientation standing for all: equal for two pieces exactly when one is a
@@ -292,7 +298,7 @@ def _same_row(a: IntArray, i: int, b: IntArray, j: int) -> bool:
     p = 0
     while p < a.shape[1] and a[i, p] == b[j, p]:
         p += 1
-    return p == a.shape[1]
+    return bool(p == a.shape[1])
 
 
 def _merge(parts: Sequence[PartSpec]) -> list[TypeInfo]:
