@@ -11,21 +11,21 @@ from __future__ import annotations
 
 import os
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.core.level import Level
 from chaingeo.core.rules import PuzzleRules
-from solvers.assemble import count_solutions
-from solvers.blockbound import analyze_by_blocks
 from solvers.btassemble import Mirrors, bt_packing_spec, count_bt, piece_groups
 from solvers.constrained import compile_packing
 from solvers.disassemble import Analysis, Rods, analyze
 from solvers.groups import PieceGroups, analyze_grouped
 from solvers.partsearch import SearchLimits
 from solvers.problem import PieceSpec
+
+if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imports
+    from chaingeo.core.level import Level
 
 #: The key of a level's ``stats`` naming the blocks of a tower (piece names, one list per unit
 #: of a stack along z), written by the generator and read here.
@@ -68,6 +68,8 @@ def analyze_puzzle(
     if blocks is not None:
         if max_group != 1 or turns:
             raise ValueError("blocks prove o_i for single-piece moves (max_group=1) only")
+        from solvers.blockbound import analyze_by_blocks  # levels with blocks only
+
         return analyze_by_blocks(shapes, blocks, limits=limits, stacked=True, search=False)
     return analyze(shapes, max_group=max_group, limits=limits, optimal=True, turns=turns, rods=rods)
 
@@ -127,6 +129,8 @@ def level_figures(
     max_group = level_max_group(level)
     out: dict[str, Any] = {"assemblies": None, "solutions": None}
     if assemble:
+        from solvers.assemble import count_solutions  # the placement engine of our levels
+
         target = Shape([c for p in level.pieces for c in p.shape.cells])
         rep = count_solutions(
             [PieceSpec(p.shape.normalized(), p.name) for p in level.pieces],

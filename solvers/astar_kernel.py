@@ -373,16 +373,7 @@ class Run:
         self.max_group = max_group
         self.limits = limits
         self.deadline = deadline
-        sizes = [len(v) for v in table.voxels]
-        self.gstarts = np.zeros(n + 1, dtype=np.int64)
-        self.gstarts[1:] = np.cumsum(sizes)
-        self.gvox = np.ascontiguousarray(
-            np.stack(
-                [np.concatenate([table.sorted_axes[i][a] for i in range(n)]) for a in range(3)]
-            )
-        )
-        self.glo = table.lo.copy()
-        self.ghi = table.hi.copy()
+        self.gvox, self.gstarts, self.glo, self.ghi = table.part_arrays(range(n))
         cap = max(2, min(4096, limits.max_states))
         self.rows = np.zeros((cap, 4 * n), dtype=np.int16)
         self.rows[0, :n] = 0  # the start: one part labelled 0, every offset zero

@@ -457,16 +457,15 @@ class MRVArrays:
         if problem.optional:
             optional[sorted(problem.optional)] = True
         rows = np.asarray(rows, dtype=np.int32)
-        ptr, flat = problem.row_ptr, problem.flat_cells
-        keep = [not optional[flat[ptr[r] : ptr[r + 1]]].all() for r in rows]
-        rows = rows[np.asarray(keep, dtype=bool)] if len(rows) else rows
+        # Whole arrays, not a Python loop per row and cell (0.02 s on SolidSixPieceBurrs).
+        owner, cells = _row_cells(problem, rows)
+        if len(rows):
+            rows = rows[~np.logical_and.reduceat(optional[cells], _starts(owner, len(rows)))]
+            owner, cells = _row_cells(problem, rows)
         masks = np.zeros((len(rows), W), dtype=np.uint64)
-        per_cell = np.zeros(n_cells, dtype=np.int64)
-        for i, r in enumerate(rows):
-            cells = flat[ptr[r] : ptr[r + 1]]
-            per_cell[cells] += 1
-            for b in bit[cells]:
-                masks[i, b // 64] |= np.uint64(1) << np.uint64(b % 64)
+        per_cell = np.bincount(cells, minlength=n_cells).astype(np.int64)
+        b = bit[cells]
+        np.bitwise_or.at(masks, (owner, b // 64), np.uint64(1) << (b % 64).astype(np.uint64))
         primary = np.zeros(W, dtype=np.uint64)
         for c in range(n_cells):
             if not optional[c]:
@@ -493,3 +492,18 @@ class MRVArrays:
             self.nb, self.region_gcd, self.region_min = region_pruning(problem)
         else:
             self.nb, self.region_gcd, self.region_min = np.zeros(8, np.uint64), 1, 0
+
+
+def _row_cells(problem: CoverProblem, rows: Int32Array) -> tuple[Int32Array, Int32Array]:
+    """The cells of ``rows`` one after the other, and the index into ``rows`` of each."""
+    ptr, flat = problem.row_ptr, problem.flat_cells
+    sizes = ptr[rows + 1] - ptr[rows]
+    owner = np.repeat(np.arange(len(rows), dtype=np.int32), sizes)
+    first = np.repeat(ptr[rows] - np.cumsum(sizes) + sizes, sizes)
+    return owner, flat[first + np.arange(len(owner))]
+
+
+def _starts(owner: Int32Array, n: int) -> Int32Array:
+    """Where each of the ``n`` rows begins in :func:`_row_cells`' arrays (rows are never
+    empty: a piece has a voxel)."""
+    return np.searchsorted(owner, np.arange(n, dtype=np.int32)).astype(np.int32)

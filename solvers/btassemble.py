@@ -28,6 +28,7 @@ import numpy as np
 
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
+from solvers import movement as mv
 from solvers.constrained import (
     ColoredPiece,
     ColorRules,
@@ -220,12 +221,32 @@ def disassemble(
     *,
     max_group: int | None = None,
     limits: SearchLimits | None = None,
+    groups: PieceGroups | None = None,
 ) -> Analysis:
-    """The disassembler's verdict on one assembly (level and moves), groups honoured."""
-    groups = piece_groups(packing)
+    """The disassembler's verdict on one assembly (level and moves), groups honoured
+    (``groups``: :func:`piece_groups` of the packing, when the caller has it already)."""
+    groups = piece_groups(packing) if groups is None else groups
     if groups.any():
         return analyze_grouped(assembly, groups, max_group=max_group, limits=limits)
     return analyze(assembly, max_group=max_group, limits=limits, optimal=False)
+
+
+class StuckCheck:
+    """:func:`solvers.movement.stuck` on a packing's rows: an assembly in which nothing can
+    move is no solution, so its disassembly search (~0.1 ms of setup) is never built."""
+
+    def __init__(self, packing: Packing) -> None:
+        problem = packing.problem
+        vox = problem.target.voxels.astype(np.int64)
+        lo = vox.min(axis=0) if len(vox) else np.zeros(3, dtype=np.int64)
+        self.box = (vox.max(axis=0) - lo + 1) if len(vox) else np.ones(3, dtype=np.int64)
+        self.pos = (vox - lo) @ np.array([self.box[1] * self.box[2], self.box[2], 1])
+        self.row_ptr = problem.row_ptr
+        self.cells = problem.flat_cells
+        self.piece = problem.row_type != packing.hole_type
+
+    def __call__(self, rows: Int32Array) -> bool:
+        return bool(mv.stuck(self.pos, self.box, self.row_ptr, self.cells, rows[self.piece[rows]]))
 
 
 @dataclass(frozen=True)
@@ -252,10 +273,15 @@ def count_bt(
     first: dict[str, Shape] | None = None
     first_an: Analysis | None = None
     anchor = choose_anchor(packing) if packing.n_rows else None
+    groups = piece_groups(packing)
+    # With piece groups a part may be done without moving (pieces of one group stay together).
+    stuck = None if groups.any() else StuckCheck(packing)
     for rows in iter_classes(packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor):
         n_asm += 1
+        if stuck is not None and stuck(rows):
+            continue
         asm = named_assembly(packing, rows)
-        result = disassemble(packing, asm, max_group=max_group, limits=limits)
+        result = disassemble(packing, asm, max_group=max_group, limits=limits, groups=groups)
         if result.disassemblable:
             n_sol += 1
             if first is None:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -26,8 +27,10 @@ from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitErro
 from chaingeo.core.turns import TurnMove
 from solvers import movement as mv
 from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
-from solvers.turnmoves import TurnTable
-from solvers.turnsearch import TurnPartSearch
+
+if TYPE_CHECKING:  # imported when a puzzle turns: most never do
+    from solvers.turnmoves import TurnTable
+    from solvers.turnsearch import TurnPartSearch
 
 __all__ = [
     "Analysis",
@@ -121,7 +124,11 @@ class _Solver:
         rods: Rods | None = None,
     ) -> None:
         self.table = PieceTable(shapes)
-        self.turn_table = TurnTable(shapes, rods or {}) if turns else None
+        self.turn_table: TurnTable | None = None
+        if turns:
+            from solvers.turnmoves import TurnTable
+
+            self.turn_table = TurnTable(shapes, rods or {})
         self.max_group = max_group
         self.limits = limits
         self.deadline = Deadline(limits.seconds)
@@ -143,6 +150,8 @@ class _Solver:
                 "raise SearchLimits(max_total_states=...)"
             )
         if self.turn_table is not None:
+            from solvers.turnsearch import TurnPartSearch
+
             return TurnPartSearch(
                 self.turn_table,
                 members,
@@ -170,7 +179,7 @@ class _Solver:
         result: Separation | None = None
         while result is None and not s.exhausted:
             # Like BurrTools, prefer taking out single pieces (then smaller groups) first.
-            found = sorted(s.expand_layer(), key=lambda r: (r.mask.bit_count(), r.node))
+            found = sorted(s.expand_layers(), key=lambda r: (r.mask.bit_count(), r.node))
             for sp in s.unique_splits(found):
                 done, removed = self.subpart(sp.removed, sp.removed_offsets)
                 if not done:
@@ -219,7 +228,7 @@ class _Solver:
         s = self.search(members, offsets)
         best, best_plan = budget, None
         while not s.exhausted and s.depth + 1 + (n - 2) < best and best > floor:
-            for sp in s.unique_splits(s.expand_layer()):
+            for sp in s.unique_splits(s.expand_layers(best - n)):
                 if best <= floor:
                     break
                 r = sp.removal

@@ -20,12 +20,13 @@ from numba import njit
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]
+I32 = npt.NDArray[np.int32]
 U64 = npt.NDArray[np.uint64]
 
 #: "Never meets": larger than any real gap.
 INF = 1 << 40
-#: Status codes returned by :func:`expand`.
-DONE, NEED_STATES, NEED_SEPS, TOO_MANY_GROUPS, NEED_MOVES = 0, 1, 2, 3, 4
+#: Status codes returned by :func:`expand` (5 and 6 are :mod:`solvers.turnmoves`' own).
+DONE, NEED_STATES, NEED_SEPS, TOO_MANY_GROUPS, NEED_MOVES, PAUSED = 0, 1, 2, 3, 4, 7
 #: Most pieces one part may hold (groups are 64-bit masks).
 MAX_PIECES = 63
 
@@ -100,6 +101,35 @@ def pair_gaps(vox: I64, starts: I64, lo: I64, hi: I64, off: I64, out: I64) -> No
 
 
 @njit(cache=True)
+def sort_axes(every: I64, starts: I64) -> I64:
+    """The voxel order :func:`pair_gaps` merges in: ``out[a]`` holds every piece's voxels
+    (piece ``p`` in rows ``starts[p]:starts[p + 1]`` of ``every``), each piece sorted by the
+    two other axes, then ``a``. Coordinates must span less than 2**20 per axis."""
+    m = every.shape[0]
+    mn = np.empty(3, dtype=np.int64)
+    span = 1
+    for t in range(3):
+        mn[t] = every[:, t].min()
+        span = max(span, every[:, t].max() - mn[t] + 1)
+    out = np.empty((3, m, 3), dtype=np.int64)
+    key = np.empty(m, dtype=np.int64)
+    for a in range(3):
+        u = (a + 1) % 3
+        w = (a + 2) % 3
+        for r in range(m):
+            key[r] = (
+                ((every[r, u] - mn[u]) * span + every[r, w] - mn[w]) * span + every[r, a] - mn[a]
+            )
+        for p in range(starts.shape[0] - 1):
+            first = starts[p]
+            order = np.argsort(key[first : starts[p + 1]])
+            for i in range(order.shape[0]):
+                for t in range(3):
+                    out[a, first + i, t] = every[first + order[i], t]
+    return out
+
+
+@njit(cache=True)
 def closures(gaps: I64, a: int, n: int) -> U64:
     """``c[i]``: the pieces that must come along when ``i`` steps along ``+a`` (with ``i``)."""
     c = np.zeros(n, dtype=np.uint64)
@@ -115,6 +145,45 @@ def closures(gaps: I64, a: int, n: int) -> U64:
             if c[i] & bk:
                 c[i] |= c[k]
     return c
+
+
+@njit(cache=True)
+def stuck(pos: I64, box: I64, row_ptr: I64, cells: I32, rows: I32) -> bool:
+    """True when no group of the placed rows can take one step at all: a sure "cannot come
+    apart", decided before any search is built (most of an assembler's assemblies are such).
+
+    Row ``r`` covers target cells ``cells[row_ptr[r]:row_ptr[r + 1]]``, cell ``c`` at index
+    ``pos[c]`` of the target's bounding box ``box`` (x major). Along each axis the smallest
+    group that must come along with each piece (as :func:`closures`) must be every piece;
+    then nothing moves along ``+a``, nor along ``-a`` (the rest would move along ``+a``)."""
+    n = rows.shape[0]
+    if n < 2 or n > MAX_PIECES:
+        return False  # nothing to take apart, or a part the search refuses: let it decide
+    grid = np.full(box[0] * box[1] * box[2], -1, dtype=np.int64)
+    for k in range(n):
+        for p in range(row_ptr[rows[k]], row_ptr[rows[k] + 1]):
+            grid[pos[cells[p]]] = k
+    full = (np.uint64(1) << np.uint64(n)) - np.uint64(1)
+    c = np.empty(n, dtype=np.uint64)
+    for a in range(3):
+        stride = box[1] * box[2] if a == 0 else (box[2] if a == 1 else 1)
+        for i in range(n):
+            c[i] = np.uint64(1) << np.uint64(i)
+        for q in range(grid.shape[0]):
+            i = grid[q]
+            if i >= 0 and (q // stride) % box[a] < box[a] - 1:
+                j = grid[q + stride]
+                if j >= 0:
+                    c[i] |= np.uint64(1) << np.uint64(j)
+        for k in range(n):  # Warshall on bit rows
+            bk = np.uint64(1) << np.uint64(k)
+            for i in range(n):
+                if c[i] & bk:
+                    c[i] |= c[k]
+        for i in range(n):
+            if c[i] != full:
+                return False
+    return True
 
 
 @njit(cache=True)
@@ -340,8 +409,11 @@ def expand(
     parent: I64,
     move: I64,
     table: I64,
-    node_start: int,
-    node_end: int,
+    node: int,
+    layers: I64,
+    n_layers: int,
+    max_depth: int,
+    budget: int,
     vox: I64,
     starts: I64,
     lo: I64,
@@ -352,64 +424,119 @@ def expand(
     n_seps: int,
     moves_buf: I64,
     groups_buf: U64,
-) -> tuple[int, int, int, int]:
-    """Expand nodes ``node_start..node_end-1`` of a breadth-first search.
+) -> tuple[int, int, int, int, int]:
+    """Breadth-first search, layer after layer in one call (no Python between layers).
 
-    New states are appended with their parent and the move that made them (``move`` rows:
-    mask, direction, distance); every removal seen is appended to ``seps`` as
-    ``(node, mask, direction)``. Returns ``(status, next node, n_states, n_seps)``; on a
-    status other than DONE the caller grows the named buffer and calls again from ``next``
-    (a node is expanded again from scratch, so its removals are dropped first).
+    Layer ``d`` holds nodes ``layers[d]:layers[d + 1]`` (``n_layers`` entries); ``node`` is
+    the next node of the deepest layer to expand. New states are appended with their parent
+    and the move that made them (``move`` rows: mask, direction, distance); every removal seen
+    is appended to ``seps`` as ``(node, mask, direction)``. Stops with DONE once a layer has
+    yielded a removal, the deepest layer is empty (every state expanded) or is deeper than
+    ``max_depth``; with PAUSED after ``budget`` nodes (the caller checks its deadline).
+    Returns ``(status, next node, n_states, n_seps, n_layers)``; on a status asking for a
+    buffer the caller grows it and calls again from ``next`` (that node is expanded again from
+    scratch, so its removals are dropped first). ``layers`` holds two more entries than
+    ``states`` rows (every layer has a node).
     """
     n = starts.shape[0] - 1
     w = 3 * n
     gaps = np.empty((3, n, n), dtype=np.int64)
     off = np.empty((n, 3), dtype=np.int64)
     child = np.empty(w, dtype=np.int16)
-    while n_seps > 0 and seps[n_seps - 1, 0] >= node_start:
+    while n_seps > 0 and seps[n_seps - 1, 0] >= node:
         n_seps -= 1
-    for node in range(node_start, node_end):
-        for p in range(n):
-            for t in range(3):
-                off[p, t] = states[node, 3 * p + t]
-        rows = node_moves(
-            vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
-        )
-        if rows == -2:
-            return TOO_MANY_GROUPS, node, n_states, n_seps
-        if rows == -1:
-            return NEED_MOVES, node, n_states, n_seps
-        for r in range(rows):
-            mask = np.uint64(moves_buf[r, 0])
-            d = moves_buf[r, 1]
-            kmax = moves_buf[r, 2]
-            if moves_buf[r, 3]:
-                if n_seps >= seps.shape[0]:
-                    return NEED_SEPS, node, n_states, n_seps
-                seps[n_seps, 0] = node
-                seps[n_seps, 1] = np.int64(mask)
-                seps[n_seps, 2] = d
-                n_seps += 1
-            a = d // 2
-            sign = 1 if d % 2 == 0 else -1
-            anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
-            for k in range(1, kmax + 1):
-                if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                    return NEED_STATES, node, n_states, n_seps
-                for t in range(w):
-                    child[t] = states[node, t]
-                for p in range(n):
-                    inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
-                    if anchor_moves:  # keep piece 0 still: move everyone else back instead
-                        if not inside:
-                            child[3 * p + a] -= sign * k
-                    elif inside:
-                        child[3 * p + a] += sign * k
-                got = find_or_insert(states, n_states, table, child)
-                if got < 0:
-                    parent[n_states] = node
-                    move[n_states, 0] = np.int64(mask)
-                    move[n_states, 1] = d
-                    move[n_states, 2] = k
-                    n_states += 1
-    return DONE, node_end, n_states, n_seps
+    done = 0
+    while True:
+        d = n_layers - 2
+        first = layers[d]
+        end = layers[d + 1]
+        if first == end or d > max_depth:
+            return DONE, node, n_states, n_seps, n_layers
+        while node < end:
+            if done >= budget:
+                return PAUSED, node, n_states, n_seps, n_layers
+            for p in range(n):
+                for t in range(3):
+                    off[p, t] = states[node, 3 * p + t]
+            rows = node_moves(
+                vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf,
+                moves_buf,
+            )  # fmt: skip
+            if rows == -2:
+                return TOO_MANY_GROUPS, node, n_states, n_seps, n_layers
+            if rows == -1:
+                return NEED_MOVES, node, n_states, n_seps, n_layers
+            for r in range(rows):
+                mask = np.uint64(moves_buf[r, 0])
+                dr = moves_buf[r, 1]
+                kmax = moves_buf[r, 2]
+                if moves_buf[r, 3]:
+                    if n_seps >= seps.shape[0]:
+                        return NEED_SEPS, node, n_states, n_seps, n_layers
+                    seps[n_seps, 0] = node
+                    seps[n_seps, 1] = np.int64(mask)
+                    seps[n_seps, 2] = dr
+                    n_seps += 1
+                a = dr // 2
+                sign = 1 if dr % 2 == 0 else -1
+                anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
+                for k in range(1, kmax + 1):
+                    if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
+                        return NEED_STATES, node, n_states, n_seps, n_layers
+                    for t in range(w):
+                        child[t] = states[node, t]
+                    for p in range(n):
+                        inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
+                        if anchor_moves:  # keep piece 0 still: move everyone else back instead
+                            if not inside:
+                                child[3 * p + a] -= sign * k
+                        elif inside:
+                            child[3 * p + a] += sign * k
+                    got = find_or_insert(states, n_states, table, child)
+                    if got < 0:
+                        parent[n_states] = node
+                        move[n_states, 0] = np.int64(mask)
+                        move[n_states, 1] = dr
+                        move[n_states, 2] = k
+                        n_states += 1
+            node += 1
+            done += 1
+        layers[n_layers] = n_states
+        n_layers += 1
+        if n_seps > 0 and seps[n_seps - 1, 0] >= first:
+            return DONE, node, n_states, n_seps, n_layers
+
+
+@njit(cache=True)
+def unique_removals(states: I16, nodes: I64, masks: I64, n: int) -> I64:
+    """Which removals lead to a sub-problem not met before in the given order (1: new): the
+    same pieces split off (the mask or its complement) and the same configurations of both
+    sides, each side's offsets taken relative to its first piece."""
+    m = nodes.shape[0]
+    full = (np.int64(1) << n) - 1
+    keys = np.zeros((max(m, 1), 3 * n + 4), dtype=np.int16)
+    size = 4
+    while size < 4 * m:
+        size *= 2
+    table = np.full(size, -1, dtype=np.int64)
+    row = np.empty(3 * n + 4, dtype=np.int16)
+    keep = np.zeros(m, dtype=np.int64)
+    count = 0
+    for r in range(m):
+        c = min(masks[r], full ^ masks[r])
+        for t in range(4):
+            row[t] = np.int16((c >> (16 * t)) & 0xFFFF)
+        pos = 4
+        for side in range(2):
+            first = -1
+            for p in range(n):
+                if ((c >> p) & 1) != side:
+                    if first < 0:
+                        first = p
+                    for t in range(3):
+                        row[pos] = states[nodes[r], 3 * p + t] - states[nodes[r], 3 * first + t]
+                        pos += 1
+        if find_or_insert(keys, count, table, row) < 0:
+            keep[r] = 1
+            count += 1
+    return keep

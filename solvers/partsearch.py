@@ -9,7 +9,7 @@ it, and collects every removal (a move that splits the part) seen on the way.
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,30 +52,32 @@ class Deadline:
 
 
 class PieceTable:
-    """Every piece's voxels (assembled position), pre-sorted per axis for the gap kernel."""
+    """Every piece's voxels (assembled position), pre-sorted per axis for the gap kernel.
+
+    Built once per analysis in one kernel call (``vox[a]``: piece by piece, each sorted by the
+    two other axes, then ``a``); a part's arrays are a gather."""
 
     def __init__(self, shapes: Mapping[str, Shape]) -> None:
         self.names: tuple[str, ...] = tuple(sorted(shapes))
         if not self.names:
             raise ValueError("a puzzle needs at least one piece")
         self.voxels = [np.ascontiguousarray(shapes[n].voxels, dtype=np.int64) for n in self.names]
-        if any(len(v) == 0 for v in self.voxels):
+        sizes = [len(v) for v in self.voxels]
+        if not all(sizes):
             raise ValueError("every piece needs at least one voxel")
-        self.sorted_axes: list[list[np.ndarray]] = []
-        for v in self.voxels:
-            per_axis = []
-            for a in range(3):
-                u, w = (a + 1) % 3, (a + 2) % 3
-                per_axis.append(v[np.lexsort((v[:, a], v[:, w], v[:, u]))])
-            self.sorted_axes.append(per_axis)
-        self.lo = np.array([v.min(axis=0) for v in self.voxels], dtype=np.int64)
-        self.hi = np.array([v.max(axis=0) for v in self.voxels], dtype=np.int64)
+        self.starts = np.zeros(len(sizes) + 1, dtype=np.int64)
+        self.starts[1:] = np.cumsum(sizes)
+        every = np.concatenate(self.voxels)
+        self.lo = np.minimum.reduceat(every, self.starts[:-1], axis=0)
+        self.hi = np.maximum.reduceat(every, self.starts[:-1], axis=0)
         # Relative offsets stay within the sum of the extents plus the assembled span.
         bound = int((self.hi - self.lo + 1).sum(axis=0).max()) + int(
             (self.hi.max(axis=0) - self.lo.min(axis=0)).max()
         )
         if bound > 30000:
             raise ValueError(f"puzzle too large for 16-bit offsets (bound {bound})")
+        self.vox = mv.sort_axes(every, self.starts)
+        self.owner = np.repeat(np.arange(len(sizes)), sizes)  # the piece of each row of vox[a]
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -84,13 +86,20 @@ class PieceTable:
         self, members: Sequence[int]
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """``(vox, starts, lo, hi)`` for the pieces ``members`` (global indices), in order."""
-        sizes = [len(self.voxels[m]) for m in members]
-        starts = np.zeros(len(members) + 1, dtype=np.int64)
+        sel = list(members)
+        sizes = self.starts[1:][sel] - self.starts[:-1][sel]
+        starts = np.zeros(len(sel) + 1, dtype=np.int64)
         starts[1:] = np.cumsum(sizes)
-        vox = np.empty((3, int(starts[-1]), 3), dtype=np.int64)
-        for a in range(3):
-            vox[a] = np.concatenate([self.sorted_axes[m][a] for m in members])
-        return vox, starts, self.lo[list(members)].copy(), self.hi[list(members)].copy()
+        if sel == list(range(len(self.names))):
+            vox = self.vox  # the kernels only read it
+        elif sel == sorted(sel):
+            keep = np.zeros(len(self.names), dtype=bool)
+            keep[sel] = True
+            vox = np.ascontiguousarray(self.vox[:, keep[self.owner]])
+        else:
+            rows = np.concatenate([np.arange(self.starts[m], self.starts[m + 1]) for m in sel])
+            vox = np.ascontiguousarray(self.vox[:, rows])
+        return vox, starts, self.lo[sel], self.hi[sel]
 
 
 @dataclass(frozen=True)
@@ -142,26 +151,30 @@ class PartSearch:
         self.deadline = deadline
         self.chunk = chunk
         self.vox, self.starts, self.lo, self.hi = table.part_arrays(self.members)
-        cap = max(2, min(1024, limits.max_states))
+        cap = max(2, min(64, limits.max_states))  # most parts come apart in a few states
         self.states = np.zeros((cap, 3 * n), dtype=np.int16)
         self.parent = np.full(cap, -1, dtype=np.int64)
         self.move = np.zeros((cap, 3), dtype=np.int64)
         self.hash = np.full(1 << (4 * cap - 1).bit_length(), -1, dtype=np.int64)
-        self.seps = np.zeros((256, 3), dtype=np.int64)
-        self.moves_buf = np.zeros((256, 4), dtype=np.int64)
-        self.groups_buf = np.zeros(min(limits.group_limit, 1 << 16) + 1, dtype=np.uint64)
+        self.seps = np.zeros((64, 3), dtype=np.int64)
+        self.moves_buf = np.zeros((64, 4), dtype=np.int64)
+        self.groups_buf = np.empty(min(limits.group_limit, 1 << 16) + 1, dtype=np.uint64)
         start = np.asarray(offsets, dtype=np.int64).reshape(n, 3)
         start = start - start[0]
         row = start.reshape(-1).astype(np.int16)
         mv.find_or_insert(self.states, 0, self.hash, row)
         self.n_states = 1
         self.n_seps = 0
-        self.layers: list[int] = [0, 1]  # layer d holds nodes layers[d]:layers[d+1]
+        # Layer d holds nodes layers[d]:layers[d + 1]; ``node``: the next one to expand.
+        self.layers = np.zeros(cap + 2, dtype=np.int64)
+        self.layers[1] = 1
+        self.n_layers = 2
+        self.node = 0
 
     @property
     def depth(self) -> int:
         """Depth of the deepest layer found so far."""
-        return len(self.layers) - 2
+        return self.n_layers - 2
 
     def offsets_of(self, node: int) -> np.ndarray:
         out: np.ndarray = self.states[node].astype(np.int64).reshape(self.n, 3)
@@ -180,6 +193,7 @@ class PartSearch:
             self.states = np.concatenate([self.states, np.zeros_like(self.states)])[:new_cap]
             self.parent = np.concatenate([self.parent, np.full(cap, -1, dtype=np.int64)])[:new_cap]
             self.move = np.concatenate([self.move, np.zeros_like(self.move)])[:new_cap]
+            self.layers = np.concatenate([self.layers, np.zeros_like(self.layers)])[: new_cap + 2]
         if self.hash.shape[0] < 4 * self.states.shape[0]:
             size = 1 << (4 * self.states.shape[0] - 1).bit_length()  # a power of two
             self.hash = np.full(size, -1, dtype=np.int64)
@@ -187,32 +201,24 @@ class PartSearch:
 
     def expand_layer(self) -> list[Removal]:
         """Expand the deepest layer; return the removals found there (in search order)."""
-        d = self.depth
-        lo, hi = self.layers[d], self.layers[d + 1]
+        return self.expand_layers(self.depth)
+
+    def expand_layers(self, max_depth: int | None = None) -> list[Removal]:
+        """Expand layer after layer (one kernel call, paused only for the deadline) up to the
+        first that yields removals, which are returned (in search order); ``[]`` once every
+        state is expanded or the next layer would be deeper than ``max_depth``."""
         first_sep = self.n_seps
-        node = lo
-        while node < hi:
+        deepest = self.limits.max_states if max_depth is None else max_depth
+        while True:
             self.deadline.check()
-            end = min(hi, node + self.chunk)
-            status, node, self.n_states, self.n_seps = mv.expand(
-                self.states,
-                self.n_states,
-                self.parent,
-                self.move,
-                self.hash,
-                node,
-                end,
-                self.vox,
-                self.starts,
-                self.lo,
-                self.hi,
-                self.max_group,
-                self.limits.group_limit,
-                self.seps,
-                self.n_seps,
-                self.moves_buf,
-                self.groups_buf,
-            )
+            status, self.node, self.n_states, self.n_seps, self.n_layers = mv.expand(
+                self.states, self.n_states, self.parent, self.move, self.hash, self.node,
+                self.layers, self.n_layers, deepest, self.chunk, self.vox, self.starts,
+                self.lo, self.hi, self.max_group, self.limits.group_limit, self.seps,
+                self.n_seps, self.moves_buf, self.groups_buf,
+            )  # fmt: skip
+            if status == mv.DONE:
+                break
             if status == mv.NEED_STATES:
                 self._grow_states()
             elif status == mv.NEED_MOVES:
@@ -224,15 +230,16 @@ class PartSearch:
                     f"more than {self.limits.group_limit} movable groups along one direction "
                     "in one state; raise SearchLimits(group_limit=...)"
                 )
-        self.layers.append(self.n_states)
+        d = self.n_layers - 3  # the layer just completed (only it can have removals)
         return [
-            Removal(int(s[0]), d, int(s[1]), int(s[2])) for s in self.seps[first_sep : self.n_seps]
+            Removal(int(s[0]), d, int(s[1]), int(s[2]))
+            for s in self.seps[first_sep : self.n_seps].tolist()
         ]
 
     @property
     def exhausted(self) -> bool:
         """True when the deepest layer is empty: every reachable state has been expanded."""
-        return self.layers[-1] == self.layers[-2]
+        return bool(self.layers[self.n_layers - 1] == self.layers[self.n_layers - 2])
 
     def local_move(self, mask: int, direction: int, distance: int | None) -> Move:
         names = self.table.names
@@ -252,27 +259,18 @@ class PartSearch:
             node = int(self.parent[node])
         return out[::-1]
 
-    def unique_splits(self, removals: Sequence[Removal]) -> list[Split]:
+    def unique_splits(self, removals: Sequence[Removal]) -> Iterator[Split]:
         """The removals that lead to different sub-problems (which pieces go, and the
-        configurations of both sides), first occurrence kept, in the given order."""
+        configurations of both sides), first occurrence kept, in the given order; each split
+        is made when asked for (the level search mostly stops at the first)."""
         if not removals:
-            return []
-        n = self.n
-        full = (1 << n) - 1
+            return
         nodes = np.array([r.node for r in removals], dtype=np.int64)
-        canon = np.array([min(r.mask, full ^ r.mask) for r in removals], dtype=np.int64)
-        keep: list[int] = []
-        for c in dict.fromkeys(canon.tolist()):
-            idx = np.nonzero(canon == c)[0]
-            inside = [i for i in range(n) if c >> i & 1]
-            outside = [i for i in range(n) if not c >> i & 1]
-            offs = self.states[nodes[idx]].astype(np.int64).reshape(len(idx), n, 3)
-            a = offs[:, inside] - offs[:, inside[:1]]
-            b = offs[:, outside] - offs[:, outside[:1]]
-            rows = np.concatenate([a.reshape(len(idx), -1), b.reshape(len(idx), -1)], axis=1)
-            _, first = np.unique(rows, axis=0, return_index=True)
-            keep.extend(int(idx[j]) for j in first)
-        return [Split(removals[i], *self.split(removals[i])) for i in sorted(keep)]
+        masks = np.array([r.mask for r in removals], dtype=np.int64)
+        keep = mv.unique_removals(self.states, nodes, masks, self.n)
+        for r, k in zip(removals, keep.tolist(), strict=True):
+            if k:
+                yield Split(r, *self.split(r))
 
     def split(
         self, removal: Removal

@@ -125,6 +125,7 @@ class CoverProblem:
     row_start: IntArray  # (T + 1,) rows of type t are row_start[t] : row_start[t + 1]
     reflections: bool  # reflections were asked for
     _cache: dict[object, object] = field(default_factory=dict, repr=False)
+    _placed: dict[int, Shape] = field(default_factory=dict, repr=False)
 
     @property
     def n_cells(self) -> int:
@@ -153,7 +154,11 @@ class CoverProblem:
         return np.concatenate(parts).astype(np.int32) if parts else np.zeros(0, np.int32)
 
     def placed_shape(self, row: int) -> Shape:
-        return Shape(self.target.voxels[self.row_cells(row)])
+        """The row's voxels (kept: the assembler names the same rows for many assemblies)."""
+        shape = self._placed.get(row)
+        if shape is None:
+            shape = self._placed[row] = Shape(self.target.voxels[self.row_cells(row)])
+        return shape
 
     # -- symmetry ------------------------------------------------------------------------------
     @cached_property

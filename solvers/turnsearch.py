@@ -110,6 +110,16 @@ class TurnPartSearch:
             self.hash = np.full(size, -1, dtype=np.int64)
             mv.rebuild_table(self.states, self.n_states, self.hash)
 
+    def expand_layers(self, max_depth: int | None = None) -> list[Removal]:
+        """Layer after layer up to the first with removals (returned); ``[]`` once every state
+        is expanded or the next layer would be deeper than ``max_depth`` (as
+        :meth:`solvers.partsearch.PartSearch.expand_layers`)."""
+        while not self.exhausted and (max_depth is None or self.depth <= max_depth):
+            found = self.expand_layer()
+            if found:
+                return found
+        return []
+
     def expand_layer(self) -> list[Removal]:
         """Expand the deepest layer; return its removals (directions in the search frame)."""
         d = self.depth

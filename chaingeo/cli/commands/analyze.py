@@ -48,7 +48,6 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.kinematics import SearchLimitError
-    from chaingeo.core.level import load_level
     from solvers.analysis import level_figures, xmpuzzle_figures
     from solvers.partsearch import SearchLimits
 
@@ -65,6 +64,8 @@ def run(args: argparse.Namespace) -> int:
                 args.mirrors,
             )
         else:
+            from chaingeo.core.level import load_level  # a BurrTools file needs no level reader
+
             level = load_level(args.file)
             out = level_figures(
                 level, limits, not args.no_optimal, not args.no_assemble, args.mirrors

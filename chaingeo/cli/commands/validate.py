@@ -11,9 +11,10 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from chaingeo.core.level import Level
+if TYPE_CHECKING:  # the level reader is imported when a command runs, not to list commands
+    from chaingeo.core.level import Level
 
 
 def register(sub: Any) -> None:
