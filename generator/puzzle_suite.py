@@ -85,8 +85,8 @@ A: Goal = "assemble"
 #: 10 easy, 12 mid, 10 hard. Every CHAIN model that imports exactly, in the tier its figures
 #: give; the generators fill the rest: six-piece burrs (Cutler's standard 2x2x8 burrs of level
 #: 7 and up in the hard tier), three-piece and three-plate burrs, interlocking cubes, a
-#: 12-piece tower and two 36-piece towers. Disassembly comes first in each family; most
-#: generated levels ask for assembly, which no baseline manages (README, 'The puzzle suite').
+#: 12-piece tower and two 36-piece towers. Both goals in every tier; most generated levels ask
+#: for assembly, which neither baseline manages (README, 'The puzzle suite').
 SUITE: tuple[SuiteEntry | ModelEntry, ...] = (
     ModelEntry("easy", "luban-3-piece", (D,), turns=True),
     ModelEntry("easy", "luban-6-piece", (D, A)),
