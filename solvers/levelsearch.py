@@ -202,14 +202,14 @@ def greedy(
         if m == 0:
             continue
         # Like BurrTools, prefer taking out single pieces (then smaller groups) first.
-        key = np.empty(m, dtype=np.int64)
-        for r in range(m):
-            size_r = mv._popcount(np.uint64(seps[first_sep + r, 1]))
-            key[r] = size_r * (np.int64(1) << 40) + seps[first_sep + r, 0]
-        order = np.argsort(key, kind="mergesort")
+        # Stable by piece count; the removals already come in node order.
         found = np.empty((m, 3), dtype=np.int64)
-        for r in range(m):
-            found[r] = seps[first_sep + order[r]]
+        r = 0
+        for size_r in range(1, k):
+            for q in range(first_sep, n_seps):
+                if mv._popcount(np.uint64(seps[q, 1])) == size_r:
+                    found[r] = seps[q]
+                    r += 1
         keep = mv.unique_removals(states, found[:, 0].copy(), found[:, 1].copy(), k)
         for r in range(m):
             if not keep[r]:
