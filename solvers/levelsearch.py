@@ -18,11 +18,10 @@ from solvers import movement as mv
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]
-F64 = npt.NDArray[np.float64]
 
-#: Status codes in ``ctx[STATUS]`` (0: fine): a cap reached, or a buffer to enlarge and rerun.
-#: OVER_BUDGET: more nodes expanded than ``params[BUDGET]``.
-OK, STATE_CAP, GROUP_CAP, TOTAL_CAP, OVER_BUDGET, NEED_BUFFERS = 0, 1, 3, 8, 9, 10
+#: Status codes in ``ctx[STATUS]`` (0: fine): a cap reached, more nodes expanded than
+#: ``params[BUDGET]``, or a buffer to enlarge and rerun.
+STATE_CAP, GROUP_CAP, TOTAL_CAP, OVER_BUDGET, NEED_BUFFERS = 1, 3, 8, 9, 10
 #: Slots of ``ctx``: counts of tree nodes, moves and memo entries, states over all searches,
 #: status and its detail (the part's piece count for STATE_CAP), nodes expanded.
 N_NODES, N_MOVES, N_MEMO, STATES, STATUS, INFO, EXPANDED = 0, 1, 2, 3, 4, 5, 6
