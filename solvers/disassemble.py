@@ -25,8 +25,9 @@ import numpy as np
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.core.turns import TurnMove
+from solvers import levelsearch as ls
 from solvers import movement as mv
-from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
+from solvers.partsearch import DIRECTION_NAMES, Deadline, PartSearch, PieceTable, SearchLimits
 
 if TYPE_CHECKING:  # imported when a puzzle turns: most never do
     from solvers.turnmoves import TurnTable
@@ -42,6 +43,11 @@ __all__ = [
 ]
 
 _UNSOLVABLE = 1 << 30
+#: Nodes the level kernel may expand before the Python search (with its deadline) takes over:
+#: the Python search's own chunk between two clock readings.
+_KERNEL_NODES = 20000
+#: Tree nodes and memo entries the level kernel starts with (4 moves per node).
+_TREE_ROWS = 64
 
 
 @dataclass(frozen=True)
@@ -195,6 +201,65 @@ class _Solver:
         self.greedy_memo[k] = result
         return result
 
+    def level_tree(self) -> Separation | None:
+        """:meth:`greedy` of the whole assembled puzzle (translations only, no piece groups)
+        in one kernel call (:func:`solvers.levelsearch.greedy`), decoded into a tree. Past
+        :data:`_KERNEL_NODES` expanded nodes it hands over to :meth:`greedy`, which checks
+        the deadline between chunks (the kernel cannot read the clock)."""
+        n = len(self.table.names)
+        if n > mv.MAX_PIECES:
+            raise ValueError(f"at most {mv.MAX_PIECES} pieces per part, got {n}")
+        lim = self.limits
+        params = np.array(
+            [
+                -1 if self.max_group is None else self.max_group,
+                lim.group_limit,
+                lim.max_states,
+                -1 if lim.max_total_states is None else lim.max_total_states,
+                _KERNEL_NODES,
+            ],
+            dtype=np.int64,
+        )
+        self.deadline.check()
+        t = self.table
+        cap = _TREE_ROWS
+        while True:  # rerun with larger buffers in the rare tree that outgrows them
+            ctx = np.zeros(7, dtype=np.int64)
+            nodes = np.zeros((cap, 4), dtype=np.int64)
+            moves = np.zeros((4 * cap, 3), dtype=np.int64)
+            keys = np.zeros((cap, 4 + 3 * n), dtype=np.int16)
+            table = np.full(4 * cap, -1, dtype=np.int64)
+            memo = np.full(cap, -3, dtype=np.int64)
+            root = ls.greedy(
+                t.vox, t.starts, t.lo, t.hi, np.arange(n, dtype=np.int64),
+                np.zeros((n, 3), dtype=np.int64), params, ctx, nodes, moves, keys, table,
+                memo,
+            )  # fmt: skip
+            if ctx[ls.STATUS] != ls.NEED_BUFFERS:
+                break
+            cap *= 4
+        status = int(ctx[ls.STATUS])
+        if status == ls.OVER_BUDGET:
+            return self.greedy(tuple(range(n)), np.zeros((n, 3), dtype=np.int64))
+        self.states += int(ctx[ls.STATES])
+        if status == ls.TOTAL_CAP:
+            raise SearchLimitError(
+                f"total state cap of {lim.max_total_states} reached over all searches; "
+                "raise SearchLimits(max_total_states=...)"
+            )
+        if status == ls.STATE_CAP:
+            raise SearchLimitError(
+                f"state cap of {lim.max_states} reached in a {int(ctx[ls.INFO])}-piece part; "
+                "raise SearchLimits(max_states=...) or --max-states"
+            )
+        if status == ls.GROUP_CAP:
+            raise SearchLimitError(
+                f"more than {lim.group_limit} movable groups along one direction "
+                "in one state; raise SearchLimits(group_limit=...)"
+            )
+        used = int(ctx[ls.N_MOVES])
+        return _decode(t.names, nodes[: ctx[ls.N_NODES]].tolist(), moves[:used].tolist(), root)
+
     def subpart(
         self, members: tuple[int, ...], offsets: np.ndarray
     ) -> tuple[bool, Separation | None]:
@@ -260,6 +325,31 @@ class _Solver:
         return budget, None
 
 
+def _decode(
+    names: tuple[str, ...], nodes: list[list[int]], moves: list[list[int]], root: int
+) -> Separation | None:
+    """The tree :func:`solvers.levelsearch.greedy` left in ``nodes``/``moves`` from ``root``."""
+    built: dict[int, Separation] = {}
+
+    def build(i: int) -> Separation | None:
+        if i < 0:
+            return None
+        if i not in built:
+            first, length, removed, left = nodes[i]
+            seq = tuple(
+                Move(
+                    tuple(names[b] for b in range(len(names)) if g >> b & 1),
+                    DIRECTION_NAMES[d],
+                    None if k < 0 else k,
+                )
+                for g, d, k in moves[first : first + length]
+            )
+            built[i] = Separation(seq, build(removed), build(left))
+        return built[i]
+
+    return build(root)
+
+
 def analyze(
     shapes: Mapping[str, Shape],
     *,
@@ -282,7 +372,7 @@ def analyze(
     offsets = np.zeros((n, 4 if turns else 3), dtype=np.int64)
     if n == 1:
         return Analysis(True, "0", 0, 0)
-    tree = solver.greedy(members, offsets)
+    tree = solver.greedy(members, offsets) if turns else solver.level_tree()
     if tree is None:
         return Analysis(False, None, None, None, states=solver.states)
     total = tree.total_moves()

@@ -26,11 +26,12 @@ from solvers.btassemble import (
     named_assembly,
 )
 from solvers.constrained import compile_packing
-from solvers.disassemble import analyze
+from solvers.disassemble import _Solver, analyze
 from solvers.groups import PieceGroups, assignable
 from solvers.partsearch import SearchLimits
 from tests import bt_reference as ref
 from tests.bt_instances import random_puzzle, reference_parts
+from tests.test_disassemble import _level_or_error
 
 
 def oracle(puzzle: BTPuzzle, index: int = 0, *, solutions: bool = False) -> dict[str, int]:
@@ -219,6 +220,25 @@ def test_stuck_check_is_exactly_no_first_move() -> None:
         verdicts.append((stuck(rows), not found.disassemblable and found.states == 1))
     assert all(s == one for s, one in verdicts)
     assert sum(s for s, _ in verdicts) == 745
+
+
+@pytest.mark.parametrize("total", [None, 20])
+def test_level_kernel_matches_python_search_on_solid_burrs(total: int | None) -> None:
+    """Every solid six-piece burr assembly that can move gets the same tree and state count
+    (or, under a total state cap, the same error) from the level kernel as from the Python
+    search; the cap fires once a finished sub-part search has counted its states."""
+    packing = compile_packing(bt_packing_spec(EXAMPLES["solid_burrs"](), 0))
+    stuck = StuckCheck(packing)
+    limits = SearchLimits(max_total_states=total)
+    errors = 0
+    for rows in iter_classes(packing):
+        if stuck(rows):
+            continue
+        shapes = named_assembly(packing, rows)
+        fast = _level_or_error(_Solver(shapes, None, limits), True)
+        assert fast == _level_or_error(_Solver(shapes, None, limits), False)
+        errors += fast[1] == -1
+    assert (errors > 0) == (total is not None)
 
 
 def test_state_caps_are_reported_not_swallowed() -> None:

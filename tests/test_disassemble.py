@@ -19,7 +19,8 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
     state_key,
 )
-from solvers.disassemble import Separation, analyze, fast_legal_moves
+from solvers import disassemble
+from solvers.disassemble import Separation, _Solver, analyze, fast_legal_moves
 from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
 from tests.puzzle_strategies import small_scenes
 
@@ -115,6 +116,42 @@ def test_optimal_steps_match_reference_bfs(shapes: dict[str, Shape], max_group: 
     assert got.tree is not None and replay_disassembly(shapes, got.tree.all_moves()).is_separated()
     if max_group is not None:
         assert all(len(m.pieces) <= max_group for m in got.plan)
+
+
+def _level_or_error(solver: _Solver, fast: bool) -> tuple[object, int]:
+    n = len(solver.table.names)
+    try:
+        if fast:
+            return solver.level_tree(), solver.states
+        return solver.greedy(tuple(range(n)), np.zeros((n, 3), dtype=np.int64)), solver.states
+    except SearchLimitError as err:
+        return str(err), -1
+
+
+@settings(max_examples=60)
+@given(
+    small_scenes(),
+    st.sampled_from([None, 1, 2]),
+    st.sampled_from([1, 3, 20000]),
+    st.sampled_from([None, 0, 3, 10]),
+)
+def test_level_kernel_matches_python_search(
+    shapes: dict[str, Shape], max_group: int | None, budget: int, total: int | None
+) -> None:
+    """The one-call level kernel finds the same tree, with the same state count (or the same
+    cap error), as the Python search it stands for, also when it outgrows its buffers or its
+    node budget."""
+    if len(shapes) < 2:
+        return
+    limits = SearchLimits(max_total_states=total)
+    mp = pytest.MonkeyPatch()
+    mp.setattr(disassemble, "_KERNEL_NODES", budget)
+    mp.setattr(disassemble, "_TREE_ROWS", 1)
+    try:
+        fast = _level_or_error(_Solver(shapes, max_group, limits), True)
+    finally:
+        mp.undo()
+    assert fast == _level_or_error(_Solver(shapes, max_group, limits), False)
 
 
 def test_level_notation_follows_burrtools() -> None:
