@@ -124,6 +124,16 @@ class Split:
     left_offsets: np.ndarray
 
 
+def part_size(members: Sequence[int]) -> int:
+    """The number of pieces of a part to search: at least two, at most the kernels' limit."""
+    n = len(members)
+    if n < 2:
+        raise ValueError("a part to search needs at least two pieces")
+    if n > mv.MAX_PIECES:
+        raise ValueError(f"at most {mv.MAX_PIECES} pieces per part, got {n}")
+    return n
+
+
 class PartSearch:
     """Layered breadth-first search of one part from one configuration."""
 
@@ -138,14 +148,9 @@ class PartSearch:
         deadline: Deadline,
         chunk: int = 20000,
     ) -> None:
-        n = len(members)
-        if n < 2:
-            raise ValueError("a part to search needs at least two pieces")
-        if n > mv.MAX_PIECES:
-            raise ValueError(f"at most {mv.MAX_PIECES} pieces per part, got {n}")
+        n = self.n = part_size(members)
         self.table = table
         self.members = tuple(members)
-        self.n = n
         self.max_group = -1 if max_group is None else int(max_group)
         self.limits = limits
         self.deadline = deadline

@@ -27,7 +27,7 @@ from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitErro
 from chaingeo.core.turns import AXES, TurnMove
 from solvers import movement as mv
 from solvers import turnmoves as tm
-from solvers.partsearch import Deadline, Removal, SearchLimits, Split
+from solvers.partsearch import Deadline, Removal, SearchLimits, Split, part_size
 
 _DIR_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 _DIR_VECS = np.array([DIRECTIONS[d] for d in _DIR_NAMES], dtype=np.int64)
@@ -54,14 +54,9 @@ class TurnPartSearch:
         deadline: Deadline,
         chunk: int = 2000,
     ) -> None:
-        n = len(members)
-        if n < 2:
-            raise ValueError("a part to search needs at least two pieces")
-        if n > mv.MAX_PIECES:
-            raise ValueError(f"at most {mv.MAX_PIECES} pieces per part, got {n}")
+        n = self.n = part_size(members)
         self.table = table
         self.members = tuple(members)
-        self.n = n
         self.max_group = -1 if max_group is None else int(max_group)
         self.limits = limits
         self.deadline = deadline

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Final, Literal
+from typing import Final, Literal, get_args
 
 from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
 
@@ -29,15 +29,7 @@ ChainCode = Literal[
     "Collision",
     "Floating",
 ]
-CHAIN_CODES: Final[tuple[ChainCode, ...]] = (
-    "PieceNotFound",
-    "PieceAlreadyPlaced",
-    "WrongCount",
-    "ShapeMismatch",
-    "OutOfBounds",
-    "Collision",
-    "Floating",
-)
+CHAIN_CODES: Final[tuple[ChainCode, ...]] = get_args(ChainCode)
 
 
 @dataclass(frozen=True)
