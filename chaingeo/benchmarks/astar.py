@@ -3,8 +3,11 @@
 Both searches run in this process on the same puzzle, one after the other (the machines are
 shared, so compare the ratios of one run, not seconds across runs). Instances: the shipped
 suite levels of at most 12 pieces (their own ``max_group``), AlPackino (problem 0 of
-``../shared/burrtools/AlPackino.xmpuzzle``, when present) and the first 36-piece tower of the
-suite played with multi-piece moves (``max_group`` None instead of the file's 1).
+``../shared/burrtools/AlPackino.xmpuzzle``, when present) and the 36-piece towers of the suite
+played with multi-piece moves (``max_group`` None instead of the file's 1). On towers (levels
+named ``burr12`` ... ``burr36``) the class bound of :mod:`solvers.classbound` over the burr units
+is printed too (``class_bound``, its ``class_bound_classes`` and seconds), and ``plan_moves``,
+the BurrTools-style plan's length: o_i lies between them.
 
 Per instance and search: ``o_i`` (or the cap it stopped at), ``seconds``, and the states:
 ``astar_expanded`` / ``astar_stored`` whole states, ``bfs_states`` the states the
@@ -58,10 +61,29 @@ def _instances(quick: bool) -> list[Instance]:
 
         (asm,) = read_xmpuzzle(bt / "AlPackino.xmpuzzle").assemblies(0)
         out.append(("AlPackino", {f"p{k:02d}": s for k, s in asm.items()}, None))
-    towers = [lv for lv in levels if re.search(r"burr36", lv.id)]
-    if towers:
-        out.append((f"{towers[0].id} (max_group None)", towers[0].shapes, None))
+    for tower in [lv for lv in levels if re.search(r"burr36", lv.id)]:
+        out.append((f"{tower.id} (max_group None)", tower.shapes, None))
     return out
+
+
+def _class_bound(name: str, shapes: Mapping[str, Shape]) -> dict[str, object]:
+    """Class bound and plan length of a tower of burr units (six layers each)."""
+    if not re.search(r"burr(12|18|24|36)\b", name):
+        return {}
+    from solvers.classbound import band_blocks, class_lower_bound
+    from solvers.disassemble import analyze
+
+    t0 = time.perf_counter()
+    found = class_lower_bound(shapes, band_blocks(shapes, 6))
+    seconds = round(time.perf_counter() - t0, 3)
+    plan = analyze(shapes, max_group=None, optimal=False).moves
+    classes = " ".join(f"{'xyz'[a]}{k}x{c}" for (a, k), c in found.classes)
+    return {
+        "class_bound": found.bound if found.complete else f">= {found.bound}",
+        "class_bound_classes": classes,
+        "class_bound_seconds": seconds,
+        "plan_moves": plan,
+    }
 
 
 def _astar(
@@ -124,6 +146,8 @@ def run(args: argparse.Namespace) -> int:
         row: dict[str, object] = {"instance": name, "pieces": len(shapes), "max_group": max_group}
         row.update(_astar(shapes, max_group, states, seconds))
         row.update(_bfs(shapes, max_group, seconds))
+        if max_group is None:
+            row.update(_class_bound(name, shapes))
         a_s, b_s = row.get("astar_seconds"), row.get("bfs_seconds")
         if row.get("astar_o_i") is not None and row.get("bfs_o_i") is not None:
             row["seconds_ratio_bfs_over_astar"] = round(
