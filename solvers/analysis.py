@@ -5,6 +5,12 @@ Everything that analyses a puzzle level goes through here: ``chain analyze``, th
 the structure a proven bound needs (``stats["blocks"]``: towers of burr units moved one piece
 at a time) is analysed with the block bound of :mod:`solvers.blockbound`, everywhere; every
 other puzzle with the plain optimal search of :mod:`solvers.disassemble`.
+
+*Time*: ``limits.seconds`` bounds one whole analysis. :func:`level_figures` and
+:func:`xmpuzzle_figures` (``chain analyze``) make one :class:`solvers.deadline.Deadline` and
+hand it to everything they run (the enumeration of assemblies, every disassembly, the optimal
+search), so the whole command stops with a :class:`SearchLimitError` naming ``seconds`` once
+it is spent (a spent optimal search alone is reported as ``optimal_error``).
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.rules import PuzzleRules
 from solvers.btassemble import Mirrors, bt_packing_spec, count_bt, piece_groups
 from solvers.constrained import compile_packing
+from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, Rods, analyze
 from solvers.groups import PieceGroups, analyze_grouped
 from solvers.partsearch import SearchLimits
@@ -60,18 +67,30 @@ def analyze_puzzle(
     blocks: Sequence[Sequence[str]] | None = None,
     turns: bool = False,
     rods: Rods | None = None,
+    deadline: Deadline | None = None,
 ) -> Analysis:
     """Level, moves, o_i and an optimal plan of an assembled puzzle. With ``blocks`` (single-piece
     moves only) o_i is proven by the block bound instead of searched, and a
     :class:`SearchLimitError` says when no quick plan meets it. With ``turns`` groups may also
-    turn (``rods``: the pieces' round rods)."""
+    turn (``rods``: the pieces' round rods). ``deadline``: shared with the caller's other
+    searches (default: one of ``limits.seconds``)."""
     if blocks is not None:
         if max_group != 1 or turns:
             raise ValueError("blocks prove o_i for single-piece moves (max_group=1) only")
         from solvers.blockbound import analyze_by_blocks  # levels with blocks only
 
-        return analyze_by_blocks(shapes, blocks, limits=limits, stacked=True, search=False)
-    return analyze(shapes, max_group=max_group, limits=limits, optimal=True, turns=turns, rods=rods)
+        return analyze_by_blocks(
+            shapes, blocks, limits=limits, stacked=True, search=False, deadline=deadline
+        )
+    return analyze(
+        shapes,
+        max_group=max_group,
+        limits=limits,
+        optimal=True,
+        turns=turns,
+        rods=rods,
+        deadline=deadline,
+    )
 
 
 def level_turns(level: Level) -> bool:
@@ -101,18 +120,34 @@ def disassembly_figures(
     blocks: Sequence[Sequence[str]] | None = None,
     turns: bool = False,
     rods: Rods | None = None,
+    deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """``level``, ``moves`` and ``optimal_steps`` of one assembly (None where unknown); if the
-    optimal search hits a cap, ``optimal_error`` says which (the level is still reported)."""
+    optimal search hits a cap, ``optimal_error`` says which (the level is still reported).
+    ``deadline``: the analysis' one (default: one of ``limits.seconds`` for both searches)."""
     out: dict[str, Any] = {}
+    if deadline is None:
+        deadline = Deadline(limits.seconds)
     first = analyze(
-        shapes, max_group=max_group, limits=limits, optimal=False, turns=turns, rods=rods
+        shapes,
+        max_group=max_group,
+        limits=limits,
+        optimal=False,
+        turns=turns,
+        rods=rods,
+        deadline=deadline,
     )
     out.update(level=first.level, moves=first.moves, optimal_steps=None)
     if optimal and first.disassemblable:
         try:
             out["optimal_steps"] = analyze_puzzle(
-                shapes, max_group=max_group, limits=limits, blocks=blocks, turns=turns, rods=rods
+                shapes,
+                max_group=max_group,
+                limits=limits,
+                blocks=blocks,
+                turns=turns,
+                rods=rods,
+                deadline=deadline,
             ).optimal_steps
         except SearchLimitError as e:
             out["optimal_error"] = str(e)
@@ -120,12 +155,20 @@ def disassembly_figures(
 
 
 def level_figures(
-    level: Level, limits: SearchLimits, optimal: bool, assemble: bool, mirrors: Mirrors = "keep"
+    level: Level,
+    limits: SearchLimits,
+    optimal: bool,
+    assemble: bool,
+    mirrors: Mirrors = "keep",
+    deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """What ``chain analyze`` prints for one of our puzzle levels (``mirrors="drop"`` also
-    identifies an assembly with its mirror image when the piece set maps to itself)."""
+    identifies an assembly with its mirror image when the piece set maps to itself), all of it
+    within ``deadline`` (default: one of ``limits.seconds``)."""
     if level.family != "puzzle":
         raise ValueError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
+    if deadline is None:
+        deadline = Deadline(limits.seconds)
     max_group = level_max_group(level)
     out: dict[str, Any] = {"assemblies": None, "solutions": None}
     if assemble:
@@ -138,6 +181,7 @@ def level_figures(
             mirror_distinct=mirrors == "keep",
             max_group=max_group,
             limits=limits,
+            deadline=deadline,
         )
         out.update(assemblies=rep.assemblies, solutions=rep.solutions)
     out.update(
@@ -149,6 +193,7 @@ def level_figures(
             blocks=level_blocks(level),
             turns=level_turns(level),
             rods=level.rods,
+            deadline=deadline,
         )
     )
     return out
@@ -174,11 +219,15 @@ def problem_figures(
     optimal: bool,
     assemble: bool,
     mirrors: Mirrors = "keep",
+    deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """What ``chain analyze`` prints for one problem of a BurrTools puzzle: BurrTools'
     assemblies and solutions (``mirrors``: see :mod:`solvers.btassemble`), then level, moves
     and o_i of the first solution (with ``assemble`` off: of the first stored assembly). With
-    piece groups o_i is not searched (``optimal_error`` says so)."""
+    piece groups o_i is not searched (``optimal_error`` says so). Everything runs within
+    ``deadline`` (default: one of ``limits.seconds``)."""
+    if deadline is None:
+        deadline = Deadline(limits.seconds)
     prob = puzzle.problem(index)
     out: dict[str, Any] = {"problem": index, "name": prob.name}
     out.update(assemblies=None, solutions=None)
@@ -186,7 +235,7 @@ def problem_figures(
     first: Analysis | None = None
     if assemble:
         packing = compile_packing(bt_packing_spec(puzzle, index))
-        rep = count_bt(packing, mirrors=mirrors, limits=limits)
+        rep = count_bt(packing, mirrors=mirrors, limits=limits, deadline=deadline)
         out.update(assemblies=rep.assemblies, solutions=rep.solutions)
         if rep.first_solution is not None:
             found, first = (rep.first_solution, piece_groups(packing)), rep.first_analysis
@@ -197,18 +246,22 @@ def problem_figures(
         return out
     shapes, groups = found
     if groups.any():
-        result = first or analyze_grouped(shapes, groups, limits=limits)
+        result = first or analyze_grouped(shapes, groups, limits=limits, deadline=deadline)
         out.update(level=result.level, moves=result.moves, optimal_steps=None)
         if optimal and result.disassemblable:
             out["optimal_error"] = "o_i is not searched for problems with piece groups"
     elif first is None:
-        out.update(disassembly_figures(shapes, max_group=None, limits=limits, optimal=optimal))
+        out.update(
+            disassembly_figures(
+                shapes, max_group=None, limits=limits, optimal=optimal, deadline=deadline
+            )
+        )
     else:  # the level is known: the assembler's disassembler found it
         out.update(level=first.level, moves=first.moves, optimal_steps=None)
         if optimal:
             try:
                 out["optimal_steps"] = analyze_puzzle(
-                    shapes, max_group=None, limits=limits
+                    shapes, max_group=None, limits=limits, deadline=deadline
                 ).optimal_steps
             except SearchLimitError as e:
                 out["optimal_error"] = str(e)
@@ -222,15 +275,19 @@ def xmpuzzle_figures(
     optimal: bool,
     assemble: bool,
     mirrors: Mirrors = "keep",
+    deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """What ``chain analyze`` prints for a BurrTools file: the figures of problem ``problem``,
-    or with None those of its only problem, or ``{"problems": [...]}`` listing every one."""
+    or with None those of its only problem, or ``{"problems": [...]}`` listing every one; all
+    of it within ``deadline`` (default: one of ``limits.seconds``)."""
+    if deadline is None:
+        deadline = Deadline(limits.seconds)
     puzzle = read_xmpuzzle(path)
     if problem is not None or len(puzzle.problems) == 1:
-        return problem_figures(puzzle, problem or 0, limits, optimal, assemble, mirrors)
+        return problem_figures(puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline)
     return {
         "problems": [
-            problem_figures(puzzle, i, limits, optimal, assemble, mirrors)
+            problem_figures(puzzle, i, limits, optimal, assemble, mirrors, deadline)
             for i in range(len(puzzle.problems))
         ]
     }

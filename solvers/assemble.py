@@ -5,7 +5,8 @@ counts them).
 Assemblies come from the exact-cover engine (:mod:`solvers.cover`) with every rotation of every
 piece, one per class of the target's rotations (symmetric duplicates removed; mirror images are
 kept apart, BurrTools' default). A *solution* is an assembly the disassembler can take apart
-completely under the reference kinematics.
+completely under the reference kinematics. :func:`count_solutions` runs the enumeration and
+every disassembly under one :class:`solvers.deadline.Deadline` (``limits.seconds``).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from dataclasses import dataclass
 
 from chaingeo.core.geometry import Shape
 from solvers.cover import iter_solutions
+from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, analyze
 from solvers.partsearch import SearchLimits
 from solvers.problem import PieceSpec
@@ -37,10 +39,12 @@ def iter_assemblies(
     optional: Shape | None = None,
     mirror_distinct: bool = True,
     node_limit: int | None = None,
+    deadline: Deadline | None = None,
 ) -> Iterator[dict[str, Shape]]:
     """Every assembly, one per symmetry class of the target (rotations; reflections too when
     ``mirror_distinct`` is False), as ``{piece name: placed voxels}``. Copies of one piece are
-    named ``name``, ``name_2``, ... in placement order."""
+    named ``name``, ``name_2``, ... in placement order. Past ``deadline`` the enumeration
+    stops with its ``SearchLimitError``."""
     solutions = iter_solutions(
         list(pieces),
         target,
@@ -48,6 +52,7 @@ def iter_assemblies(
         reflections=not mirror_distinct,
         optional=optional,
         node_limit=node_limit,
+        deadline=deadline,
     )
     base_of = {p.name: p.name for p in pieces}
     for sol in solutions:
@@ -70,16 +75,27 @@ def count_solutions(
     max_group: int | None = None,
     limits: SearchLimits | None = None,
     keep: int = 0,
+    deadline: Deadline | None = None,
 ) -> AssemblyReport:
-    """Count assemblies and those that come apart; keep the first ``keep`` solutions."""
+    """Count assemblies and those that come apart; keep the first ``keep`` solutions. The
+    enumeration and every disassembly share ``deadline`` (default: one of ``limits.seconds``;
+    without ``limits`` the enumeration has no time limit and each disassembly the default
+    one)."""
     start = time.perf_counter()
+    if deadline is None and limits is not None:
+        deadline = Deadline(limits.seconds)
     n_asm = 0
     n_sol = 0
     first: dict[str, Shape] | None = None
     kept: list[dict[str, Shape]] = []
-    for asm in iter_assemblies(pieces, target, optional=optional, mirror_distinct=mirror_distinct):
+    assemblies = iter_assemblies(
+        pieces, target, optional=optional, mirror_distinct=mirror_distinct, deadline=deadline
+    )
+    for asm in assemblies:
         n_asm += 1
-        result: Analysis = analyze(asm, max_group=max_group, limits=limits, optimal=False)
+        result: Analysis = analyze(
+            asm, max_group=max_group, limits=limits, optimal=False, deadline=deadline
+        )
         if result.disassemblable:
             n_sol += 1
             if first is None:

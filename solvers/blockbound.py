@@ -41,6 +41,7 @@ from collections.abc import Mapping, Sequence
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, Move, MoveError, SearchLimitError
+from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, analyze, translations
 from solvers.partsearch import SearchLimits
 
@@ -68,7 +69,10 @@ def block_lower_bound(
 
 
 def _block_plans(
-    shapes: Mapping[str, Shape], blocks: Sequence[Sequence[str]], limits: SearchLimits | None
+    shapes: Mapping[str, Shape],
+    blocks: Sequence[Sequence[str]],
+    limits: SearchLimits | None,
+    deadline: Deadline | None = None,
 ) -> list[list[Move]]:
     """One optimal single-piece plan per block (the block alone, assembled)."""
     plans: list[list[Move]] = []
@@ -77,7 +81,7 @@ def _block_plans(
             plans.append([])
             continue
         part = {n: shapes[n] for n in block}
-        result = analyze(part, max_group=1, limits=limits, optimal=True)
+        result = analyze(part, max_group=1, limits=limits, optimal=True, deadline=deadline)
         if result.optimal_steps is None:
             raise ValueError(f"block {sorted(block)} cannot be taken apart on its own")
         plans.append(translations(result.plan))
@@ -163,18 +167,22 @@ def analyze_by_blocks(
     limits: SearchLimits | None = None,
     stacked: bool = False,
     search: bool = True,
+    deadline: Deadline | None = None,
 ) -> Analysis:
     """:func:`solvers.disassemble.analyze` with single-piece moves and the block bound: a plan
     whose length meets the bound is optimal. Tried in turn: the BurrTools-style plan, (when
     ``stacked``: the blocks form a stack along z, see :func:`end_first_plan`) the stack taken
     apart from its ends, and (when ``search``) the exact search, which stops once it meets
-    the bound; without it, :class:`SearchLimitError` when no quick plan meets the bound."""
-    plans = _block_plans(shapes, blocks, limits)
+    the bound; without it, :class:`SearchLimitError` when no quick plan meets the bound.
+    ``deadline``: one for all of these searches (default: one of ``limits.seconds``)."""
+    if deadline is None:
+        deadline = Deadline((limits or SearchLimits()).seconds)
+    plans = _block_plans(shapes, blocks, limits, deadline)
     names = sorted(shapes)
     if sorted(n for b in blocks for n in b) != names:
         raise ValueError("the blocks must split the pieces: every name in exactly one block")
     bound = len(names) - 1 + sum(len(p) - (len(b) - 1) for p, b in zip(plans, blocks, strict=True))
-    quick = analyze(shapes, max_group=1, limits=limits, optimal=False)
+    quick = analyze(shapes, max_group=1, limits=limits, optimal=False, deadline=deadline)
     if not quick.disassemblable:
         return quick
     if quick.moves == bound and (not stacked or removals_touch(shapes, translations(quick.plan))):
@@ -185,4 +193,6 @@ def analyze_by_blocks(
             return dataclasses.replace(quick, optimal_steps=bound, plan=tuple(plan))
     if not search:
         raise SearchLimitError(f"no quick plan meets the block bound {bound} (best {quick.moves})")
-    return analyze(shapes, max_group=1, limits=limits, optimal=True, lower_bound=bound)
+    return analyze(
+        shapes, max_group=1, limits=limits, optimal=True, lower_bound=bound, deadline=deadline
+    )

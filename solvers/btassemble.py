@@ -15,6 +15,10 @@ least once; canonical keys (:func:`solvers.constrained.canonical_keys`) then kee
 once, the first met in the engine's fixed order. *Solutions* are the classes the disassembler
 takes apart (:func:`solvers.disassemble.analyze`; with piece groups
 :func:`solvers.groups.analyze_grouped`), under the same moves as everything else here.
+
+*Time*: :func:`count_bt` runs the enumeration and every disassembly under one
+:class:`solvers.deadline.Deadline` (the caller's, else one of ``limits.seconds``); past it a
+:class:`SearchLimitError` naming ``seconds`` is raised, wherever the time went.
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from solvers.constrained import (
     PartSpec,
     canonical_keys,
 )
+from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, analyze
 from solvers.groups import PieceGroups, analyze_grouped
 from solvers.partsearch import SearchLimits
@@ -148,9 +153,11 @@ def iter_classes(
     mirrors: Mirrors = "keep",
     node_limit: int | None = None,
     anchor: Anchor | Literal["auto"] | None = "auto",
+    deadline: Deadline | None = None,
 ) -> Iterator[Int32Array]:
     """One assembly per class (its rows, sorted), in the search's fixed order. ``anchor``:
-    the symmetry cut (:func:`choose_anchor` by default; None searches every row)."""
+    the symmetry cut (:func:`choose_anchor` by default; None searches every row). Past
+    ``deadline`` the search stops with its :class:`SearchLimitError`."""
     if mirrors not in ("keep", "drop"):
         raise ValueError(f"mirrors: 'keep' or 'drop', got {mirrors!r}")
     if packing.n_rows == 0:
@@ -160,7 +167,10 @@ def iter_classes(
     rot = packing.row_maps(False)
     full = packing.row_maps(True) if mirrors == "drop" else None
     search = CoverSearch(
-        packing.problem, None if anchor is None else anchor.rows, node_limit=node_limit
+        packing.problem,
+        None if anchor is None else anchor.rows,
+        node_limit=node_limit,
+        deadline=deadline,
     )
     max_holes = packing.spec.max_holes if packing.hole_type < 0 else None  # else in the rows
     n_var = len(packing.problem.optional)
@@ -222,13 +232,17 @@ def disassemble(
     max_group: int | None = None,
     limits: SearchLimits | None = None,
     groups: PieceGroups | None = None,
+    deadline: Deadline | None = None,
 ) -> Analysis:
     """The disassembler's verdict on one assembly (level and moves), groups honoured
-    (``groups``: :func:`piece_groups` of the packing, when the caller has it already)."""
+    (``groups``: :func:`piece_groups` of the packing, when the caller has it already;
+    ``deadline``: the analysis' shared one, else one of ``limits.seconds``)."""
     groups = piece_groups(packing) if groups is None else groups
     if groups.any():
-        return analyze_grouped(assembly, groups, max_group=max_group, limits=limits)
-    return analyze(assembly, max_group=max_group, limits=limits, optimal=False)
+        return analyze_grouped(
+            assembly, groups, max_group=max_group, limits=limits, deadline=deadline
+        )
+    return analyze(assembly, max_group=max_group, limits=limits, optimal=False, deadline=deadline)
 
 
 class StuckCheck:
@@ -266,9 +280,14 @@ def count_bt(
     max_group: int | None = None,
     limits: SearchLimits | None = None,
     node_limit: int | None = None,
+    deadline: Deadline | None = None,
 ) -> BTReport:
-    """BurrTools' assemblies and solutions of a packing, and the first solution."""
+    """BurrTools' assemblies and solutions of a packing, and the first solution. The search
+    and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
+    ``limits`` the enumeration has no time limit and each disassembly the default one)."""
     start = time.perf_counter()
+    if deadline is None and limits is not None:
+        deadline = Deadline(limits.seconds)
     n_asm = n_sol = 0
     first: dict[str, Shape] | None = None
     first_an: Analysis | None = None
@@ -276,12 +295,17 @@ def count_bt(
     groups = piece_groups(packing)
     # With piece groups a part may be done without moving (pieces of one group stay together).
     stuck = None if groups.any() else StuckCheck(packing)
-    for rows in iter_classes(packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor):
+    classes = iter_classes(
+        packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor, deadline=deadline
+    )
+    for rows in classes:
         n_asm += 1
         if stuck is not None and stuck(rows):
             continue
         asm = named_assembly(packing, rows)
-        result = disassemble(packing, asm, max_group=max_group, limits=limits, groups=groups)
+        result = disassemble(
+            packing, asm, max_group=max_group, limits=limits, groups=groups, deadline=deadline
+        )
         if result.disassemblable:
             n_sol += 1
             if first is None:

@@ -37,7 +37,9 @@ also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``
 ``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
 the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a
 ``SearchLimitError``) is raised carrying the solutions found so far and the stats; iterators
-first yield what they found.
+first yield what they found. Every function also takes a ``deadline``
+(:class:`solvers.deadline.Deadline`): past it the search stops with the deadline's
+``SearchLimitError`` (it names ``seconds``), iterators again first yielding what they found.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
+from solvers.deadline import Deadline
 from solvers.placements import Int32Array
 from solvers.problem import (
     CoverError,
@@ -258,12 +261,13 @@ def count_solutions(
     node_limit: int | None = None,
     symmetry: bool = True,
     anchor: str | None = None,
+    deadline: Deadline | None = None,
 ) -> CoverResult:
     """Count all solutions and (if asked) the distinct ones up to the target's symmetries."""
     problem = _problem(pieces, target, optional, reflections)
     syms, _ = problem.symmetry
     plan = anchor_plan(problem, anchor) if symmetry else None
-    budget = _Budget(node_limit)
+    budget = _Budget(node_limit, deadline)
     if plan is None:
         search = budget.search(problem, None, engine)
         if not distinct:
@@ -303,18 +307,19 @@ def count_solutions(
 
 
 class _Budget:
-    """Shares one node limit across the several searches of a count."""
+    """Shares one node limit (and the deadline) across the several searches of a count."""
 
-    def __init__(self, node_limit: int | None) -> None:
+    def __init__(self, node_limit: int | None, deadline: Deadline | None) -> None:
         if node_limit is not None and node_limit < 0:
             raise CoverError(f"node_limit: must be >= 0, got {node_limit}")
         self.limit = node_limit
+        self.deadline = deadline
         self.stats = CoverStats()
         self.found = 0
 
     def search(self, problem: CoverProblem, rows: Int32Array | None, engine: Engine) -> CoverSearch:
         left = None if self.limit is None else max(self.limit - self.stats.nodes, 0)
-        return CoverSearch(problem, rows, engine=engine, node_limit=left)
+        return CoverSearch(problem, rows, engine=engine, node_limit=left, deadline=self.deadline)
 
     def _run(self, search: CoverSearch, collect: bool) -> list[Int32Array]:
         blocks: list[Int32Array] = []
@@ -361,6 +366,7 @@ def iter_solutions(
     engine: Engine = "auto",
     node_limit: int | None = None,
     symmetry: bool = False,
+    deadline: Deadline | None = None,
 ) -> Iterator[Solution]:
     """Every solution, lazily, in the engine's fixed order; ``distinct=True`` yields one per
     symmetry class (the first met), remembering the canonical form of each class.
@@ -374,7 +380,7 @@ def iter_solutions(
     rows = None
     if plan is not None:
         rows = _restricted_rows(problem, plan, np.concatenate([plan.free_reps, plan.fixed_reps]))
-    search = CoverSearch(problem, rows, engine=engine, node_limit=node_limit)
+    search = CoverSearch(problem, rows, engine=engine, node_limit=node_limit, deadline=deadline)
     seen: set[bytes] = set()
     for block in search.batches(64):
         forms = canonical_forms(problem, block) if distinct else block
@@ -395,10 +401,11 @@ def first_solution(
     optional: Shape | None = None,
     engine: Engine = "auto",
     node_limit: int | None = None,
+    deadline: Deadline | None = None,
 ) -> Solution | None:
     """The first solution in the engine's fixed order, or ``None`` if there is none."""
     problem = _problem(pieces, target, optional, reflections)
-    search = CoverSearch(problem, engine=engine, node_limit=node_limit)
+    search = CoverSearch(problem, engine=engine, node_limit=node_limit, deadline=deadline)
     for block in search.batches(1):
         return make_solution(problem, block[0])
     return None
@@ -413,6 +420,7 @@ def random_solutions(
     optional: Shape | None = None,
     engine: Engine = "auto",
     node_limit: int | None = None,
+    deadline: Deadline | None = None,
 ) -> Iterator[Solution]:
     """All solutions, each once, in an order shuffled at every search node by ``rng``.
 
@@ -422,6 +430,6 @@ def random_solutions(
     if rng is None:
         raise CoverError("rng: random_solutions needs a numpy.random.Generator")
     problem = _problem(pieces, target, optional, reflections)
-    search = CoverSearch(problem, engine=engine, rng=rng, node_limit=node_limit)
+    search = CoverSearch(problem, engine=engine, rng=rng, node_limit=node_limit, deadline=deadline)
     for block in search.batches(1):
         yield make_solution(problem, block[0])

@@ -27,7 +27,8 @@ from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitErro
 from chaingeo.core.turns import TurnMove
 from solvers import levelsearch as ls
 from solvers import movement as mv
-from solvers.partsearch import DIRECTION_NAMES, Deadline, PartSearch, PieceTable, SearchLimits
+from solvers.deadline import Deadline
+from solvers.partsearch import DIRECTION_NAMES, PartSearch, PieceTable, SearchLimits
 
 if TYPE_CHECKING:  # imported when a puzzle turns: most never do
     from solvers.turnmoves import TurnTable
@@ -119,7 +120,8 @@ class _Solver:
 
     With ``turns`` a part's configuration is ``(n, 4)`` poses (offset, rotation index) in real
     coordinates, searched by :class:`solvers.turnsearch.TurnPartSearch`; plans then name turn
-    centres in real coordinates, so memo keys keep the absolute poses."""
+    centres in real coordinates, so memo keys keep the absolute poses. ``deadline``: the one
+    the whole analysis shares (default: a new one of ``limits.seconds``)."""
 
     def __init__(
         self,
@@ -128,6 +130,7 @@ class _Solver:
         limits: SearchLimits,
         turns: bool = False,
         rods: Rods | None = None,
+        deadline: Deadline | None = None,
     ) -> None:
         self.table = PieceTable(shapes)
         self.turn_table: TurnTable | None = None
@@ -137,7 +140,7 @@ class _Solver:
             self.turn_table = TurnTable(shapes, rods or {})
         self.max_group = max_group
         self.limits = limits
-        self.deadline = Deadline(limits.seconds)
+        self.deadline = Deadline(limits.seconds) if deadline is None else deadline
         self.greedy_memo: dict[PartKey, Separation | None] = {}
         self.opt_memo: dict[PartKey, tuple[int, bool, list[Move | TurnMove]]] = {}
         self.states = 0
@@ -359,14 +362,16 @@ def analyze(
     lower_bound: int | None = None,
     turns: bool = False,
     rods: Rods | None = None,
+    deadline: Deadline | None = None,
 ) -> Analysis:
     """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
     state (every piece at offset zero, one part). ``lower_bound``: a *proven* lower bound on
     o_i (e.g. :func:`solvers.blockbound.block_lower_bound`); the search stops at a plan that
     meets it, and a plan below it raises ``ValueError`` (the bound was not a bound). With
     ``turns`` groups may also turn (:mod:`solvers.turnsearch`; ``rods``: the round rods of each
-    piece, which spin in place)."""
-    solver = _Solver(shapes, max_group, limits or SearchLimits(), turns, rods)
+    piece, which spin in place). ``deadline``: shared with the caller's other searches (default:
+    one of ``limits.seconds`` for this analysis alone)."""
+    solver = _Solver(shapes, max_group, limits or SearchLimits(), turns, rods, deadline)
     n = len(solver.table.names)
     members = tuple(range(n))
     offsets = np.zeros((n, 4 if turns else 3), dtype=np.int64)

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
+from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, Separation, _Solver
 from solvers.partsearch import SearchLimits
 
@@ -93,8 +94,9 @@ class GroupedSolver(_Solver):
         groups: PieceGroups,
         max_group: int | None,
         limits: SearchLimits,
+        deadline: Deadline | None = None,
     ) -> None:
-        super().__init__(shapes, max_group, limits)
+        super().__init__(shapes, max_group, limits, deadline=deadline)
         self.groups = groups
         self.grouped: list[list[str]] = []  # the parts accepted by rule 2
 
@@ -121,9 +123,11 @@ def analyze_grouped(
     *,
     max_group: int | None = None,
     limits: SearchLimits | None = None,
+    deadline: Deadline | None = None,
 ) -> Analysis:
-    """Level and moves of an assembly under the group rule (``optimal_steps`` is None)."""
-    solver = GroupedSolver(shapes, groups, max_group, limits or SearchLimits())
+    """Level and moves of an assembly under the group rule (``optimal_steps`` is None;
+    ``deadline``: as in :func:`solvers.disassemble.analyze`)."""
+    solver = GroupedSolver(shapes, groups, max_group, limits or SearchLimits(), deadline)
     n = len(solver.table.names)
     if n == 1:
         return Analysis(True, "0", 0, None)

@@ -8,7 +8,6 @@ it, and collects every removal (a move that splits the part) seen on the way.
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
 
@@ -17,6 +16,7 @@ import numpy as np
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import DIRECTIONS, Move, SearchLimitError
 from solvers import movement as mv
+from solvers.deadline import Deadline as Deadline  # re-exported: its historical home
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 
@@ -34,21 +34,6 @@ class SearchLimits:
     seconds: float | None = 120.0
     group_limit: int = 4096
     max_total_states: int | None = None  # over every search of one analysis (deterministic)
-
-
-class Deadline:
-    """The wall-clock budget shared by every search of one analysis."""
-
-    def __init__(self, seconds: float | None) -> None:
-        self.seconds = seconds
-        self.end = None if seconds is None else time.monotonic() + seconds
-
-    def check(self) -> None:
-        if self.end is not None and time.monotonic() > self.end:
-            raise SearchLimitError(
-                f"time limit of {self.seconds:g} s reached; pass a larger limit "
-                "(SearchLimits(seconds=...) or --seconds)"
-            )
 
 
 class PieceTable:

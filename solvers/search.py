@@ -3,6 +3,16 @@
 :class:`CoverSearch` owns the mutable state of one search (the numba kernels keep nothing
 between calls), so a search can hand out solutions in batches, stop at a node limit, and be
 resumed; engines are interchangeable behind it.
+
+*Deadline*: a kernel cannot read the clock, so with a :class:`solvers.deadline.Deadline` the
+search runs in *slices*: each kernel call gets a node budget (its node limit is the nodes so far
+plus the budget; every kernel stops at a node boundary and resumes exactly there), and the
+deadline is checked before every slice. The budget adapts so that a slice takes about
+:data:`SLICE_SECONDS` (doubled while slices are quicker than half of it, halved when slower than
+twice it), starting from :data:`FIRST_SLICE` nodes: a kernel call costs ~4 us, so the clock
+costs well under 0.1 % and the search stops within a few slices of the deadline. Solutions and
+their order do not depend on the slicing. Without a deadline (or one of ``None`` seconds) the
+kernel runs in one call, as before.
 """
 
 from __future__ import annotations
@@ -18,6 +28,7 @@ from chaingeo.core.kinematics import SearchLimitError
 from solvers import kernels
 from solvers.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
 from solvers.bitmrv import MRVArrays, mrv_run, mrv_wide_run
+from solvers.deadline import Deadline
 from solvers.dlx import DLXArrays, dlx_run
 from solvers.placements import Int32Array
 from solvers.problem import CoverError, CoverProblem
@@ -28,6 +39,11 @@ ENGINES: tuple[str, ...] = ("auto", "dlx", "bitboard", "bitboard-first", "bitboa
 #: Targets of at most this many cells always branch on the first empty cell (``"bitboard"``).
 FIRST_CELL_SMALL = 32
 NO_LIMIT = np.iinfo(np.int64).max
+#: Wall time one slice of a search under a deadline aims at, and the node budget of its first
+#: slice (one node of a wide MRV search over a large problem may take ~0.1 ms).
+SLICE_SECONDS = 0.01
+FIRST_SLICE = 256
+MAX_SLICE = 1 << 40
 
 
 @dataclass(frozen=True)
@@ -126,6 +142,9 @@ class CoverSearch:
 
     ``rng`` (a :class:`numpy.random.Generator`) shuffles the branches at every node, which gives
     the solutions in a seeded random order; without it the order is fixed by the row order.
+    ``deadline``: past it, :meth:`count` and :meth:`batches` raise its :class:`SearchLimitError`
+    (``batches`` first yields the solutions found so far); the search can then be resumed
+    under a new :attr:`deadline`. ``slice_nodes`` fixes the node budget of a slice (tests).
     """
 
     def __init__(
@@ -136,9 +155,17 @@ class CoverSearch:
         engine: Engine = "auto",
         rng: np.random.Generator | None = None,
         node_limit: int | None = None,
+        deadline: Deadline | None = None,
+        slice_nodes: int | None = None,
     ) -> None:
         if node_limit is not None and node_limit < 0:
             raise CoverError(f"node_limit: must be >= 0, got {node_limit}")
+        if slice_nodes is not None and slice_nodes < 1:
+            raise CoverError(f"slice_nodes: must be >= 1, got {slice_nodes}")
+        self.deadline = deadline
+        self._fixed_slice = slice_nodes
+        self._slice = FIRST_SLICE if slice_nodes is None else int(slice_nodes)
+        self._expired = False
         self.problem = problem
         self.kernel = choose_kernel(problem, engine)
         self.engine = "dlx" if self.kernel == "dlx" else "bitboard"
@@ -200,54 +227,96 @@ class CoverSearch:
     def done(self) -> bool:
         return int(self._regs[kernels.REG_STATUS]) == kernels.DONE
 
-    def _call(self, max_store: int, stop_after: int) -> Int32Array:
-        out = np.zeros((max(max_store, 1), self._depth), dtype=np.int32)
-        t0 = time.perf_counter()
+    def _kernel(self, out: Int32Array, max_store: int, stop_after: int, node_limit: int) -> int:
+        """One call of the search's kernel up to ``node_limit`` nodes in total; solutions go to
+        ``out`` (see :func:`solvers.dlx.dlx_run`)."""
         a = self._arr
         if isinstance(a, DLXArrays):
             HL, HR, U, D, TOP, RW, S = self._links
-            n = dlx_run(
+            return dlx_run(
                 HL, HR, U, D, TOP, RW, S, a.kind, a.lo, a.hi, self._cnt, a.counters,
                 self._buf, self._nbuf, self._pos, self._aux, self._chosen,
                 self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, self.node_limit,
+                out, max_store, stop_after, node_limit,
             )  # fmt: skip
-        elif isinstance(a, BitboardArrays):
-            n = bitboard_run(
+        if isinstance(a, BitboardArrays):
+            return bitboard_run(
                 a.mask, a.rtype, a.rid, a.cand_ptr, a.cand, a.skip,
                 a.type_ptr, a.exact1, a.mrv_depth, a.primary,
                 a.lo, a.hi, self._cnt, a.counters, a.table,
                 a.nb, a.region_gcd, a.region_min,
                 self._occ, self._perm, self._nbuf, self._pos, self._aux, self._chosen,
                 self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, self.node_limit,
+                out, max_store, stop_after, node_limit,
             )  # fmt: skip
-        elif a.words == 1:
-            n = mrv_run(
+        if a.words == 1:
+            return mrv_run(
                 a.mask, a.rtype, a.rid, a.allrows, a.primary[0],
                 a.lo, a.hi, self._cnt, a.counters, a.pieces, a.table,
                 a.nb, a.region_gcd, a.region_min,
                 self._live, self._lstart, self._occ[:, 0], self._tcount, self._tally,
                 self._buf, self._nbuf, self._pos, self._chosen,
                 self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, self.node_limit,
+                out, max_store, stop_after, node_limit,
             )  # fmt: skip
+        return mrv_wide_run(
+            a.masks, a.rtype, a.rid, a.allrows, a.primary,
+            a.lo, a.hi, self._cnt, a.counters, a.pieces, a.table,
+            self._live, self._lstart, self._occ, self._tcount, self._tally,
+            self._planes, self._scratch,
+            self._buf, self._nbuf, self._pos, self._chosen,
+            self._regs, self._rng, self._shuffle,
+            out, max_store, stop_after, node_limit,
+        )  # fmt: skip
+
+    def _call(self, max_store: int, stop_after: int) -> Int32Array:
+        out = np.zeros((max(max_store, 1), self._depth), dtype=np.int32)
+        t0 = time.perf_counter()
+        self._expired = False
+        if self.deadline is None or not self.deadline.bounded:
+            n = self._kernel(out, max_store, stop_after, self.node_limit)
         else:
-            n = mrv_wide_run(
-                a.masks, a.rtype, a.rid, a.allrows, a.primary,
-                a.lo, a.hi, self._cnt, a.counters, a.pieces, a.table,
-                self._live, self._lstart, self._occ, self._tcount, self._tally,
-                self._planes, self._scratch,
-                self._buf, self._nbuf, self._pos, self._chosen,
-                self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, self.node_limit,
-            )  # fmt: skip
+            n = self._sliced(self.deadline, out, max_store, stop_after)
         self._seconds += time.perf_counter() - t0
         return out[:n]
 
+    def _sliced(self, deadline: Deadline, out: Int32Array, max_store: int, stop_after: int) -> int:
+        """:meth:`_kernel` in slices of :attr:`_slice` nodes, the deadline checked before each:
+        returns the solutions stored, with :attr:`_expired` set when the deadline passed."""
+        regs = self._regs
+        n = 0
+        found = self.found
+        while True:
+            if deadline.expired():
+                self._expired = True
+                return n
+            cap = min(self.node_limit, int(regs[kernels.REG_NODES]) + self._slice)
+            store = max_store - n if max_store > 0 else 0
+            after = stop_after - (self.found - found) if stop_after > 0 else 0
+            t0 = time.perf_counter()
+            n += self._kernel(out[n:], store, after, cap)
+            if int(regs[kernels.REG_STATUS]) != kernels.LIMIT or cap == self.node_limit:
+                return n  # done, the batch is full, or the search's own node limit
+            if self._fixed_slice is None:  # a whole slice was spent: adapt its budget
+                dt = time.perf_counter() - t0
+                if dt < SLICE_SECONDS / 2:
+                    self._slice = min(2 * self._slice, MAX_SLICE)
+                elif dt > 2 * SLICE_SECONDS:
+                    self._slice = max(self._slice // 2, 1)
+
+    def _time_error(self) -> SearchLimitError:
+        assert self.deadline is not None
+        return self.deadline.error(
+            f"the exact-cover search ({self.stats.nodes} nodes, {self.found} solutions so far)"
+        )
+
     @property
     def limited(self) -> bool:
-        return int(self._regs[kernels.REG_STATUS]) == kernels.LIMIT
+        """Whether the search stopped at its node limit (not at the end of a slice)."""
+        r = self._regs
+        return int(r[kernels.REG_STATUS]) == kernels.LIMIT and int(r[kernels.REG_NODES]) >= (
+            self.node_limit
+        )
 
     def _raise_limit(self) -> None:
         raise CoverLimitError(self.node_limit, self.found, self.stats)
@@ -256,6 +325,8 @@ class CoverSearch:
         """Run to the end and return the number of solutions found in total."""
         while not self.done:
             self._call(0, 0)
+            if self._expired:
+                raise self._time_error()
             if self.limited:
                 self._raise_limit()
         return self.found
@@ -264,11 +335,14 @@ class CoverSearch:
         """Solutions as arrays of row ids (``-1`` padded), at most ``size`` per batch.
 
         At the node limit the solutions found so far are yielded, then
-        :class:`CoverLimitError` is raised.
+        :class:`CoverLimitError` is raised; past the deadline likewise, then the deadline's
+        :class:`SearchLimitError` (it names ``seconds``).
         """
         while not self.done:
             block = self._call(size, 0)
             if len(block):
                 yield block
+            if self._expired:
+                raise self._time_error()
             if self.limited:
                 self._raise_limit()

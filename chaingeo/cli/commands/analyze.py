@@ -6,12 +6,17 @@ object. A ``.xmpuzzle`` with several problems and no ``--problem`` gives
 ``--mirrors keep`` (default) counts mirror images apart: BurrTools' stored figures (e.g. 1063
 assemblies / 314 solutions on its SolidSixPieceBurrs example); ``--mirrors drop`` identifies an
 assembly with its mirror image when that is an assembly too: what BurrTools' command-line
-solver prints (588 / 179 there)."""
+solver prints (588 / 179 there).
+
+``--seconds`` bounds the whole command: the enumeration of assemblies, every disassembly and the
+optimal search share one deadline; past it the command fails with the limit's message (exit
+status 2), except that a spent optimal search alone is reported as ``optimal_error``."""
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from pathlib import Path
 from typing import Any
@@ -37,7 +42,12 @@ def register(sub: Any) -> None:
         help="keep mirror-image assemblies apart (BurrTools' stored counts) or drop them "
         "(BurrTools' command-line solver)",
     )
-    p.add_argument("--seconds", type=float, default=120.0, help="time limit of each search")
+    p.add_argument(
+        "--seconds",
+        type=float,
+        default=120.0,
+        help="time limit of the whole analysis (assemblies, disassembly and optimal search)",
+    )
     p.add_argument("--max-states", type=int, default=2_000_000, help="state cap per part")
     p.add_argument("--no-optimal", action="store_true", help="skip the optimal-plan search")
     p.add_argument(
@@ -51,6 +61,8 @@ def run(args: argparse.Namespace) -> int:
     from solvers.analysis import level_figures, xmpuzzle_figures
     from solvers.partsearch import SearchLimits
 
+    if not (math.isfinite(args.seconds) and args.seconds > 0):
+        raise CommandError(f"--seconds: expected a positive number of seconds, got {args.seconds}")
     limits = SearchLimits(max_states=args.max_states, seconds=args.seconds)
     start = time.perf_counter()
     try:

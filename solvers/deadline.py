@@ -1,0 +1,51 @@
+"""The wall-clock budget of one analysis, shared by every search in it.
+
+One :class:`Deadline` is made per analysis (``SearchLimits.seconds``) and handed down to every
+search it runs: the exact-cover enumeration of assemblies (:class:`solvers.search.CoverSearch`)
+and the disassembly searches (:mod:`solvers.disassemble`, :mod:`solvers.partsearch`). Numba
+kernels cannot read the clock, so each of them stops after a budget of work and the Python side
+checks the deadline between two calls.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+from chaingeo.core.kinematics import SearchLimitError
+
+
+class Deadline:
+    """The wall-clock budget shared by every search of one analysis (None: no time limit).
+    ``ValueError`` for a negative or NaN number of seconds (NaN would never expire)."""
+
+    def __init__(self, seconds: float | None) -> None:
+        if seconds is not None and (math.isnan(seconds) or seconds < 0):
+            raise ValueError(f"seconds: a time limit must be >= 0, got {seconds}")
+        self.seconds = seconds
+        self.end = None if seconds is None else time.monotonic() + seconds
+
+    @property
+    def bounded(self) -> bool:
+        """Whether there is a time limit at all."""
+        return self.end is not None
+
+    def expired(self) -> bool:
+        return self.end is not None and time.monotonic() > self.end
+
+    def error(self, where: str = "") -> SearchLimitError:
+        """The error that names this cap (``where``: what was running, for the message)."""
+        at = f" in {where}" if where else ""
+        return SearchLimitError(
+            f"time limit of {self.seconds:g} s reached{at}; pass a larger limit "
+            "(SearchLimits(seconds=...) or --seconds)"
+        )
+
+    def check(self) -> None:
+        if self.expired():
+            raise self.error()
+
+
+def deadline_of(seconds: float | None, deadline: Deadline | None) -> Deadline:
+    """``deadline`` when the caller shares one, else a new one of ``seconds``."""
+    return Deadline(seconds) if deadline is None else deadline
