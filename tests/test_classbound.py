@@ -12,12 +12,13 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from chaingeo.core.geometry import Shape
-from chaingeo.core.kinematics import SearchLimitError
+from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import Level, load_level
 from generator.config import PuzzleConfig
 from generator.puzzle import make
+from solvers.blockbound import end_first_plan
 from solvers.classbound import band_blocks, below, class_lower_bound, join, minimal, smallest_join
-from solvers.disassemble import analyze
+from solvers.disassemble import analyze, translations
 from tests.puzzle_strategies import small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
@@ -90,6 +91,17 @@ def test_thirty_six_piece_towers_with_multi_piece_moves(name: str, bound: int, p
     found = class_lower_bound(level.shapes, blocks)
     assert found.complete and found.removals == 35 and found.bound == bound
     assert analyze(level.shapes, max_group=None, optimal=False).moves == plan >= bound
+
+
+def test_tower_taken_apart_unit_by_unit_is_within_three_of_the_bound() -> None:
+    """puzzle-hard-09 with multi-piece moves: the units leave the stack one by one, each by its
+    own optimal plan (5 + 36 = 41 moves, replayed), so 38 <= o_i <= 41."""
+    shapes = dict(load_level(SUITE / "puzzle-hard-09-burr36.json").shapes)
+    blocks = band_blocks(shapes, 6)
+    own = [translations(analyze({n: shapes[n] for n in b}, max_group=None).plan) for b in blocks]
+    plan = end_first_plan(shapes, blocks, own)
+    assert plan is not None and len(plan) == 41
+    assert replay_disassembly(shapes, plan).is_separated()
 
 
 def test_errors() -> None:

@@ -7,7 +7,9 @@ suite levels of at most 12 pieces (their own ``max_group``), AlPackino (problem 
 played with multi-piece moves (``max_group`` None instead of the file's 1). On towers (levels
 named ``burr12`` ... ``burr36``) the class bound of :mod:`solvers.classbound` over the burr units
 is printed too (``class_bound``, its ``class_bound_classes`` and seconds), and ``plan_moves``,
-the BurrTools-style plan's length: o_i lies between them.
+the shorter of the BurrTools-style plan and the units taken out one by one from the ends of the
+stack (each by its own optimal plan, :func:`solvers.blockbound.end_first_plan`, replayed with
+the reference kinematics): o_i lies between them.
 
 Per instance and search: ``o_i`` (or the cap it stopped at), ``seconds``, and the states:
 ``astar_expanded`` / ``astar_stored`` whole states, ``bfs_states`` the states the
@@ -70,19 +72,25 @@ def _class_bound(name: str, shapes: Mapping[str, Shape]) -> dict[str, object]:
     """Class bound and plan length of a tower of burr units (six layers each)."""
     if not re.search(r"burr(12|18|24|36)\b", name):
         return {}
+    from solvers.blockbound import end_first_plan
     from solvers.classbound import band_blocks, class_lower_bound
-    from solvers.disassemble import analyze
+    from solvers.disassemble import analyze, translations
 
     t0 = time.perf_counter()
-    found = class_lower_bound(shapes, band_blocks(shapes, 6))
+    blocks = band_blocks(shapes, 6)
+    found = class_lower_bound(shapes, blocks)
     seconds = round(time.perf_counter() - t0, 3)
     plan = analyze(shapes, max_group=None, optimal=False).moves
+    own = [translations(analyze({n: shapes[n] for n in b}, max_group=None).plan) for b in blocks]
+    stack = end_first_plan(shapes, blocks, own)  # units one by one from the ends, replayed
     classes = " ".join(f"{'xyz'[a]}{k}x{c}" for (a, k), c in found.classes)
     return {
         "class_bound": found.bound if found.complete else f">= {found.bound}",
         "class_bound_classes": classes,
         "class_bound_seconds": seconds,
-        "plan_moves": plan,
+        "plan_moves": min(
+            m for m in (plan, None if stack is None else len(stack)) if m is not None
+        ),
     }
 
 
