@@ -138,6 +138,14 @@ class _Search:
         self.buf = np.zeros((4096, 4), dtype=np.int64)
         self.groups = np.zeros(4097, dtype=np.uint64)
 
+    def tick(self) -> None:
+        """Count one more state searched; past the cap, stop."""
+        self.states += 1
+        if self.states > self.max_states:
+            raise SearchLimitError(
+                f"class bound state cap: more than {self.max_states} one-part states"
+            )
+
     def moves(self, members: tuple[int, ...], off: Offsets) -> list[list[int]]:
         """Rows ``(mask, direction, kmax, removable)``, one of each group / rest pair."""
         vox, starts, lo, hi = self.table.part_arrays(members)
@@ -172,22 +180,14 @@ class _Search:
             for state, prefix in layer:
                 if any(below(v, prefix) for v in found):
                     continue  # every plan on from here is above a vector already found
-                self.states += 1
-                if self.states > self.max_states:
-                    raise SearchLimitError(
-                        f"class bound state cap: more than {self.max_states} one-part states"
-                    )
+                self.tick()
                 for mask, d, kmax, removable in self.moves(members, state):
                     if removable:
                         found.extend(self._split(members, state, mask, prefix, budget))
                     if depth == budget:
                         continue
                     for k in range(1, kmax + 1):
-                        after = state.copy()
-                        for i in range(n):
-                            if mask >> i & 1:
-                                after[i] += _STEP[d] * k
-                        after -= after[0]
+                        after = _moved(state, mask, d, k)
                         v = plus(prefix, (((d // 2, k), 1),))
                         there = seen.setdefault(after.tobytes(), [])
                         if any(below(u, v) for u in there):
@@ -277,6 +277,16 @@ def band_blocks(shapes: Mapping[str, Shape], height: int, axis: int = 2) -> list
     return [bands[k] for k in sorted(bands)]
 
 
+def _moved(state: Offsets, mask: int, d: int, k: int) -> Offsets:
+    """The offsets after the pieces of ``mask`` move ``k`` along direction ``d``, seen from
+    piece 0 again."""
+    after = state.copy()
+    picked = [i for i in range(len(state)) if mask >> i & 1]
+    after[picked] += _STEP[d] * k
+    after -= after[0]
+    return after
+
+
 def _assembled(members: tuple[int, ...]) -> Offsets:
     return np.zeros((len(members), 3), dtype=np.int64)
 
@@ -288,20 +298,12 @@ def _locked(search: _Search, members: tuple[int, ...]) -> bool:
     todo = [start]
     while todo:
         state = todo.pop()
-        search.states += 1
-        if search.states > search.max_states:
-            raise SearchLimitError(
-                f"class bound state cap: more than {search.max_states} one-part states"
-            )
+        search.tick()
         for mask, d, kmax, removable in search.moves(members, state):
             if removable:
                 return False
             for k in range(1, kmax + 1):
-                after = state.copy()
-                for i in range(len(members)):
-                    if mask >> i & 1:
-                        after[i] += _STEP[d] * k
-                after -= after[0]
+                after = _moved(state, mask, d, k)
                 if after.tobytes() not in seen:
                     seen.add(after.tobytes())
                     todo.append(after)
