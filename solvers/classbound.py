@@ -126,8 +126,9 @@ class ClassBound:
     states: int
 
 
-class _Search:
-    """``V`` of one-part states within a budget, memoised (module docstring)."""
+class ClassVectors:
+    """``V`` of one-part states within a budget, memoised (module docstring); shared with the
+    search of :mod:`solvers.classsearch`, which asks for the blocks of many states."""
 
     def __init__(self, table: PieceTable, max_group: int | None, max_states: int) -> None:
         self.table = table
@@ -187,7 +188,7 @@ class _Search:
                     if depth == budget:
                         continue
                     for k in range(1, kmax + 1):
-                        after = _moved(state, mask, d, k)
+                        after = moved(state, mask, d, k)
                         v = plus(prefix, (((d // 2, k), 1),))
                         there = seen.setdefault(after.tobytes(), [])
                         if any(below(u, v) for u in there):
@@ -247,7 +248,7 @@ def class_lower_bound(
     if sorted(n for b in blocks for n in b) != names:
         raise ValueError("the blocks must split the pieces: every name in exactly one block")
     table = PieceTable({n: shapes[n] for n in names})
-    search = _Search(table, max_group, max_states)
+    search = ClassVectors(table, max_group, max_states)
     members = [tuple(sorted(table.index(n) for n in b)) for b in blocks]
     removals = len(names) - 1
     vectors: list[list[ClassVector]] = []
@@ -277,7 +278,7 @@ def band_blocks(shapes: Mapping[str, Shape], height: int, axis: int = 2) -> list
     return [bands[k] for k in sorted(bands)]
 
 
-def _moved(state: Offsets, mask: int, d: int, k: int) -> Offsets:
+def moved(state: Offsets, mask: int, d: int, k: int) -> Offsets:
     """The offsets after the pieces of ``mask`` move ``k`` along direction ``d``, seen from
     piece 0 again."""
     after = state.copy()
@@ -291,7 +292,7 @@ def _assembled(members: tuple[int, ...]) -> Offsets:
     return np.zeros((len(members), 3), dtype=np.int64)
 
 
-def _locked(search: _Search, members: tuple[int, ...]) -> bool:
+def _locked(search: ClassVectors, members: tuple[int, ...]) -> bool:
     """Does the one-part block never come apart (no removal anywhere in its finite moves)?"""
     start = _assembled(members)
     seen = {start.tobytes()}
@@ -303,7 +304,7 @@ def _locked(search: _Search, members: tuple[int, ...]) -> bool:
             if removable:
                 return False
             for k in range(1, kmax + 1):
-                after = _moved(state, mask, d, k)
+                after = moved(state, mask, d, k)
                 if after.tobytes() not in seen:
                     seen.add(after.tobytes())
                     todo.append(after)
