@@ -94,20 +94,82 @@ def join(a: ClassVector, b: ClassVector) -> ClassVector:
     return tuple(sorted(out.items()))
 
 
-def plus(a: ClassVector, b: ClassVector) -> ClassVector:
-    out = dict(a)
-    for c, count in b:
-        out[c] = out.get(c, 0) + count
-    return tuple(sorted(out.items()))
+#: Largest budget (and so count per class) the packed vectors hold: 7 bits a field.
+MAX_BUDGET = 127
 
 
-def minimal(vectors: Sequence[ClassVector]) -> list[ClassVector]:
-    """The minimal elements (none below another), smallest totals first."""
-    out: list[ClassVector] = []
-    for v in sorted(set(vectors), key=lambda v: (total(v), v)):
-        if not any(below(w, v) for w in out):
-            out.append(v)
-    return out
+class Packing:
+    """Class vectors packed in one integer, 8 bits per class (the searches compare millions of
+    them). A field holds a count up to :data:`MAX_BUDGET`, its top bit is a guard, so
+    comparison and maximum work on every field at once without borrows crossing fields:
+    ``w <= v`` iff ``(v + H - w) & H == H`` (``H``: the guard bits of the fields in use), and
+    the total is ``v % 255`` (``256 = 1 mod 255``; totals stay below 255)."""
+
+    def __init__(self) -> None:
+        self.index: dict[tuple[int, int], int] = {}
+        self.classes: list[tuple[int, int]] = []
+        self.high = 0  # the guard bit of every field in use
+        self.full = 0  # every bit of every field in use
+
+    def unit(self, axis: int, k: int) -> int:
+        """One move of class ``(axis, k)``."""
+        i = self.index.get((axis, k))
+        if i is None:
+            i = self.index[(axis, k)] = len(self.classes)
+            self.classes.append((axis, k))
+            self.high |= 0x80 << (8 * i)
+            self.full |= 0xFF << (8 * i)
+        return 1 << (8 * i)
+
+    def encode(self, v: ClassVector) -> int:
+        out = 0
+        for (axis, k), count in v:
+            if not 0 <= count <= MAX_BUDGET:
+                raise ValueError(f"a count per class is 0..{MAX_BUDGET}, got {count}")
+            out += count * self.unit(axis, k)
+        return out
+
+    def decode(self, v: int) -> ClassVector:
+        out = [(c, v >> (8 * i) & 0xFF) for i, c in enumerate(self.classes)]
+        return tuple(sorted((c, count) for c, count in out if count))
+
+    @staticmethod
+    def total(v: int) -> int:
+        return v % 255
+
+    def below(self, w: int, v: int) -> bool:
+        """``w <= v`` in every class."""
+        return (v + self.high - w) & self.high == self.high
+
+    def join(self, a: int, b: int) -> int:
+        """The element-wise maximum."""
+        a_wins = (((a + self.high - b) & self.high) >> 7) * 0xFF  # 0xFF where a >= b
+        return (a & a_wins) | (b & (self.full ^ a_wins))
+
+    def minimal(self, vectors: Sequence[int]) -> list[int]:
+        """The minimal elements (none below another), smallest totals first."""
+        out: list[int] = []
+        for v in sorted(set(vectors), key=lambda v: (v % 255, v)):
+            if not any(self.below(w, v) for w in out):
+                out.append(v)
+        return out
+
+    def smallest_join(self, choices: Sequence[Sequence[int]], cap: int) -> int | None:
+        """A join of one vector per block with the smallest total, if some total is <= ``cap``."""
+        best: list[int | None] = [None]
+        limit = [cap + 1]
+
+        def pick(i: int, acc: int) -> None:
+            if acc % 255 >= limit[0]:
+                return
+            if i == len(choices):
+                best[0], limit[0] = acc, acc % 255
+                return
+            for v in choices[i]:
+                pick(i + 1, self.join(acc, v))
+
+        pick(0, 0)
+        return best[0]
 
 
 @dataclass(frozen=True)
@@ -135,7 +197,8 @@ class ClassVectors:
         self.max_group = -1 if max_group is None else max_group
         self.max_states = max_states
         self.states = 0
-        self.memo: dict[tuple[tuple[int, ...], bytes, int], list[ClassVector]] = {}
+        self.packing = Packing()
+        self.memo: dict[tuple[tuple[int, ...], bytes], tuple[int, list[int]]] = {}
         self.buf = np.zeros((4096, 4), dtype=np.int64)
         self.groups = np.zeros(4097, dtype=np.uint64)
 
@@ -164,72 +227,68 @@ class ClassVectors:
         out: list[list[int]] = self.buf[:rows].tolist()
         return out
 
-    def vectors(self, members: tuple[int, ...], off: Offsets, budget: int) -> list[ClassVector]:
-        """Minimal vectors of total <= ``budget`` of the one-part state ``members`` at ``off``."""
-        n = len(members)
-        if n == 1:
-            return [()]
+    def vectors(self, members: tuple[int, ...], off: Offsets, budget: int) -> list[int]:
+        """Minimal vectors (packed, :attr:`packing`) of total <= ``budget`` of the one-part
+        state ``members`` at ``off``. Known for a larger budget, they are those of total <=
+        ``budget`` among its (a vector below one of them has no larger total)."""
+        if not 0 <= budget <= MAX_BUDGET:
+            raise ValueError(f"a budget is 0..{MAX_BUDGET}, got {budget}")
+        if len(members) == 1:
+            return [0]
         off = off - off[0]
-        key = (members, off.tobytes(), budget)
-        if key in self.memo:
-            return self.memo[key]
-        seen: dict[bytes, list[ClassVector]] = {off.tobytes(): [()]}
-        layer: list[tuple[Offsets, ClassVector]] = [(off, ())]
-        found: list[ClassVector] = []
+        key = (members, off.tobytes())
+        known = self.memo.get(key)
+        if known is not None and known[0] >= budget:
+            return [v for v in known[1] if v % 255 <= budget]
+        found = self._search(members, off, budget)
+        self.memo[key] = (budget, found)
+        return found
+
+    def _search(self, members: tuple[int, ...], off: Offsets, budget: int) -> list[int]:
+        """The breadth-first search of prefixes behind :meth:`vectors`."""
+        pk = self.packing
+        full = (1 << len(members)) - 1
+        seen: dict[bytes, list[int]] = {off.tobytes(): [0]}
+        layer: list[tuple[Offsets, int]] = [(off, 0)]
+        found: list[int] = []
         for depth in range(budget + 1):
-            following: list[tuple[Offsets, ClassVector]] = []
+            following: list[tuple[Offsets, int]] = []
             for state, prefix in layer:
-                if any(below(v, prefix) for v in found):
+                if any(pk.below(v, prefix) for v in found):
                     continue  # every plan on from here is above a vector already found
                 self.tick()
+                split: set[int] = set()  # a group removable several ways splits one way
                 for mask, d, kmax, removable in self.moves(members, state):
-                    if removable:
+                    if removable and min(mask, full ^ mask) not in split:
+                        split.add(min(mask, full ^ mask))
                         found.extend(self._split(members, state, mask, prefix, budget))
                     if depth == budget:
                         continue
                     for k in range(1, kmax + 1):
                         after = moved(state, mask, d, k)
-                        v = plus(prefix, (((d // 2, k), 1),))
+                        v = prefix + pk.unit(d // 2, k)
                         there = seen.setdefault(after.tobytes(), [])
-                        if any(below(u, v) for u in there):
+                        if any(pk.below(u, v) for u in there):
                             continue
-                        there[:] = [u for u in there if not below(v, u)] + [v]
+                        there[:] = [u for u in there if not pk.below(v, u)] + [v]
                         following.append((after, v))
-            found = minimal(found)
-            if found == [()]:
+            found = pk.minimal(found)
+            if found == [0]:
                 break
             layer = following
-        self.memo[key] = found
         return found
 
     def _split(
-        self, members: tuple[int, ...], off: Offsets, mask: int, prefix: ClassVector, budget: int
-    ) -> list[ClassVector]:
-        left = budget - total(prefix)
+        self, members: tuple[int, ...], off: Offsets, mask: int, prefix: int, budget: int
+    ) -> list[int]:
+        left = budget - prefix % 255
         inside = [i for i in range(len(members)) if mask >> i & 1]
         outside = [i for i in range(len(members)) if not mask >> i & 1]
         a = self.vectors(tuple(members[i] for i in inside), off[inside], left)
         b = self.vectors(tuple(members[i] for i in outside), off[outside], left)
-        out = [plus(prefix, join(x, y)) for x in a for y in b]
-        return [v for v in out if total(v) <= budget]
-
-
-def smallest_join(choices: Sequence[Sequence[ClassVector]], cap: int) -> ClassVector | None:
-    """A join of one vector per block with the smallest total, if some total is <= ``cap``."""
-    best: list[ClassVector | None] = [None]
-    limit = [cap + 1]
-
-    def pick(i: int, acc: ClassVector) -> None:
-        if total(acc) >= limit[0]:
-            return
-        if i == len(choices):
-            best[0], limit[0] = acc, total(acc)
-            return
-        for v in choices[i]:
-            pick(i + 1, join(acc, v))
-
-    pick(0, ())
-    return best[0]
+        join = self.packing.join
+        out = [prefix + join(x, y) for x in a for y in b]
+        return [v for v in out if v % 255 <= budget]
 
 
 def class_lower_bound(
@@ -251,21 +310,24 @@ def class_lower_bound(
     search = ClassVectors(table, max_group, max_states)
     members = [tuple(sorted(table.index(n) for n in b)) for b in blocks]
     removals = len(names) - 1
-    vectors: list[list[ClassVector]] = []
+    if not 0 <= max_budget <= MAX_BUDGET:
+        raise ValueError(f"max_budget is 0..{MAX_BUDGET}, got {max_budget}")
+    pk = search.packing
+    vectors: list[list[int]] = []
     for budget in range(max_budget + 1):
         vectors = [search.vectors(m, _assembled(m), budget) for m in members]
-        best = smallest_join(vectors, budget)
+        best = pk.smallest_join(vectors, budget)
         if best is not None:
             return ClassBound(
-                removals + total(best), removals, total(best), True, best,
-                tuple(tuple(v) for v in vectors), search.states,
+                removals + pk.total(best), removals, pk.total(best), True, pk.decode(best),
+                tuple(tuple(map(pk.decode, v)) for v in vectors), search.states,
             )  # fmt: skip
     for b, m, v in zip(blocks, members, vectors, strict=True):
         if not v and _locked(search, m):  # no vector: more than the budget, or never apart
             raise ValueError(f"block {sorted(b)} cannot be taken apart on its own")
     return ClassBound(
         removals + max_budget + 1, removals, max_budget + 1, False, (),
-        tuple(tuple(v) for v in vectors), search.states,
+        tuple(tuple(map(pk.decode, v)) for v in vectors), search.states,
     )  # fmt: skip
 
 

@@ -3,8 +3,8 @@
 Towers of burr units played with moves that may carry any group of pieces have state spaces far
 beyond breadth-first search, and A* with pair databases (:mod:`solvers.astar`) proves only 36
 on the suite's 36-piece towers. The class bound of :mod:`solvers.classbound` is much closer; as
-the heuristic of a depth-first iterative deepening search it closes them (module README: the
-figures of ``chain bench astar``).
+the heuristic of a depth-first iterative deepening search it closes them (figures: README,
+"Class search", and ``chain bench astar``).
 
 **Problem** as in :mod:`solvers.astar`: a state is a partition of the pieces into parts with
 offsets; a move carries a proper group of one part one or more steps along an axis, or away for
@@ -45,7 +45,7 @@ import numpy as np
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Move, SearchLimitError
 from solvers import movement as mv
-from solvers.classbound import ClassVectors, moved, smallest_join
+from solvers.classbound import MAX_BUDGET, ClassVectors, moved
 from solvers.deadline import Deadline
 from solvers.partsearch import DIRECTION_NAMES, PieceTable
 
@@ -147,19 +147,21 @@ class _Search:
         return subs
 
     def m_value(self, members: tuple[int, ...], off: Offsets, cap: int) -> int:
-        """``M(P)`` when it is at most ``cap``, else a proven lower bound above ``cap``."""
+        """``M(P)`` when it is at most ``cap``, else a proven lower bound above ``cap`` (or
+        above :data:`MAX_BUDGET`, the most the class vectors count)."""
         key = (members, off.tobytes())
         low, known = self.m_cache.get(key, (0, False))
         if known or low > cap:
             return low
         subs = [(m, off[idx]) for m, idx in self._subs(members)]
-        for budget in range(low, cap + 1):
+        top = min(cap, MAX_BUDGET)  # past it, M > MAX_BUDGET is still a proven bound
+        for budget in range(low, top + 1):
             choices = [self.vectors.vectors(m, o, budget) for m, o in subs]
-            if smallest_join(choices, budget) is not None:
+            if self.vectors.packing.smallest_join(choices, budget) is not None:
                 self.m_cache[key] = (budget, True)
                 return budget
-        self.m_cache[key] = (cap + 1, False)
-        return cap + 1
+        self.m_cache[key] = (top + 1, False)
+        return top + 1
 
     def bound(self, members: tuple[int, ...], off: Offsets, cap: int) -> int:
         """A proven lower bound on ``d(P)``, exact enough to compare with ``cap``."""

@@ -17,7 +17,16 @@ from chaingeo.core.level import Level, load_level
 from generator.config import PuzzleConfig
 from generator.puzzle import make
 from solvers.blockbound import end_first_plan
-from solvers.classbound import band_blocks, below, class_lower_bound, join, minimal, smallest_join
+from solvers.classbound import (
+    MAX_BUDGET,
+    ClassVector,
+    Packing,
+    band_blocks,
+    below,
+    class_lower_bound,
+    join,
+    total,
+)
 from solvers.disassemble import analyze, translations
 from tests.puzzle_strategies import small_scenes
 
@@ -29,10 +38,35 @@ def test_vector_algebra() -> None:
     b = (((0, 1), 1), ((2, 3), 1))
     assert join(a, b) == (((0, 1), 2), ((2, 3), 1))
     assert below(a, join(a, b)) and below(b, join(a, b)) and not below(a, b)
-    assert minimal([join(a, b), a, b, ()]) == [()]
-    assert minimal([join(a, b), a, b]) == [b, a]  # by total, then by class
-    assert smallest_join([[a, b], [b]], 10) == b  # b alone serves both blocks
-    assert smallest_join([[a], [b]], 2) is None  # the join has total 3
+    pk = Packing()
+    pa, pb = pk.encode(a), pk.encode(b)
+    assert pk.decode(pk.join(pa, pb)) == join(a, b) and pk.total(pa) == 2
+    assert pk.minimal([pk.join(pa, pb), pa, pb, 0]) == [0]
+    assert sorted(pk.minimal([pk.join(pa, pb), pa, pb])) == sorted([pa, pb])  # the join is above
+    assert pk.smallest_join([[pa, pb], [pb]], 10) == pb  # b alone serves both blocks
+    assert pk.smallest_join([[pa], [pb]], 2) is None  # the join has total 3
+    with pytest.raises(ValueError, match="count per class"):
+        pk.encode((((0, 1), MAX_BUDGET + 1),))
+
+
+_vectors = st.lists(
+    st.tuples(st.tuples(st.integers(0, 2), st.integers(1, 4)), st.integers(1, 40)),
+    max_size=3,
+    unique_by=lambda cv: cv[0],
+).map(lambda v: tuple(sorted(v)))
+
+
+@settings(max_examples=200, deadline=None)
+@given(_vectors, _vectors)
+def test_packed_vectors_agree_with_the_counts(a: ClassVector, b: ClassVector) -> None:
+    """The packed fields compare, join and add up as the counts per class do (no borrow or
+    carry crosses a field, whatever order the classes were met in)."""
+    pk = Packing()
+    pb, pa = pk.encode(b), pk.encode(a)
+    assert pk.decode(pa) == a and pk.decode(pb) == b
+    assert pk.below(pa, pb) == below(a, b) and pk.below(pb, pa) == below(b, a)
+    assert pk.decode(pk.join(pa, pb)) == join(a, b)
+    assert pk.total(pa) == total(a)
 
 
 @settings(max_examples=40, deadline=None)
@@ -95,7 +129,8 @@ def test_thirty_six_piece_towers_with_multi_piece_moves(name: str, bound: int, p
 
 def test_tower_taken_apart_unit_by_unit_is_within_three_of_the_bound() -> None:
     """puzzle-hard-09 with multi-piece moves: the units leave the stack one by one, each by its
-    own optimal plan (5 + 36 = 41 moves, replayed), so 38 <= o_i <= 41."""
+    own optimal plan (5 + 36 = 41 moves, replayed), so 38 <= o_i <= 41 (the class search
+    finds 38: tests/test_classsearch.py)."""
     shapes = dict(load_level(SUITE / "puzzle-hard-09-burr36.json").shapes)
     blocks = band_blocks(shapes, 6)
     own = [translations(analyze({n: shapes[n] for n in b}, max_group=None).plan) for b in blocks]

@@ -71,7 +71,7 @@ def test_thirty_six_piece_tower_with_multi_piece_moves_is_closed() -> None:
 
 @pytest.mark.slow
 def test_the_other_thirty_six_piece_tower() -> None:
-    """puzzle-hard-08 with multi-piece moves: o_i = 41, its class bound (about 6 minutes;
+    """puzzle-hard-08 with multi-piece moves: o_i = 41, its class bound (about 4 minutes;
     ``chain bench astar`` prints it too)."""
     level = load_level(SUITE / "puzzle-hard-08-burr36.json")
     found = class_search_optimal(level.shapes, band_blocks(level.shapes, 6))

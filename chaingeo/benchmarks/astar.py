@@ -9,7 +9,10 @@ named ``burr12`` ... ``burr36``) the class bound of :mod:`solvers.classbound` ov
 is printed too (``class_bound``, its ``class_bound_classes`` and seconds), and ``plan_moves``,
 the shorter of the BurrTools-style plan and the units taken out one by one from the ends of the
 stack (each by its own optimal plan, :func:`solvers.blockbound.end_first_plan`, replayed with
-the reference kinematics): o_i lies between them.
+the reference kinematics): o_i lies between them. Then the search under the class bound
+(:mod:`solvers.classsearch`) closes the gap: ``class_search_o_i`` (its plan replayed),
+``class_search_nodes`` and ``class_search_seconds``, or ``class_search_bound`` when it stops at
+its cap (``CHAIN_BENCH_CLASS_SEARCH_SECONDS``, default 900).
 
 Per instance and search: ``o_i`` (or the cap it stopped at), ``seconds``, and the states:
 ``astar_expanded`` / ``astar_stored`` whole states, ``bfs_states`` the states the
@@ -91,6 +94,31 @@ def _class_bound(name: str, shapes: Mapping[str, Shape]) -> dict[str, object]:
         "plan_moves": min(
             m for m in (plan, None if stack is None else len(stack)) if m is not None
         ),
+        **_class_search(shapes, blocks),
+    }
+
+
+def _class_search(shapes: Mapping[str, Shape], blocks: list[list[str]]) -> dict[str, object]:
+    """o_i by the search under the class bound, its plan replayed, or its proven bound."""
+    from chaingeo.core.kinematics import replay_disassembly
+    from solvers.classsearch import ClassSearchLimits, class_search_optimal
+
+    seconds = float(os.environ.get("CHAIN_BENCH_CLASS_SEARCH_SECONDS", "900"))
+    t0 = time.perf_counter()
+    try:
+        r = class_search_optimal(shapes, blocks, limits=ClassSearchLimits(seconds=seconds))
+    except SearchLimitError as e:
+        bound = re.search(r"lower bound (\d+)", str(e))
+        return {
+            "class_search_bound": int(bound.group(1)) if bound else None,
+            "class_search_seconds": round(time.perf_counter() - t0, 3),
+        }
+    return {
+        "class_search_o_i": r.optimal_steps,
+        "class_search_replayed": replay_disassembly(shapes, r.plan).is_separated(),
+        "class_search_nodes": r.nodes,
+        "class_search_children": r.children,
+        "class_search_seconds": round(time.perf_counter() - t0, 3),
     }
 
 
