@@ -2,9 +2,10 @@
 
 Everything that analyses a puzzle level goes through here: ``chain analyze``, the generator
 (:func:`generator.puzzle.puzzle_level`), the suite tests and the bench. A level that carries
-the structure a proven bound needs (``stats["blocks"]``: towers of burr units moved one piece
-at a time) is analysed with the block bound of :mod:`solvers.blockbound`, everywhere; every
-other puzzle with the plain optimal search of :mod:`solvers.disassemble`.
+the structure a proven bound needs (``stats["blocks"]``: towers of burr units) is analysed with
+it, everywhere: the block bound of :mod:`solvers.blockbound` for moves of one piece, the search
+under the class bound of :mod:`solvers.classsearch` for moves of several; every other puzzle
+with the plain optimal search of :mod:`solvers.disassemble`.
 
 *Time*: ``limits.seconds`` bounds one whole analysis. :func:`level_figures` and
 :func:`xmpuzzle_figures` (``chain analyze``) make one :class:`solvers.deadline.Deadline` and
@@ -40,8 +41,8 @@ BLOCKS_KEY = "blocks"
 
 
 def level_blocks(level: Level) -> list[list[str]] | None:
-    """The blocks a level carries for the block bound, or None. Raises ValueError when they are
-    malformed or the level allows multi-piece moves (the bound holds for single-piece moves)."""
+    """The blocks a level carries for a proven bound, or None (the block bound for single-piece
+    moves, the class search otherwise). Raises ValueError when they are malformed."""
     raw = level.stats.get(BLOCKS_KEY)
     if raw is None:
         return None
@@ -50,8 +51,8 @@ def level_blocks(level: Level) -> list[list[str]] | None:
         isinstance(b, list) and b and all(isinstance(n, str) and n in names for n in b) for b in raw
     ):
         raise ValueError(f"{level.id}: stats.{BLOCKS_KEY} must be lists of piece names")
-    if level_max_group(level) != 1:
-        raise ValueError(f"{level.id}: blocks prove o_i for single-piece moves (max_group 1) only")
+    if sorted(n for b in raw for n in b) != sorted(names):
+        raise ValueError(f"{level.id}: stats.{BLOCKS_KEY} must hold every piece exactly once")
     return [list(b) for b in raw]
 
 
@@ -69,14 +70,20 @@ def analyze_puzzle(
     rods: Rods | None = None,
     deadline: Deadline | None = None,
 ) -> Analysis:
-    """Level, moves, o_i and an optimal plan of an assembled puzzle. With ``blocks`` (single-piece
-    moves only) o_i is proven by the block bound instead of searched, and a
-    :class:`SearchLimitError` says when no quick plan meets it. With ``turns`` groups may also
-    turn (``rods``: the pieces' round rods). ``deadline``: shared with the caller's other
-    searches (default: one of ``limits.seconds``)."""
+    """Level, moves, o_i and an optimal plan of an assembled puzzle. With ``blocks`` o_i is proven
+    with them: for single-piece moves by the block bound instead of searched (a
+    :class:`SearchLimitError` says when no quick plan meets it), else by the class search.
+    With ``turns`` groups may also turn (``rods``: the pieces' round rods). ``deadline``:
+    shared with the caller's other searches (default: one of ``limits.seconds``)."""
+    if blocks is not None and turns:
+        raise ValueError("blocks prove o_i for translations only, not with turns")
+    if blocks is not None and max_group != 1:
+        from solvers.classsearch import analyze_by_classes  # levels with blocks only
+
+        return analyze_by_classes(
+            shapes, blocks, max_group=max_group, limits=limits, deadline=deadline
+        )
     if blocks is not None:
-        if max_group != 1 or turns:
-            raise ValueError("blocks prove o_i for single-piece moves (max_group=1) only")
         from solvers.blockbound import analyze_by_blocks  # levels with blocks only
 
         return analyze_by_blocks(

@@ -38,7 +38,7 @@ round proves ``o_i > r``, and a cap reached in round ``r`` still proves ``o_i >=
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -46,13 +46,19 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Move, SearchLimitError
 from solvers import movement as mv
 from solvers.classbound import MAX_BUDGET, ClassVectors, moved
-from solvers.deadline import Deadline
-from solvers.partsearch import DIRECTION_NAMES, PieceTable
+from solvers.deadline import Deadline, deadline_of
+from solvers.disassemble import Analysis, analyze
+from solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits
 
 Offsets = np.ndarray
 Key = tuple[tuple[int, ...], bytes]
 
-__all__ = ["ClassSearchLimits", "ClassSearchResult", "class_search_optimal"]
+__all__ = [
+    "ClassSearchLimits",
+    "ClassSearchResult",
+    "analyze_by_classes",
+    "class_search_optimal",
+]
 
 
 @dataclass(frozen=True)
@@ -277,10 +283,12 @@ def class_search_optimal(
     *,
     max_group: int | None = None,
     limits: ClassSearchLimits | None = None,
+    deadline: Deadline | None = None,
 ) -> ClassSearchResult:
     """o_i of ``shapes`` (assembled as given) and an optimal plan, by the search of the module
     docstring with the class bound over ``blocks`` (a partition of the piece names; for a
-    tower of burr units, :func:`solvers.classbound.band_blocks`).
+    tower of burr units, :func:`solvers.classbound.band_blocks`). ``deadline``: shared with
+    the caller's other searches (default: one of ``limits.seconds``).
 
     Raises ``ValueError`` when the blocks are not a partition, and :class:`SearchLimitError`
     at a cap, naming the proven lower bound (``"proven lower bound N"``). A puzzle that never
@@ -297,7 +305,7 @@ def class_search_optimal(
         [sorted(table.index(n) for n in b) for b in blocks],
         max_group,
         lim,
-        Deadline(lim.seconds),
+        deadline_of(lim.seconds, deadline),
     )
     members = tuple(range(len(names)))
     start = np.zeros((len(names), 3), dtype=np.int64)
@@ -318,4 +326,35 @@ def class_search_optimal(
         nodes=search.nodes,
         children=search.children,
         vector_states=search.vectors.states,
+    )
+
+
+def analyze_by_classes(
+    shapes: Mapping[str, Shape],
+    blocks: Sequence[Sequence[str]],
+    *,
+    max_group: int | None,
+    limits: SearchLimits | None = None,
+    deadline: Deadline | None = None,
+) -> Analysis:
+    """:func:`solvers.disassemble.analyze` of a puzzle made of ``blocks`` with moves of several
+    pieces: level and moves from the BurrTools-style search, o_i and its plan from
+    :func:`class_search_optimal` (``states`` counts both). Its caps come from ``limits``:
+    ``max_total_states`` (default 1,000,000) expanded states, ``max_states`` class-vector
+    states, one deadline of ``seconds`` for both searches."""
+    lim = limits or SearchLimits()
+    deadline = deadline_of(lim.seconds, deadline)
+    quick = analyze(shapes, max_group=max_group, limits=lim, optimal=False, deadline=deadline)
+    if not quick.disassemblable:
+        return quick
+    caps = ClassSearchLimits(
+        max_nodes=lim.max_total_states or ClassSearchLimits.max_nodes,
+        vector_states=lim.max_states,
+        group_limit=max(lim.group_limit, ClassSearchLimits.group_limit),
+    )
+    found = class_search_optimal(
+        shapes, blocks, max_group=max_group, limits=caps, deadline=deadline
+    )
+    return replace(
+        quick, optimal_steps=found.optimal_steps, plan=found.plan, states=quick.states + found.nodes
     )

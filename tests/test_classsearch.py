@@ -11,12 +11,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from chaingeo.cli.main import main
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import load_level
+from solvers.analysis import analyze_level
 from solvers.classbound import band_blocks, class_lower_bound
 from solvers.classsearch import ClassSearchLimits, class_search_optimal
-from solvers.disassemble import analyze
+from solvers.disassemble import analyze, translations
 from tests.puzzle_strategies import small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
@@ -92,3 +94,26 @@ def test_caps_and_errors() -> None:
         class_search_optimal(level.shapes, blocks[1:])
     with pytest.raises(ValueError, match="max_nodes"):
         ClassSearchLimits(max_nodes=0)
+
+
+def test_chain_analyze_proves_a_multi_piece_tower(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A tower level that carries its blocks and allows moves of any size: ``chain analyze``
+    (one analysis everywhere, :mod:`solvers.analysis`) proves o_i with the class search."""
+    raw = json.loads((SUITE / "puzzle-hard-09-burr36.json").read_text())
+    raw["rules"]["max_group"] = None
+    path = tmp_path / "tower.json"
+    path.write_text(json.dumps(raw))
+    assert main(["analyze", str(path), "--no-assemble", "--seconds", "60"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    level = load_level(path)
+    quick = analyze(level.shapes, max_group=None, optimal=False)  # BurrTools' level and moves
+    assert out["optimal_steps"] == 38 and (out["level"], out["moves"]) == (quick.level, quick.moves)
+    found = analyze_level(level)
+    assert found.optimal_steps == len(found.plan) == 38 and quick.moves == 42
+    assert replay_disassembly(level.shapes, translations(found.plan)).is_separated()
+    raw["stats"]["blocks"] = raw["stats"]["blocks"][1:]
+    path.write_text(json.dumps(raw))
+    with pytest.raises(ValueError, match="every piece exactly once"):
+        analyze_level(load_level(path))
