@@ -192,15 +192,18 @@ class ClassVectors:
     """``V`` of one-part states within a budget, memoised (module docstring); shared with the
     search of :mod:`solvers.classsearch`, which asks for the blocks of many states."""
 
-    def __init__(self, table: PieceTable, max_group: int | None, max_states: int) -> None:
+    def __init__(
+        self, table: PieceTable, max_group: int | None, max_states: int, group_limit: int = 4096
+    ) -> None:
         self.table = table
+        self.group_limit = group_limit
         self.max_group = -1 if max_group is None else max_group
         self.max_states = max_states
         self.states = 0
         self.packing = Packing()
         self.memo: dict[tuple[tuple[int, ...], bytes], tuple[int, list[int]]] = {}
         self.buf = np.zeros((4096, 4), dtype=np.int64)
-        self.groups = np.zeros(4097, dtype=np.uint64)
+        self.groups = np.zeros(group_limit + 1, dtype=np.uint64)
 
     def tick(self) -> None:
         """Count one more state searched; past the cap, stop."""
@@ -211,19 +214,23 @@ class ClassVectors:
             )
 
     def moves(self, members: tuple[int, ...], off: Offsets) -> list[list[int]]:
-        """Rows ``(mask, direction, kmax, removable)``, one of each group / rest pair."""
+        """Rows ``(mask, direction, kmax, removable)``, one of each group / rest pair, of the
+        one-part state ``members`` at ``off``."""
         vox, starts, lo, hi = self.table.part_arrays(members)
         n = len(members)
         gaps = np.empty((3, n, n), dtype=np.int64)
         while True:
             rows = mv.node_moves(
-                vox, starts, lo, hi, off, self.max_group, 4096, False, gaps, self.groups, self.buf
-            )
+                vox, starts, lo, hi, off, self.max_group, self.group_limit,
+                False, gaps, self.groups, self.buf,
+            )  # fmt: skip
             if rows != -1:
                 break
             self.buf = np.zeros((2 * self.buf.shape[0], 4), dtype=np.int64)
         if rows == -2:
-            raise SearchLimitError("class bound: more than 4096 movable groups along one axis")
+            raise SearchLimitError(
+                f"class bound: more than {self.group_limit} movable groups along one axis"
+            )
         out: list[list[int]] = self.buf[:rows].tolist()
         return out
 

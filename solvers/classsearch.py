@@ -123,7 +123,7 @@ class _Search:
         for b, block in enumerate(blocks):
             self.block_of[list(block)] = b
         self.max_group = -1 if max_group is None else max_group
-        self.vectors = ClassVectors(table, max_group, limits.vector_states)
+        self.vectors = ClassVectors(table, max_group, limits.vector_states, limits.group_limit)
         self.limits = limits
         self.deadline = deadline
         self.lower: dict[Key, int] = {}
@@ -132,8 +132,6 @@ class _Search:
         self.sub_cache: dict[tuple[int, ...], list[tuple[tuple[int, ...], list[int]]]] = {}
         self.nodes = 0
         self.children = 0
-        self.groups = np.zeros(limits.group_limit + 1, dtype=np.uint64)
-        self.buf = np.zeros((4096, 4), dtype=np.int64)
 
     # -- the heuristic -------------------------------------------------------------------
 
@@ -190,25 +188,6 @@ class _Search:
         if self.deadline.expired():
             raise self.deadline.error("the class search")
 
-    def _moves(self, members: tuple[int, ...], off: Offsets) -> list[list[int]]:
-        vox, starts, lo, hi = self.table.part_arrays(members)
-        n = len(members)
-        gaps = np.empty((3, n, n), dtype=np.int64)
-        while True:
-            rows = mv.node_moves(
-                vox, starts, lo, hi, off, self.max_group, self.limits.group_limit,
-                False, gaps, self.groups, self.buf,
-            )  # fmt: skip
-            if rows != -1:
-                break
-            self.buf = np.zeros((2 * self.buf.shape[0], 4), dtype=np.int64)
-        if rows == -2:
-            raise SearchLimitError(
-                f"class search: more than {self.limits.group_limit} movable groups along one axis"
-            )
-        out: list[list[int]] = self.buf[:rows].tolist()
-        return out
-
     def _move(self, members: tuple[int, ...], mask: int, d: int, k: int | None) -> Move:
         names = self.table.names
         pieces = tuple(names[m] for i, m in enumerate(members) if mask >> i & 1)
@@ -229,7 +208,7 @@ class _Search:
             return None
         self._tick()
         kids: list[_Child] = []
-        for mask, d, kmax, removable in self._moves(members, off):
+        for mask, d, kmax, removable in self.vectors.moves(members, off):
             if removable:
                 self.children += 1
                 ins = [i for i in range(n) if mask >> i & 1]

@@ -37,3 +37,13 @@ def small_scenes(draw: st.DrawFn, max_pieces: int = 4) -> dict[str, Shape]:
     dims = (draw(st.integers(2, 3)), draw(st.integers(2, 3)), draw(st.integers(1, 2)))
     k = draw(st.integers(2, min(max_pieces, dims[0] * dims[1] * dims[2])))
     return random_partition(dims, k, draw(st.integers(0, 2**32 - 1)))
+
+
+def random_blocks(names: list[str], data: st.DataObject, most: int = 3) -> list[list[str]]:
+    """A random partition of ``names`` into at most ``most`` non-empty blocks."""
+    labels = data.draw(st.lists(st.integers(0, most - 1), min_size=len(names), max_size=len(names)))
+    return [
+        b
+        for k in range(most)
+        if (b := [n for n, lab in zip(names, labels, strict=True) if lab == k])
+    ]

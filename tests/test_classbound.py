@@ -28,7 +28,7 @@ from solvers.classbound import (
     total,
 )
 from solvers.disassemble import analyze, translations
-from tests.puzzle_strategies import small_scenes
+from tests.puzzle_strategies import random_blocks, small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
 
@@ -75,10 +75,7 @@ def test_at_most_the_exact_optimum(
     shapes: dict[str, Shape], data: st.DataObject, max_group: int | None
 ) -> None:
     names = sorted(shapes)
-    labels = data.draw(st.lists(st.integers(0, 2), min_size=len(names), max_size=len(names)))
-    blocks = [
-        b for k in range(3) if (b := [n for n, lab in zip(names, labels, strict=True) if lab == k])
-    ]
+    blocks = random_blocks(names, data)
     exact = analyze(shapes, max_group=max_group).optimal_steps
     assume(exact is not None)  # then every block comes apart alone too
     assert exact is not None

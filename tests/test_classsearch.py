@@ -19,7 +19,7 @@ from solvers.analysis import analyze_level
 from solvers.classbound import band_blocks, class_lower_bound
 from solvers.classsearch import ClassSearchLimits, class_search_optimal
 from solvers.disassemble import analyze, translations
-from tests.puzzle_strategies import small_scenes
+from tests.puzzle_strategies import random_blocks, small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
 
@@ -30,10 +30,7 @@ def test_the_exact_optimum_on_random_scenes(
     shapes: dict[str, Shape], data: st.DataObject, max_group: int | None
 ) -> None:
     names = sorted(shapes)
-    labels = data.draw(st.lists(st.integers(0, 2), min_size=len(names), max_size=len(names)))
-    blocks = [
-        b for k in range(3) if (b := [n for n, lab in zip(names, labels, strict=True) if lab == k])
-    ]
+    blocks = random_blocks(names, data)
     exact = analyze(shapes, max_group=max_group).optimal_steps
     limits = ClassSearchLimits(max_nodes=20_000)
     if exact is None:  # never comes apart: every round fails, the search ends at its cap
