@@ -204,6 +204,7 @@ class ClassVectors:
         self.memo: dict[tuple[tuple[int, ...], bytes], tuple[int, list[int]]] = {}
         self.buf = np.zeros((4096, 4), dtype=np.int64)
         self.groups = np.zeros(group_limit + 1, dtype=np.uint64)
+        self.arrays: dict[tuple[int, ...], tuple[np.ndarray, ...]] = {}  # per set of pieces
 
     def tick(self) -> None:
         """Count one more state searched; past the cap, stop."""
@@ -216,7 +217,10 @@ class ClassVectors:
     def moves(self, members: tuple[int, ...], off: Offsets) -> list[list[int]]:
         """Rows ``(mask, direction, kmax, removable)``, one of each group / rest pair, of the
         one-part state ``members`` at ``off``."""
-        vox, starts, lo, hi = self.table.part_arrays(members)
+        arrays = self.arrays.get(members)
+        if arrays is None:
+            arrays = self.arrays[members] = self.table.part_arrays(members)
+        vox, starts, lo, hi = arrays
         n = len(members)
         gaps = np.empty((3, n, n), dtype=np.int64)
         while True:
