@@ -103,7 +103,7 @@ class _Child:
     mask: int
     direction: int
     distance: int | None
-    after: Offsets
+    after: Offsets | None
     split: tuple[tuple[int, ...], Offsets, tuple[int, ...], Offsets, int] | None
 
 
@@ -122,7 +122,6 @@ class _Search:
         self.block_of = np.zeros(len(table.names), dtype=np.int64)
         for b, block in enumerate(blocks):
             self.block_of[list(block)] = b
-        self.max_group = -1 if max_group is None else max_group
         self.vectors = ClassVectors(table, max_group, limits.vector_states, limits.group_limit)
         self.limits = limits
         self.deadline = deadline
@@ -217,7 +216,7 @@ class _Search:
                 m2, o2 = tuple(members[i] for i in out), off[out] - off[out[0]]
                 h1, h2 = self.bound(m1, o1, r - 1), self.bound(m2, o2, r - 1)
                 if 1 + h1 + h2 <= r:
-                    kids.append(_Child(1 + h1 + h2, mask, d, None, o1, (m1, o1, m2, o2, h2)))
+                    kids.append(_Child(1 + h1 + h2, mask, d, None, None, (m1, o1, m2, o2, h2)))
             for k in range(1, kmax + 1):
                 self.children += 1
                 after = moved(off, mask, d, k)
@@ -227,11 +226,12 @@ class _Search:
         kids.sort(key=lambda kid: (kid.f, kid.distance is not None))  # stable: removals first
         for kid in kids:
             here = self._move(members, kid.mask, kid.direction, kid.distance)
-            if kid.split is None:
+            if kid.after is not None:
                 plan = self.within(members, kid.after, r - 1)
                 if plan is not None:
                     return [here, *plan]
                 continue
+            assert kid.split is not None
             m1, o1, m2, o2, h2 = kid.split
             first = self.exact_upto(m1, o1, r - 1 - h2)
             if first is not None:
