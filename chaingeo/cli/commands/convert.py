@@ -1,4 +1,10 @@
-"""``chain convert``: move levels between our format and the original CHAIN stacking JSON.
+"""``chain convert``: move levels between our format, the original CHAIN stacking JSON and
+BurrTools' ``.xmpuzzle``.
+
+``--to xmpuzzle`` writes any level (a file or a level id of the shipped suite) as a BurrTools
+file: the assembled shape (puzzles) or the box (stacking) as the result, each piece its own
+shape, the level's assembly stored as the solution (:mod:`chaingeo.core.formats.bt_level`);
+rules BurrTools cannot express (turns, a cap on group size) are named on standard error.
 
 ``--from chain`` (or ``--to chain-level``) reads CHAIN's level file as CHAIN writes it: packed
 (the cells fill the box) or in tray form (each piece where it lies beside the box). A tray
@@ -15,6 +21,9 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from chaingeo.cli.errors import CommandError
+from chaingeo.cli.level_arg import find_level
+
 if TYPE_CHECKING:  # the command imports its work lazily, so `chain --help` stays fast
     from chaingeo.core.formats.chain_json import ChainStacking
     from chaingeo.core.geometry import Shape
@@ -26,19 +35,24 @@ _DIFFICULTY_RE = re.compile(r"(?:^|[_\-.])(easy|mid|hard)(?:$|[_\-.])")
 
 
 def register(sub: Any) -> None:
-    p = sub.add_parser("convert", help="import/export the original CHAIN stacking JSON format")
-    p.add_argument("source", type=Path)
+    p = sub.add_parser(
+        "convert",
+        help="import/export CHAIN's stacking JSON; export any level as a BurrTools .xmpuzzle",
+    )
+    p.add_argument("source", help="the file to read (for an export: a level file or level id)")
     p.add_argument(
         "target",
         type=Path,
         nargs="?",
-        help="the file to write (default: the level on standard output)",
+        help="the file to write (default: the level on standard output); same as --out",
     )
+    p.add_argument("--out", type=Path, default=None, help="the file to write")
     direction = p.add_mutually_exclusive_group(required=True)
     direction.add_argument(
         "--to",
-        choices=("chain-level", "chain-json"),
-        help="chain-level: import an original file; chain-json: export one of ours",
+        choices=("chain-level", "chain-json", "xmpuzzle"),
+        help="chain-level: import an original file; chain-json: export one of our stacking "
+        "levels; xmpuzzle: export one of our levels as a BurrTools file",
     )
     direction.add_argument(
         "--from",
@@ -62,22 +76,43 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.out is not None:
+        if args.target is not None and args.target != args.out:
+            raise CommandError("give the file to write once: as TARGET or as --out")
+        args.target = args.out
     from chaingeo.core.formats.chain_json import write_chain_stacking
-    from chaingeo.core.level import level_bytes, load_level, save_level
+    from chaingeo.core.level import level_bytes, save_level
 
-    if args.to == "chain-json":
+    if args.to in ("chain-json", "xmpuzzle"):
         if args.target is None:
-            raise ValueError("--to chain-json needs a target file")
-        write_chain_stacking(load_level(args.source), args.target)
+            raise CommandError(f"--to {args.to} needs a target file")
+        level = find_level(args.source)
+        if args.to == "xmpuzzle":
+            export_xmpuzzle(level, args.target)
+        else:
+            write_chain_stacking(level, args.target)
         print(args.target)
         return 0
-    level = import_chain_file(args.source, args.id, args.difficulty, args.rules)
+    level = import_chain_file(Path(args.source), args.id, args.difficulty, args.rules)
     if args.target is None:
         sys.stdout.write(level_bytes(level).decode("utf-8"))
         return 0
     save_level(level, args.target)
     print(args.target)
     return 0
+
+
+def export_xmpuzzle(level: Level, target: Path) -> None:
+    """Write ``level`` as a BurrTools file, naming on stderr the rules the file cannot carry."""
+    from chaingeo.core.formats.bt_level import level_puzzle, rules_not_carried
+    from chaingeo.core.formats.bt_write import write_xmpuzzle
+
+    write_xmpuzzle(level_puzzle(level), target)
+    for rule in rules_not_carried(level):
+        print(
+            f"chain convert: {level.id}: not carried into the BurrTools file: {rule}",
+            file=sys.stderr,
+        )
 
 
 def import_chain_file(

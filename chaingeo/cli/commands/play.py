@@ -14,7 +14,7 @@ import tempfile
 from pathlib import Path
 from typing import Any, TextIO
 
-from chaingeo.cli.errors import CommandError
+from chaingeo.cli.level_arg import find_level
 
 
 def register(sub: Any) -> None:
@@ -32,22 +32,8 @@ def register(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def _find_level(spec: str, folder: Path | None) -> Any:
-    from chaingeo.core.level import load_level, load_levels
-    from chaingeo.core.suite import shipped_levels
-
-    path = Path(spec)
-    if path.suffix == ".json" or path.is_file():
-        return load_level(path)
-    root = folder if folder is not None else shipped_levels()
-    for level in load_levels(root) if root.is_dir() else []:
-        if level.id == spec:
-            return level
-    raise CommandError(f"no level file or level id {spec!r} (looked in {root})")
-
-
 def run(args: argparse.Namespace) -> int:
-    level = _find_level(args.level, args.levels)
+    level = find_level(args.level, args.levels)
     views = None
     if not args.no_images:
         views = args.views or Path(tempfile.mkdtemp(prefix=f"chain-play-{level.id}-"))

@@ -1,0 +1,31 @@
+"""A level named on the command line: a level file, or the id of a level in a folder (by
+default the shipped suite). One resolver, so every command that takes a level takes both."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from chaingeo.cli.errors import CommandError
+
+if TYPE_CHECKING:
+    from chaingeo.core.level import Level
+
+
+def is_level_file(spec: str | Path) -> bool:
+    path = Path(spec)
+    return path.suffix == ".json" or path.is_file()
+
+
+def find_level(spec: str | Path, folder: Path | None = None) -> Level:
+    """The level in file ``spec``, else the level whose id is ``spec`` under ``folder``."""
+    from chaingeo.core.level import load_level, load_levels
+    from chaingeo.core.suite import shipped_levels
+
+    if is_level_file(spec):
+        return load_level(spec)
+    root = folder if folder is not None else shipped_levels()
+    for level in load_levels(root) if root.is_dir() else []:
+        if level.id == str(spec):
+            return level
+    raise CommandError(f"no level file or level id {str(spec)!r} (looked in {root})")
