@@ -29,9 +29,9 @@ from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
 from chaingeo.core.geometry import NEIGHBOURS, Shape
+from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Assembly, SearchLimitError
 from generator.candidate import Candidate, evaluate, piece_names, probe_limits
 from generator.config import PuzzleConfig

@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
+from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import SearchLimitError
 from solvers import movement as mv
 from solvers.pattern_db import DEAD, KEY_WIDTH, lookup

@@ -19,8 +19,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from chaingeo.core.jit import njit
 from solvers.kernels import (
     DONE,
     FRESH,

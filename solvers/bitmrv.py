@@ -25,8 +25,8 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from chaingeo.core.jit import njit
 from solvers.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
 from solvers.kernels import (
     DONE,

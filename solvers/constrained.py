@@ -25,9 +25,9 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-from numba import njit
 
 from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
+from chaingeo.core.jit import njit
 from solvers.placements import Int32Array, IntArray, Placements, target_index
 from solvers.problem import CoverError, CoverProblem, PieceType
 

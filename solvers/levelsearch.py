@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
+from chaingeo.core.jit import njit
 from solvers import movement as mv
 
 I64 = npt.NDArray[np.int64]

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
+
+from chaingeo.core.jit import njit
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]

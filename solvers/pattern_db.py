@@ -23,8 +23,8 @@ from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
+from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import SearchLimitError
 from solvers import movement as mv
 from solvers.partsearch import Deadline, PieceTable

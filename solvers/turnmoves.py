@@ -24,9 +24,9 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
 from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
+from chaingeo.core.jit import njit
 from chaingeo.core.turns import quarter_index, swept_squares
 from solvers import movement as mv
 

@@ -25,7 +25,13 @@ def find_level(spec: str | Path, folder: Path | None = None) -> Level:
     if is_level_file(spec):
         return load_level(spec)
     root = folder if folder is not None else shipped_levels()
-    for level in load_levels(root) if root.is_dir() else []:
+    if not root.is_dir():
+        raise CommandError(f"no level file or level id {str(spec)!r} ({root} is no folder)")
+    for path in sorted(root.rglob(f"{Path(spec).name}.json")):  # files are named by id
+        level = load_level(path)
+        if level.id == str(spec):
+            return level
+    for level in load_levels(root):
         if level.id == str(spec):
             return level
     raise CommandError(f"no level file or level id {str(spec)!r} (looked in {root})")

@@ -44,6 +44,9 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    # The process' own command line, for a command that starts itself again (analyze); None
+    # when main() is called from Python.
+    args.command_line = list(sys.argv[1:]) if argv is None else None
     if not getattr(args, "func", None):
         parser.print_help()
         return 0

@@ -25,9 +25,9 @@ from collections.abc import Iterator, Mapping, Sequence
 from typing import overload
 
 import numpy as np
-from numba import njit
 
 from chaingeo.core.geometry import Cell
+from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import (
     DIRECTIONS,
     OPPOSITE,

@@ -1,34 +1,61 @@
-"""``chain analyze FILE [--problem N] [--mirrors keep|drop]``: assemblies, solutions, level, moves
-and o_i of a puzzle (one of our level files or a BurrTools ``.xmpuzzle``), printed as one JSON
-object. A ``.xmpuzzle`` with several problems and no ``--problem`` gives
-``{"problems": [...], "seconds": ...}``, one object per problem.
+"""``chain analyze FILE... [--problem N] [--mirrors keep|drop]``: assemblies, solutions, level,
+moves and o_i of puzzles (our level files or level ids, BurrTools ``.xmpuzzle`` files), one JSON
+line per file, so a designer's batch pays the start-up once. A ``.xmpuzzle`` with several
+problems and no ``--problem`` gives ``{"problems": [...], ...}``, one object per problem.
 
 ``--mirrors keep`` (default) counts mirror images apart: BurrTools' stored figures (e.g. 1063
 assemblies / 314 solutions on its SolidSixPieceBurrs example); ``--mirrors drop`` identifies an
 assembly with its mirror image when that is an assembly too: what BurrTools' command-line
 solver prints (588 / 179 there).
 
-``--seconds`` bounds the whole command: the enumeration of assemblies, every disassembly and the
-optimal search share one deadline; past it the command fails with the limit's message (exit
-status 2), except that a spent optimal search alone is reported as ``optimal_error``."""
+``--seconds`` bounds the whole analysis of one file: the enumeration of assemblies, every
+disassembly and the optimal search share one deadline; past it the file fails with the limit's
+message, except that a spent optimal search alone is reported as ``optimal_error``.
+
+``--jit auto`` (default) runs a single small file with interpreted kernels: starting numba costs
+more than the work (:mod:`chaingeo.core.jit`); if the work takes more than
+:data:`INTERPRETED_SECONDS` of CPU time, the command starts again with numba.
+
+Exit status: 0, or 2 when some file failed (its line carries ``error``; the message is also on
+standard error).
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
 import math
+import os
+import signal
+import sys
 import time
 from pathlib import Path
-from typing import Any
+from types import FrameType
+from typing import Any, Final
 
 from chaingeo.cli.errors import CommandError
+from chaingeo.cli.level_arg import find_level, is_level_file
+
+#: Work an interpreted run may do before the command starts again with numba (seconds of the
+#: process' CPU time, so that a busy machine does not change the choice).
+INTERPRETED_SECONDS: Final = 0.15
+#: A file is tried interpreted only up to these sizes (pieces, voxels of all pieces).
+SMALL_PIECES: Final = 12
+SMALL_VOXELS: Final = 160
 
 
 def register(sub: Any) -> None:
     p = sub.add_parser(
-        "analyze", help="assemblies, solutions, level and optimal steps of a puzzle file"
+        "analyze",
+        help="assemblies, solutions, level and optimal steps of puzzles (one JSON line each)",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    p.add_argument("file", type=Path, help="a chain-level/1 puzzle file or a .xmpuzzle file")
+    p.add_argument(
+        "files",
+        nargs="+",
+        metavar="FILE",
+        help="chain-level/1 puzzle files, level ids of the shipped suite, or .xmpuzzle files",
+    )
     p.add_argument(
         "--problem",
         type=int,
@@ -46,29 +73,62 @@ def register(sub: Any) -> None:
         "--seconds",
         type=float,
         default=120.0,
-        help="time limit of the whole analysis (assemblies, disassembly and optimal search)",
+        help="time limit of one file's analysis (assemblies, disassembly and optimal search)",
     )
     p.add_argument("--max-states", type=int, default=2_000_000, help="state cap per part")
     p.add_argument("--no-optimal", action="store_true", help="skip the optimal-plan search")
     p.add_argument(
         "--no-assemble", action="store_true", help="skip counting assemblies (level only)"
     )
+    p.add_argument(
+        "--jit",
+        choices=("auto", "numba", "python"),
+        default="auto",
+        help="kernels compiled by numba, interpreted, or interpreted for one small file",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    if not (math.isfinite(args.seconds) and args.seconds > 0):
+        raise CommandError(f"--seconds: expected a positive number of seconds, got {args.seconds}")
+    if args.max_states < 1:
+        raise CommandError(f"--max-states: expected a positive number, got {args.max_states}")
+    if _interpreted_first(args):
+        return _run_interpreted(args)
+    if args.jit != "auto":
+        _set_mode(args.jit)
+    return _run_all(args)
+
+
+def _run_all(args: argparse.Namespace) -> int:
+    status = 0
+    for spec in args.files:
+        try:
+            out = analyze_file(spec, args)
+        except CommandError as e:
+            if len(args.files) == 1:
+                raise
+            print(f"chain analyze: {spec}: error: {e}", file=sys.stderr)
+            out, status = {"file": str(spec), "error": str(e)}, 2
+        print(json.dumps(out, sort_keys=True), flush=True)
+    return status
+
+
+def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
+    """The figures of one file (``CommandError`` for any failure, with the reason)."""
+    from chaingeo.core.formats.bt_model import BurrToolsError
     from chaingeo.core.kinematics import SearchLimitError
+    from chaingeo.core.level import LevelError
     from solvers.analysis import level_figures, xmpuzzle_figures
     from solvers.partsearch import SearchLimits
 
-    if not (math.isfinite(args.seconds) and args.seconds > 0):
-        raise CommandError(f"--seconds: expected a positive number of seconds, got {args.seconds}")
     limits = SearchLimits(max_states=args.max_states, seconds=args.seconds)
     start = time.perf_counter()
     try:
-        if args.file.suffix == ".xmpuzzle":
+        if Path(spec).suffix == ".xmpuzzle":
             out = xmpuzzle_figures(
-                args.file,
+                spec,
                 args.problem,
                 limits,
                 not args.no_optimal,
@@ -76,16 +136,99 @@ def run(args: argparse.Namespace) -> int:
                 args.mirrors,
             )
         else:
-            from chaingeo.core.level import load_level  # a BurrTools file needs no level reader
-
-            level = load_level(args.file)
+            level = find_level(spec)
             out = level_figures(
                 level, limits, not args.no_optimal, not args.no_assemble, args.mirrors
             )
-    except SearchLimitError as e:
+    except (SearchLimitError, LevelError, BurrToolsError, FileNotFoundError) as e:
         raise CommandError(str(e)) from None
-    except (IndexError, RuntimeError) as e:
+    except (IndexError, RuntimeError, ValueError) as e:
         raise CommandError(str(e)) from None
+    from chaingeo.core.jit import mode
+
+    out["file"] = str(spec)
+    out["kernels"] = mode()
     out["seconds"] = round(time.perf_counter() - start, 3)
-    print(json.dumps(out, sort_keys=True))
+    return out
+
+
+# -- interpreted kernels for one small file ---------------------------------------------------
+
+
+class _TooLong(BaseException):
+    """The interpreted run's budget is spent (a BaseException: no analysis code catches it)."""
+
+
+def _set_mode(wanted: str) -> None:
+    from chaingeo.core.jit import set_mode
+
+    try:
+        set_mode("python" if wanted == "python" else "numba")
+    except RuntimeError as e:  # the process has kernels already (a caller of main())
+        raise CommandError(f"--jit {wanted}: {e}") from None
+
+
+def _interpreted_first(args: argparse.Namespace) -> bool:
+    """Whether to try the one file interpreted: ``--jit auto``, one small file, no mode forced
+    by ``CHAINGEO_JIT``, and a command line to start again with (not a call of ``main``)."""
+    from chaingeo.core import jit
+
+    argv = getattr(args, "command_line", None)
+    if args.jit != "auto" or len(args.files) != 1 or argv is None or jit.ENV in os.environ:
+        return False
+    return _small(args.files[0], args.problem)
+
+
+def _small(spec: str, problem: int | None) -> bool:
+    """A cheap look at the file: few pieces and voxels (anything unreadable: not small, and the
+    real run says why)."""
+    try:
+        if Path(spec).suffix == ".xmpuzzle":
+            from chaingeo.core.formats.burrtools import read_xmpuzzle
+
+            puzzle = read_xmpuzzle(spec)
+            problems = (
+                puzzle.problems if problem is None else puzzle.problems[problem : problem + 1]
+            )
+            pieces = sum(p.max for prob in problems for p in prob.parts)
+            voxels = sum(len(puzzle.shapes[prob.result].cells) for prob in problems)
+        elif is_level_file(spec):
+            from chaingeo.core.level import load_level
+
+            level = load_level(spec)
+            pieces = len(level.pieces)
+            voxels = sum(len(p.shape) for p in level.pieces)
+        else:
+            return False
+    except Exception:  # a look only: the analysis itself reports what is wrong
+        return False
+    return 0 < pieces <= SMALL_PIECES and voxels <= SMALL_VOXELS
+
+
+def _run_interpreted(args: argparse.Namespace) -> int:
+    """Analyse interpreted within :data:`INTERPRETED_SECONDS`, else start again with numba
+    (nothing has been printed by then)."""
+
+    def expire(signum: int, frame: FrameType | None) -> None:
+        raise _TooLong
+
+    _set_mode("python")
+    previous = signal.signal(signal.SIGPROF, expire)
+    signal.setitimer(signal.ITIMER_PROF, INTERPRETED_SECONDS)
+    try:
+        out = analyze_file(args.files[0], args)
+        signal.setitimer(signal.ITIMER_PROF, 0)
+    except _TooLong:
+        _restart_with_numba(args.command_line)
+    finally:
+        signal.signal(signal.SIGPROF, previous)
+    print(json.dumps(out, sort_keys=True), flush=True)
     return 0
+
+
+def _restart_with_numba(argv: list[str]) -> None:
+    from chaingeo.core.jit import ENV
+
+    env = dict(os.environ, **{ENV: "numba"})
+    sys.stdout.flush()
+    os.execve(sys.executable, [sys.executable, "-m", "chaingeo.cli.main", *argv], env)

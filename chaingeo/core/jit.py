@@ -1,0 +1,77 @@
+"""The one place kernels are compiled: numba's ``njit``, or the plain Python function.
+
+Every kernel of the toolkit is written once, for numba, on flat numpy arrays, and decorated with
+:func:`njit` from here. By default that is numba's ``njit``. In *interpreted* mode the decorator
+returns the function itself and numba is never imported: starting numba and loading its cached
+kernels costs ~0.3 s of a process, many times the work of a small puzzle, so ``chain analyze``
+runs a single small file interpreted and moves to numba when the work turns out larger (it starts
+itself again with the mode set, see :mod:`chaingeo.cli.commands.analyze`).
+
+The mode is read from ``CHAINGEO_JIT`` (``numba``, the default, or ``python``) when a kernel
+module is first imported, so it is fixed for a process before any kernel is defined; changing it
+later raises. Interpreted kernels compute the same results: fixed-width numpy integers wrap as
+numba's do (numpy's overflow warnings are silenced in that mode).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+from typing import Any, Final, Literal, TypeVar, overload
+
+import numpy as np
+
+Mode = Literal["numba", "python"]
+ENV: Final = "CHAINGEO_JIT"
+MODES: Final[tuple[Mode, ...]] = ("numba", "python")
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+_mode: Mode | None = None
+
+
+def mode() -> Mode:
+    """The process' mode, fixed at the first call (``CHAINGEO_JIT``; default numba)."""
+    if _mode is None:
+        raw = os.environ.get(ENV, "numba").strip().lower() or "numba"
+        if raw not in MODES:
+            raise ValueError(f"{ENV}: expected one of {', '.join(MODES)}, got {raw!r}")
+        _fix("python" if raw == "python" else "numba")
+    assert _mode is not None
+    return _mode
+
+
+def set_mode(wanted: Mode) -> None:
+    """Fix the mode before any kernel is defined; ``RuntimeError`` once another is in force.
+    (The environment is left alone: a child process chooses for itself.)"""
+    if wanted not in MODES:
+        raise ValueError(f"mode: expected one of {', '.join(MODES)}, got {wanted!r}")
+    if _mode is not None and _mode != wanted:
+        raise RuntimeError(f"kernels are already {_mode}; the mode is fixed per process")
+    _fix(wanted)
+
+
+def _fix(wanted: Mode) -> None:
+    global _mode
+    _mode = wanted
+    if wanted == "python":
+        np.seterr(over="ignore")  # numpy scalars warn where numba's integers wrap silently
+
+
+@overload
+def njit(fn: F, /) -> F: ...
+@overload
+def njit(**options: Any) -> Callable[[F], F]: ...
+def njit(*args: Any, **options: Any) -> Any:
+    """``numba.njit`` with the same arguments, or (interpreted) the function unchanged."""
+    if mode() == "python":
+        if args and callable(args[0]):
+            return args[0]
+        return _identity
+    import numba  # only here: interpreted processes never import it
+
+    return numba.njit(*args, **options)
+
+
+def _identity(fn: F) -> F:
+    return fn

@@ -1,0 +1,128 @@
+"""``chain analyze FILE...``: many files in one process (one JSON line each), level ids, and
+kernels interpreted for one small file (the same figures as numba's, and a move to numba when
+the work is large)."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from chaingeo.cli.main import main
+from chaingeo.core.suite import shipped_levels
+
+DATA = Path(__file__).parent / "data" / "burrtools"
+#: Small files whose whole analysis takes well under a second interpreted.
+SMALL = [
+    "puzzle-easy-02-luban-6-piece",
+    "puzzle-easy-04-burr6",
+    "puzzle-easy-07-burr3",
+    "puzzle-easy-08-plate3",
+    "puzzle-easy-09-cube3",
+    str(DATA / "linked_rings.xmpuzzle"),
+    str(DATA / "ring_maze.xmpuzzle"),
+]
+
+
+def _lines(text: str) -> list[dict[str, Any]]:
+    return [json.loads(line) for line in text.splitlines() if line.strip()]
+
+
+def _figures(row: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in row.items() if k not in ("seconds", "kernels")}
+
+
+def _chain(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "chaingeo.cli.main", "analyze", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, **(env or {})},
+        check=False,
+    )
+
+
+def test_many_files_one_line_each_and_a_bad_file_does_not_stop_the_batch(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "bad.xmpuzzle"
+    bad.write_bytes(b"not a puzzle")
+    level = "puzzle-easy-07-burr3"
+    by_file = shipped_levels("puzzle") / f"{level}.json"
+    status = main(["analyze", level, str(bad), str(by_file), "--no-optimal", "--jit", "numba"])
+    assert status == 2
+    captured = capsys.readouterr()
+    first, broken, last = _lines(captured.out)
+    assert first["file"] == level and last["file"] == str(by_file)
+    assert _figures(first) | {"file": ""} == _figures(last) | {"file": ""}
+    assert (first["assemblies"], first["solutions"], first["level"]) == (1, 1, "2")
+    assert broken["file"] == str(bad) and broken["error"]
+    assert f"{bad}: error:" in captured.err
+
+
+def test_one_bad_file_is_an_error_with_no_json(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["analyze", "no-such-level", "--jit", "numba"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert "no level file or level id 'no-such-level'" in captured.err
+
+
+def test_kernels_cannot_change_in_a_process_that_has_them(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    from chaingeo.core.jit import mode
+
+    assert mode() == "numba"  # the test process compiles its kernels
+    assert main(["analyze", "puzzle-easy-07-burr3", "--jit", "python"]) == 2
+    assert "the mode is fixed per process" in capsys.readouterr().err
+
+
+def test_interpreted_kernels_give_numba_s_figures(capsys: pytest.CaptureFixture[str]) -> None:
+    interpreted = _chain(*SMALL, "--mirrors", "drop", "--jit", "python")
+    assert interpreted.returncode == 0, interpreted.stderr
+    assert main(["analyze", *SMALL, "--mirrors", "drop", "--jit", "numba"]) == 0
+    compiled = _lines(capsys.readouterr().out)
+    rows = _lines(interpreted.stdout)
+    assert {r["kernels"] for r in rows} == {"python"}
+    assert {r["kernels"] for r in compiled} == {"numba"}
+    assert [_figures(r) for r in rows] == [_figures(r) for r in compiled]
+
+
+def test_auto_runs_a_small_file_interpreted_and_a_large_one_with_numba() -> None:
+    small = _chain(str(DATA / "linked_rings.xmpuzzle"))
+    assert small.returncode == 0, small.stderr
+    assert _lines(small.stdout)[0]["kernels"] == "python"
+    # Small by its size, but seconds of work interpreted: the command starts again with numba.
+    slow = _chain(str(DATA / "deep_maze.xmpuzzle"), "--no-optimal")
+    assert slow.returncode == 0, slow.stderr
+    (row,) = _lines(slow.stdout)
+    assert (row["kernels"], row["level"]) == ("numba", "51")
+    forced = _chain(str(DATA / "linked_rings.xmpuzzle"), env={"CHAINGEO_JIT": "numba"})
+    assert _lines(forced.stdout)[0]["kernels"] == "numba"
+
+
+def test_a_bad_mode_in_the_environment_is_named() -> None:
+    bad = _chain(str(DATA / "linked_rings.xmpuzzle"), env={"CHAINGEO_JIT": "fast"})
+    assert bad.returncode == 2
+    assert "CHAINGEO_JIT: expected one of numba, python, got 'fast'" in bad.stderr
+
+
+def test_an_interpreted_analysis_never_imports_numba() -> None:
+    script = (
+        "import sys\n"
+        "from chaingeo.cli.main import main\n"
+        f"status = main(['analyze', {str(DATA / 'linked_rings.xmpuzzle')!r}, '--jit', 'python'])\n"
+        "print('numba' in sys.modules, status)\n"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert run.stdout.splitlines()[-1] == "False 0", run.stderr
