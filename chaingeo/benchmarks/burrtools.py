@@ -23,7 +23,9 @@ BurrTools' semantics, timed in the same run:
 repeated; ``agree`` says whether the previous engine's figures are ours). Every run builds
 its problem from scratch (the engines' placement caches are cleared first); JIT compilation is
 excluded: both engines run a small problem first. ``--quick``:
-four small instances, previous engine capped at 5 s. ``CHAIN_BENCH_BT_SECONDS`` sets the time
+four small instances, previous engine capped at 5 s. Last, when burrTxt can be built here, the
+whole-process comparison with BurrTools itself (:mod:`chaingeo.benchmarks.burrtxt`, also
+``chain bench burrtxt`` alone). ``CHAIN_BENCH_BT_SECONDS`` sets the time
 limit of each search (default 120, as ``chain analyze``).
 """
 
@@ -295,4 +297,6 @@ def run(args: argparse.Namespace) -> int:
             {"instances": len(rows), "seconds": round(total, 3), "rows": rows}, sort_keys=True
         )
     )
-    return 0
+    from chaingeo.benchmarks import burrtxt
+
+    return burrtxt.run(args)
