@@ -36,10 +36,7 @@ class Deadline:
     def error(self, where: str = "") -> SearchLimitError:
         """The error that names this cap (``where``: what was running, for the message)."""
         at = f" in {where}" if where else ""
-        return SearchLimitError(
-            f"time limit of {self.seconds:g} s reached{at}; pass a larger limit "
-            "(SearchLimits(seconds=...) or --seconds)"
-        )
+        return SearchLimitError(f"time limit of {self.seconds:g} s reached{at}", "seconds")
 
     def check(self) -> None:
         if self.expired():

@@ -316,7 +316,17 @@ class Assembly:
 
 
 class SearchLimitError(RuntimeError):
-    """A search or enumeration stopped at its cap; the message says which cap and how to lift it."""
+    """A search or enumeration stopped at its cap; the message says which cap and how to lift it.
+
+    ``reason`` says what was reached; ``cap`` names the cap when it is a field of the caller's
+    limits (``"seconds"``, ``"max_states"``, ...), so a front end names its own option for it
+    (the command line its flag) while the message names the Python field."""
+
+    def __init__(self, reason: str, cap: str | None = None, owner: str = "SearchLimits") -> None:
+        hint = f"; raise {owner}({cap}=...)" if cap else ""
+        super().__init__(reason + hint)
+        self.reason = reason
+        self.cap = cap
 
 
 def movable_groups(state: Assembly, direction: str, limit: int = 4096) -> list[tuple[str, ...]]:

@@ -31,10 +31,13 @@ import sys
 import time
 from pathlib import Path
 from types import FrameType
-from typing import Any, Final
+from typing import TYPE_CHECKING, Any, Final
 
 from chaingeo.cli.errors import CommandError
 from chaingeo.cli.level_arg import find_level, is_level_file
+
+if TYPE_CHECKING:
+    from chaingeo.core.kinematics import SearchLimitError
 
 #: Work an interpreted run may do before the command starts again with numba (seconds of the
 #: process' CPU time, so that a busy machine does not change the choice).
@@ -42,6 +45,10 @@ INTERPRETED_SECONDS: Final = 0.15
 #: A file is tried interpreted only up to these sizes (pieces, voxels of all pieces).
 SMALL_PIECES: Final = 12
 SMALL_VOXELS: Final = 160
+
+
+#: The flags that set the fields of ``SearchLimits`` a search may reach.
+LIMIT_FLAGS: Final = {"seconds": "--seconds", "max_states": "--max-states"}
 
 
 def register(sub: Any) -> None:
@@ -140,7 +147,9 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
             out = level_figures(
                 level, limits, not args.no_optimal, not args.no_assemble, args.mirrors
             )
-    except (SearchLimitError, LevelError, BurrToolsError, FileNotFoundError) as e:
+    except SearchLimitError as e:
+        raise CommandError(limit_message(e)) from None
+    except (LevelError, BurrToolsError, FileNotFoundError) as e:
         raise CommandError(str(e)) from None
     except (IndexError, RuntimeError, ValueError) as e:
         raise CommandError(str(e)) from None
@@ -150,6 +159,12 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
     out["kernels"] = mode()
     out["seconds"] = round(time.perf_counter() - start, 3)
     return out
+
+
+def limit_message(e: SearchLimitError) -> str:
+    """The limit's reason, naming the flag that raises it (not the Python field)."""
+    flag = LIMIT_FLAGS.get(e.cap or "")
+    return f"{e.reason}; raise it with {flag}" if flag else str(e)
 
 
 # -- interpreted kernels for one small file ---------------------------------------------------
