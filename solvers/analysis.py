@@ -135,6 +135,7 @@ def disassembly_figures(
     out: dict[str, Any] = {}
     if deadline is None:
         deadline = Deadline(limits.seconds)
+    deadline.progress.stage = "taking the assembly apart"
     first = analyze(
         shapes,
         max_group=max_group,
@@ -146,6 +147,7 @@ def disassembly_figures(
     )
     out.update(level=first.level, moves=first.moves, optimal_steps=None)
     if optimal and first.disassemblable:
+        deadline.progress.stage = "searching for the optimal plan"
         try:
             out["optimal_steps"] = analyze_puzzle(
                 shapes,
@@ -181,6 +183,7 @@ def level_figures(
     if assemble:
         from solvers.assemble import count_solutions  # the placement engine of our levels
 
+        deadline.progress.stage = "counting assemblies"
         target = Shape([c for p in level.pieces for c in p.shape.cells])
         rep = count_solutions(
             [PieceSpec(p.shape.normalized(), p.name) for p in level.pieces],
@@ -241,6 +244,7 @@ def problem_figures(
     found: tuple[dict[str, Shape], PieceGroups] | None = None
     first: Analysis | None = None
     if assemble:
+        deadline.progress.stage = f"problem {index}: counting assemblies"
         packing = compile_packing(bt_packing_spec(puzzle, index))
         rep = count_bt(packing, mirrors=mirrors, limits=limits, deadline=deadline)
         out.update(assemblies=rep.assemblies, solutions=rep.solutions)
@@ -266,6 +270,7 @@ def problem_figures(
     else:  # the level is known: the assembler's disassembler found it
         out.update(level=first.level, moves=first.moves, optimal_steps=None)
         if optimal:
+            deadline.progress.stage = f"problem {index}: searching for the optimal plan"
             try:
                 out["optimal_steps"] = analyze_puzzle(
                     shapes, max_group=None, limits=limits, deadline=deadline

@@ -15,15 +15,32 @@ import time
 from chaingeo.core.kinematics import SearchLimitError
 
 
+class Progress:
+    """What an analysis is doing now (``stage``) and its running counts, written by the
+    searches as they go and read by a front end that reports progress (from another thread:
+    plain attribute writes, read as a snapshot)."""
+
+    def __init__(self) -> None:
+        self.stage = ""
+        self.counts: dict[str, int] = {}
+
+    def text(self) -> str:
+        counts = ", ".join(f"{k} {v}" for k, v in self.counts.items())
+        return f"{self.stage} ({counts})" if counts else self.stage
+
+
 class Deadline:
-    """The wall-clock budget shared by every search of one analysis (None: no time limit).
-    ``ValueError`` for a negative or NaN number of seconds (NaN would never expire)."""
+    """The wall-clock budget shared by every search of one analysis (None: no time limit),
+    with the analysis' :class:`Progress`. ``ValueError`` for a negative or NaN number of
+    seconds (NaN would never expire)."""
 
     def __init__(self, seconds: float | None) -> None:
         if seconds is not None and (math.isnan(seconds) or seconds < 0):
             raise ValueError(f"seconds: a time limit must be >= 0, got {seconds}")
         self.seconds = seconds
-        self.end = None if seconds is None else time.monotonic() + seconds
+        self.start = time.monotonic()
+        self.end = None if seconds is None else self.start + seconds
+        self.progress = Progress()
 
     @property
     def bounded(self) -> bool:

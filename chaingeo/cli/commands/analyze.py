@@ -8,9 +8,11 @@ assemblies / 314 solutions on its SolidSixPieceBurrs example); ``--mirrors drop`
 assembly with its mirror image when that is an assembly too: what BurrTools' command-line
 solver prints (588 / 179 there).
 
-``--seconds`` bounds the whole analysis of one file: the enumeration of assemblies, every
-disassembly and the optimal search share one deadline; past it the file fails with the limit's
-message, except that a spent optimal search alone is reported as ``optimal_error``.
+A file that takes more than a few seconds reports on standard error what it is doing
+(:mod:`chaingeo.cli.progress`). ``--seconds`` bounds the whole analysis of one file: the
+enumeration of assemblies, every disassembly and the optimal search share one deadline; past it
+the file fails with the limit's message, except that a spent optimal search alone is reported as
+``optimal_error``.
 
 ``--jit auto`` (default) runs a single small file with interpreted kernels: starting numba costs
 more than the work (:mod:`chaingeo.core.jit`); if the work takes more than
@@ -35,6 +37,7 @@ from typing import TYPE_CHECKING, Any, Final
 
 from chaingeo.cli.errors import CommandError
 from chaingeo.cli.level_arg import find_level, is_level_file
+from chaingeo.cli.progress import ProgressLines
 
 if TYPE_CHECKING:
     from chaingeo.core.kinematics import SearchLimitError
@@ -128,25 +131,34 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
     from chaingeo.core.kinematics import SearchLimitError
     from chaingeo.core.level import LevelError
     from solvers.analysis import level_figures, xmpuzzle_figures
+    from solvers.deadline import Deadline
     from solvers.partsearch import SearchLimits
 
     limits = SearchLimits(max_states=args.max_states, seconds=args.seconds)
+    deadline = Deadline(limits.seconds)
     start = time.perf_counter()
     try:
-        if Path(spec).suffix == ".xmpuzzle":
-            out = xmpuzzle_figures(
-                spec,
-                args.problem,
-                limits,
-                not args.no_optimal,
-                not args.no_assemble,
-                args.mirrors,
-            )
-        else:
-            level = find_level(spec)
-            out = level_figures(
-                level, limits, not args.no_optimal, not args.no_assemble, args.mirrors
-            )
+        with ProgressLines(f"chain analyze: {spec}", deadline.progress):
+            if Path(spec).suffix == ".xmpuzzle":
+                out = xmpuzzle_figures(
+                    spec,
+                    args.problem,
+                    limits,
+                    not args.no_optimal,
+                    not args.no_assemble,
+                    args.mirrors,
+                    deadline,
+                )
+            else:
+                level = find_level(spec)
+                out = level_figures(
+                    level,
+                    limits,
+                    not args.no_optimal,
+                    not args.no_assemble,
+                    args.mirrors,
+                    deadline,
+                )
     except SearchLimitError as e:
         raise CommandError(limit_message(e)) from None
     except (LevelError, BurrToolsError, FileNotFoundError) as e:
