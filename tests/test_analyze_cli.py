@@ -126,3 +126,12 @@ def test_an_interpreted_analysis_never_imports_numba() -> None:
         [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=False
     )
     assert run.stdout.splitlines()[-1] == "False 0", run.stderr
+
+
+def test_chain_version(capsys: pytest.CaptureFixture[str]) -> None:
+    from chaingeo import __version__
+
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0
+    assert capsys.readouterr().out.strip() == f"chain {__version__}"

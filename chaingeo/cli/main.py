@@ -16,6 +16,7 @@ import sys
 from collections.abc import Sequence
 
 import chaingeo.cli.commands
+from chaingeo import __version__
 from chaingeo.cli.errors import CommandError
 from chaingeo.core.level_reader import LevelError
 
@@ -35,6 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="chain",
         description="CHAIN-geo: exact discrete-geometry levels, solvers and agent evaluation.",
     )
+    parser.add_argument("--version", action="version", version=f"chain {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         importlib.import_module(name).register(sub)
