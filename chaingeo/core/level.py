@@ -527,7 +527,7 @@ def decode_json(text: str, source: str) -> Any:
     try:
         return limits.loads_bounded(text)
     except limits.LimitError as e:
-        raise LevelError(source, "(file)", e.reason) from None
+        raise LevelError(source, e.field or "(file)", e.reason) from None
     except json.JSONDecodeError as e:
         raise LevelError(
             source, "(file)", f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}"

@@ -1,0 +1,119 @@
+"""Hostile files (issue #21, items 9-12): level files with non-finite numbers or more pieces
+than the search kernels take, BurrTools XML that hides a DOCTYPE in another encoding, and the
+command-line paths a new user meets first. Each input gets one typed error or a clear row,
+never a traceback. Model folders (``chain import``) are in ``test_hostile_models.py``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from chaingeo.cli.main import main
+from chaingeo.core.geometry import Shape, puzzle_signature
+from chaingeo.core.level import LevelError, load_level
+from chaingeo.core.suite import shipped_levels
+from solvers.movement import MAX_PIECES
+
+BURR = shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"
+
+# ---------------------------------------------------------------------------------------------
+# Item 9: level files
+# ---------------------------------------------------------------------------------------------
+
+#: (where the literal goes, the literal, the field the error must name)
+NON_FINITE = [
+    ("stats", '{"score": NaN}', "stats.score"),
+    ("stats", '{"a": [1, {"b": -Infinity}]}', "stats.a[1].b"),
+    ("stats", '{"big": 1e999}', "stats.big"),
+    ("stats", '{"small": -1E+400}', "stats.small"),
+    ("max_steps", "Infinity", "max_steps"),
+]
+
+
+def _with_literal(tmp_path: Path, key: str, literal: str) -> Path:
+    """The shipped burr level with ``key`` set to raw JSON text (json.dumps cannot write NaN
+    in every position we want, so the text is spliced)."""
+    data = json.loads(BURR.read_text())
+    data[key] = "@@"
+    path = tmp_path / "level.json"
+    path.write_text(json.dumps(data).replace('"@@"', literal))
+    return path
+
+
+@pytest.mark.parametrize(("key", "literal", "field"), NON_FINITE)
+def test_non_finite_number_is_a_level_error_naming_the_field(
+    tmp_path: Path, key: str, literal: str, field: str
+) -> None:
+    path = _with_literal(tmp_path, key, literal)
+    with pytest.raises(LevelError) as err:
+        load_level(path)
+    assert err.value.field == field and "not a finite number" in err.value.reason
+
+
+def test_every_command_refuses_a_non_finite_level_by_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = _with_literal(tmp_path, "stats", '{"score": NaN}')
+    out = str(tmp_path / "out.json")
+    for argv in (
+        ["validate", str(path)],
+        ["convert", str(path), out, "--to", "chain-json"],
+        ["play", str(path), "--no-images"],
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert "stats.score: NaN is not a finite number" in err and err.count("\n") == 1
+    assert not (tmp_path / "out.json").exists()
+
+
+def line_puzzle(n: int) -> dict[str, Any]:
+    """``n`` one-cell pieces in a row along x, taken apart from the +x end one by one."""
+    pieces = [
+        {"name": f"p{i}", "rgb": f"#{i:02x}{i:02x}{i:02x}", "voxels": [[i, 0, 0]]} for i in range(n)
+    ]
+    moves = [
+        {"pieces": [f"p{i}"], "direction": "+x", "distance": None} for i in range(n - 1, 0, -1)
+    ]
+    return {
+        "format": "chain-level/1", "id": f"line-{n}", "family": "puzzle", "difficulty": "hard",
+        "goal": "disassemble", "box": None, "pieces": pieces, "solution": {"moves": moves},
+        "optimal_steps": n - 1, "max_steps": 2 * n, "rules": {},
+        "provenance": {"generator": "test", "version": "1", "seed": None, "index": None,
+                       "signature": puzzle_signature(Shape([(i, 0, 0)]) for i in range(n))},
+        "stats": {},
+    }  # fmt: skip
+
+
+def _validate(path: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, dict[str, Any]]:
+    code = main(["validate", str(path)])
+    out = capsys.readouterr().out.splitlines()
+    return code, json.loads(out[0])
+
+
+def test_validate_reports_a_part_past_the_kernel_bound_unchecked(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The loader takes 256 pieces; the search kernels 63 in a part: validate says so."""
+    path = tmp_path / "line.json"
+    path.write_text(json.dumps(line_puzzle(MAX_PIECES + 1)))
+    load_level(path)  # a valid level
+    code, row = _validate(path, capsys)
+    assert code == 0 and row["optimal_checked"] is False and "error" not in row
+    assert row["unchecked_reason"] == (
+        f"{MAX_PIECES + 1} pieces; the optimal search takes at most {MAX_PIECES} pieces in a part"
+    )
+
+
+def test_validate_reports_malformed_blocks_as_an_error_row(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    data = json.loads(BURR.read_text())
+    data["stats"]["blocks"] = [["nobody"]]
+    path = tmp_path / "blocks.json"
+    path.write_text(json.dumps(data))
+    code, row = _validate(path, capsys)
+    assert code == 2 and row["optimal_checked"] is False
+    assert row["error"].startswith(f"{path}: stats.blocks:")
