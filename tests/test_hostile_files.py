@@ -5,6 +5,7 @@ never a traceback. Model folders (``chain import``) are in ``test_hostile_models
 
 from __future__ import annotations
 
+import gzip
 import json
 from pathlib import Path
 from typing import Any
@@ -12,6 +13,7 @@ from typing import Any
 import pytest
 
 from chaingeo.cli.main import main
+from chaingeo.core.formats.burrtools import BurrToolsError, parse_xmpuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape, puzzle_signature
 from chaingeo.core.level import LevelError, load_level
 from chaingeo.core.suite import shipped_levels
@@ -117,3 +119,47 @@ def test_validate_reports_malformed_blocks_as_an_error_row(
     code, row = _validate(path, capsys)
     assert code == 2 and row["optimal_checked"] is False
     assert row["error"].startswith(f"{path}: stats.blocks:")
+
+
+# ---------------------------------------------------------------------------------------------
+# Item 10: BurrTools XML in any encoding
+# ---------------------------------------------------------------------------------------------
+
+_PUZZLE = (
+    '<puzzle version="2"><shapes><voxel x="1" y="1" z="1" type="0">#</voxel></shapes>'
+    "<comment>{text}</comment></puzzle>"
+)
+_LAUGHS = '<!DOCTYPE puzzle [<!ENTITY x "laugh">]>' + _PUZZLE.format(text="&x;")
+
+
+def _declared(encoding: str) -> str:
+    return f'<?xml version="1.0" encoding="{encoding}"?>'
+
+
+#: name -> the bytes of an XML file carrying a DOCTYPE with an entity
+HIDDEN_DOCTYPES = {
+    "utf-16 with BOM": (_declared("UTF-16") + _LAUGHS).encode("utf-16"),
+    "utf-16le, no BOM": (_declared("UTF-16LE") + _LAUGHS).encode("utf-16-le"),
+    "utf-16be, no BOM": (_declared("UTF-16BE") + _LAUGHS).encode("utf-16-be"),
+    "utf-16, no declaration": _LAUGHS.encode("utf-16"),
+    "utf-8 with BOM": b"\xef\xbb\xbf" + _LAUGHS.encode(),
+    "latin-1 declared": (_declared("ISO-8859-1") + _LAUGHS).encode("latin-1"),
+    "gzip of utf-16": gzip.compress((_declared("UTF-16") + _LAUGHS).encode("utf-16"), mtime=0),
+    "utf-32": (_declared("UTF-32") + _LAUGHS).encode("utf-32"),  # expat cannot read it at all
+}
+
+
+@pytest.mark.parametrize("name", sorted(HIDDEN_DOCTYPES))
+def test_doctype_is_refused_in_any_encoding(name: str, tmp_path: Path) -> None:
+    path = tmp_path / "laughs.xmpuzzle"
+    path.write_bytes(HIDDEN_DOCTYPES[name])
+    with pytest.raises(BurrToolsError) as err:
+        read_xmpuzzle(path)
+    assert err.value.source == str(path) and err.value.where == "(file)"
+    expected = "invalid XML" if name == "utf-32" else "DOCTYPE is not allowed"
+    assert expected in err.value.reason
+
+
+def test_clean_utf16_puzzle_still_reads() -> None:
+    puzzle = parse_xmpuzzle((_declared("UTF-16") + _PUZZLE.format(text="hi")).encode("utf-16"))
+    assert puzzle.comment == "hi" and len(puzzle.shapes) == 1

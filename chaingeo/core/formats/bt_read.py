@@ -8,7 +8,8 @@ tags), result, colour rules (``<bitmap>`` pairs, 0-based colour numbers in the f
 
 Hostile input meets a typed error before it costs anything: the sizes in
 :mod:`chaingeo.core.limits` bound the decompressed XML, the grids, the shapes, problems and
-pieces; a DOCTYPE (entity expansion) is refused; every number is checked. Each error is a
+pieces; a DOCTYPE or entity declaration is refused in any encoding (looked for after decoding,
+:mod:`chaingeo.core.formats.xml_guard`); every number is checked. Each error is a
 :class:`BurrToolsError` naming the file, the element and the reason.
 """
 
@@ -33,6 +34,7 @@ from chaingeo.core.formats.bt_model import (
     BurrToolsError,
     Cell,
 )
+from chaingeo.core.formats.xml_guard import doctype_problem
 from chaingeo.core.geometry import Shape
 
 
@@ -70,8 +72,9 @@ def _decompress(data: bytes, source: str) -> bytes:
         raise BurrToolsError(
             source, "(file)", f"more than {limits.MAX_XMPUZZLE_XML_BYTES} bytes of XML"
         )
-    if b"<!DOCTYPE" in raw or b"<!ENTITY" in raw:
-        raise BurrToolsError(source, "(file)", "a DOCTYPE or entity declaration is not allowed")
+    problem = doctype_problem(raw)  # after decoding, in whatever encoding the XML declares
+    if problem is not None:
+        raise BurrToolsError(source, "(file)", problem)
     return raw
 
 
