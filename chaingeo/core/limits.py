@@ -154,3 +154,29 @@ def _non_finite_path(data: Any) -> str:
             continue
         stack.extend(reversed(items))
     return "(file)"
+
+
+# ---------------------------------------------------------------------------------------------
+# chain import: CHAIN's URDF/OBJ model folders (issue #21, item 11)
+# ---------------------------------------------------------------------------------------------
+
+#: Parts (URDF files) of one model folder, counted before any is read (the palette names 48
+#: pieces; CHAIN's models have at most 15 parts).
+MAX_MODEL_PARTS: Final = 64
+#: Bytes of one URDF file (CHAIN's largest: 43 KB) and ``visual`` meshes in it (CHAIN's: 1).
+MAX_URDF_BYTES: Final = 1024 * 1024
+MAX_PART_MESHES: Final = 16
+#: Bytes of one OBJ mesh file (CHAIN's largest: 650 KB), checked before reading.
+MAX_MESH_BYTES: Final = 8 * 1024 * 1024
+#: Vertices and triangles of one part, all its meshes together, counted in the text before
+#: parsing (CHAIN's largest part: 6,381 and 12,838). The voxeliser's work is triangles times
+#: samples, so this also bounds it per cell.
+MAX_PART_VERTICES: Final = 100_000
+MAX_PART_TRIANGLES: Final = 100_000
+#: Sample-triangle pairs the voxeliser may evaluate for one part (cells of its bounding box
+#: times 27 samples times triangles), checked before any: at most about 15 s of work here,
+#: usually a third of that. CHAIN's largest part needs 3e7.
+MAX_WINDING_PAIRS: Final = 300_000_000
+#: Magnitude of a number in a URDF (``origin xyz``, ``rpy``, mesh ``scale``) or of an OBJ
+#: vertex coordinate (CHAIN's stay under 100).
+MAX_MODEL_NUMBER: Final = 1e6
