@@ -6,7 +6,9 @@ never a traceback. Model folders (``chain import``) are in ``test_hostile_models
 from __future__ import annotations
 
 import gzip
+import io
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -15,9 +17,10 @@ import pytest
 from chaingeo.cli.main import main
 from chaingeo.core.formats.burrtools import BurrToolsError, parse_xmpuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape, puzzle_signature
-from chaingeo.core.level import LevelError, load_level
+from chaingeo.core.level import LevelError, load_level, save_level
 from chaingeo.core.suite import shipped_levels
 from solvers.movement import MAX_PIECES
+from tests.env_levels import tiny_level
 
 BURR = shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"
 
@@ -163,3 +166,48 @@ def test_doctype_is_refused_in_any_encoding(name: str, tmp_path: Path) -> None:
 def test_clean_utf16_puzzle_still_reads() -> None:
     puzzle = parse_xmpuzzle((_declared("UTF-16") + _PUZZLE.format(text="hi")).encode("utf-16"))
     assert puzzle.comment == "hi" and len(puzzle.shapes) == 1
+
+
+# ---------------------------------------------------------------------------------------------
+# Item 12: what a new user meets first
+# ---------------------------------------------------------------------------------------------
+
+_RED = "place red (1,1,1) (2,1,1) (1,2,1)"
+
+
+def _play(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    lines: list[str],
+) -> tuple[list[str], list[int]]:
+    """The replies to ``undo`` and every "Steps used" figure printed, in order."""
+    path = save_level(tiny_level(), tmp_path / "tiny.json")
+    monkeypatch.setattr("sys.stdin", io.StringIO("\n".join(lines) + "\n"))
+    main(["play", str(path), "--no-images"])
+    out = capsys.readouterr().out
+    undos = re.findall(r"(?:Undone|Nothing to undo)[^\n]*", out)  # after a "> " prompt
+    return undos, [int(n) for n in re.findall(r"Steps used: (\d+) of", out)]
+
+
+def test_undo_after_a_refused_turn_keeps_the_turn_counted(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Steps used = turns taken - actions undone, whatever order they come in."""
+    undos, steps = _play(tmp_path, monkeypatch, capsys, [_RED, "place nothing", "undo", "undo"])
+    # start 0; red 1; refused 2; undo takes red back: 1; nothing left to undo: 1
+    assert steps == [0, 1, 2, 1, 1]
+    assert undos[0].startswith("Undone: place red") and "your last turn was refused" in undos[0]
+    assert undos[1].startswith("Nothing to undo: no action has been carried out")
+
+
+def test_undo_of_a_first_refused_turn_is_nothing_and_keeps_its_step(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    undos, steps = _play(tmp_path, monkeypatch, capsys, ["place nothing", "undo", _RED, "undo"])
+    assert steps == [0, 1, 1, 2, 1]
+    assert undos[0] == (
+        "Nothing to undo: no action has been carried out "
+        "(refused turns change nothing and keep their steps)."
+    )
+    assert undos[1].startswith("Undone: place red") and "refused" not in undos[1]
