@@ -9,6 +9,8 @@ import gzip
 import io
 import json
 import re
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -211,3 +213,18 @@ def test_undo_of_a_first_refused_turn_is_nothing_and_keeps_its_step(
         "(refused turns change nothing and keep their steps)."
     )
     assert undos[1].startswith("Undone: place red") and "refused" not in undos[1]
+
+
+def test_export_prints_no_nanobind_leak_warnings(tmp_path: Path) -> None:
+    """Meshes hold copies, not views of manifold3d's nanobind objects, which then die with
+    the function: nothing is left to report as leaked at exit."""
+    out = tmp_path / "burr.glb"
+    run = subprocess.run(
+        [sys.executable, "-m", "chaingeo.cli.main", "export", str(BURR), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert run.returncode == 0 and run.stdout.strip() == str(out)
+    assert run.stderr == "" and out.read_bytes()[:4] == b"glTF"
