@@ -228,3 +228,12 @@ def test_export_prints_no_nanobind_leak_warnings(tmp_path: Path) -> None:
     )
     assert run.returncode == 0 and run.stdout.strip() == str(out)
     assert run.stderr == "" and out.read_bytes()[:4] == b"glTF"
+
+
+def test_bench_cover_without_xcover_says_how_to_install_it(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setitem(sys.modules, "xcover", None)  # as if not installed
+    assert main(["bench", "cover", "--quick"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "pip install 'chaingeo[bench]'" in err
