@@ -15,7 +15,6 @@ import trimesh
 
 from chaingeo.cli.main import main
 from chaingeo.core import limits
-from chaingeo.core.formats.model_files import load_model_parts
 from chaingeo.core.formats.models import ModelImportError, import_model
 
 _CORNERS = [(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)]
@@ -111,7 +110,7 @@ def no_parsing(monkeypatch: pytest.MonkeyPatch) -> None:
 
 def _refusal(model: Path) -> ModelImportError:
     with pytest.raises(ModelImportError) as err:
-        load_model_parts(model)
+        import_model(model)
     assert err.value.source == str(model)
     assert err.value.field.startswith("a/urdf/a.urdf"), err.value  # the part and its URDF
     return err.value
