@@ -5,9 +5,11 @@ never a traceback. Model folders (``chain import``) are in ``test_hostile_models
 
 from __future__ import annotations
 
+import dataclasses
 import gzip
 import io
 import json
+import math
 import re
 import subprocess
 import sys
@@ -19,7 +21,7 @@ import pytest
 from chaingeo.cli.main import main
 from chaingeo.core.formats.burrtools import BurrToolsError, parse_xmpuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape, puzzle_signature
-from chaingeo.core.level import LevelError, load_level, save_level
+from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
 from chaingeo.core.suite import shipped_levels
 from solvers.movement import MAX_PIECES
 from tests.env_levels import tiny_level
@@ -74,6 +76,12 @@ def test_every_command_refuses_a_non_finite_level_by_name(
         err = capsys.readouterr().err
         assert "stats.score: NaN is not a finite number" in err and err.count("\n") == 1
     assert not (tmp_path / "out.json").exists()
+
+
+def test_level_built_in_code_with_nan_names_the_field_when_written() -> None:
+    level = dataclasses.replace(load_level(BURR), stats={"score": [1.0, math.nan]})
+    with pytest.raises(ValueError, match=r"^stats\.score\[1\]: nan is not a finite number$"):
+        level_bytes(level)
 
 
 def line_puzzle(n: int) -> dict[str, Any]:
