@@ -122,11 +122,16 @@ def test_validate_reports_a_part_past_the_kernel_bound_unchecked(
     )
 
 
+@pytest.mark.parametrize("case", ["unknown piece", "blocks with turns"])
 def test_validate_reports_malformed_blocks_as_an_error_row(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     data = json.loads(BURR.read_text())
-    data["stats"]["blocks"] = [["nobody"]]
+    if case == "unknown piece":
+        data["stats"]["blocks"] = [["nobody"]]
+    else:  # well formed, but the bounds that use blocks hold for translations only
+        data["stats"]["blocks"] = [[p["name"] for p in data["pieces"]]]
+        data["rules"]["turns"] = True
     path = tmp_path / "blocks.json"
     path.write_text(json.dumps(data))
     code, row = _validate(path, capsys)

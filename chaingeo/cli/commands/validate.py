@@ -62,7 +62,7 @@ def recheck_optimal(level: Level) -> int:
             "pieces in a part"
         )
     try:
-        level_blocks(level)
+        blocks = level_blocks(level)
     except ValueError as e:
         raise BadBlocks(str(e)) from None
     limits = SearchLimits(
@@ -72,6 +72,10 @@ def recheck_optimal(level: Level) -> int:
         optimum = analyze_level(level, limits).optimal_steps
     except SearchLimitError as e:
         raise NotRechecked(f"the search stopped at its cap: {e}") from None
+    except ValueError as e:  # the solvers refuse what they cannot take with a ValueError
+        if blocks is not None:  # blocks the bound cannot use (with turns, not a tower, ...)
+            raise BadBlocks(str(e)) from None
+        raise NotRechecked(f"the search cannot take this level: {e}") from None
     if optimum is None:  # the stored plan replays, so this is the search's shortfall
         raise NotRechecked("the search found no plan")
     return optimum
