@@ -205,6 +205,8 @@ BAD_OBJ: dict[str, tuple[str | bytes, str]] = {
     "negative index past the start": (CUBE + "f -1 -2 -9\n", "corner '-9'"),
     "index zero": (CUBE + "f 0 1 2\n", "corner '0'"),
     "non-numeric index": (CUBE + "f a b c\n", "corner 'a'"),
+    "superscript index": (CUBE + "f 1 2 \u00b2\n", "corner '\u00b2'"),
+    "20-digit index": (CUBE + "f 1 2 " + "9" * 20 + "\n", "corner '99999"),
     "not UTF-8": (CUBE.encode() + b"# \xff\xfe\n", "not UTF-8 text"),
     "infinite vertex": (CUBE.replace("v 1 1 1", "v 1e999 1 1"), "not a finite number"),
     "nan vertex": (CUBE.replace("v 1 1 1", "v nan 1 1"), "not a finite number"),

@@ -43,6 +43,7 @@ from chaingeo.core.level_reader import short
 
 _VERTEX_RE: Final = re.compile(r"^[ \t]*v[ \t]([^\n]*)", re.MULTILINE)
 _FACE_RE: Final = re.compile(r"^[ \t]*f[ \t]([^\n]*)", re.MULTILINE)
+_INDEX_RE: Final = re.compile(rf"-?[0-9]{{1,{limits.MAX_INT_DIGITS}}}")
 
 
 def _natural_key(text: str) -> tuple[object, ...]:
@@ -161,7 +162,7 @@ def _check_obj_text(text: str, what: str, budget: _Budget, at: _Where) -> None:
     for n, face in enumerate(faces):
         for corner in face.split():
             index = corner.split("/", 1)[0]
-            ok = index.lstrip("-").isdigit() and len(index) <= limits.MAX_INT_DIGITS
+            ok = _INDEX_RE.fullmatch(index) is not None  # ASCII digits: "²".isdigit() is True
             if not ok or not (1 <= abs(int(index)) <= vertices):
                 raise at.fail(
                     f"{what}: face {n + 1} has corner {short(corner)}; the file has "
