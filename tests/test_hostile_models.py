@@ -157,6 +157,15 @@ def test_symlink_out_of_the_folder_is_refused_unopened(tmp_path: Path) -> None:
     assert "leads outside" in _refusal(tmp_path / "n").reason
 
 
+@pytest.mark.usefixtures("no_parsing")
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs here")
+def test_fifo_named_as_a_mesh_is_never_opened(tmp_path: Path) -> None:
+    """Opening a FIFO blocks until someone writes to it: only regular files are read."""
+    model = write_model(tmp_path, filename="../meshes/obj/pipe.obj")
+    os.mkfifo(model / "a" / "meshes" / "obj" / "pipe.obj")
+    assert _refusal(model).reason == "mesh '../meshes/obj/pipe.obj': not a regular file"
+
+
 def test_refusal_is_one_line_from_the_command(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -81,8 +81,10 @@ def _inside(root: Path, path: Path, what: str, at: _Where) -> Path:
 def _read_bounded(path: Path, limit: int, what: str, at: _Where) -> bytes:
     """The bytes of a regular file of at most ``limit`` bytes (checked before reading)."""
     try:
-        if not path.is_file():
-            raise at.fail(f"{what}: no such file")
+        if not path.is_file():  # a folder, a FIFO or a device is never read
+            raise at.fail(
+                f"{what}: not a regular file" if path.exists() else f"{what}: no such file"
+            )
         size = path.stat().st_size
         if size > limit:
             raise at.fail(f"{what}: {size} bytes; at most {limit}")
