@@ -10,9 +10,12 @@ import gzip
 import io
 import json
 import math
+import os
 import re
 import subprocess
 import sys
+import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -82,6 +85,38 @@ def test_level_built_in_code_with_nan_names_the_field_when_written() -> None:
     level = dataclasses.replace(load_level(BURR), stats={"score": [1.0, math.nan]})
     with pytest.raises(ValueError, match=r"^stats\.score\[1\]: nan is not a finite number$"):
         level_bytes(level)
+
+
+def _unblock_later(fifo: Path, data: bytes) -> None:
+    """Should a reader block on ``fifo``, feed it ``data`` within 3 s, so a regression fails
+    instead of hanging; with no reader this gives up quietly (daemon thread)."""
+
+    def feed() -> None:
+        for _ in range(30):
+            try:
+                fd = os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)  # fails while no one reads
+            except OSError:
+                time.sleep(0.1)
+                continue
+            os.write(fd, data)
+            os.close(fd)
+            return
+
+    threading.Thread(target=feed, daemon=True).start()
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs here")
+def test_fifo_level_or_puzzle_file_is_refused_unopened(tmp_path: Path) -> None:
+    """``chain validate`` over a folder holding a FIFO named ``x.json`` hung for good."""
+    for name, load, error in (
+        ("x.json", load_level, LevelError),
+        ("x.xmpuzzle", read_xmpuzzle, BurrToolsError),
+    ):
+        fifo = tmp_path / name
+        os.mkfifo(fifo)
+        _unblock_later(fifo, BURR.read_bytes() if name.endswith("json") else b"<puzzle/>")
+        with pytest.raises(error, match="not a regular file"):
+            load(fifo)
 
 
 def line_puzzle(n: int) -> dict[str, Any]:

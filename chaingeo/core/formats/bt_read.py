@@ -16,6 +16,7 @@ pieces; a DOCTYPE or entity declaration is refused in any encoding (looked for a
 from __future__ import annotations
 
 import os
+import stat
 import xml.etree.ElementTree as ET
 import zlib
 from pathlib import Path
@@ -321,7 +322,10 @@ def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
 def read_xmpuzzle(path: str | os.PathLike[str]) -> BTPuzzle:
     source = str(path)
     try:
-        size = Path(path).stat().st_size
+        st = Path(path).stat()
+        if not stat.S_ISREG(st.st_mode):  # a FIFO would block the read forever
+            raise BurrToolsError(source, "(file)", "not a regular file")
+        size = st.st_size
         if size > limits.MAX_FILE_BYTES:
             raise BurrToolsError(source, "(file)", f"{size} bytes; at most {limits.MAX_FILE_BYTES}")
         data = Path(path).read_bytes()
