@@ -39,8 +39,9 @@ def test_play_to_the_end_with_undo(
     code, out = run_play(monkeypatch, capsys, [str(path), "--no-images"], "\n".join(moves) + "\n")
     assert code == 0
     assert "OK: red placed." in out and "Could not read the action 'place nothing'" in out
-    assert "Undone: place red (1,1,1) (1,2,1) (2,1,1)" in out and "Nothing to undo." in out
-    assert "Solved in 3 steps (optimal: 3)." in out
+    assert "Undone: place red (1,1,1) (1,2,1) (2,1,1) (your last turn was refused" in out
+    assert "Nothing to undo: no action has been carried out" in out
+    assert "Solved in 4 steps (optimal: 3)." in out  # the refused turn stays counted
     assert "In the box:" in out and "Steps used: 2 of 30" in out
 
 

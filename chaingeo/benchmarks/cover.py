@@ -26,6 +26,11 @@ from dataclasses import dataclass
 from chaingeo.core.geometry import Shape
 from chaingeo.core.piecesets import BEDLAM, PENTOMINOES, SOMA
 
+#: Modules this benchmark needs beyond the base install, and the extra that brings them:
+#: ``chain bench`` checks them before running and says how to install them.
+REQUIRES: tuple[str, ...] = ("xcover",)
+EXTRA = "bench"
+
 
 @dataclass(frozen=True)
 class Instance:

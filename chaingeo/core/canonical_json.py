@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from collections.abc import Mapping, Sequence
 
 _SCALARS = (str, int, float, bool, type(None))
@@ -23,7 +24,25 @@ def _is_flat(value: object) -> bool:
     )
 
 
-def _encode(value: object, indent: int) -> str:
+def _finite(value: object, path: str) -> None:
+    """JSON has no NaN or infinity: say which value is one (``json.dumps`` would not)."""
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"{path or '(top level)'}: {value} is not a finite number")
+    if isinstance(value, list | tuple):
+        for i, v in enumerate(value):
+            _finite(v, f"{path}[{i}]")
+
+
+def _scalars(value: object, path: str, separators: tuple[str, str] | None) -> str:
+    """``json.dumps`` of a scalar or flat list; the path is looked for only when it fails."""
+    try:
+        return json.dumps(value, separators=separators, allow_nan=False)
+    except ValueError:
+        _finite(value, path)
+        raise
+
+
+def _encode(value: object, indent: int, path: str = "") -> str:
     pad = "  " * indent
     inner = "  " * (indent + 1)
     if isinstance(value, Mapping):
@@ -32,19 +51,23 @@ def _encode(value: object, indent: int) -> str:
         keys = sorted(value)
         if any(not isinstance(k, str) for k in keys):
             raise TypeError("canonical JSON needs string keys")
-        items = [f"{inner}{json.dumps(k)}: {_encode(value[k], indent + 1)}" for k in keys]
+        items = [
+            f"{inner}{json.dumps(k)}: {_encode(value[k], indent + 1, f'{path}.{k}' if path else k)}"
+            for k in keys
+        ]
         return "{\n" + ",\n".join(items) + "\n" + pad + "}"
     if isinstance(value, list | tuple):
         if _is_flat(value):
-            return json.dumps(value, separators=(", ", ": "), allow_nan=False)
-        items = [f"{inner}{_encode(v, indent + 1)}" for v in value]
+            return _scalars(value, path, (", ", ": "))
+        items = [f"{inner}{_encode(v, indent + 1, f'{path}[{i}]')}" for i, v in enumerate(value)]
         return "[\n" + ",\n".join(items) + "\n" + pad + "]"
     if isinstance(value, _SCALARS):
-        return json.dumps(value, allow_nan=False)
+        return _scalars(value, path, None)
     raise TypeError(f"not JSON-serialisable: {type(value).__name__}")
 
 
 def dumps(value: Mapping[str, object] | Sequence[object]) -> str:
+    """The canonical text; a ``ValueError`` naming the path of a non-finite number."""
     return _encode(value, 0) + "\n"
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import stat
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -29,6 +30,7 @@ from chaingeo.core.kinematics import (
 )
 from chaingeo.core.level_reader import LevelError as LevelError  # re-exported
 from chaingeo.core.level_reader import Reader, only_keys, short
+from chaingeo.core.level_reader import decode_json as decode_json  # re-exported
 from chaingeo.core.rules import (
     STACKING_PROFILES,
     SUPPORT_RULES,
@@ -504,7 +506,10 @@ def load_level(path: str | os.PathLike[str]) -> Level:
     """Read and fully validate one level file."""
     source = str(path)
     try:
-        size = Path(path).stat().st_size
+        st = Path(path).stat()
+        if not stat.S_ISREG(st.st_mode):  # a FIFO would block the read forever
+            raise LevelError(source, "(file)", "not a regular file")
+        size = st.st_size
         if size > limits.MAX_FILE_BYTES:
             raise LevelError(
                 source, "(file)", f"{size} bytes; a level file has at most {limits.MAX_FILE_BYTES}"
@@ -520,20 +525,6 @@ def load_level(path: str | os.PathLike[str]) -> Level:
     except UnicodeDecodeError:
         raise LevelError(source, "(file)", "not UTF-8 text") from None
     return parse_level(decode_json(text, source), source)
-
-
-def decode_json(text: str, source: str) -> Any:
-    """``json.loads`` within :mod:`chaingeo.core.limits`; :class:`LevelError` otherwise."""
-    try:
-        return limits.loads_bounded(text)
-    except limits.LimitError as e:
-        raise LevelError(source, "(file)", e.reason) from None
-    except json.JSONDecodeError as e:
-        raise LevelError(
-            source, "(file)", f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}"
-        ) from None
-    except (ValueError, RecursionError) as e:  # defensive: never a traceback for a file
-        raise LevelError(source, "(file)", f"invalid JSON: {type(e).__name__}") from None
 
 
 def load_levels(folder: str | os.PathLike[str]) -> list[Level]:

@@ -3,6 +3,7 @@ every problem becomes one :class:`LevelError` naming the source, the field and t
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -106,3 +107,17 @@ def only_keys(
     extra = sorted(set(obj) - allowed)
     if extra:
         raise r.fail(f"{fld}.{extra[0]}", f"unknown {what}; known: {sorted(allowed)}")
+
+
+def decode_json(text: str, source: str) -> Any:
+    """``json.loads`` within :mod:`chaingeo.core.limits`; :class:`LevelError` otherwise."""
+    try:
+        return limits.loads_bounded(text)
+    except limits.LimitError as e:
+        raise LevelError(source, e.field or "(file)", e.reason) from None
+    except json.JSONDecodeError as e:
+        raise LevelError(
+            source, "(file)", f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}"
+        ) from None
+    except (ValueError, RecursionError) as e:  # defensive: never a traceback for a file
+        raise LevelError(source, "(file)", f"invalid JSON: {type(e).__name__}") from None

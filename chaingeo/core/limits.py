@@ -11,6 +11,7 @@ peaks at 36 pieces, 577 voxels, coordinates under 40, budgets of 116 steps and 1
 from __future__ import annotations
 
 import json
+import math
 import re
 from typing import Any, Final
 
@@ -78,11 +79,13 @@ def json_depth(text: str) -> int:
 
 
 class LimitError(ValueError):
-    """Input past one of these limits; ``reason`` says which."""
+    """Input past one of these limits; ``reason`` says which, ``field`` where when known (the
+    path of a JSON value, e.g. ``stats.score``)."""
 
-    def __init__(self, reason: str) -> None:
-        super().__init__(reason)
+    def __init__(self, reason: str, field: str | None = None) -> None:
+        super().__init__(reason if field is None else f"{field}: {reason}")
         self.reason = reason
+        self.field = field
 
 
 def _bounded_int(text: str) -> int:
@@ -93,9 +96,87 @@ def _bounded_int(text: str) -> int:
 
 
 def loads_bounded(text: str) -> Any:
-    """``json.loads`` with the nesting depth checked first (the decoder recurses) and integer
-    literals of at most :data:`MAX_INT_DIGITS` digits; :class:`LimitError` past either."""
+    """``json.loads`` with the nesting depth checked first (the decoder recurses), integer
+    literals of at most :data:`MAX_INT_DIGITS` digits and finite numbers only; :class:`LimitError`
+    past any of them. ``NaN``, ``Infinity`` and overflowing literals (``1e999``) are caught by
+    the parser's own hooks, so no non-finite float ever leaves this function: each becomes a
+    marker while parsing and the first one is reported with its path (:func:`_non_finite_path`)."""
     depth = json_depth(text)
     if depth > MAX_JSON_DEPTH:
         raise LimitError(f"JSON nested {depth} deep; at most {MAX_JSON_DEPTH}")
-    return json.loads(text, parse_int=_bounded_int)
+    found: list[_NonFinite] = []
+
+    def non_finite(literal: str) -> _NonFinite:
+        found.append(_NonFinite(literal))
+        return found[-1]
+
+    def finite_float(literal: str) -> float | _NonFinite:
+        value = float(literal)
+        return value if math.isfinite(value) else non_finite(literal)
+
+    data = json.loads(
+        text, parse_int=_bounded_int, parse_float=finite_float, parse_constant=non_finite
+    )
+    if found:
+        literal = found[0].literal
+        shown = literal if len(literal) <= 24 else literal[:21] + "..."
+        raise LimitError(f"{shown} is not a finite number", _non_finite_path(data))
+    return data
+
+
+# ---------------------------------------------------------------------------------------------
+# Non-finite numbers in JSON (issue #21, item 9)
+# ---------------------------------------------------------------------------------------------
+
+
+class _NonFinite:
+    """What :func:`loads_bounded` reads a non-finite number as, until it reports it."""
+
+    __slots__ = ("literal",)
+
+    def __init__(self, literal: str) -> None:
+        self.literal = literal
+
+
+def _non_finite_path(data: Any) -> str:
+    """The path (``stats.a[2]``) of the first :class:`_NonFinite` in document order; keys are
+    cut to 40 characters. Iterative: the depth is bounded already, but no recursion is needed."""
+    stack: list[tuple[Any, str]] = [(data, "")]
+    while stack:
+        value, path = stack.pop()
+        if isinstance(value, _NonFinite):
+            return path or "(top level)"
+        if isinstance(value, dict):
+            items = [(v, f"{path}.{k[:40]}" if path else k[:40]) for k, v in value.items()]
+        elif isinstance(value, list):
+            items = [(v, f"{path}[{i}]") for i, v in enumerate(value)]
+        else:
+            continue
+        stack.extend(reversed(items))
+    return "(file)"
+
+
+# ---------------------------------------------------------------------------------------------
+# chain import: CHAIN's URDF/OBJ model folders (issue #21, item 11)
+# ---------------------------------------------------------------------------------------------
+
+#: Parts (URDF files) of one model folder, counted before any is read (the palette names 48
+#: pieces; CHAIN's models have at most 15 parts).
+MAX_MODEL_PARTS: Final = 64
+#: Bytes of one URDF file (CHAIN's largest: 43 KB) and ``visual`` meshes in it (CHAIN's: 1).
+MAX_URDF_BYTES: Final = 1024 * 1024
+MAX_PART_MESHES: Final = 16
+#: Bytes of one OBJ mesh file (CHAIN's largest: 650 KB), checked before reading.
+MAX_MESH_BYTES: Final = 8 * 1024 * 1024
+#: Vertices and triangles of one part, all its meshes together, counted in the text before
+#: parsing (CHAIN's largest part: 6,381 and 12,838). The voxeliser's work is triangles times
+#: samples, so this also bounds it per cell.
+MAX_PART_VERTICES: Final = 100_000
+MAX_PART_TRIANGLES: Final = 100_000
+#: Sample-triangle pairs the voxeliser may evaluate for one part (cells of its bounding box
+#: times 27 samples times triangles), checked before any: at most about 15 s of work here,
+#: usually a third of that. CHAIN's largest part needs 3e7.
+MAX_WINDING_PAIRS: Final = 300_000_000
+#: Magnitude of a number in a URDF (``origin xyz``, ``rpy``, mesh ``scale``) or of an OBJ
+#: vertex coordinate (CHAIN's stay under 100).
+MAX_MODEL_NUMBER: Final = 1e6

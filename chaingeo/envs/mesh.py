@@ -46,14 +46,26 @@ def piece_manifold(shape: Shape) -> manifold3d.Manifold:
     return solid
 
 
+def _mesh_copy(
+    solid: manifold3d.Manifold,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+    """Vertices and triangles of a solid as numpy arrays that own their memory.
+
+    manifold3d's arrays are views into a nanobind ``Mesh64``; a view kept in a trimesh object
+    keeps that instance alive, and at exit (the ``chain`` command freezes the collector there)
+    nanobind reports every such instance as leaked. Copies let it go when this returns."""
+    raw = solid.to_mesh64()
+    vertices = np.array(raw.vert_properties[:, :3], dtype=np.float64, copy=True)
+    faces = np.array(raw.tri_verts, dtype=np.int64, copy=True)
+    return vertices, faces
+
+
 def piece_mesh(
     shape: Shape, color: ColorLike | None = None, name: str = "piece"
 ) -> trimesh.Trimesh:
     """A closed, outward-oriented triangle mesh of the piece (coplanar faces merged), coloured
     with a PBR base colour when ``color`` is given."""
-    raw = piece_manifold(shape).to_mesh64()
-    vertices = np.asarray(raw.vert_properties, dtype=np.float64)[:, :3]
-    faces = np.asarray(raw.tri_verts, dtype=np.int64)
+    vertices, faces = _mesh_copy(piece_manifold(shape))
     mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
     if color is not None:
         r, g, b = parse_color(color)
@@ -71,9 +83,8 @@ def eroded_mesh(shape: Shape, eps: float) -> trimesh.Trimesh:
     if not 0 < eps < 0.5:
         raise ValueError(f"erosion must be in (0, 0.5), got {eps}")
     probe = manifold3d.Manifold.cube([2 * eps] * 3, center=True)
-    raw = piece_manifold(shape).minkowski_difference(probe).to_mesh64()
-    vertices = np.asarray(raw.vert_properties, dtype=np.float64)[:, :3]
-    return trimesh.Trimesh(vertices=vertices, faces=np.asarray(raw.tri_verts), process=False)
+    vertices, faces = _mesh_copy(piece_manifold(shape).minkowski_difference(probe))
+    return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
 
 
 def scene_of(pieces: PieceMap) -> trimesh.Scene:

@@ -7,7 +7,9 @@ behave identically everywhere: stepping on agent text (an action that cannot be 
 out changes nothing but still costs a step), ``push``/``pop``, the budget and ``finish``.
 
 A step is one agent turn. ``apply`` (and ``push``) count a step for a legal action;
-``step_text`` counts one for every turn, legal or not. ``finish`` counts like any action and
+``step_text`` counts one for every turn, legal or not. ``pop`` takes back the last action
+carried out and its one step; a refused turn changed nothing, so nothing of it is taken back
+and its step stays counted, whenever it came. ``finish`` counts like any action and
 ends the game: afterwards every action is illegal. ``state`` (:class:`StateAction`) is legal
 while the game is not finished, costs its step like any turn and changes nothing else; its
 feedback is the text state (:mod:`chaingeo.envs.text_state`). It is not in
@@ -110,7 +112,7 @@ class BaseState(ABC):
         self.level = level
         self._steps_used = 0
         self._finished = False
-        self._stack: list[tuple[Action, Any, int, bool]] = []
+        self._stack: list[tuple[Action, Any, bool]] = []  # action, position, finished before
         self._history: list[Turn] = []
 
     # -- family hooks -------------------------------------------------------------------------
@@ -214,7 +216,7 @@ class BaseState(ABC):
             raise IllegalActionError(
                 why.reason, action=resolved, state_key=self.key(), code=why.code
             )
-        self._stack.append((resolved, self._position, self._steps_used, self._finished))
+        self._stack.append((resolved, self._position, self._finished))
         if isinstance(resolved, FinishAction):
             self._finished = True
         elif not isinstance(resolved, StateAction):
@@ -222,12 +224,14 @@ class BaseState(ABC):
         self._steps_used += 1
 
     def pop(self) -> Action:
-        """Undo the last applied action (position, steps used and finish); return it."""
+        """Undo the last applied action (its position change, its finish and its one step) and
+        return it. Refused turns after it keep their steps: restoring the step count of the
+        snapshot would erase turns that were taken (issue #21, item 12)."""
         if not self._stack:
             raise IndexError("pop from an empty action stack")
-        action, position, steps, finished = self._stack.pop()
+        action, position, finished = self._stack.pop()
         self._position = position
-        self._steps_used = steps
+        self._steps_used -= 1
         self._finished = finished
         return action
 

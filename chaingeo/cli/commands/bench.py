@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import pkgutil
 from typing import Any
 
 import chaingeo.benchmarks
+from chaingeo.cli.errors import CommandError
 
 #: Benchmark names: the modules of :mod:`chaingeo.benchmarks`, discovered.
 BENCHMARKS: tuple[str, ...] = tuple(
@@ -26,4 +28,11 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     module = importlib.import_module(f"chaingeo.benchmarks.{args.name}")
+    missing = [m for m in getattr(module, "REQUIRES", ()) if importlib.util.find_spec(m) is None]
+    if missing:  # before any work: one line saying what to install, not a traceback
+        extra = getattr(module, "EXTRA", "bench")
+        raise CommandError(
+            f"the {args.name} benchmark needs {', '.join(missing)}, which is not installed: "
+            f"pip install 'chaingeo[{extra}]'"
+        )
     return int(module.run(args) or 0)

@@ -2,8 +2,11 @@
 
 After every turn it prints the feedback (the very text an agent gets), the state with every
 piece's cells (1-based) and the paths of the freshly rendered views. ``undo`` takes back the
-last action that was carried out (and the step it cost, and any failed turns after it);
-``help`` repeats the task; ``quit`` (or end of input) stops. Exit status 0 when solved, else 1.
+last action that was carried out and gives back the one step it cost; a refused turn changed
+nothing, so there is nothing of it to undo and its step stays counted (every turn is a step, as
+for an agent). So "Steps used" is always the turns taken minus the actions undone. ``undo``
+is not a turn. ``help`` repeats the task; ``quit`` (or end of input) stops. Exit status 0 when
+solved, else 1.
 """
 
 from __future__ import annotations
@@ -40,6 +43,20 @@ def run(args: argparse.Namespace) -> int:
     return play(level, sys.stdin, sys.stdout, views, args.size)
 
 
+def _undo(state: Any) -> str:
+    """Take back the last action carried out (see the module doc) and say what happened."""
+    refused = bool(state.history) and not state.history[-1].legal
+    note = " (refused turns change nothing and keep their steps)" if refused else ""
+    try:
+        undone = state.pop()
+    except IndexError:
+        return f"Nothing to undo: no action has been carried out{note}."
+    if refused:
+        note = " (your last turn was refused and changed nothing; this was the last action "
+        note += "carried out, and the refused turns keep their steps)"
+    return f"Undone: {undone.to_text()}{note}"
+
+
 def play(level: Any, stdin: TextIO, out: TextIO, views: Path | None, size: int = 512) -> int:
     """The game loop (separate from argument handling so tests can drive it)."""
     from chaingeo.envs.machines import new_state
@@ -73,12 +90,7 @@ def play(level: Any, stdin: TextIO, out: TextIO, views: Path | None, size: int =
         if word == "help":
             print(instruction(state), file=out)
         elif word == "undo":
-            try:
-                undone = state.pop()
-            except IndexError:
-                print("Nothing to undo.", file=out)
-            else:
-                print(f"Undone: {undone.to_text()}", file=out)
+            print(_undo(state), file=out)
         else:
             result = state.step_text(text)
             print(result.feedback, file=out)

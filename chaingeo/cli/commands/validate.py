@@ -2,8 +2,14 @@
 
 Beyond what loading checks, a puzzle's ``optimal_steps`` is re-derived by the optimal search
 when that search stays within :data:`chaingeo.core.limits.RECHECK_MAX_STATES` states (the same
-cap the tests use): a stored value that is not the optimum is an error (exit status 2). Larger
-puzzles are reported with ``"optimal_checked": false``.
+cap the tests use): a stored value that is not the optimum is an error. A puzzle the search
+cannot settle (past the state cap, or a part of more pieces than the search kernels take) is
+reported with ``"optimal_checked": false`` and ``"unchecked_reason"``: every level the loader
+accepts gets a row, never an exception.
+
+Exit status: 0 when every file loads and no re-derived optimum contradicts the stored one
+(unchecked puzzles included); 2 when a file does not load, a stored optimum is not the optimum
+or the structure a proven bound needs (``stats.blocks``) is malformed.
 """
 
 from __future__ import annotations
@@ -26,23 +32,69 @@ def register(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-def recheck_optimal(level: Level) -> int | None:
-    """The true optimum of a puzzle level when the capped search finds it, else None
-    (stacking levels: their optimum is the piece count, which loading already checks)."""
+class NotRechecked(Exception):
+    """The optimal search cannot settle this level's optimum; ``reason`` says why."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+
+
+class BadBlocks(ValueError):
+    """``stats.blocks`` (the towers a proven bound uses) is malformed: the file is wrong."""
+
+
+def recheck_optimal(level: Level) -> int:
+    """The true optimum of a puzzle level (stacking levels: the piece count, which loading
+    already checks). Raises :class:`NotRechecked` when the capped search cannot settle it and
+    :class:`BadBlocks` when the level's ``stats.blocks`` is malformed."""
     from chaingeo.core.kinematics import SearchLimitError
     from chaingeo.core.limits import RECHECK_MAX_STATES
-    from solvers.analysis import analyze_level
+    from solvers.analysis import analyze_level, level_blocks
+    from solvers.movement import MAX_PIECES
     from solvers.partsearch import SearchLimits
 
     if level.family != "puzzle":
         return len(level.pieces)
+    if len(level.pieces) > MAX_PIECES:  # the search starts from one part of every piece
+        raise NotRechecked(
+            f"{len(level.pieces)} pieces; the optimal search takes at most {MAX_PIECES} "
+            "pieces in a part"
+        )
+    try:
+        blocks = level_blocks(level)
+    except ValueError as e:
+        raise BadBlocks(str(e)) from None
     limits = SearchLimits(
         max_states=RECHECK_MAX_STATES, seconds=None, max_total_states=RECHECK_MAX_STATES
     )
     try:
-        return analyze_level(level, limits).optimal_steps
-    except SearchLimitError:
-        return None
+        optimum = analyze_level(level, limits).optimal_steps
+    except SearchLimitError as e:
+        raise NotRechecked(f"the search stopped at its cap: {e}") from None
+    except ValueError as e:  # the solvers refuse what they cannot take with a ValueError
+        if blocks is not None:  # blocks the bound cannot use (with turns, not a tower, ...)
+            raise BadBlocks(str(e)) from None
+        raise NotRechecked(f"the search cannot take this level: {e}") from None
+    if optimum is None:  # the stored plan replays, so this is the search's shortfall
+        raise NotRechecked("the search found no plan")
+    return optimum
+
+
+def _recheck_row(level: Level, f: Path) -> tuple[dict[str, Any], bool]:
+    """The row's re-check fields and whether they report an error."""
+    try:
+        true_optimum = recheck_optimal(level)
+    except NotRechecked as e:
+        return {"optimal_checked": False, "unchecked_reason": e.reason}, False
+    except BadBlocks as e:
+        return {"optimal_checked": False, "error": f"{f}: stats.blocks: {e}"}, True
+    row: dict[str, Any] = {"optimal_checked": True}
+    if true_optimum != level.optimal_steps:
+        row["error"] = (
+            f"{f}: optimal_steps: {level.optimal_steps} recorded but the optimum is {true_optimum}"
+        )
+    return row, "error" in row
 
 
 def run(args: argparse.Namespace) -> int:
@@ -65,14 +117,9 @@ def run(args: argparse.Namespace) -> int:
             "content_hash": content_hash(lv),
         }
         if not args.no_recheck:
-            true_optimum = recheck_optimal(lv)
-            row["optimal_checked"] = true_optimum is not None
-            if true_optimum is not None and true_optimum != lv.optimal_steps:
-                row["error"] = (
-                    f"{f}: optimal_steps: {lv.optimal_steps} recorded but the optimum is "
-                    f"{true_optimum}"
-                )
-                status = 2
+            checked, failed = _recheck_row(lv, f)
+            row.update(checked)
+            status = 2 if failed else status
         print(json.dumps(row))
     print(json.dumps({"levels": len(levels), "level_set_hash": level_set_hash(levels)}))
     return status

@@ -8,13 +8,15 @@ tags), result, colour rules (``<bitmap>`` pairs, 0-based colour numbers in the f
 
 Hostile input meets a typed error before it costs anything: the sizes in
 :mod:`chaingeo.core.limits` bound the decompressed XML, the grids, the shapes, problems and
-pieces; a DOCTYPE (entity expansion) is refused; every number is checked. Each error is a
+pieces; a DOCTYPE or entity declaration is refused in any encoding (looked for after decoding,
+:mod:`chaingeo.core.formats.xml_guard`); every number is checked. Each error is a
 :class:`BurrToolsError` naming the file, the element and the reason.
 """
 
 from __future__ import annotations
 
 import os
+import stat
 import xml.etree.ElementTree as ET
 import zlib
 from pathlib import Path
@@ -33,6 +35,7 @@ from chaingeo.core.formats.bt_model import (
     BurrToolsError,
     Cell,
 )
+from chaingeo.core.formats.xml_guard import doctype_problem
 from chaingeo.core.geometry import Shape
 
 
@@ -70,8 +73,9 @@ def _decompress(data: bytes, source: str) -> bytes:
         raise BurrToolsError(
             source, "(file)", f"more than {limits.MAX_XMPUZZLE_XML_BYTES} bytes of XML"
         )
-    if b"<!DOCTYPE" in raw or b"<!ENTITY" in raw:
-        raise BurrToolsError(source, "(file)", "a DOCTYPE or entity declaration is not allowed")
+    problem = doctype_problem(raw)  # after decoding, in whatever encoding the XML declares
+    if problem is not None:
+        raise BurrToolsError(source, "(file)", problem)
     return raw
 
 
@@ -318,7 +322,10 @@ def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
 def read_xmpuzzle(path: str | os.PathLike[str]) -> BTPuzzle:
     source = str(path)
     try:
-        size = Path(path).stat().st_size
+        st = Path(path).stat()
+        if not stat.S_ISREG(st.st_mode):  # a FIFO would block the read forever
+            raise BurrToolsError(source, "(file)", "not a regular file")
+        size = st.st_size
         if size > limits.MAX_FILE_BYTES:
             raise BurrToolsError(source, "(file)", f"{size} bytes; at most {limits.MAX_FILE_BYTES}")
         data = Path(path).read_bytes()

@@ -2,8 +2,9 @@
 
 This is the geometric half of the model importer (:mod:`chaingeo.core.formats.models` is the other):
 
-* **Loading**: every URDF of a puzzle folder is one part; its ``visual`` meshes (OBJ, read with
-  trimesh) are scaled, turned by the ``origin rpy`` (fixed axes: ``Rz(yaw) Ry(pitch) Rx(roll)``)
+* **Loading** (:mod:`chaingeo.core.formats.model_files`, which reads the files as hostile
+  input): every URDF of a puzzle folder is one part; its ``visual`` meshes (OBJ) are scaled,
+  turned by the ``origin rpy`` (fixed axes: ``Rz(yaw) Ry(pitch) Rx(roll)``)
   and shifted by ``origin xyz`` into the assembled arrangement. Angles in the files are rounded
   to five decimals (``1.57080``), so a rotation within 1e-4 of a signed permutation is taken to be
   that permutation: otherwise no face would be exactly axis-aligned.
@@ -25,19 +26,16 @@ This is the geometric half of the model importer (:mod:`chaingeo.core.formats.mo
 from __future__ import annotations
 
 import math
-import re
-import xml.etree.ElementTree as ET
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from pathlib import Path
 from typing import Final
 
 import numba
 import numpy as np
 import numpy.typing as npt
-import trimesh
 
+from chaingeo.core import limits
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.level import LevelError
 
@@ -103,11 +101,6 @@ class PartMesh:
 # ---------------------------------------------------------------------------------------------
 
 
-def _natural_key(text: str) -> tuple[object, ...]:
-    """``obj_2`` before ``obj_10``: the order a person numbering parts meant."""
-    return tuple(int(t) if t.isdigit() else t for t in re.split(r"(\d+)", text))
-
-
 def rpy_matrix(roll: float, pitch: float, yaw: float) -> FloatArray:
     """URDF's fixed-axis roll-pitch-yaw rotation ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``, with a
     rotation within 1e-4 of a signed permutation snapped to it (the files round angles)."""
@@ -121,96 +114,6 @@ def rpy_matrix(roll: float, pitch: float, yaw: float) -> FloatArray:
     if np.abs(m - snapped).max() < 1e-4 and np.all(np.abs(snapped).sum(axis=0) == 1):
         return np.asarray(snapped, dtype=np.float64)
     return m
-
-
-def _floats(text: str | None, count: int, default: float, where: str, source: str) -> list[float]:
-    if text is None:
-        return [default] * count
-    try:
-        values = [float(v) for v in text.split()]
-    except ValueError:
-        values = []
-    if len(values) != count:
-        raise ModelImportError(source, where, f"expected {count} numbers, got {text!r}")
-    return values
-
-
-def _materials(root: ET.Element) -> dict[str, tuple[float, float, float, float]]:
-    out: dict[str, tuple[float, float, float, float]] = {}
-    for mat in root.findall("material"):
-        color = mat.find("color")
-        if mat.get("name") and color is not None and color.get("rgba"):
-            r, g, b, a = (float(v) for v in str(color.get("rgba")).split()[:4])
-            out[str(mat.get("name"))] = (r, g, b, a)
-    return out
-
-
-def load_urdf_part(urdf: Path, model_dir: Path) -> PartMesh:
-    """The visual geometry of every link of one URDF, placed as the file says, as one mesh."""
-    source = str(model_dir)
-    part = urdf.parent.parent.name if urdf.parent.name == "urdf" else urdf.stem
-    try:
-        root = ET.parse(urdf).getroot()
-    except (OSError, ET.ParseError) as e:
-        raise ModelImportError(source, f"{part}/urdf", f"cannot read {urdf.name}: {e}") from None
-    named = _materials(root)
-    verts: list[FloatArray] = []
-    faces: list[IntArray] = []
-    files: list[str] = []
-    rgba: tuple[float, float, float, float] | None = None
-    material: str | None = None
-    offset = 0
-    for i, vis in enumerate(root.iter("visual")):
-        where = f"{part}/visual[{i}]"
-        origin = vis.find("origin")
-        xyz = _floats(None if origin is None else origin.get("xyz"), 3, 0.0, where, source)
-        rpy = _floats(None if origin is None else origin.get("rpy"), 3, 0.0, where, source)
-        mesh_el = vis.find("geometry/mesh")
-        if mesh_el is None or not mesh_el.get("filename"):
-            raise ModelImportError(source, where, "only mesh geometry is supported")
-        scale = _floats(mesh_el.get("scale"), 3, 1.0, where, source)
-        path = (urdf.parent / str(mesh_el.get("filename"))).resolve()
-        try:
-            mesh = trimesh.load(str(path), force="mesh", process=True)
-        except (OSError, ValueError) as e:
-            raise ModelImportError(source, where, f"cannot load {path.name}: {e}") from None
-        if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-            raise ModelImportError(source, where, f"{path.name} holds no triangles")
-        v = np.asarray(mesh.vertices, dtype=np.float64) * np.asarray(scale)
-        v = v @ rpy_matrix(*rpy).T + np.asarray(xyz)
-        verts.append(v)
-        faces.append(np.asarray(mesh.faces, dtype=np.int64) + offset)
-        offset += len(v)
-        files.append(str(path.relative_to(model_dir.resolve())))
-        mat = vis.find("material")
-        if mat is not None and rgba is None:
-            inline = mat.find("color")
-            material = mat.get("name")
-            if inline is not None and inline.get("rgba"):
-                r, g, b, a = (float(x) for x in str(inline.get("rgba")).split()[:4])
-                rgba = (r, g, b, a)
-            elif material in named:
-                rgba = named[material]
-    if not verts:
-        raise ModelImportError(source, part, f"{urdf.name} has no visual geometry")
-    return PartMesh(
-        part, np.concatenate(verts), np.concatenate(faces), rgba, material, tuple(files)
-    )
-
-
-def load_model_parts(model_dir: str | Path) -> list[PartMesh]:
-    """Every part of a puzzle folder (``PART/urdf/*.urdf``), in natural order of part names."""
-    folder = Path(model_dir)
-    if not folder.is_dir():
-        raise ModelImportError(str(folder), "(folder)", "no such model folder")
-    urdfs = sorted(folder.glob("*/urdf/*.urdf"), key=lambda p: _natural_key(str(p)))
-    if not urdfs:
-        raise ModelImportError(str(folder), "(folder)", "no PART/urdf/*.urdf files")
-    parts = [load_urdf_part(u, folder) for u in urdfs]
-    names = [p.name for p in parts]
-    if len(set(names)) != len(names):
-        raise ModelImportError(str(folder), "(folder)", f"part names repeat: {names}")
-    return parts
 
 
 # ---------------------------------------------------------------------------------------------
@@ -497,10 +400,14 @@ class PartVoxels:
     ambiguous: tuple[tuple[Cell, float], ...]  # (cell, share of inside samples)
 
 
-def voxelize(part: PartMesh, planes: Planes, fit: LatticeFit) -> PartVoxels:
+def voxelize(
+    part: PartMesh, planes: Planes, fit: LatticeFit, source: str = "<model>"
+) -> PartVoxels:
     """Decide every cell the part's bounding box touches by 27 sub-samples, in two stages:
     the centre and the eight corner samples everywhere, the other 18 where those disagree
-    (uniform cells, most of them, are taken to agree; this cuts the cost about threefold)."""
+    (uniform cells, most of them, are taken to agree; this cuts the cost about threefold).
+    The work (samples times triangles) is bounded by :data:`limits.MAX_WINDING_PAIRS` before
+    any is done; ``source`` names the model in that error."""
     maps = []
     ranges = []
     lo, hi = part.bounds
@@ -513,6 +420,14 @@ def voxelize(part: PartMesh, planes: Planes, fit: LatticeFit) -> PartVoxels:
         low = math.ceil((lo[a] - start) / fit.unit - 0.8)
         high = math.floor((hi[a] - start) / fit.unit - 0.2)
         ranges.append(np.arange(low, high + 1, dtype=np.int64))
+    pairs = math.prod(len(r) for r in ranges) * len(SAMPLE_OFFSETS) ** 3 * len(part.faces)
+    if pairs > limits.MAX_WINDING_PAIRS:
+        raise ModelImportError(
+            source,
+            f"parts.{part.name}",
+            f"{pairs:.2g} sample-triangle pairs to decide its cells; at most "
+            f"{limits.MAX_WINDING_PAIRS:.2g} (too many cells or triangles)",
+        )
     gx, gy, gz = np.meshgrid(*ranges, indexing="ij")
     cells = np.stack([gx.ravel(), gy.ravel(), gz.ravel()], axis=1)
     offs = np.asarray(SAMPLE_OFFSETS)

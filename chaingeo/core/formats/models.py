@@ -43,9 +43,9 @@ from chaingeo.core.formats.mesh_lattice import (
     face_planes,
     find_container,
     fit_lattice,
-    load_model_parts,
     voxelize,
 )
+from chaingeo.core.formats.model_files import load_model_parts
 from chaingeo.core.formats.rods import round_rods
 from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape, puzzle_signature
 from chaingeo.core.kinematics import Move
@@ -374,7 +374,7 @@ def import_model(model_dir: str | Path, kind: Kind | Literal["auto"] = "auto") -
         source,
         common=container is None,
     )
-    voxels = [voxelize(parts[i], planes[i], fit) for i in pieces]
+    voxels = [voxelize(parts[i], planes[i], fit, source) for i in pieces]
     for v in voxels:
         if len(v.cells) == 0:
             raise ModelImportError(source, f"parts.{v.name}", "no cell is inside the part")
