@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import stat
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -19,7 +18,7 @@ from pathlib import Path
 from typing import Any, Final, Literal
 
 from chaingeo.core import canonical_json, limits
-from chaingeo.core.files import atomic_write
+from chaingeo.core.files import UnreadableFile, atomic_write, read_bounded
 from chaingeo.core.geometry import Cell, Shape, box_cells, puzzle_signature
 from chaingeo.core.kinematics import (
     DIRECTIONS,
@@ -506,20 +505,9 @@ def load_level(path: str | os.PathLike[str]) -> Level:
     """Read and fully validate one level file."""
     source = str(path)
     try:
-        st = Path(path).stat()
-        if not stat.S_ISREG(st.st_mode):  # a FIFO would block the read forever
-            raise LevelError(source, "(file)", "not a regular file")
-        size = st.st_size
-        if size > limits.MAX_FILE_BYTES:
-            raise LevelError(
-                source, "(file)", f"{size} bytes; a level file has at most {limits.MAX_FILE_BYTES}"
-            )
-        with open(path, "rb") as fh:
-            raw = fh.read(limits.MAX_FILE_BYTES + 1)
-    except OSError as e:
-        raise LevelError(source, "(file)", f"cannot read: {e.strerror or e}") from None
-    if len(raw) > limits.MAX_FILE_BYTES:
-        raise LevelError(source, "(file)", f"more than {limits.MAX_FILE_BYTES} bytes")
+        raw = read_bounded(path, limits.MAX_FILE_BYTES)
+    except UnreadableFile as e:
+        raise LevelError(source, "(file)", e.reason) from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:

@@ -16,12 +16,11 @@ pieces; a DOCTYPE or entity declaration is refused in any encoding (looked for a
 from __future__ import annotations
 
 import os
-import stat
 import xml.etree.ElementTree as ET
 import zlib
-from pathlib import Path
 
 from chaingeo.core import limits
+from chaingeo.core.files import UnreadableFile, read_bounded
 from chaingeo.core.formats.bt_model import (
     MAX_COLORS,
     RGB,
@@ -322,13 +321,7 @@ def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
 def read_xmpuzzle(path: str | os.PathLike[str]) -> BTPuzzle:
     source = str(path)
     try:
-        st = Path(path).stat()
-        if not stat.S_ISREG(st.st_mode):  # a FIFO would block the read forever
-            raise BurrToolsError(source, "(file)", "not a regular file")
-        size = st.st_size
-        if size > limits.MAX_FILE_BYTES:
-            raise BurrToolsError(source, "(file)", f"{size} bytes; at most {limits.MAX_FILE_BYTES}")
-        data = Path(path).read_bytes()
-    except OSError as e:
-        raise BurrToolsError(source, "(file)", f"cannot read: {e.strerror or e}") from None
+        data = read_bounded(path, limits.MAX_FILE_BYTES)
+    except UnreadableFile as e:
+        raise BurrToolsError(source, "(file)", e.reason) from None
     return parse_xmpuzzle(data, source)

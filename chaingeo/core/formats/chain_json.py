@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from chaingeo.core import canonical_json, limits
+from chaingeo.core.files import UnreadableFile, read_bounded
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.level import (
     Difficulty,
@@ -180,11 +181,11 @@ def load_chain_file(path: str | os.PathLike[str]) -> ChainStacking:
     """Read and check one CHAIN file (size, JSON nesting and numbers bounded)."""
     source = str(path)
     try:
-        if Path(path).stat().st_size > limits.MAX_FILE_BYTES:
-            raise LevelError(source, "(file)", f"more than {limits.MAX_FILE_BYTES} bytes")
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise LevelError(source, "(file)", f"cannot read: {e}") from None
+        text = read_bounded(path, limits.MAX_FILE_BYTES).decode("utf-8")
+    except UnreadableFile as e:
+        raise LevelError(source, "(file)", e.reason) from None
+    except UnicodeDecodeError:
+        raise LevelError(source, "(file)", "not UTF-8 text") from None
     return read_chain_data(decode_json(text, source), source)
 
 
