@@ -29,6 +29,7 @@ from solvers.constrained import compile_packing
 from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, Rods, analyze
 from solvers.groups import PieceGroups, analyze_grouped
+from solvers.movement import MAX_PIECES
 from solvers.partsearch import SearchLimits
 from solvers.problem import PieceSpec
 
@@ -130,8 +131,18 @@ def disassembly_figures(
     deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """``level``, ``moves`` and ``optimal_steps`` of one assembly (None where unknown); if the
-    optimal search hits a cap, ``optimal_error`` says which (the level is still reported).
-    ``deadline``: the analysis' one (default: one of ``limits.seconds`` for both searches)."""
+    optimal search hits a cap, ``optimal_error`` says which (the level is still reported); an
+    assembly of more pieces than the search kernels take is reported unsearched, with
+    ``disassembly_error`` saying why. ``deadline``: the analysis' one (default: one of
+    ``limits.seconds`` for both searches)."""
+    if len(shapes) > MAX_PIECES:
+        return {
+            "level": None,
+            "moves": None,
+            "optimal_steps": None,
+            "disassembly_error": f"{len(shapes)} pieces in one part; the disassembler "
+            f"searches parts of at most {MAX_PIECES} pieces",
+        }
     out: dict[str, Any] = {}
     if deadline is None:
         deadline = Deadline(limits.seconds)

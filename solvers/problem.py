@@ -233,7 +233,7 @@ def _orientation_keys(vox: IntArray) -> list[bytes]:
     rel = vox - vox.min(axis=1, keepdims=True)
     base = int(rel.max()) + 1 if rel.size else 1
     keys = np.sort((rel[..., 0] * base + rel[..., 1]) * base + rel[..., 2], axis=1)
-    return [bytes([base]) + row.tobytes() for row in keys]
+    return [base.to_bytes(4, "little") + row.tobytes() for row in keys]
 
 
 def _stacked(p: Placements) -> IntArray:

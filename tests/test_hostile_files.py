@@ -285,3 +285,24 @@ def test_bench_cover_without_xcover_says_how_to_install_it(
     assert main(["bench", "cover", "--quick"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "pip install 'chaingeo[bench]'" in err
+
+
+def test_analyze_reports_a_part_past_the_kernel_bound_unsearched(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = tmp_path / "line-64.json"
+    path.write_text(json.dumps(line_puzzle(64)))
+    assert main(["analyze", str(path), "--no-assemble", "--jit", "numba"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["level"] is None and out["optimal_steps"] is None
+    assert "64 pieces in one part" in out["disassembly_error"]
+    assert "at most 63" in out["disassembly_error"]
+
+
+def test_a_piece_longer_than_255_cells_is_counted(tmp_path: Path) -> None:
+    from solvers.assemble import count_solutions
+    from solvers.problem import PieceSpec
+
+    rod = Shape([(x, 0, 0) for x in range(300)])
+    report = count_solutions([PieceSpec(rod, "rod")], rod)
+    assert report.assemblies == 1
