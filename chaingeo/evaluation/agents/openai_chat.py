@@ -33,6 +33,7 @@ import json
 from collections.abc import Mapping, Sequence
 from typing import Any, Final
 
+from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.base import Agent, AgentError, Reply, ToolCall, Turn
 from chaingeo.evaluation.agents.http import ChatClient, RequestRejected, ServerSettings
@@ -205,10 +206,8 @@ class OpenAIAgent(Agent):
     def _read(
         self, answer: Mapping[str, Any], turn: Turn, tools: Sequence[dict[str, Any]]
     ) -> tuple[str, str | None, tuple[ToolCall, ...], Usage]:
-        choice = answer["choices"][0] if isinstance(answer["choices"][0], dict) else {}
-        message = choice.get("message") or {}
-        if not isinstance(message, dict):
-            message = {}
+        """The parts of an answer the client checked (:func:`protocol.check_answer`)."""
+        message = answer["choices"][0]["message"]
         text = _content_text(message.get("content"))
         reasoning = message.get("reasoning_content") or message.get("reasoning")
         calls = _tool_calls(message.get("tool_calls"), tools, turn) if self._native else ()
@@ -251,11 +250,12 @@ def _content_text(content: Any) -> str:
 
 
 def _tool_calls(raw: Any, tools: Sequence[dict[str, Any]], turn: Turn) -> tuple[ToolCall, ...]:
-    """The calls of an assistant message, each translated (a call without an id gets one)."""
+    """The calls of an assistant message, each translated (a call without an id gets one); at
+    most :data:`~chaingeo.core.limits.MAX_TOOL_CALLS`, the rest dropped unplayed."""
     if not isinstance(raw, list):
         return ()
     out: list[ToolCall] = []
-    for i, call in enumerate(raw):
+    for i, call in enumerate(raw[: limits.MAX_TOOL_CALLS]):
         call = call if isinstance(call, dict) else {}
         fn = call.get("function")
         fn = fn if isinstance(fn, dict) else {}
