@@ -173,10 +173,11 @@ def _exchange(url: str, data: bytes, headers: Mapping[str, str], timeout: float)
     except ValueError as e:  # a port that is not a number
         raise AgentError(f"{url}: {e}") from None
 
+    opened: list[socket.socket] = []  # the connection drops its socket once answered
+
     def abort() -> None:
         expired.set()
-        sock = conn.sock
-        if sock is not None:
+        for sock in opened:
             with contextlib.suppress(OSError):
                 sock.shutdown(socket.SHUT_RDWR)
 
@@ -184,6 +185,11 @@ def _exchange(url: str, data: bytes, headers: Mapping[str, str], timeout: float)
     timer.daemon = True
     timer.start()
     try:
+        conn.connect()
+        if conn.sock is not None:
+            opened.append(conn.sock)
+            if expired.is_set():  # the deadline passed while connecting
+                abort()
         path = (parts.path or "/") + (f"?{parts.query}" if parts.query else "")
         conn.request("POST", path, body=data, headers=dict(headers))
         resp = conn.getresponse()
