@@ -199,6 +199,18 @@ def test_a_same_origin_307_is_followed_with_the_key() -> None:
     assert script.problems == [] and len(script.requests) == 2
 
 
+def test_the_environments_proxy_is_used_for_a_remote_server_as_urllib_did(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    seen = Served()
+    with serve([reply("via the proxy")], seen) as proxy:
+        monkeypatch.setenv("HTTP_PROXY", proxy.removesuffix("/v1"))
+        monkeypatch.delenv("NO_PROXY", raising=False)
+        answer = ChatClient("http://models.example.invalid/v1", KEY).complete(GOOD_BODY)
+    assert answer["choices"][0]["message"]["content"] == "via the proxy"
+    assert [h["Host"] for h in seen.headers] == ["models.example.invalid"]
+
+
 # 7 ---------------------------------------------------------------------------- log budgets
 
 

@@ -26,6 +26,7 @@ import socket
 import threading
 import time
 import urllib.parse
+import urllib.request
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Final
@@ -159,17 +160,37 @@ class _Answer:
     body: bytes
 
 
+def _connection(url: str, timeout: float) -> tuple[http.client.HTTPConnection, str]:
+    """A connection for ``url`` and the request target: direct, or through the proxy the
+    environment names (``HTTPS_PROXY``/``HTTP_PROXY``, ``NO_PROXY``) as urllib did; a server on
+    this machine is always reached directly. HTTPS goes through a CONNECT tunnel, so the proxy
+    never sees the key."""
+    parts = urllib.parse.urlsplit(url)
+    https = parts.scheme.lower() == "https"
+    host = parts.hostname or ""
+    path = (parts.path or "/") + (f"?{parts.query}" if parts.query else "")
+    proxy = urllib.request.getproxies().get("https" if https else "http")
+    if proxy and not is_loopback(url) and not urllib.request.proxy_bypass(host):
+        via = urllib.parse.urlsplit(proxy if "://" in proxy else f"http://{proxy}")
+        proxy_host, proxy_port = via.hostname or "", via.port or 80
+        if https:
+            tunnel = http.client.HTTPSConnection(proxy_host, proxy_port, timeout=timeout)
+            tunnel.set_tunnel(host, parts.port or 443)
+            return tunnel, path
+        return http.client.HTTPConnection(proxy_host, proxy_port, timeout=timeout), url
+    if https:
+        return http.client.HTTPSConnection(host, parts.port, timeout=timeout), path
+    return http.client.HTTPConnection(host, parts.port, timeout=timeout), path
+
+
 def _exchange(url: str, data: bytes, headers: Mapping[str, str], timeout: float) -> _Answer:
     """One POST whose connect, send and whole answer finish within ``timeout`` seconds of wall
     clock: a watchdog shuts the socket at the deadline, so a server trickling a byte at a time
     cannot hold the call (a per-read timeout would restart with every byte). The body is read up
     to :data:`~chaingeo.core.limits.MAX_ANSWER_BYTES` (plus one, to see it is longer)."""
-    parts = urllib.parse.urlsplit(url)
-    https = parts.scheme.lower() == "https"
-    conn_class = http.client.HTTPSConnection if https else http.client.HTTPConnection
     expired = threading.Event()
     try:
-        conn = conn_class(parts.hostname or "", parts.port, timeout=timeout)
+        conn, path = _connection(url, timeout)
     except ValueError as e:  # a port that is not a number
         raise AgentError(f"{url}: {e}") from None
 
@@ -190,7 +211,6 @@ def _exchange(url: str, data: bytes, headers: Mapping[str, str], timeout: float)
             opened.append(conn.sock)
             if expired.is_set():  # the deadline passed while connecting
                 abort()
-        path = (parts.path or "/") + (f"?{parts.query}" if parts.query else "")
         conn.request("POST", path, body=data, headers=dict(headers))
         resp = conn.getresponse()
         chunks: list[bytes] = []
