@@ -17,11 +17,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.benchmarks.hostile_server import Served, serve
 from chaingeo.core import limits
 from chaingeo.evaluation.agents.base import AgentError
 from chaingeo.evaluation.agents.http import ChatClient, RetryPolicy
 from chaingeo.evaluation.agents.prompt import extract_action, extract_plan
+from chaingeo.evaluation.hostile_server import Served, serve
 from chaingeo.evaluation.report import load_run
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from chaingeo.evaluation.usage import Price, PriceError, PriceTable, Usage

@@ -3,7 +3,7 @@
 It checks every request's shape (model, system + user messages, base64 PNG images, the sampling
 parameters, the bearer key) and answers from a script: each entry is a reply text, native tool
 calls (:func:`calls`), or a fault (``timeout``, ``500``, ``429`` with Retry-After, ``malformed``
-JSON, ``cutoff``), or one of the hostile faults of :mod:`chaingeo.benchmarks.hostile_server`
+JSON, ``cutoff``), or one of the hostile faults of :mod:`chaingeo.evaluation.hostile_server`
 (``trickle``, ``redirect`` to another port, ``answer``: any JSON as the body, ``retry-after``;
 ``raw_usage`` sends any usage block). Reply text goes out through ``json.dumps``, so lone
 surrogates arrive escaped as from a hostile server. When the script runs out it answers
@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler
 from typing import Any
 
-from chaingeo.benchmarks.hostile_server import chat_answer, play, send, serving
 from chaingeo.core import limits
+from chaingeo.evaluation.hostile_server import chat_answer, play, send, serving
 
 
 @dataclass

@@ -1,6 +1,7 @@
 """A hostile OpenAI-compatible chat server on 127.0.0.1: every answer plays one scripted entry.
 
-For ``chain bench robustness`` (:func:`serve`) and the tests' validating fake server
+For ``chain bench robustness`` (:func:`serve`; it lives here because every module of
+:mod:`chaingeo.benchmarks` is a benchmark name) and the tests' validating fake server
 (``tests/eval_support/fake_openai.py``, which answers through :func:`chat_answer` and
 :func:`play`). An entry is a dict: a reply (``reply`` text, ``tool_calls`` as ``(name,
 arguments)`` pairs, ``usage`` as ``(prompt, completion)`` or ``raw_usage``, any JSON value, sent
