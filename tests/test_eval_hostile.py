@@ -276,3 +276,19 @@ def test_chain_eval_prints_each_distinct_error_reason_with_its_count(
     lines = capsys.readouterr().out.splitlines()
     reasons = [x for x in lines if x.startswith("  2 x ")]
     assert len(reasons) == 1 and "connection failed" in reasons[0], lines
+
+
+# ------------------------------------------------------------------ chain bench robustness
+
+
+def test_the_benchs_tool_call_and_server_fault_classes_find_nothing() -> None:
+    from chaingeo.benchmarks.robustness import tool_call_fuzz
+    from chaingeo.evaluation.drills import fault_table, server_fault_rows
+
+    calls = tool_call_fuzz(40)
+    assert calls["other_exceptions"] == calls["contract_violations"] == 0
+    assert calls["calls"]["malformed"] > 0 and calls["calls"]["translated"] > 0
+    rows = server_fault_rows(["302 to another port", "lone surrogate as a tool name"])
+    assert [(r["crash"], r["hang"], r["leak"], r["episodes"]) for r in rows] == [(0, 0, 0, 2)] * 2
+    assert [r["server_errors"] for r in rows] == [0, 2]  # the model's bad call; the redirect
+    assert "| **all** | 2 attacks | 4 |" in fault_table(rows)
