@@ -24,6 +24,7 @@ from chaingeo.evaluation.agents.prompt import extract_action, extract_plan
 from chaingeo.evaluation.hostile_server import Served, serve
 from chaingeo.evaluation.report import load_run
 from chaingeo.evaluation.runner import RunConfig, evaluate
+from chaingeo.evaluation.sanitize import bound_record, clean, size
 from chaingeo.evaluation.usage import Price, PriceError, PriceTable, Usage
 from tests.eval_support.fake_openai import Script, calls, fake_openai, reply
 from tests.test_eval_faults import _eval, _openai, _suite
@@ -231,6 +232,28 @@ def test_run_logs_stay_within_their_byte_budgets(tmp_path: Path) -> None:
     assert "truncated: 400015 characters, sha256 " in recs[0]["steps"][1]["reply"]
     called = [s for s in recs[0]["steps"] if "calls" in s]
     assert len(called) == 1 and len(called[0]["calls"]) == limits.MAX_TOOL_CALLS
+
+
+def test_an_episode_past_its_budget_keeps_only_the_outcome_of_later_steps() -> None:
+    step = {"turn": 0, "reply": "r" * 60_000, "sent": "x", "action": None, "legal": False}
+    record = {
+        "key": "L#0",
+        "cost_usd": float("nan"),
+        "steps": [{**step, "error": "unparseable"}] * 400,
+    }
+    out = bound_record(record)
+    assert size(out) <= limits.MAX_LOG_EPISODE_BYTES + limits.MAX_LOG_REPLY_BYTES
+    assert out["cost_usd"] is None and 0 < out["log_compacted_steps"] < 400
+    last = out["steps"][-1]
+    assert last["compacted"] and last["error"] == "unparseable" and "reply" not in last
+    assert "sha256" in out["steps"][0]["reply"] and len(out["steps"]) == 400
+
+
+def test_a_key_is_redacted_before_any_cut_so_no_part_of_it_stays() -> None:
+    cap = limits.MAX_LOG_FIELD_CHARS
+    text = "a" * (cap - 5) + KEY + "\ud800"
+    out = clean(text, cap, lambda t: t.replace(KEY, "[REDACTED]"))
+    assert KEY[:5] not in out and "\ud800" not in out and out.startswith("a" * (cap - 5) + "[REDA")
 
 
 # 8 ------------------------------------------------------------------------- protocol breaks
