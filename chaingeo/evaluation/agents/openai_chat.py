@@ -3,9 +3,11 @@
 Options (all logged; the key is not an option): ``model``, ``base_url`` (default: env
 ``OPENAI_BASE_URL``, else ``https://api.openai.com/v1``), ``api_key_env`` (the variable holding
 the key, default ``OPENAI_API_KEY``; a local server may need none), ``temperature`` 0.6 and
-``top_p`` 0.95 (the paper's), ``max_tokens``, ``timeout``, ``max_retries``, ``backoff_base``,
-``tools``, ``model_options``, ``send_seed`` (pass a per-call seed to servers that accept one),
-``image_detail``, ``views`` (subset of views sent).
+``top_p`` 0.95 (the paper's), ``max_tokens``, ``timeout`` (a wall-clock deadline per request),
+``max_retries``, ``backoff_base``, ``retry_budget`` (seconds for all retries of one call, at most
+:data:`~chaingeo.core.limits.MAX_RETRY_SECONDS`), ``tools``, ``model_options``, ``send_seed``
+(pass a per-call seed to servers that accept one), ``image_detail``, ``views`` (subset of views
+sent).
 
 ``tools`` is ``auto`` (default), ``on`` or ``off``. With tools the model is offered one function
 per action kind (:mod:`chaingeo.evaluation.agents.tools`); each call it makes is one action, and
