@@ -119,7 +119,8 @@ def test_usage_is_additive_and_reads_openai_blocks() -> None:
     assert total_usage([u, u, Usage()]) == Usage(240, 160, 100, 200, 2)
     assert Usage.from_json(json.loads(json.dumps(u.to_json()))) == u
     assert Usage.from_openai(None) == Usage(calls=1)
-    for bad in ({"prompt_tokens": "x"}, {"completion_tokens": -3}, [1]):
+    assert Usage.from_openai({"prompt_tokens": 12.0}) == Usage(12, calls=1)  # whole, as a float
+    for bad in ({"prompt_tokens": "x"}, {"completion_tokens": -3}, {"prompt_tokens": 2.5}, [1]):
         with pytest.raises(UsageError):  # a server fault, never a silent zero
             Usage.from_openai(bad)  # type: ignore[arg-type]
 

@@ -115,6 +115,8 @@ def _count(value: Any, where: str) -> int:
     before any arithmetic sees it."""
     if value is None:
         return 0
+    if isinstance(value, float) and value.is_integer():  # 12.0 from some proxies: still whole
+        value = int(value) if abs(value) <= limits.MAX_USAGE_TOKENS else value
     ok = isinstance(value, int) and not isinstance(value, bool)
     if not ok or not 0 <= value <= limits.MAX_USAGE_TOKENS:
         raise UsageError(
