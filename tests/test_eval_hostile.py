@@ -236,6 +236,7 @@ def test_run_logs_stay_within_their_byte_budgets(tmp_path: Path) -> None:
 
 def test_an_episode_past_its_budget_keeps_only_the_outcome_of_later_steps() -> None:
     step = {"turn": 0, "reply": "r" * 60_000, "sent": "x", "action": None, "legal": False}
+    step["images"] = {"iso": "f" * 64 + ".png"}
     record = {
         "key": "L#0",
         "cost_usd": float("nan"),
@@ -247,6 +248,7 @@ def test_an_episode_past_its_budget_keeps_only_the_outcome_of_later_steps() -> N
     last = out["steps"][-1]
     assert last["compacted"] and last["error"] == "unparseable" and "reply" not in last
     assert "sha256" in out["steps"][0]["reply"] and len(out["steps"]) == 400
+    assert out["steps"][-1]["images"] == {"iso": "f" * 64 + ".png"}  # still names its picture
 
 
 def test_a_key_is_redacted_before_any_cut_so_no_part_of_it_stays() -> None:

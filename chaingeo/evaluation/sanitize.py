@@ -25,8 +25,9 @@ from chaingeo.core import limits
 _SURROGATE_RE: Final = re.compile("[\ud800-\udfff]")
 #: A data URL of base64 bytes (an image a model pasted into its reply).
 _DATA_URL_RE: Final = re.compile(r"data:[\w.+-]{1,40}/[\w.+-]{1,40};base64,[A-Za-z0-9+/=]{256,}")
-#: The field caps tried, longest first, until a reply's record fits its budget.
-_CAPS: Final = (limits.MAX_LOG_FIELD_CHARS, 2048, 256, 32)
+#: The field caps tried, longest first, until a reply's record fits its budget; the last keeps
+#: an image's file name (64 hex digits + ``.png``) whole.
+_CAPS: Final = (limits.MAX_LOG_FIELD_CHARS, 2048, 256, 80)
 #: Step fields kept when the episode's budget is spent (the outcome, never model text).
 _OUTCOME_FIELDS: Final = ("turn", "call", "action", "legal", "error", "usage", "images")
 
