@@ -114,6 +114,17 @@ def test_tool_call_arguments_past_the_limits_are_the_models_unparseable_step(
     assert f"more than {limits.MAX_AGENT_DIGITS} digits" in second["sent"]
 
 
+def test_arguments_a_server_sent_decoded_obey_the_same_limits() -> None:
+    from chaingeo.evaluation.agents.tools import tool_specs, translate
+
+    offered = tool_specs(_levels(1)[0])
+    huge = translate("place", {"piece": "red", "cells": [[10**15, 1, 1]]}, offered)
+    assert huge.problem is not None and "digits" in huge.problem
+    wide = translate("place", {"piece": "red", "cells": [[1, 1, 1]] * 2000}, offered)
+    assert wide.problem is not None and f"at most {limits.MAX_TOOL_ARGUMENT_CHARS}" in wide.problem
+    assert translate("place", {"piece": "red", "cells": [[1, 1, 1]]}, offered).problem is None
+
+
 # 4 ------------------------------------------------------------------ linear action extraction
 
 

@@ -16,6 +16,7 @@ counts the step, and the agent is told why.
 
 from __future__ import annotations
 
+import json
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -258,17 +259,21 @@ class Translation:
 
 def _arguments(arguments: Any) -> Any:
     """A call's arguments decoded; :class:`_Malformed` saying why when its text is not JSON
-    within the agent-text limits (length, nesting, digits of every number)."""
+    within the agent-text limits (length, nesting, digits of every number). Arguments a server
+    sent already decoded go through the same limits as their JSON text."""
     if arguments is None:
         return {}
-    if isinstance(arguments, str):
-        if not arguments.strip():
-            return {}  # an empty argument string: a call with no arguments
+    if not isinstance(arguments, str):  # decoded by the server: measured as the text it was
         try:
-            return loads_agent_json(arguments, limits.MAX_TOOL_ARGUMENT_CHARS)
-        except AgentJsonError as e:
-            raise _Malformed(f"the arguments are not usable JSON: {e.reason}") from None
-    return arguments
+            arguments = json.dumps(arguments)
+        except (TypeError, ValueError, RecursionError):
+            return arguments  # no JSON value at all: refused as not an object
+    if not arguments.strip():
+        return {}  # an empty argument string: a call with no arguments
+    try:
+        return loads_agent_json(arguments, limits.MAX_TOOL_ARGUMENT_CHARS)
+    except AgentJsonError as e:
+        raise _Malformed(f"the arguments are not usable JSON: {e.reason}") from None
 
 
 def parse_arguments(arguments: Any) -> Any:
