@@ -28,8 +28,9 @@ _DATA_URL_RE: Final = re.compile(r"data:[\w.+-]{1,40}/[\w.+-]{1,40};base64,[A-Za
 #: The field caps tried, longest first, until a reply's record fits its budget; the last keeps
 #: an image's file name (64 hex digits + ``.png``) whole.
 _CAPS: Final = (limits.MAX_LOG_FIELD_CHARS, 2048, 256, 80)
-#: Step fields kept when the episode's budget is spent (the outcome, never model text).
-_OUTCOME_FIELDS: Final = ("turn", "call", "action", "legal", "error", "usage", "images")
+#: Step fields kept when the episode's budget is spent: the outcome and what was played (for
+#: `replay`), never the reply.
+_OUTCOME_FIELDS: Final = ("turn", "call", "sent", "action", "legal", "error", "usage", "images")
 
 Redact = Callable[[str], str]
 
