@@ -11,7 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from chaingeo.evaluation import metrics as m
-from chaingeo.evaluation.usage import Price, PriceError, PriceTable, Usage, total_usage
+from chaingeo.evaluation.usage import Price, PriceError, PriceTable, Usage, UsageError, total_usage
 
 U = Usage(input_tokens=1000, output_tokens=500, calls=1)
 
@@ -119,7 +119,10 @@ def test_usage_is_additive_and_reads_openai_blocks() -> None:
     assert total_usage([u, u, Usage()]) == Usage(240, 160, 100, 200, 2)
     assert Usage.from_json(json.loads(json.dumps(u.to_json()))) == u
     assert Usage.from_openai(None) == Usage(calls=1)
-    assert Usage.from_openai({"prompt_tokens": "x", "completion_tokens": -3}) == Usage(calls=1)
+    assert Usage.from_openai({"prompt_tokens": 12.0}) == Usage(12, calls=1)  # whole, as a float
+    for bad in ({"prompt_tokens": "x"}, {"completion_tokens": -3}, {"prompt_tokens": 2.5}, [1]):
+        with pytest.raises(UsageError):  # a server fault, never a silent zero
+            Usage.from_openai(bad)  # type: ignore[arg-type]
 
 
 def test_prices_come_from_the_data_file_and_user_files_win(tmp_path: Path) -> None:

@@ -132,7 +132,7 @@ def test_replies_without_an_action_cost_a_step_not_a_crash(tmp_path: Path) -> No
     assert "called no tool and had no <action>" in second
     # The malformed call was answered (the fake server checks the ids) with the reason.
     tool_msg = script.requests[4]["body"]["messages"][3]
-    assert tool_msg["role"] == "tool" and "arguments are not a JSON object" in tool_msg["content"]
+    assert tool_msg["role"] == "tool" and "arguments are not usable JSON" in tool_msg["content"]
 
 
 def test_giving_up_is_an_episode_error_and_resume_retries_it(tmp_path: Path) -> None:

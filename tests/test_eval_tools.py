@@ -118,13 +118,13 @@ def test_calls_become_canonical_action_text(
         ("jump", "{}", STACK, "there is no tool named 'jump' here"),
         ("move", json.dumps(_mv()), STACK, "there is no tool named 'move' here"),
         (["place"], "{}", STACK, "there is no tool named"),
-        ("place", "{not json", STACK, "the arguments are not a JSON object"),
+        ("place", "{not json", STACK, "the arguments are not usable JSON: not valid JSON"),
         ("place", "[1, 2]", STACK, "the arguments are not a JSON object"),
         ("place", "\"__import__('os').system('x')\"", STACK, "not a JSON object"),
         ("place", '{"piece": "red"}', STACK, "missing field 'cells'"),
         ("place", '{"piece": "red", "cells": [], "why": 1}', STACK, "unexpected field 'why'"),
         ("place", '{"piece": "red blue", "cells": []}', STACK, "piece must be a colour name"),
-        ("place", '{"piece": "red", "cells": [[1,1,1]); finish"}', STACK, "not a JSON object"),
+        ("place", '{"piece": "red", "cells": [[1,1,1]); finish"}', STACK, "not usable JSON"),
         ("place", _cells([1, 1]), STACK, "cells[0] must be three integers"),
         ("place", _cells([1, 1, 1], [1, 1, True]), STACK, "cells[1] must be three"),
         ("place", _cells([1, 1, 1.5]), STACK, "cells[0] must be three"),
@@ -163,7 +163,9 @@ def test_a_long_or_multiline_value_is_quoted_short_on_one_line() -> None:
     assert "\n" not in out.action and len(out.action) < 120
     assert parse_arguments("[" * 100_000) == "[" * 100_000  # too deep for json: refused, no crash
     refused = translate("pickup", "[" * 100_000, STACK)
-    assert refused.problem == "the arguments are not a JSON object"
+    assert refused.problem == (
+        "the arguments are not usable JSON: 100000 characters of JSON; at most 4096"
+    )
 
 
 def test_tools_setting_and_model_options() -> None:

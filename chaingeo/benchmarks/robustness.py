@@ -1,4 +1,5 @@
-"""``chain bench robustness``: ``step_text`` on hostile agent text never raises, never hangs.
+"""``chain bench robustness``: hostile agent text, tool calls and model servers never crash a
+run, never hang it, never leak the key and never fill the disk.
 
 States: a stacking, a puzzle-disassembly and a puzzle-assembly level of the shipped suite, each
 at its start and halfway along its stored plan (6 states). Strings: a seeded generator
@@ -8,7 +9,14 @@ brackets, Unicode digits) and long texts (thousands of digits, deep brackets, re
 Each string is played on a fresh clone of the state; the contract (:func:`check_turn`) is: a
 :class:`chaingeo.envs.state.StepResult`, exactly one step counted, one turn logged and the
 position unchanged when rejected. Printed: the typed outcomes, the other exceptions (must be
-0), contract violations (must be 0) and the slowest call. ``--quick``: fewer strings.
+0), contract violations (must be 0) and the slowest call. ``--quick``: fewer strings and calls.
+
+Tool calls (:func:`tool_call_fuzz`): seeded hostile native calls (numbers of 5,000 digits,
+nesting 100,000 deep, NaN, lone surrogates, wrong types, unknown names) are translated and
+played under the same contract. Server faults (:mod:`chaingeo.evaluation.drills`): a hostile
+server plays each attack of issue #21 against a real ``evaluate`` run; the table counts the
+episodes done and errored, run crashes, hangs, key leaks and the largest log (all but the last
+must be 0).
 """
 
 from __future__ import annotations
@@ -19,11 +27,14 @@ import random
 import time
 from collections import Counter
 from collections.abc import Iterator
+from typing import Any
 
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import shipped_levels
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.state import BaseState, StepResult
+from chaingeo.evaluation.agents.tools import tool_specs, translate
+from chaingeo.evaluation.drills import fault_table, server_fault_rows
 
 #: Strings per state: 6 states x 8,500 = 51,000 in the full run.
 PER_STATE = 8_500
@@ -231,8 +242,96 @@ def _plan_texts(level: Level) -> list[str]:
     return [m.describe() for m in sol.moves]
 
 
-def run(args: argparse.Namespace) -> int:
-    per_state = PER_STATE_QUICK if args.quick else PER_STATE
+# ---------------------------------------------------------------------------------------------
+# Tool calls: a model's native calls, arguments as hostile as its text
+# ---------------------------------------------------------------------------------------------
+
+#: Hostile tool calls per state: 6 states x 2,000 = 12,000 in the full run.
+TOOL_CALLS = 2_000
+TOOL_CALLS_QUICK = 150
+
+
+def _hostile_value(rng: random.Random, names: list[str], depth: int = 0) -> Any:
+    r = rng.random()
+    if r < 0.2 or depth > 2:
+        return rng.choice((*names, "\ud800", "x" * 5_000, "", "inf", "+x", "z", "red\n" * 50))
+    if r < 0.45:
+        return rng.choice((0, -1, 1, 2, 90, -90, 10**30, 1e308, 2.5, True, None))
+    if r < 0.8:
+        return [_hostile_value(rng, names, depth + 1) for _ in range(rng.choice((0, 1, 3, 3, 70)))]
+    return {rng.choice(_KEYS): _hostile_value(rng, names, depth + 1) for _ in range(3)}
+
+
+_KEYS = ("piece", "cells", "pieces", "direction", "distance", "axis", "angle", "into", "offset")
+_RAW_ARGUMENTS = (
+    '{"piece": "red", "cells": [[' + "9" * 5_000 + ", 1, 1]]}",
+    '{"piece": "red", "cells": [[' + "9" * 50 + ", 1, 1]]}",
+    "[" * 100_000,
+    '{"pieces": ["red"], "direction": "+x", "distance": NaN}',
+    '{"pieces": ["red"], "direction": "+x", "distance": Infinity}',
+    '{"piece": "\\ud800"}',
+    "{not json",
+    '"a string"',
+    " ",
+    '{"piece": "' + "r" * 10_000 + '"}',
+)
+
+
+def hostile_calls(state: BaseState, rng: random.Random) -> Iterator[tuple[Any, Any]]:
+    """An endless seeded stream of hostile ``(name, arguments)`` tool calls for ``state``."""
+    names = sorted(p.name for p in state.level.pieces)
+    offered = [t["function"]["name"] for t in tool_specs(state.level)]
+    while True:
+        r = rng.random()
+        name: Any = rng.choice(offered) if r < 0.85 else rng.choice(("\ud800", 7, None, "x" * 999))
+        if rng.random() < 0.25:
+            yield name, rng.choice(_RAW_ARGUMENTS)
+            continue
+        args = {rng.choice(_KEYS): _hostile_value(rng, names) for _ in range(rng.randint(0, 4))}
+        yield name, (json.dumps(args) if rng.random() < 0.7 else args)
+
+
+def tool_call_fuzz(per_state: int) -> dict[str, Any]:
+    """Hostile tool calls translated (:func:`translate`) and played (:func:`check_turn`) on the
+    six states: counts of malformed and translated calls, the step outcomes, other exceptions
+    (must be 0), contract violations (must be 0) and the slowest call."""
+    rng = random.Random(SEED + 1)
+    translated: Counter[str] = Counter()
+    outcomes: Counter[str] = Counter()
+    others: Counter[str] = Counter()
+    violations = 0
+    slowest = 0.0
+    for base in fuzz_states():
+        offered = tool_specs(base.level)
+        calls = hostile_calls(base, rng)
+        for _ in range(per_state):
+            name, arguments = next(calls)
+            t0 = time.perf_counter()
+            try:
+                out = translate(name, arguments, offered)
+                translated["malformed" if out.problem else "translated"] += 1
+                result, _ = check_turn(base.clone(), out.action)
+            except AssertionError:
+                violations += 1
+                continue
+            except Exception as e:  # must stay 0
+                others[type(e).__name__] += 1
+                continue
+            slowest = max(slowest, time.perf_counter() - t0)
+            outcomes[result.error or "legal"] += 1
+    return {
+        "tool_calls": sum(translated.values()) + sum(others.values()),
+        "calls": dict(sorted(translated.items())),
+        "typed_results": dict(sorted(outcomes.items())),
+        "other_exceptions": sum(others.values()),
+        "other_exception_types": dict(sorted(others.items())),
+        "contract_violations": violations,
+        "slowest_call_ms": round(1000 * slowest, 2),
+    }
+
+
+def _step_text_fuzz(per_state: int) -> dict[str, Any]:
+    """The original class: hostile agent text through ``step_text`` on the six states."""
     rng = random.Random(SEED)
     outcomes: Counter[str] = Counter()
     others: Counter[str] = Counter()
@@ -257,20 +356,28 @@ def run(args: argparse.Namespace) -> int:
                 slowest = (seconds, text)
     total = sum(outcomes.values()) + sum(others.values()) + violations
     shown = slowest[1] if len(slowest[1]) <= 80 else slowest[1][:77] + "..."
-    print(
-        json.dumps(
-            {
-                "strings": total,
-                "typed_results": dict(sorted(outcomes.items())),
-                "other_exceptions": sum(others.values()),
-                "other_exception_types": dict(sorted(others.items())),
-                "contract_violations": violations,
-                "slowest_call_ms": round(1000 * slowest[0], 2),
-                "slowest_text": shown,
-                "slowest_text_chars": len(slowest[1]),
-                "seconds": round(time.perf_counter() - t_start, 1),
-            },
-            sort_keys=True,
-        )
-    )
-    return 1 if others or violations else 0
+    return {
+        "strings": total,
+        "typed_results": dict(sorted(outcomes.items())),
+        "other_exceptions": sum(others.values()),
+        "other_exception_types": dict(sorted(others.items())),
+        "contract_violations": violations,
+        "slowest_call_ms": round(1000 * slowest[0], 2),
+        "slowest_text": shown,
+        "slowest_text_chars": len(slowest[1]),
+        "seconds": round(time.perf_counter() - t_start, 1),
+    }
+
+
+def run(args: argparse.Namespace) -> int:
+    """Every class; prints the step-text figures (JSON), then the tool-call and server-fault
+    tables; exit 1 if any class broke its contract."""
+    text = _step_text_fuzz(PER_STATE_QUICK if args.quick else PER_STATE)
+    print(json.dumps(text, sort_keys=True))
+    calls = tool_call_fuzz(TOOL_CALLS_QUICK if args.quick else TOOL_CALLS)
+    print(json.dumps(calls, sort_keys=True))
+    rows = server_fault_rows()
+    print(fault_table(rows))
+    broken = text["other_exceptions"] or text["contract_violations"]
+    broken = broken or calls["other_exceptions"] or calls["contract_violations"]
+    return 1 if broken or any(r["crash"] or r["hang"] or r["leak"] for r in rows) else 0

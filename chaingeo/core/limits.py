@@ -57,6 +57,37 @@ MAX_BT_PROBLEMS: Final = 1024
 RECHECK_MAX_STATES: Final = 200_000
 
 
+# ---------------------------------------------------------------------------------------------
+# The evaluation harness: model servers and their replies (untrusted like agent text).
+# ---------------------------------------------------------------------------------------------
+
+#: Characters of a model reply searched for ``<action>``/``<plan>`` tags (one linear scan); a
+#: longer reply is an unparseable step, unread.
+MAX_REPLY_CHARS: Final = 200_000
+#: Characters of one tool call's JSON arguments (like agent text), and tool calls taken from
+#: one reply (the rest are dropped and said so); a call's numbers obey the agent-text limits.
+MAX_TOOL_ARGUMENT_CHARS: Final = MAX_TEXT_CHARS
+MAX_TOOL_CALLS: Final = 64
+#: Bytes of one server answer, read before parsing; digits of any integer in it (usage counts,
+#: timestamps); one usage field (tokens of one call). Past any: a protocol error of the server.
+MAX_ANSWER_BYTES: Final = 16 * 1024 * 1024
+MAX_ANSWER_INT_DIGITS: Final = 20
+MAX_USAGE_TOKENS: Final = 10**9
+#: A USD price per million tokens (prices files); with the usage bound every cost is finite.
+MAX_PRICE_USD: Final = 1_000_000.0
+#: Seconds: the longest ``Retry-After`` honoured, and all retries of one call together
+#: (requests and waits); the request timeout is a wall-clock deadline for connect + answer.
+MAX_RETRY_AFTER_SECONDS: Final = 60.0
+MAX_RETRY_SECONDS: Final = 900.0
+#: Same-origin HTTP 307/308 redirects followed per request (other redirects never are).
+MAX_REDIRECTS: Final = 3
+#: Run logs: characters of one logged string (longer ones keep a head and their length and
+#: SHA-256), bytes of one reply's record (a step, a plan, a candidate) and of one episode's
+#: record; past the episode budget later steps keep only their outcome.
+MAX_LOG_FIELD_CHARS: Final = 16_384
+MAX_LOG_REPLY_BYTES: Final = 64 * 1024
+MAX_LOG_EPISODE_BYTES: Final = 4 * 1024 * 1024
+
 #: A JSON string (or an unterminated one up to the end): it always matches, so it never
 #: backtracks across the text.
 _STRING_RE: Final = re.compile(r'"(?:[^"\\]|\\.)*(?:"|\\?\Z)', re.DOTALL)

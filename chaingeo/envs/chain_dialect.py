@@ -141,16 +141,48 @@ def _constant(name: str) -> Any:
     raise _Bad(f"{name} is not a number")
 
 
-def _loads(body: str) -> Any:
+class AgentJsonError(ValueError):
+    """Agent JSON that is malformed or past a limit of :mod:`chaingeo.core.limits` (length,
+    nesting, digits); ``too_big``: an integer longer than an agent number may be."""
+
+    def __init__(self, reason: str, too_big: bool = False) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.too_big = too_big
+
+
+def loads_agent_json(body: str, max_chars: int = limits.MAX_TEXT_CHARS) -> Any:
+    """``json.loads`` on untrusted agent JSON (a CHAIN tool call, a model's tool-call
+    arguments) within the agent-text limits: at most ``max_chars`` characters and
+    :data:`~chaingeo.core.limits.MAX_JSON_DEPTH` levels (checked before the decoder recurses),
+    integers of at most :data:`~chaingeo.core.limits.MAX_AGENT_DIGITS` digits (refused before
+    Python builds them), no ``NaN``/``Infinity``. :class:`AgentJsonError` otherwise."""
+    if len(body) > max_chars:
+        raise AgentJsonError(f"{len(body)} characters of JSON; at most {max_chars}")
     depth = limits.json_depth(body)
     if depth > limits.MAX_JSON_DEPTH:
-        raise _Bad(f"JSON nested {depth} deep")
+        raise AgentJsonError(f"JSON nested {depth} deep")
     try:
         return json.loads(body, parse_int=_int, parse_constant=_constant)
+    except _TooBig:
+        raise AgentJsonError(
+            f"a number of more than {limits.MAX_AGENT_DIGITS} digits", too_big=True
+        ) from None
+    except _Bad as e:
+        raise AgentJsonError(e.hint) from None
     except json.JSONDecodeError as e:
-        raise _Bad(f"not valid JSON ({e.msg} at character {e.pos + 1})") from None
+        raise AgentJsonError(f"not valid JSON ({e.msg} at character {e.pos + 1})") from None
     except (RecursionError, ValueError) as e:  # defensive: json's own limits
-        raise _Bad(f"not valid JSON ({type(e).__name__})") from None
+        raise AgentJsonError(f"not valid JSON ({type(e).__name__})") from None
+
+
+def _loads(body: str) -> Any:
+    try:
+        return loads_agent_json(body)
+    except AgentJsonError as e:
+        if e.too_big:
+            raise _TooBig from None
+        raise _Bad(e.reason) from None
 
 
 def _number(value: Any, where: str) -> int:

@@ -9,9 +9,11 @@ Layout of ``RUN/``::
 
 A killed run leaves at most one partial line at the end of ``episodes.jsonl``; reading ignores
 it and resuming cuts it off before appending, so no finished episode is lost and none is
-recorded twice. Every line written passes through :meth:`RunLog.redact`, which replaces each
-registered secret (API keys) wherever it appears, so a key echoed back by a server never lands
-in a log either.
+recorded twice. Everything written passes through :mod:`chaingeo.evaluation.sanitize` with
+:meth:`RunLog.redact`, which replaces each registered secret (API keys) wherever it appears, so
+a key echoed back by a server never lands in a log either; there text is made encodable, numbers
+finite and each record bounded in bytes, so a hostile reply can neither stop the writer nor fill
+the disk.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from typing import Any, Final
 
 from chaingeo.core import canonical_json
 from chaingeo.core.files import atomic_write
+from chaingeo.evaluation.sanitize import clean, dumps_line
 
 RUN_FORMAT: Final = "chain-run/1"
 HEADER: Final = "header.json"
@@ -151,7 +154,11 @@ class RunLog:
             raise RunError(f"{log.path}: exists and is not a run directory")
         (log.path / IMAGES).mkdir(parents=True, exist_ok=True)
         atomic_write(
-            head, log.redact(canonical_json.dumps(dict(header))).encode("utf-8"), durable=True
+            head,
+            log.redact(canonical_json.dumps(clean(dict(header), redact=log.redact))).encode(
+                "utf-8"
+            ),
+            durable=True,
         )
         (log.path / EPISODES).touch()
         return log
@@ -173,9 +180,8 @@ class RunLog:
         return text
 
     def append(self, record: Mapping[str, Any]) -> None:
-        """One line, written whole, flushed and fsynced before returning."""
-        line = json.dumps(record, sort_keys=True, ensure_ascii=False, allow_nan=False)
-        data = (self.redact(line) + "\n").encode("utf-8")
+        """One line (sanitised and bounded), written whole, flushed and fsynced."""
+        data = (dumps_line(record, self.redact) + "\n").encode("utf-8")
         fd = os.open(self.path / EPISODES, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
         try:
             view = memoryview(data)

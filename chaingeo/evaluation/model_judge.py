@@ -25,7 +25,8 @@ JUDGE_PROMPT: Final = (
     "candidate has already been checked to be legal. Pick the one most likely to lead to "
     "solving the task. Answer with <choice>N</choice>, N the candidate's number."
 )
-_CHOICE_RE: Final = re.compile(r"<choice>\s*(\d+)\s*</choice>", re.IGNORECASE)
+#: At most 9 digits: a longer number names no candidate (and ``int`` never sees 5,000 digits).
+_CHOICE_RE: Final = re.compile(r"<choice>\s*(\d{1,9})\s*</choice>", re.IGNORECASE)
 
 
 class ModelJudge(Judge):

@@ -4,6 +4,11 @@ A :class:`Usage` is what one model call consumed; records add up (per step, per 
 run) with ``+``. Conventions follow the OpenAI chat-completions ``usage`` block: reasoning tokens
 are part of the output tokens and cached tokens are part of the input tokens, so the total is
 ``input + output`` and nothing is counted twice.
+
+A server's usage block is untrusted: each field must be a whole number from 0 to
+:data:`~chaingeo.core.limits.MAX_USAGE_TOKENS` (:class:`UsageError` otherwise, which the agent
+reports as a protocol error of the server), and prices are finite and bounded, so no cost is
+ever infinite or NaN.
 """
 
 from __future__ import annotations
@@ -13,7 +18,17 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Final
+
+from chaingeo.core import limits
+
+#: The largest count a cost multiplies (int64, what any real counter holds): with prices at
+#: most :data:`~chaingeo.core.limits.MAX_PRICE_USD` every cost is a finite float.
+_MAX_PRICED: Final = 2**63 - 1
+
+
+class UsageError(ValueError):
+    """A usage block that is not whole, non-negative, bounded token counts; names the field."""
 
 
 @dataclass(frozen=True)
@@ -63,12 +78,15 @@ class Usage:
         """Read an OpenAI-style ``usage`` block (missing fields count as zero). Reasoning and
         cached tokens come from ``completion_tokens_details``/``prompt_tokens_details``, or from
         the ``output_``/``input_tokens_details`` some servers write, or from a bare top-level
-        ``reasoning_tokens``/``cached_tokens``."""
-        if not isinstance(obj, Mapping):
+        ``reasoning_tokens``/``cached_tokens``. :class:`UsageError` for a field that is not a
+        whole number of tokens within bounds, or a block that is not an object."""
+        if obj is None:
             return Usage(calls=1)
+        if not isinstance(obj, Mapping):
+            raise UsageError(f"usage is {_shown(obj)}, not an object")
         return Usage(
-            input_tokens=_count(obj.get("prompt_tokens")),
-            output_tokens=_count(obj.get("completion_tokens")),
+            input_tokens=_count(obj.get("prompt_tokens"), "prompt_tokens"),
+            output_tokens=_count(obj.get("completion_tokens"), "completion_tokens"),
             reasoning_tokens=_detail(
                 obj, ("completion_tokens_details", "output_tokens_details"), "reasoning_tokens"
             ),
@@ -83,12 +101,29 @@ def _detail(obj: Mapping[str, Any], blocks: tuple[str, ...], key: str) -> int:
     for block in blocks:
         details = obj.get(block)
         if isinstance(details, Mapping) and key in details:
-            return _count(details[key])
-    return _count(obj.get(key))
+            return _count(details[key], f"{block}.{key}")
+    return _count(obj.get(key), key)
 
 
-def _count(value: Any) -> int:
-    return value if isinstance(value, int) and not isinstance(value, bool) and value > 0 else 0
+def _shown(value: Any) -> str:
+    text = repr(value) if not isinstance(value, int) or value < 10**20 else "a huge number"
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _count(value: Any, where: str) -> int:
+    """A token count: absent or null is 0; else a whole number within the bound, checked
+    before any arithmetic sees it."""
+    if value is None:
+        return 0
+    if isinstance(value, float) and value.is_integer():  # 12.0 from some proxies: still whole
+        value = int(value) if abs(value) <= limits.MAX_USAGE_TOKENS else value
+    ok = isinstance(value, int) and not isinstance(value, bool)
+    if not ok or not 0 <= value <= limits.MAX_USAGE_TOKENS:
+        raise UsageError(
+            f"usage.{where} is {_shown(value)}: expected a whole number of tokens from 0 to"
+            f" {limits.MAX_USAGE_TOKENS}"
+        )
+    return int(value)
 
 
 def total_usage(records: Iterable[Usage]) -> Usage:
@@ -107,12 +142,15 @@ class Price:
     cached_input: float | None = None  # None: cached tokens cost the input rate
 
     def cost(self, usage: Usage) -> float:
+        """USD, finite whatever the counts (each capped at int64, cached within input)."""
         cached_rate = self.input if self.cached_input is None else self.cached_input
-        fresh = usage.input_tokens - usage.cached_tokens
+        inputs = min(max(usage.input_tokens, 0), _MAX_PRICED)
+        cached = min(max(usage.cached_tokens, 0), inputs)
+        outputs = min(max(usage.output_tokens, 0), _MAX_PRICED)
         return (
-            fresh * self.input
-            + usage.cached_tokens * cached_rate
-            + usage.output_tokens * self.output
+            float(inputs - cached) * self.input
+            + float(cached) * cached_rate
+            + float(outputs) * self.output
         ) / 1_000_000
 
 
@@ -135,7 +173,7 @@ class PriceTable:
         for path in extra:
             try:
                 data = json.loads(Path(path).read_text("utf-8"))
-            except (OSError, json.JSONDecodeError) as e:
+            except (OSError, ValueError) as e:  # ValueError: not JSON, or a 5,000-digit number
                 raise PriceError(f"{path}: cannot read price table: {e}") from None
             prices.update(_parse_prices(data, str(path)))
         return PriceTable(prices)
@@ -168,8 +206,15 @@ def _parse_prices(data: Any, source: str) -> dict[str, Price]:
             if v is None and key == "cached_input":
                 values[key] = None
                 continue
-            if isinstance(v, bool) or not isinstance(v, int | float) or v < 0:
-                raise PriceError(f"{source}: models.{name}.{key}: expected a price >= 0")
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, int | float)
+                or not 0 <= v <= limits.MAX_PRICE_USD  # also refuses NaN and infinities
+            ):
+                raise PriceError(
+                    f"{source}: models.{name}.{key}: expected a price from 0 to"
+                    f" {limits.MAX_PRICE_USD:g} (USD per 1M tokens)"
+                )
             values[key] = float(v)
         inp, outp = values["input"], values["output"]
         assert inp is not None and outp is not None

@@ -3,7 +3,11 @@
 It checks every request's shape (model, system + user messages, base64 PNG images, the sampling
 parameters, the bearer key) and answers from a script: each entry is a reply text, native tool
 calls (:func:`calls`), or a fault (``timeout``, ``500``, ``429`` with Retry-After, ``malformed``
-JSON, ``cutoff``). When the script runs out it answers ``<action>finish</action>``.
+JSON, ``cutoff``), or one of the hostile faults of :mod:`chaingeo.evaluation.hostile_server`
+(``trickle``, ``redirect`` to another port, ``answer``: any JSON as the body, ``retry-after``;
+``raw_usage`` sends any usage block). Reply text goes out through ``json.dumps``, so lone
+surrogates arrive escaped as from a hostile server. When the script runs out it answers
+``<action>finish</action>``.
 
 Tool calling: an answer's calls get ids ``call_<request>_<i>``. The next request must answer
 them (unless its entry says ``new_episode``): the previous observation, the assistant message
@@ -18,10 +22,13 @@ import json
 import threading
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager, suppress
+from contextlib import contextmanager
 from dataclasses import dataclass, field
-from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from http.server import BaseHTTPRequestHandler
 from typing import Any
+
+from chaingeo.core import limits
+from chaingeo.evaluation.hostile_server import chat_answer, play, send, serving
 
 
 @dataclass
@@ -61,7 +68,7 @@ REFUSAL = '"auto" tool choice requires --enable-auto-tool-choice and --tool-call
 
 def _check_tool_history(middle: list[Any], script: Script, fresh: bool) -> str | None:
     """The messages between the system prompt and the new observation answer the last calls."""
-    pending = script.pending
+    pending = script.pending[: limits.MAX_TOOL_CALLS]  # a client plays (and echoes) no more
     if not middle:
         missing = pending and not fresh
         return "the tool results of the last answer did not come back" if missing else None
@@ -146,14 +153,7 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
             pass
 
         def _send(self, code: int, payload: bytes, headers: dict[str, str] | None = None) -> None:
-            self.send_response(code)
-            self.send_header("Content-Type", "application/json")
-            self.send_header("Content-Length", str(len(payload)))
-            for k, v in (headers or {}).items():
-                self.send_header(k, v)
-            self.end_headers()
-            with suppress(BrokenPipeError, ConnectionResetError):
-                self.wfile.write(payload)
+            send(self, code, payload, headers)
 
         def do_POST(self) -> None:
             n = int(self.headers.get("Content-Length", 0))
@@ -177,6 +177,8 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
                 self._send(400, json.dumps({"error": {"message": REFUSAL}}).encode())
                 return
             entry = script.next()
+            if play(self, entry, body["model"]):
+                return
             fault = entry.get("fault")
             if fault == "timeout":
                 time.sleep(float(entry.get("sleep", 1.0)))
@@ -207,42 +209,7 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
                 key = self.headers.get("Authorization", "")
                 self._send(401, json.dumps({"error": {"message": f"bad key {key}"}}).encode())
                 return
-            text = entry.get("reply", "")
-            prompt, completion = entry.get("usage", (100, 20))
-            message: dict[str, Any] = {"role": "assistant", "content": text or None}
-            made = [
-                (
-                    f"call_{number}_{i}",
-                    name,
-                    args if isinstance(args, str) else json.dumps(args),
-                )
-                for i, (name, args) in enumerate(entry.get("tool_calls", []))
-            ]
-            script.pending = made
-            if made:
-                message["tool_calls"] = [
-                    {"id": cid, "type": "function", "function": {"name": name, "arguments": a}}
-                    for cid, name, a in made
-                ]
-            answer = {
-                "id": "x",
-                "object": "chat.completion",
-                "model": body["model"],
-                "choices": [
-                    {
-                        "index": 0,
-                        "message": message,
-                        "finish_reason": "length" if fault == "cutoff" else "stop",
-                    }
-                ],
-                "usage": {
-                    "prompt_tokens": prompt,
-                    "completion_tokens": completion,
-                    "total_tokens": prompt + completion,
-                    "completion_tokens_details": {"reasoning_tokens": entry.get("reasoning", 0)},
-                    "prompt_tokens_details": {"cached_tokens": entry.get("cached", 0)},
-                },
-            }
+            answer, script.pending = chat_answer(entry, body["model"], number)
             self._send(200, json.dumps(answer).encode())
 
     return Handler
@@ -251,12 +218,5 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
 @contextmanager
 def fake_openai(script: Script) -> Iterator[str]:
     """Serve ``script``; yields the base URL (``http://127.0.0.1:PORT/v1``)."""
-    server = ThreadingHTTPServer(("127.0.0.1", 0), _make_handler(script))
-    server.daemon_threads = True
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    try:
-        yield f"http://127.0.0.1:{server.server_address[1]}/v1"
-    finally:
-        server.shutdown()
-        server.server_close()
+    with serving(_make_handler(script)) as url:
+        yield url

@@ -13,7 +13,8 @@ once per run. ``--model-option KEY=VALUE`` passes a field through to the server'
 ``extra_body='{"top_k": 20}'`` merged in).
 
 Exit status: 0 when every episode was played; 1 when some episode errored (agent or environment
-fault, server down after every retry; said above the leaderboard), unless ``--allow-errors``;
+fault, server down after every retry; said above the leaderboard with one line per distinct
+reason and its count), unless ``--allow-errors``;
 2 for a usage error or refused credentials (HTTP 401/403, or no key for a remote server), which
 stop the run at the first call.
 """
@@ -25,6 +26,7 @@ import datetime as _dt
 import json
 import re
 import sys
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -148,6 +150,23 @@ def _say_tool_fallback(run: str, records: list[dict[str, Any]]) -> None:
         )
 
 
+#: Characters of one error reason printed on the console.
+MAX_REASON_CHARS = 300
+
+
+def _error_reasons(records: list[dict[str, Any]]) -> list[str]:
+    """One line per distinct reason of the errored episodes, most frequent first, with counts
+    (cleaned of code points a terminal cannot take, bounded)."""
+    from chaingeo.evaluation.sanitize import clean_text, shorten
+
+    reasons = Counter(
+        shorten(clean_text(str(r.get("error") or r.get("error_type") or "?")), MAX_REASON_CHARS)
+        for r in records
+        if r.get("status") == "error"
+    )
+    return [f"  {n} x {reason}" for reason, n in sorted(reasons.items(), key=lambda x: -x[1])]
+
+
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.level import load_level, load_levels
     from chaingeo.core.suite import shipped_levels
@@ -214,6 +233,7 @@ def run(args: argparse.Namespace) -> int:
     )
     runs: list[Run] = []
     errored: dict[str, int] = {}
+    failed: list[dict[str, Any]] = []
     for name in names:
         # Built-in baselines take no model options; only pass what was given explicitly.
         opts = (
@@ -243,6 +263,7 @@ def run(args: argparse.Namespace) -> int:
             runs.append(load_run(run_dir))
             records = list(RunLog(run_dir).latest().values())
             errored[run_dir.name] = sum(r.get("status") == "error" for r in records)
+            failed += [r for r in records if r.get("status") == "error"]
             _say_tool_fallback(run_dir.name, records)
     total = sum(errored.values())
     if total:
@@ -252,6 +273,7 @@ def run(args: argparse.Namespace) -> int:
             f"WARNING: {total} episode(s) errored ({where}); they count as unsolved;"
             f" {verdict}; `--resume --retry-errors` reruns them"
         )
+        print("\n".join(_error_reasons(failed)))
     print(table1(runs).markdown())
     print(f"runs written to {args.out}; `chain report {args.out}` for every table and the plot")
     return 1 if total and not args.allow_errors else 0

@@ -136,7 +136,15 @@ class AuthenticationError(AgentError):
 
 #: Options that say how to reach an agent, not how it behaves.
 TRANSPORT = frozenset(
-    {"base_url", "timeout", "max_retries", "backoff_base", "backoff_max", "api_key_env"}
+    {
+        "base_url",
+        "timeout",
+        "max_retries",
+        "backoff_base",
+        "backoff_max",
+        "retry_budget",
+        "api_key_env",
+    }
 )
 
 

@@ -3,9 +3,11 @@
 Options (all logged; the key is not an option): ``model``, ``base_url`` (default: env
 ``OPENAI_BASE_URL``, else ``https://api.openai.com/v1``), ``api_key_env`` (the variable holding
 the key, default ``OPENAI_API_KEY``; a local server may need none), ``temperature`` 0.6 and
-``top_p`` 0.95 (the paper's), ``max_tokens``, ``timeout``, ``max_retries``, ``backoff_base``,
-``tools``, ``model_options``, ``send_seed`` (pass a per-call seed to servers that accept one),
-``image_detail``, ``views`` (subset of views sent).
+``top_p`` 0.95 (the paper's), ``max_tokens``, ``timeout`` (a wall-clock deadline per request),
+``max_retries``, ``backoff_base``, ``retry_budget`` (seconds for all retries of one call, at most
+:data:`~chaingeo.core.limits.MAX_RETRY_SECONDS`), ``tools``, ``model_options``, ``send_seed``
+(pass a per-call seed to servers that accept one), ``image_detail``, ``views`` (subset of views
+sent).
 
 ``tools`` is ``auto`` (default), ``on`` or ``off``. With tools the model is offered one function
 per action kind (:mod:`chaingeo.evaluation.agents.tools`); each call it makes is one action, and
@@ -33,6 +35,7 @@ import json
 from collections.abc import Mapping, Sequence
 from typing import Any, Final
 
+from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.base import Agent, AgentError, Reply, ToolCall, Turn
 from chaingeo.evaluation.agents.http import ChatClient, RequestRejected, ServerSettings
@@ -205,10 +208,8 @@ class OpenAIAgent(Agent):
     def _read(
         self, answer: Mapping[str, Any], turn: Turn, tools: Sequence[dict[str, Any]]
     ) -> tuple[str, str | None, tuple[ToolCall, ...], Usage]:
-        choice = answer["choices"][0] if isinstance(answer["choices"][0], dict) else {}
-        message = choice.get("message") or {}
-        if not isinstance(message, dict):
-            message = {}
+        """The parts of an answer the client checked (:func:`protocol.check_answer`)."""
+        message = answer["choices"][0]["message"]
         text = _content_text(message.get("content"))
         reasoning = message.get("reasoning_content") or message.get("reasoning")
         calls = _tool_calls(message.get("tool_calls"), tools, turn) if self._native else ()
@@ -251,11 +252,12 @@ def _content_text(content: Any) -> str:
 
 
 def _tool_calls(raw: Any, tools: Sequence[dict[str, Any]], turn: Turn) -> tuple[ToolCall, ...]:
-    """The calls of an assistant message, each translated (a call without an id gets one)."""
+    """The calls of an assistant message, each translated (a call without an id gets one); at
+    most :data:`~chaingeo.core.limits.MAX_TOOL_CALLS`, the rest dropped unplayed."""
     if not isinstance(raw, list):
         return ()
     out: list[ToolCall] = []
-    for i, call in enumerate(raw):
+    for i, call in enumerate(raw[: limits.MAX_TOOL_CALLS]):
         call = call if isinstance(call, dict) else {}
         fn = call.get("function")
         fn = fn if isinstance(fn, dict) else {}

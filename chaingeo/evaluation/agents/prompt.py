@@ -4,6 +4,7 @@ The reply format is the original benchmark's: the action goes between ``<action>
 ``</action>`` (the last such pair wins, so a model may think aloud first); a one-shot plan goes
 between ``<plan>`` and ``</plan>``, one action per line (or as several ``<action>`` tags).
 Nothing a model writes is ever evaluated: the text found is handed to the environment's parser.
+Reading is one linear scan over at most :data:`~chaingeo.core.limits.MAX_REPLY_CHARS` characters.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import re
 from collections.abc import Sequence
 from typing import Any, Final
 
+from chaingeo.core import limits
 from chaingeo.evaluation.agents.base import ObservationLike
 
 SYSTEM_PROMPT: Final = (
@@ -42,10 +44,9 @@ ONESHOT_TOOLS_PROMPT: Final = (
     "write the plan, one action per line, between <plan> and </plan>.)"
 )
 
-_ACTION_RE: Final = re.compile(r"<action>(.*?)</action>", re.IGNORECASE | re.DOTALL)
-_OPEN_RE: Final = re.compile(r"<action>", re.IGNORECASE)
-_PLAN_RE: Final = re.compile(r"<plan>(.*?)</plan>", re.IGNORECASE | re.DOTALL)
 _BULLET_RE: Final = re.compile(r"^\s*(?:[-*•]|\d+[.):]|step\s+\d+\s*[:.)-])\s*", re.IGNORECASE)
+#: ASCII upper case to lower case only: keeps every index of the text (``str.lower`` may not).
+_ASCII_LOWER: Final = str.maketrans("ABCDEFGHIJKLMNOPQRSTUVWXYZ", "abcdefghijklmnopqrstuvwxyz")
 
 
 def _clean(action: str) -> str:
@@ -53,30 +54,60 @@ def _clean(action: str) -> str:
     return " ".join(text.split())
 
 
+def _tagged(text: str, tag: str) -> tuple[list[str], bool]:
+    """Every ``<tag>...</tag>`` body left to right (each from an opening tag to the first
+    closing tag after it, tags in any case) and whether an opening tag is left unclosed. One
+    forward scan with ``str.find``: linear whatever the text (a regular expression with a lazy
+    ``.*?`` rescans the rest of the text from every opening tag)."""
+    folded = text.translate(_ASCII_LOWER)
+    opening, closing = f"<{tag}>", f"</{tag}>"
+    found: list[str] = []
+    pos = 0
+    while (start := folded.find(opening, pos)) >= 0:
+        end = folded.find(closing, start + len(opening))
+        if end < 0:
+            return found, True
+        found.append(text[start + len(opening) : end])
+        pos = end + len(closing)
+    return found, False
+
+
+def _too_long(text: str) -> str | None:
+    if len(text) <= limits.MAX_REPLY_CHARS:
+        return None
+    return f"your reply has {len(text)} characters; at most {limits.MAX_REPLY_CHARS} are read"
+
+
 def extract_action(text: str) -> tuple[str | None, str | None]:
     """(action, None) for the last ``<action>`` pair, else (None, why not)."""
-    found = _ACTION_RE.findall(text)
+    too_long = _too_long(text)
+    if too_long:
+        return None, too_long
+    found, unclosed = _tagged(text, "action")
     if found:
         action = _clean(found[-1])
         if action:
             return action, None
         return None, "the <action></action> tags were empty"
-    if _OPEN_RE.search(text):
+    if unclosed:
         return None, "your reply was cut off before </action>"
     return None, "no <action>...</action> found in your reply"
 
 
 def extract_plan(text: str) -> tuple[tuple[str, ...], str | None]:
     """The plan's actions in order: ``<plan>`` lines, else every ``<action>`` tag."""
-    blocks = _PLAN_RE.findall(text)
+    too_long = _too_long(text)
+    if too_long:
+        return (), too_long
+    blocks, unclosed = _tagged(text, "plan")
     if blocks:
         lines = [_clean(_BULLET_RE.sub("", line)) for line in blocks[-1].splitlines()]
         actions = tuple(line for line in lines if line)
         return actions, None if actions else "the <plan></plan> block was empty"
-    actions = tuple(a for a in (_clean(x) for x in _ACTION_RE.findall(text)) if a)
+    actions = tuple(a for a in (_clean(x) for x in _tagged(text, "action")[0]) if a)
     if actions:
         return actions, None
-    if re.search(r"<plan>", text, re.IGNORECASE):
+    if unclosed:
         return (), "your reply was cut off before </plan>"
     return (), "no <plan>...</plan> found in your reply"
 

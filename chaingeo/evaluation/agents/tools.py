@@ -7,9 +7,11 @@ only where the level's rules allow turns, and ``state {}``/``finish {}`` everywh
 translated into the canonical action text of :mod:`chaingeo.envs.actions` by plain string
 building (``place red (1,1,1) (2,1,1)``, ``pickup red``, ``move red+blue -z inf``), so the
 environment's own parser judges it like any typed action. The arguments are read with
-``json.loads`` only and checked strictly against the schema offered (types, allowed fields); a
-call that fails becomes an action text starting with ``!``, which no grammar accepts: the
-environment rejects it as unparseable and counts the step, and the agent is told why.
+``json.loads`` only, within the agent-text limits of :mod:`chaingeo.core.limits` (length,
+nesting, digits: :func:`chaingeo.envs.chain_dialect.loads_agent_json`), and checked strictly
+against the schema offered (types, allowed fields); a call that fails becomes an action text
+starting with ``!``, which no grammar accepts: the environment rejects it as unparseable and
+counts the step, and the agent is told why.
 """
 
 from __future__ import annotations
@@ -20,7 +22,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Final
 
+from chaingeo.core import limits
 from chaingeo.core.level import Level
+from chaingeo.envs.chain_dialect import AgentJsonError, loads_agent_json
 
 DIRECTIONS: Final = ("+x", "-x", "+y", "-y", "+z", "-z")
 AXES: Final = ("x", "y", "z")
@@ -253,20 +257,33 @@ class Translation:
     problem: str | None = None  # why the call was malformed (its action text then starts "!")
 
 
-def parse_arguments(arguments: Any) -> Any:
-    """A call's arguments: a JSON object's text (decoded with ``json.loads``, nothing else), or
-    an object some servers send already decoded (none or empty text: no arguments). Anything
-    else comes back as is, to be refused."""
+def _arguments(arguments: Any) -> Any:
+    """A call's arguments decoded; :class:`_Malformed` saying why when its text is not JSON
+    within the agent-text limits (length, nesting, digits of every number). Arguments a server
+    sent already decoded go through the same limits as their JSON text."""
     if arguments is None:
         return {}
-    if isinstance(arguments, str):
-        if not arguments.strip():
-            return {}  # an empty argument string: a call with no arguments
+    if not isinstance(arguments, str):  # decoded by the server: measured as the text it was
         try:
-            return json.loads(arguments)
-        except (json.JSONDecodeError, RecursionError):
-            return arguments
-    return arguments
+            arguments = json.dumps(arguments)
+        except (TypeError, ValueError, RecursionError):
+            return arguments  # no JSON value at all: refused as not an object
+    if not arguments.strip():
+        return {}  # an empty argument string: a call with no arguments
+    try:
+        return loads_agent_json(arguments, limits.MAX_TOOL_ARGUMENT_CHARS)
+    except AgentJsonError as e:
+        raise _Malformed(f"the arguments are not usable JSON: {e.reason}") from None
+
+
+def parse_arguments(arguments: Any) -> Any:
+    """A call's arguments: a JSON object's text (decoded with ``json.loads`` only, within the
+    agent-text limits), or an object some servers send already decoded (none or empty text: no
+    arguments). Anything else, or text past a limit, comes back as is, to be refused."""
+    try:
+        return _arguments(arguments)
+    except _Malformed:
+        return arguments
 
 
 def translate(name: Any, arguments: Any, offered: Sequence[Mapping[str, Any]]) -> Translation:
@@ -276,7 +293,7 @@ def translate(name: Any, arguments: Any, offered: Sequence[Mapping[str, Any]]) -
     try:
         if not isinstance(name, str) or name not in schemas:
             raise _Malformed(f"there is no tool named {_shown(name)} here")
-        args = parse_arguments(arguments)
+        args = _arguments(arguments)
         if not isinstance(args, dict):
             raise _Malformed("the arguments are not a JSON object")
         schema = schemas[name]
