@@ -28,7 +28,7 @@ from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
 from solvers import movement as mv
 from solvers import turnmoves as tm
 from solvers.partsearch import Deadline, Removal, SearchLimits, Split, part_size
-from solvers.sweep import FAR_LIMIT, stencils, swept_through
+from solvers.sweep import FAR_LIMIT, Stencils, stencils, swept_through
 
 _DIR_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 _DIR_VECS = np.array([DIRECTIONS[d] for d in _DIR_NAMES], dtype=np.int64)
@@ -258,13 +258,19 @@ class TurnPartSearch:
 
 
 def turn_rows(
-    state: Assembly, max_group: int | None, table: tm.TurnTable, group_limit: int = 4096
+    state: Assembly,
+    max_group: int | None,
+    table: tm.TurnTable,
+    group_limit: int = 4096,
+    st: Stencils | None = None,
 ) -> list[tuple[tuple[str, ...], np.ndarray]]:
     """The legal turns of ``state`` in the kernel's raw form: per part of two or more pieces,
     its piece names (sorted) and int64 rows ``(mask, axis, sense, c0, c1, c2)`` (see
-    :func:`solvers.turnmoves.node_turns`). ``table`` holds the state's pieces and rods."""
+    :func:`solvers.turnmoves.node_turns`). ``table`` holds the state's pieces and rods; ``st``
+    is the stencil table (the one of :func:`solvers.sweep.stencils` unless a test asks for
+    another reach)."""
     out: list[tuple[tuple[str, ...], np.ndarray]] = []
-    st = stencils()
+    st = stencils() if st is None else st
     for part in sorted(state.parts, key=lambda p: sorted(p)):
         if len(part) < 2:
             continue
@@ -296,13 +302,16 @@ def turn_rows(
 
 
 def fast_legal_turns(
-    state: Assembly, max_group: int | None = None, table: tm.TurnTable | None = None
+    state: Assembly,
+    max_group: int | None = None,
+    table: tm.TurnTable | None = None,
+    st: Stencils | None = None,
 ) -> list[TurnMove]:
     """Every legal turn of ``state``, as :func:`chaingeo.core.kinematics.legal_turns` lists
-    them, computed by the numba kernel."""
+    them, computed by the numba kernel (stencils from ``st``, as :func:`turn_rows`)."""
     table = tm.TurnTable(state.shapes, state.rods) if table is None else table
     out: list[TurnMove] = []
-    for names, rows in turn_rows(state, max_group, table):
+    for names, rows in turn_rows(state, max_group, table, st=st):
         for mask, axis, sense, c0, c1, c2 in rows.tolist():
             pieces = tuple(names[i] for i in range(len(names)) if mask >> i & 1)
             out.append(TurnMove.listed(pieces, AXES[axis], 1 - 2 * sense, (c0, c1, c2)))

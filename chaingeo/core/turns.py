@@ -115,9 +115,7 @@ class TurnMove:
         """A turn a kernel listed (pieces sorted and distinct, a valid centre with its axis
         component 0), built without checking again: a state lists thousands."""
         move = object.__new__(cls)
-        for name, value in (("pieces", pieces), ("axis", axis), ("quarter", quarter)):
-            object.__setattr__(move, name, value)
-        object.__setattr__(move, "centre2", centre2)
+        move.__dict__.update(pieces=pieces, axis=axis, quarter=quarter, centre2=centre2)
         return move
 
     @property
