@@ -244,35 +244,61 @@ def swept_through(moving: I64, fixed: I64, axis: int, sense: int, centre2: I64) 
 
 
 @njit(cache=True)
+def _push(cells: I64, total: int, x: int, y: int) -> I64:
+    """``cells`` with row ``total`` set to ``(x, y)`` (grown by doubling when full)."""
+    if total == cells.shape[0]:
+        grown = np.empty((2 * total, 2), dtype=np.int64)
+        grown[:total] = cells
+        cells = grown
+    cells[total, 0] = x
+    cells[total, 1] = y
+    return cells
+
+
+@njit(cache=True)
 def build_stencils(bound: int) -> tuple[I64, I64, I64]:
     """``(start, end, cells)``: ``cells[start[k, i, j]:end[k, i, j]]`` are the squares
     (relative to the axis) that square ``(i - bound, j - bound)`` sweeps turning +90 (``k`` 0) or
-    -90 (``k`` 1); the -90 stencils are the +90 ones mirrored (v -> -v)."""
+    -90 (``k`` 1). Only squares with ``x > 0, y >= 0`` (and the one on the axis) are computed:
+    the others are those turned by quarter turns, and -90 is the mirror image (v -> -v)."""
     w = 2 * bound + 1
     start = np.zeros((2, w, w), dtype=np.int64)
     end = np.zeros((2, w, w), dtype=np.int64)
     cells = np.empty((1024, 2), dtype=np.int64)
     total = 0
-    for i in range(w):
-        for j in range(w):
+    for i in range(bound, w):
+        for j in range(bound, w):
             sx = i - bound
             sy = j - bound
-            if (sx - sy) % 2 != 0:
-                continue  # not a square of either lattice
-            r2 = rmax2(sx, sy)
-            reach = int(np.sqrt(r2)) + 2
+            if (sx - sy) % 2 != 0 or (sx == 0 and sy > 0):
+                continue  # not a square of either lattice, or not in the quadrant
+            reach = int(np.sqrt(rmax2(sx, sy))) + 2
             first = -reach - 2 if (reach - sx) % 2 == 0 else -reach - 3  # sx's parity
             start[0, i, j] = total
             for fx in range(first, reach + 1, 2):
                 for fy in range(first, reach + 1, 2):
                     if square_hit(sx, sy, fx, fy):
-                        if total == cells.shape[0]:
-                            grown = np.empty((2 * total, 2), dtype=np.int64)
-                            grown[:total] = cells
-                            cells = grown
-                        cells[total, 0] = fx
-                        cells[total, 1] = fy
+                        cells = _push(cells, total, fx, fy)
                         total += 1
+            end[0, i, j] = total
+    for i in range(w):
+        for j in range(w):
+            x = i - bound
+            y = j - bound
+            if (x - y) % 2 != 0 or (x > 0 and y >= 0) or (x == 0 and y == 0):
+                continue
+            k = 0
+            while not (x > 0 and y >= 0):  # turn back into the quadrant
+                x, y = y, -x
+                k += 1
+            a = start[0, x + bound, y + bound]
+            start[0, i, j] = total
+            for e in range(a, end[0, x + bound, y + bound]):
+                fx, fy = cells[e, 0], cells[e, 1]
+                for _ in range(k):
+                    fx, fy = -fy, fx
+                cells = _push(cells, total, fx, fy)
+                total += 1
             end[0, i, j] = total
     out = np.empty((2 * total, 2), dtype=np.int64)
     out[:total] = cells[:total]
@@ -283,12 +309,11 @@ def build_stencils(bound: int) -> tuple[I64, I64, I64]:
             m = 2 * bound - j  # the mirror image of (i - bound, j - bound)
             a = start[0, i, m]
             n = end[0, i, m] - a
-            base = total + a
-            start[1, i, j] = base
-            end[1, i, j] = base + n
+            start[1, i, j] = total + a
+            end[1, i, j] = total + a + n
             for e in range(n):
-                out[base + e, 0] = cells[a + e, 0]
-                out[base + e, 1] = -cells[a + e, 1]
+                out[total + a + e, 0] = cells[a + e, 0]
+                out[total + a + e, 1] = -cells[a + e, 1]
     return start, end, out
 
 
