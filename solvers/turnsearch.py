@@ -335,7 +335,8 @@ def turn_problem(state: Assembly, move: TurnMove) -> str | None:
     sense = 0 if move.quarter == 1 else 1
     for other in sorted(state.part_of(move.pieces[0]) - set(move.pieces)):
         fixed = sorted(state.cells_of(other) - state.spinning([other], a, move.centre2))
-        flags = swept_through(moving, np.array(fixed, dtype=np.int64), a, sense, centre)
+        cells = np.array(fixed, dtype=np.int64).reshape(-1, 3)
+        flags = swept_through(moving, cells, a, sense, centre)
         hit = spin.intersection(fixed) | {
             f for f, h in zip(fixed, flags.tolist(), strict=True) if h
         }

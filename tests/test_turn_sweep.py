@@ -217,3 +217,17 @@ def test_random_episode_on_the_turn_level_is_bounded(monkeypatch: pytest.MonkeyP
     assert sweep.stencils() is table and table.bound == sweep.BOUND
     # a part wider than 13 cells puts cells more than 24 doubled units from some centre
     assert max(spans) > 13, spans
+
+
+def test_turn_problem_passes_a_piece_that_is_all_spinning_rod() -> None:
+    """A one-cell rod on the axis line spins in place: nothing of it is left to hit (the U
+    around it turns freely)."""
+    u_shape = [(0, 0, 0), (0, 1, 0), (1, 1, 0), (2, 1, 0), (2, 0, 0)]
+    shapes = {"a": Shape(u_shape), "r": Shape([(0, 0, 0)])}
+    state = Assembly(
+        shapes, {"a": (0, 0, 0), "r": (1, 0, 0)}, (frozenset(shapes),), {}, {"r": {(0, 0, 0): 2}}
+    )
+    for quarter in (1, -1):
+        move = TurnMove(("a",), "z", quarter, (2, 0, 0))
+        assert turn_problem(state, move) == state.turn_problem(move)
+    assert turn_problem(state, TurnMove(("a",), "z", 1, (2, 0, 0))) is None
