@@ -9,10 +9,11 @@ As for translations (:mod:`solvers.movement`), the legal groups of one turn (axi
 are the sets closed under a relation between pieces, here "turning alone, ``j`` would sweep through
 ``i``": a group sweeps through nothing outside it exactly when it holds everyone its members
 sweep through. The relation comes from the exact swept-cell *stencils* of
-:mod:`solvers.sweep` (one fixed table of relative positions near the axis, looked up in an
-occupancy grid of the state) and, for cells further out, the exact pair test against the other
+:mod:`solvers.sweep` (one fixed table of relative positions near the axis, looked up in a
+hash of the state's cells) and, for cells further out, the exact pair test against the other
 pieces' cells of the same slice; the closed sets come from :func:`solvers.movement.closed_groups`,
-never from trying subsets. Nothing here grows with how far apart the pieces stand.
+never from trying subsets. No table or grid grows with how far apart the pieces stand: the work
+per centre is bounded by the cells (the centres are those of the part's box).
 
 A part's pieces may stand in any of the 24 orientations, so every piece is pre-rotated: slot
 ``24 p + r`` holds piece ``p`` turned by ``ROTATIONS[r]`` (cells ``R v``), sorted per axis for
