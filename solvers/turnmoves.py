@@ -9,9 +9,11 @@ As for translations (:mod:`solvers.movement`), the legal groups of one turn (axi
 are the sets closed under a relation between pieces, here "turning alone, ``j`` would sweep through
 ``i``": a group sweeps through nothing outside it exactly when it holds everyone its members
 sweep through. The relation comes from the exact swept-cell *stencils* of
-:func:`chaingeo.core.turns.swept_squares` (computed once per relative position in Python, looked
-up here) and an occupancy grid of the state; the closed sets come from
-:func:`solvers.movement.closed_groups`, never from trying subsets.
+:mod:`solvers.sweep` (one fixed table of relative positions near the axis, looked up in a
+hash of the state's cells) and, for cells further out, the exact pair test against the other
+pieces' cells of the same slice; the closed sets come from :func:`solvers.movement.closed_groups`,
+never from trying subsets. No table or grid grows with how far apart the pieces stand: the work
+per centre is bounded by the cells (the centres are those of the part's box).
 
 A part's pieces may stand in any of the 24 orientations, so every piece is pre-rotated: slot
 ``24 p + r`` holds piece ``p`` turned by ``ROTATIONS[r]`` (cells ``R v``), sorted per axis for
@@ -27,14 +29,16 @@ import numpy.typing as npt
 
 from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
 from chaingeo.core.jit import njit
-from chaingeo.core.turns import quarter_index, swept_squares
+from chaingeo.core.turns import quarter_index
 from solvers import movement as mv
+from solvers.sweep import FAR_LIMIT, rmax2, rmin2, turn_hit
 
 I64 = npt.NDArray[np.int64]
 U64 = npt.NDArray[np.uint64]
 N_ROT = 24
-#: Extra status of :func:`node_turns` and the search kernel: a stencil lies beyond the table.
-NEED_STENCIL = 5
+#: Extra status of the search kernel: a cell lies beyond :data:`solvers.sweep.FAR_LIMIT` of a
+#: turn's axis, where the exact int64 test would overflow.
+TOO_FAR = 5
 #: Move kinds in the search's move rows: 0..5 translations (``DIRECTIONS`` order), then turns
 #: ``TURN_BASE + 2 axis + (0 for +90, 1 for -90)``.
 TURN_BASE = 6
@@ -50,47 +54,6 @@ MATRICES = np.ascontiguousarray(np.stack(ROTATIONS), dtype=np.int64)
 QUARTERS = np.array([[quarter_index(a, 1), quarter_index(a, -1)] for a in range(3)], np.int64)
 
 
-class Stencils:
-    """Swept-square stencils for every relative position ``s`` (doubled units, both
-    coordinates within ``bound``) and both senses, flattened for numba:
-    ``cells[start[k, i, j]:end[k, i, j]]`` are the squares (relative to the axis) that square
-    ``s = (i - bound, j - bound)`` sweeps turning +90 (``k = 0``) or -90 (``k = 1``)."""
-
-    def __init__(self, bound: int) -> None:
-        self.bound = bound
-        w = 2 * bound + 1
-        self.start = np.zeros((2, w, w), dtype=np.int64)
-        self.end = np.zeros((2, w, w), dtype=np.int64)
-        chunks: list[tuple[tuple[int, int], ...]] = []
-        total = 0
-        for k, quarter in enumerate((1, -1)):
-            for i in range(w):
-                for j in range(w):
-                    s = (i - bound, j - bound)
-                    if (s[0] - s[1]) % 2:
-                        continue  # not a square of either lattice
-                    sq = swept_squares(s, quarter)
-                    self.start[k, i, j] = total
-                    total += len(sq)
-                    self.end[k, i, j] = total
-                    chunks.append(sq)
-        self.cells = np.array([c for sq in chunks for c in sq], dtype=np.int64).reshape(-1, 2)
-
-
-_STENCILS: dict[int, Stencils] = {}
-
-
-def stencils(bound: int) -> Stencils:
-    """The stencil table reaching at least ``bound`` (shared; grown by doubling)."""
-    have = max(_STENCILS, default=0)
-    if have >= bound:
-        return _STENCILS[have]
-    size = max(bound, 2 * have, 16)
-    _STENCILS.clear()
-    _STENCILS[size] = Stencils(size)
-    return _STENCILS[size]
-
-
 class TurnTable:
     """Every piece in every orientation: sorted voxels, bounding boxes, rod flags.
 
@@ -103,8 +66,19 @@ class TurnTable:
         self.names: tuple[str, ...] = tuple(sorted(shapes))
         self.shapes = {n: shapes[n] for n in self.names}
         self.rods = {n: dict(rods.get(n, {})) for n in self.names}
+        self._parts: dict[tuple[int, ...], tuple[I64, I64, I64, I64, I64]] = {}
+        #: Row buffer for :func:`node_turns`, kept (and grown) across states.
+        self.rows_buf = np.zeros((256, 6), dtype=np.int64)
 
     def part_arrays(self, members: Sequence[int]) -> tuple[I64, I64, I64, I64, I64]:
+        """:meth:`build_part_arrays`, kept per set of members (a position's parts recur)."""
+        key = tuple(members)
+        got = self._parts.get(key)
+        if got is None:
+            got = self._parts[key] = self.build_part_arrays(members)
+        return got
+
+    def build_part_arrays(self, members: Sequence[int]) -> tuple[I64, I64, I64, I64, I64]:
         """``(vox, starts, lo, hi, rod)`` for the pieces ``members`` (indices into ``names``),
         slot ``24 i + r`` for the ``i``-th member turned by ``ROTATIONS[r]``: ``vox[a]`` sorted
         by (the two other axes, then ``a``), ``rod`` aligned with ``vox[0]`` (-1: no rod)."""
@@ -173,6 +147,18 @@ def gather(
 
 
 @njit(cache=True)
+def _hash_slot(keys: I64, key: int, bits: int) -> int:
+    """The slot of ``key`` in the open-addressing table ``keys`` (or the empty slot it would
+    take)."""
+    mask = np.int64((1 << bits) - 1)
+    mixed = (np.uint64(key) * np.uint64(0x9E3779B97F4A7C15)) >> np.uint64(64 - bits)
+    h = np.int64(mixed)
+    while keys[h] != -1 and keys[h] != key:
+        h = (h + np.int64(1)) & mask
+    return int(h)
+
+
+@njit(cache=True)
 def node_turns(
     vox: I64,
     starts: I64,
@@ -191,8 +177,12 @@ def node_turns(
 ) -> int:
     """List the legal turns of one state into ``out`` rows ``(mask, axis, sense, c0, c1,
     c2)`` (sense 0: +90, 1: -90; ``c`` the doubled centre, its axis component 0). Returns the
-    row count; -1 if ``out`` is too small, -2 past ``group_limit`` groups of one turn, and
-    ``-3 - b`` when a stencil beyond the table (``b`` > ``bound``) is needed."""
+    row count; -1 if ``out`` is too small, -2 past ``group_limit`` groups of one turn, -3 when
+    a cell lies beyond :data:`solvers.sweep.FAR_LIMIT` of a centre.
+
+    A cell within ``bound`` of the axis looks its stencil (``st_*``, :mod:`solvers.sweep`) up
+    in a hash of the occupied cells; a cell further out is tested pair by pair against the other
+    pieces' cells of its slice. Memory is linear in the cells, whatever their spread."""
     n = starts.shape[0] - 1
     full = (np.uint64(1) << np.uint64(n)) - np.uint64(1)
     total = starts[n]
@@ -209,11 +199,18 @@ def node_turns(
         glo[t] = cells[:, t].min()
         ghi[t] = cells[:, t].max()
     dims = ghi - glo + 1
-    grid = np.full((dims[0], dims[1], dims[2]), -1, dtype=np.int64)
-    rods = np.full((dims[0], dims[1], dims[2]), -1, dtype=np.int64)
+    bits = 4
+    while (1 << bits) < 4 * total:
+        bits += 1
+    keys = np.full(1 << bits, -1, dtype=np.int64)
+    key_cell = np.full(1 << bits, -1, dtype=np.int64)  # slot -> the cell index k there
     for k in range(total):
-        grid[cells[k, 0] - glo[0], cells[k, 1] - glo[1], cells[k, 2] - glo[2]] = owner[k]
-        rods[cells[k, 0] - glo[0], cells[k, 1] - glo[1], cells[k, 2] - glo[2]] = rod[k]
+        key = ((cells[k, 0] - glo[0]) * dims[1] + cells[k, 1] - glo[1]) * dims[2] + (
+            cells[k, 2] - glo[2]
+        )
+        h = _hash_slot(keys, key, bits)
+        keys[h] = key
+        key_cell[h] = k
     # each piece's bounding box now, for the "centre inside the group's box" rule
     plo = np.empty((n, 3), dtype=np.int64)
     phi = np.empty((n, 3), dtype=np.int64)
@@ -222,28 +219,91 @@ def node_turns(
             plo[i, t] = lo[i, t] + off[i, t]
             phi[i, t] = hi[i, t] + off[i, t]
     hits = np.zeros(n, dtype=np.uint64)
+    reach = np.zeros(n, dtype=np.uint64)
+    r_lo = np.empty(total, dtype=np.int64)
+    r_hi = np.empty(total, dtype=np.int64)
+    p_lo = np.empty(n, dtype=np.int64)
+    p_hi = np.empty(n, dtype=np.int64)
     c = np.empty(3, dtype=np.int64)
     hit_cell = np.empty(3, dtype=np.int64)
     rows = 0
     for a in range(3):
         u = (a + 1) % 3
         v = (a + 2) % 3
+        # the cells by slice across ``a``: cells ``order[s_lo[k]:s_hi[k]]`` share cell k's slice
+        order = np.argsort(cells[:, a], kind="mergesort")
+        s_lo = np.empty(total, dtype=np.int64)
+        s_hi = np.empty(total, dtype=np.int64)
+        first = 0
+        for e in range(1, total + 1):
+            if e == total or cells[order[e], a] != cells[order[first], a]:
+                for f in range(first, e):
+                    s_lo[order[f]] = first
+                    s_hi[order[f]] = e
+                first = e
         for cu in range(2 * glo[u] - 1, 2 * ghi[u] + 2):
             for cv in range(2 * glo[v] - 1, 2 * ghi[v] + 2):
                 if (cu - cv) % 2 != 0:
                     continue
+                # squares meet turning only if their ranges of radii overlap: per cell, per
+                # piece, and so which pieces each piece may reach at all (sharing a slice)
+                p_lo[:] = 1 << 62
+                p_hi[:] = -1
+                for k in range(total):
+                    su = 2 * cells[k, u] - cu
+                    sv = 2 * cells[k, v] - cv
+                    r_lo[k] = rmin2(su, sv)
+                    r_hi[k] = rmax2(su, sv)
+                    p_lo[owner[k]] = min(p_lo[owner[k]], r_lo[k])
+                    p_hi[owner[k]] = max(p_hi[owner[k]], r_hi[k])
+                for i in range(n):
+                    reach[i] = np.uint64(0)
+                    for o in range(n):
+                        if (
+                            o != i
+                            and plo[i, a] <= phi[o, a]
+                            and plo[o, a] <= phi[i, a]
+                            and max(p_lo[i], p_lo[o]) < min(p_hi[i], p_hi[o])
+                        ):
+                            reach[i] |= np.uint64(1) << np.uint64(o)
                 for sense in range(2):
                     for i in range(n):
                         hits[i] = np.uint64(1) << np.uint64(i)
                     for k in range(total):
                         i = owner[k]
+                        todo = reach[i] & ~hits[i]
+                        if todo == 0:
+                            continue  # it sweeps through every piece it may reach
+                        near = False
+                        for o in range(n):
+                            if todo & (np.uint64(1) << np.uint64(o)) and max(
+                                r_lo[k], p_lo[o]
+                            ) < min(r_hi[k], p_hi[o]):
+                                near = True
+                                break
+                        if not near:
+                            continue  # no piece left to hit at its radii
                         su = 2 * cells[k, u] - cu
                         sv = 2 * cells[k, v] - cv
                         if su == 0 and sv == 0 and rod[k] == a:
                             continue  # a round rod spinning about its own axis
                         need = max(abs(su), abs(sv))
-                        if need > bound:
-                            return int(-3 - need)
+                        if need > FAR_LIMIT:
+                            return -3
+                        if need > bound:  # far out: the exact test against its slice
+                            for e in range(s_lo[k], s_hi[k]):
+                                k2 = order[e]
+                                o = owner[k2]
+                                bo = np.uint64(1) << np.uint64(o)
+                                if hits[i] & bo:
+                                    continue
+                                fu = 2 * cells[k2, u] - cu
+                                fv = 2 * cells[k2, v] - cv
+                                if fu == 0 and fv == 0 and rod[k2] == a:
+                                    continue  # a rod spinning on the axis line is passed by
+                                if turn_hit(su, sv, fu, fv, sense):
+                                    hits[i] |= bo
+                            continue
                         for e in range(st_start[sense, su + bound, sv + bound],
                                        st_end[sense, su + bound, sv + bound]):  # fmt: skip
                             hit_cell[a] = cells[k, a]
@@ -253,13 +313,12 @@ def node_turns(
                             y = hit_cell[1] - glo[1]
                             z = hit_cell[2] - glo[2]
                             if 0 <= x < dims[0] and 0 <= y < dims[1] and 0 <= z < dims[2]:
-                                o = grid[x, y, z]
-                                if o >= 0 and not (
-                                    rods[x, y, z] == a
-                                    and 2 * hit_cell[u] == cu
-                                    and 2 * hit_cell[v] == cv
+                                h = _hash_slot(keys, (x * dims[1] + y) * dims[2] + z, bits)
+                                k2 = key_cell[h]
+                                if k2 >= 0 and not (
+                                    rod[k2] == a and 2 * hit_cell[u] == cu and 2 * hit_cell[v] == cv
                                 ):  # (a rod spinning on the axis line is passed by)
-                                    hits[i] |= np.uint64(1) << np.uint64(o)
+                                    hits[i] |= np.uint64(1) << np.uint64(owner[k2])
                     # close "must come along" (Warshall on bit rows)
                     for m in range(n):
                         bm = np.uint64(1) << np.uint64(m)
@@ -356,9 +415,9 @@ def expand_turns(
     ``move`` rows: ``(mask, kind, p0, p1, p2)``, kind ``0..5`` a translation by ``p0`` along
     that direction, ``TURN_BASE + 2 axis + sense`` a turn about doubled centre ``(p0, p1, p2)``;
     ``mask`` is the group that moves (as a move of the reference it names those pieces).
-    Returns ``(status, next node, n_states, n_seps, extra)``; ``extra`` is the stencil bound
-    needed on ``NEED_STENCIL``. On a status other than DONE the caller grows that buffer and
-    calls again from the next node (re-expanded from scratch)."""
+    Returns ``(status, next node, n_states, n_seps, 0)``. On a status other than DONE (or
+    ``TOO_FAR``, which ends the search) the caller grows that buffer and calls again from the
+    next node (re-expanded from scratch)."""
     n = starts_all.shape[0] // 24
     w = 4 * n
     gaps = np.empty((3, n, n), dtype=np.int64)
@@ -390,8 +449,8 @@ def expand_turns(
             return NEED_TURNS, node, n_states, n_seps, 0
         if nt == -2:
             return mv.TOO_MANY_GROUPS, node, n_states, n_seps, 0
-        if nt <= -3:
-            return NEED_STENCIL, node, n_states, n_seps, -3 - nt
+        if nt == -3:
+            return TOO_FAR, node, n_states, n_seps, 0
         for r in range(rows):
             mask = np.uint64(moves_buf[r, 0])
             d = moves_buf[r, 1]

@@ -24,10 +24,11 @@ import numpy as np
 
 from chaingeo.core.geometry import ROTATIONS, rotation_index
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
-from chaingeo.core.turns import AXES, TurnMove
+from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
 from solvers import movement as mv
 from solvers import turnmoves as tm
 from solvers.partsearch import Deadline, Removal, SearchLimits, Split, part_size
+from solvers.sweep import FAR_LIMIT, Stencils, stencils, swept_through
 
 _DIR_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 _DIR_VECS = np.array([DIRECTIONS[d] for d in _DIR_NAMES], dtype=np.int64)
@@ -62,7 +63,6 @@ class TurnPartSearch:
         self.deadline = deadline
         self.chunk = chunk
         self.vox, self.starts, self.lo, self.hi, self.rod = table.part_arrays(self.members)
-        self.stencils = tm.stencils(16)
         cap = max(2, min(1024, limits.max_states))
         self.states = np.zeros((cap, 4 * n), dtype=np.int16)
         self.parent = np.full(cap, -1, dtype=np.int64)
@@ -124,8 +124,8 @@ class TurnPartSearch:
         while node < hi:
             self.deadline.check()
             end = min(hi, node + self.chunk)
-            st = self.stencils
-            status, node, self.n_states, self.n_seps, extra = tm.expand_turns(
+            st = stencils()
+            status, node, self.n_states, self.n_seps, _ = tm.expand_turns(
                 self.states, self.n_states, self.parent, self.move, self.hash, node, end,
                 self.vox, self.starts, self.lo, self.hi, self.rod,
                 st.start, st.end, st.cells, st.bound,
@@ -140,8 +140,11 @@ class TurnPartSearch:
                 self.turns_buf = np.zeros((2 * self.turns_buf.shape[0], 6), dtype=np.int64)
             elif status == mv.NEED_SEPS:
                 self.seps = np.concatenate([self.seps, np.zeros_like(self.seps)])
-            elif status == tm.NEED_STENCIL:
-                self.stencils = tm.stencils(extra)
+            elif status == tm.TOO_FAR:
+                raise SearchLimitError(
+                    f"pieces more than {FAR_LIMIT // 2} cells from a turn's axis: beyond the "
+                    "exact integer range of the turn kernel"
+                )
             elif status == mv.TOO_MANY_GROUPS:
                 raise SearchLimitError(
                     f"more than {self.limits.group_limit} movable groups of one move in one "
@@ -255,13 +258,19 @@ class TurnPartSearch:
 
 
 def turn_rows(
-    state: Assembly, max_group: int | None, table: tm.TurnTable, group_limit: int = 4096
+    state: Assembly,
+    max_group: int | None,
+    table: tm.TurnTable,
+    group_limit: int = 4096,
+    st: Stencils | None = None,
 ) -> list[tuple[tuple[str, ...], np.ndarray]]:
     """The legal turns of ``state`` in the kernel's raw form: per part of two or more pieces,
     its piece names (sorted) and int64 rows ``(mask, axis, sense, c0, c1, c2)`` (see
-    :func:`solvers.turnmoves.node_turns`). ``table`` holds the state's pieces and rods."""
+    :func:`solvers.turnmoves.node_turns`). ``table`` holds the state's pieces and rods; ``st``
+    is the stencil table (the one of :func:`solvers.sweep.stencils` unless a test asks for
+    another reach)."""
     out: list[tuple[tuple[str, ...], np.ndarray]] = []
-    st = tm.stencils(16)
+    st = stencils() if st is None else st
     for part in sorted(state.parts, key=lambda p: sorted(p)):
         if len(part) < 2:
             continue
@@ -272,33 +281,65 @@ def turn_rows(
         vox, starts, lo, hi, rod = tm.gather(vox_all, starts_all, lo_all, hi_all, rod_all, rot)
         off = np.array([state.offsets[p] for p in names], dtype=np.int64)
         groups = np.zeros(group_limit + 1, dtype=np.uint64)
-        buf = np.zeros((256, 6), dtype=np.int64)
         while True:
+            buf = table.rows_buf
             rows = tm.node_turns(
                 vox, starts, lo, hi, rod, off, st.start, st.end, st.cells, st.bound,
                 -1 if max_group is None else max_group, group_limit, groups, buf,
             )  # fmt: skip
-            if rows == -1:
-                buf = np.zeros((2 * buf.shape[0], 6), dtype=np.int64)
-            elif rows <= -3:
-                st = tm.stencils(-3 - rows)
-            else:
+            if rows != -1:
                 break
+            table.rows_buf = np.zeros((2 * buf.shape[0], 6), dtype=np.int64)
         if rows == -2:
             raise SearchLimitError(f"more than {group_limit} groups of one turn in one state")
+        if rows == -3:
+            raise SearchLimitError(
+                f"pieces more than {FAR_LIMIT // 2} cells from a turn's axis: beyond the exact "
+                "integer range of the turn kernel"
+            )
         out.append((names, buf[:rows].copy()))
     return out
 
 
 def fast_legal_turns(
-    state: Assembly, max_group: int | None = None, table: tm.TurnTable | None = None
+    state: Assembly,
+    max_group: int | None = None,
+    table: tm.TurnTable | None = None,
+    st: Stencils | None = None,
 ) -> list[TurnMove]:
     """Every legal turn of ``state``, as :func:`chaingeo.core.kinematics.legal_turns` lists
-    them, computed by the numba kernel."""
+    them, computed by the numba kernel (stencils from ``st``, as :func:`turn_rows`)."""
     table = tm.TurnTable(state.shapes, state.rods) if table is None else table
     out: list[TurnMove] = []
-    for names, rows in turn_rows(state, max_group, table):
+    for names, rows in turn_rows(state, max_group, table, st=st):
         for mask, axis, sense, c0, c1, c2 in rows.tolist():
             pieces = tuple(names[i] for i in range(len(names)) if mask >> i & 1)
-            out.append(TurnMove(pieces, AXES[axis], 1 - 2 * sense, (c0, c1, c2)))
+            out.append(TurnMove.listed(pieces, AXES[axis], 1 - 2 * sense, (c0, c1, c2)))
     return sorted(out)
+
+
+def turn_problem(state: Assembly, move: TurnMove) -> str | None:
+    """:meth:`chaingeo.core.kinematics.Assembly.turn_problem` (the same answer, the same words)
+    from the exact pair test of :mod:`solvers.sweep`, whose cost does not grow with how far the
+    group stands from the axis (the reference lists every cell each cell sweeps)."""
+    a = move.axis_index
+    group = [c for n in move.pieces for c in state.cells_of(n)]
+    if not centre_inside(group, a, move.centre2):
+        return "the axis must pass through the group's bounding box"
+    spin = state.spinning(move.pieces, a, move.centre2)
+    moving = np.array([c for c in group if c not in spin], dtype=np.int64).reshape(-1, 3)
+    centre = np.array(move.centre2, dtype=np.int64)
+    lat = list(lateral(a))
+    if moving.size and int(np.abs(2 * moving[:, lat] - centre[lat]).max()) > FAR_LIMIT:
+        return state.turn_problem(move)  # beyond the int64 range: the reference decides
+    sense = 0 if move.quarter == 1 else 1
+    for other in sorted(state.part_of(move.pieces[0]) - set(move.pieces)):
+        fixed = sorted(state.cells_of(other) - state.spinning([other], a, move.centre2))
+        cells = np.array(fixed, dtype=np.int64).reshape(-1, 3)
+        flags = swept_through(moving, cells, a, sense, centre)
+        hit = spin.intersection(fixed) | {
+            f for f, h in zip(fixed, flags.tolist(), strict=True) if h
+        }
+        if hit:
+            return f"it would sweep through {other} at {min(hit)}"
+    return None

@@ -110,6 +110,14 @@ class TurnMove:
         object.__setattr__(self, "pieces", tuple(sorted(self.pieces)))
         object.__setattr__(self, "centre2", (c[0], c[1], c[2]))
 
+    @classmethod
+    def listed(cls, pieces: tuple[str, ...], axis: str, quarter: int, centre2: Cell) -> TurnMove:
+        """A turn a kernel listed (pieces sorted and distinct, a valid centre with its axis
+        component 0), built without checking again: a state lists thousands."""
+        move = object.__new__(cls)
+        move.__dict__.update(pieces=pieces, axis=axis, quarter=quarter, centre2=centre2)
+        return move
+
     @property
     def axis_index(self) -> int:
         return AXES.index(self.axis)

@@ -517,8 +517,8 @@ class PuzzleState(BaseState):
 
     # -- applying -----------------------------------------------------------------------------
     def _after(self, action: Action) -> Any:
-        if isinstance(action, TurnAction):
-            return self._asm.apply(action.turn)
+        if isinstance(action, TurnAction):  # checked already (listed, or turn_problem)
+            return self._asm.turned(action.turn)
         assert isinstance(action, MoveAction)
         if self.mode == "disassemble":
             return self._asm.apply(action.move)

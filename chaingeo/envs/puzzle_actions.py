@@ -147,10 +147,15 @@ def turn_actions(asm: Assembly, max_group: int | None, table: TurnTable) -> list
     :func:`chaingeo.core.kinematics.legal_turns`)."""
     out: list[TurnAction] = []
     for names, rows in turn_rows(asm, max_group, table, GROUP_LIMIT):
+        groups: dict[int, tuple[str, ...]] = {}
         for mask, axis, sense, c0, c1, c2 in rows.tolist():
-            pieces = tuple(names[i] for i in range(len(names)) if mask >> i & 1)
-            out.append(TurnAction(TurnMove(pieces, AXES[axis], 1 - 2 * sense, (c0, c1, c2))))
-    return sorted(out)
+            pieces = groups.get(mask)
+            if pieces is None:
+                pieces = groups[mask] = tuple(n for i, n in enumerate(names) if mask >> i & 1)
+            turn = TurnMove.listed(pieces, AXES[axis], 1 - 2 * sense, (c0, c1, c2))
+            out.append(TurnAction(turn))
+    out.sort(key=TurnAction.sort_key)  # one kind: the key alone orders them, as sorted() would
+    return out
 
 
 class _Lazy(Sequence[MoveAction]):

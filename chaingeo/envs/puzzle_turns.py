@@ -1,10 +1,11 @@
 """Turns in the puzzle state machine (levels whose rules allow them).
 
-A turn is legal exactly when :meth:`chaingeo.core.kinematics.Assembly.turn_problem` says so, in
-both goals: it turns a proper group of one part (never a whole part: parts apart never
-interact, and assembling is disassembly played backwards, where no part turns alone). Text may
-leave the centre open (``rotate red z +90``): it resolves to the only legal centre for that group,
-axis and sense, else it is ambiguous and lists the candidates, else illegal with the reason.
+A turn is legal exactly when :meth:`chaingeo.core.kinematics.Assembly.turn_problem` says so
+(decided by its fast equal, :func:`solvers.turnsearch.turn_problem`), in both goals: it turns a
+proper group of one part (never a whole part: parts apart never interact, and assembling is
+disassembly played backwards, where no part turns alone). Text may leave the centre open
+(``rotate red z +90``): it resolves to the only legal centre for that group, axis and sense, else
+it is ambiguous and lists the candidates, else illegal with the reason.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from chaingeo.envs.actions import (
     TurnRequest,
     rules_text,
 )
+from solvers.turnsearch import turn_problem as turn_sweep_problem
 
 NO_TURNS = "this level does not allow turns; use move or finish"
 
@@ -61,7 +63,7 @@ def turn_problem(
         return f"{'+'.join(turn.pieces)} are in different parts; a turn carries one part"
     if parts.pop() == frozenset(turn.pieces):
         return f"{'+'.join(turn.pieces)} is a whole part: nothing to turn it against"
-    why = asm.turn_problem(turn)
+    why = turn_sweep_problem(asm, turn)
     return None if why is None else rules_text(why)
 
 
