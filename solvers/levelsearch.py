@@ -170,24 +170,11 @@ def greedy(
                         ctx[INFO] = k
                         return -2
                     new_cap = min(2 * cap, max_states)
-                    grown = np.zeros((new_cap, w), dtype=np.int16)
-                    grown[:cap] = states
-                    states = grown
-                    grown_parent = np.full(new_cap, -1, dtype=np.int64)
-                    grown_parent[:cap] = parent
-                    parent = grown_parent
-                    grown_move = np.zeros((new_cap, 3), dtype=np.int64)
-                    grown_move[:cap] = move
-                    move = grown_move
+                    states, parent, move = mv.grow_search(states, parent, move, new_cap)
                     grown_layers = np.zeros(new_cap + 2, dtype=np.int64)
                     grown_layers[: cap + 2] = layers
                     layers = grown_layers
-                if table.shape[0] < 4 * states.shape[0]:
-                    size = 1
-                    while size < 4 * states.shape[0]:
-                        size *= 2
-                    table = np.full(size, -1, dtype=np.int64)
-                    mv.rebuild_table(states, n_states, table)
+                table = mv.fit_table(table, states, n_states)
             elif status == mv.NEED_MOVES:
                 moves_buf = np.zeros((2 * moves_buf.shape[0], 4), dtype=np.int64)
             elif status == mv.NEED_SEPS:

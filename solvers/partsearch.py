@@ -42,8 +42,12 @@ class PieceTable:
     Built once per analysis in one kernel call (``vox[a]``: piece by piece, each sorted by the
     two other axes, then ``a``); a part's arrays are a gather."""
 
-    def __init__(self, shapes: Mapping[str, Shape]) -> None:
-        self.names: tuple[str, ...] = tuple(sorted(shapes))
+    def __init__(self, shapes: Mapping[str, Shape], order: Sequence[str] | None = None) -> None:
+        # BurrTools lists moves piece by piece: ``order`` is its piece order (default: sorted
+        # names, the order chaingeo.core.formats.bt_write.assembled_puzzle writes them in).
+        self.names: tuple[str, ...] = tuple(sorted(shapes)) if order is None else tuple(order)
+        if sorted(self.names) != sorted(shapes):
+            raise ValueError("order: every piece name exactly once")
         if not self.names:
             raise ValueError("a puzzle needs at least one piece")
         self.voxels = [np.ascontiguousarray(shapes[n].voxels, dtype=np.int64) for n in self.names]
