@@ -33,7 +33,7 @@ import numpy as np
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
 from solvers import movement as mv
-from solvers.btorient import bt_image
+from solvers.btorient import BTImage
 from solvers.constrained import (
     ColoredPiece,
     ColorRules,
@@ -222,7 +222,7 @@ def named_assembly(packing: Packing, rows: Int32Array) -> dict[str, Shape]:
 
 class BTFrame:
     """Turns an assembly into the symmetric image BurrTools' assembler reports
-    (:func:`solvers.btorient.bt_image`), whose disassembly BurrTools prints."""
+    (:class:`solvers.btorient.BTImage`), whose disassembly BurrTools prints."""
 
     def __init__(self, packing: Packing) -> None:
         spec = packing.spec
@@ -234,13 +234,14 @@ class BTFrame:
             for slot in packing.problem.types[t].slots:
                 self.grids[slot] = grid if grid is not None else info.piece.shape.voxels
         self.slots = [packing.problem.types[t].slots for t, _ in self.types]
-        self.symmetries = [(sym.matrix, sym.shift) for sym in packing.symmetries]
-        self.result = np.asarray(spec.result.voxels, dtype=np.int64)
+        symmetries = [(sym.matrix, sym.shift) for sym in packing.symmetries]
+        result = np.asarray(spec.result.voxels, dtype=np.int64)
+        self.image = BTImage(self.grids, symmetries, result)
 
     def __call__(self, assembly: dict[str, Shape]) -> dict[str, Shape]:
         parts = [[n for n in slots if n in assembly] for slots in self.slots]
         parts = [p for p in parts if p]
-        image, _ = bt_image(assembly, self.grids, parts, self.symmetries, self.result)
+        image, _ = self.image(assembly, parts)
         return image
 
 

@@ -21,7 +21,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from chaingeo.core.formats.bt_model import ROTATIONS_BT
+from chaingeo.core.formats.bt_model import TRANSFORMS_BT
 from chaingeo.core.geometry import SYMMETRIES, Shape
 
 Key = tuple[int, int, int, int]
@@ -32,24 +32,6 @@ Symmetry = tuple[np.ndarray, np.ndarray]
 def _normal(cells: np.ndarray) -> bytes:
     c = cells - cells.min(axis=0)
     return bytes(c[np.lexsort(c.T[::-1])].tobytes())
-
-
-def placement(grid: np.ndarray, placed: np.ndarray) -> Key | None:
-    """BurrTools' placement ``(transformation, x, y, z)`` of a shape (voxels ``grid`` in its own
-    grid) whose voxels lie at ``placed``; None when no rotation gives that orientation."""
-    want = _normal(placed)
-    for t, m in enumerate(ROTATIONS_BT):
-        rot = grid @ m.T
-        if _normal(rot) == want:
-            pos = placed.min(axis=0) - rot.min(axis=0)
-            return (t, int(pos[0]), int(pos[1]), int(pos[2]))
-    return None
-
-
-def self_rotations(cells: np.ndarray) -> int:
-    """How many of the 48 symmetries map the voxels onto themselves (up to translation)."""
-    want = _normal(cells)
-    return sum(_normal(cells @ m.T) == want for m in SYMMETRIES)
 
 
 def symmetries_of(cells: np.ndarray) -> list[Symmetry]:
@@ -64,64 +46,107 @@ def symmetries_of(cells: np.ndarray) -> list[Symmetry]:
     return out
 
 
-def bt_image(
-    placed: Mapping[str, Shape],
-    grids: Mapping[str, np.ndarray],
-    parts: Sequence[Sequence[str]],
-    symmetries: Sequence[Symmetry],
-    result: np.ndarray | None = None,
-) -> tuple[dict[str, Shape], np.ndarray]:
-    """The image of the assembly ``placed`` that BurrTools disassembles, pieces in its order.
+class BTImage:
+    """Chooses BurrTools' image of assemblies of one problem (the shapes, parts and result
+    symmetries fixed; tables built once, about 1 ms an assembly).
 
-    ``grids``: each piece's voxels in its shape's own grid; ``parts``: the pieces of each part
-    of the problem in order (copies of a shape together); ``symmetries``: the result's (proper
-    and improper; improper ones are used only when every piece is its own mirror image);
-    ``result``: the result's cells, for the pivot (default: the union of the pieces). Returns
-    the image and the symmetry's matrix (the identity when the assembly stays as it is)."""
-    names = [n for p in parts for n in p]
-    eye = np.eye(3, dtype=np.int64)
-    if len(names) < 2 or len(symmetries) < 2:
-        return {n: placed[n] for n in names}, eye
-    achiral = all(
-        _normal(grids[n] * np.array([-1, 1, 1])) in {_normal(grids[n] @ m.T) for m in ROTATIONS_BT}
-        for n in names
-    )
-    cells = np.concatenate([placed[n].voxels for n in names]) if result is None else result
-    res_syms = symmetries_of(cells)
-    counts = []
-    for p in parts:
-        g = grids[p[0]]
-        shared = sum(_normal(g @ m.T) == _normal(g) for m, _ in res_syms)
-        counts.append(shared)
-    pivot_part = int(np.argmin(counts))
-    pivot = sum(len(p) for p in parts[:pivot_part]) if len(parts[pivot_part]) == 1 else -1
-    best: tuple[list[Key], dict[str, Shape], np.ndarray] | None = None
-    for m, shift in symmetries:
-        if round(float(np.linalg.det(m))) < 0 and not achiral:
-            continue
+    ``grids``: each piece's voxels in its shape's own grid (every piece that may occur);
+    ``symmetries``: the result's (proper and improper; improper ones are used only when every
+    piece is its own mirror image); ``result``: the result's cells (for the pivot)."""
+
+    def __init__(
+        self,
+        grids: Mapping[str, np.ndarray],
+        symmetries: Sequence[Symmetry],
+        result: np.ndarray,
+    ) -> None:
+        names = list(grids)
+        mats = [np.asarray(m, dtype=np.int64) for m in TRANSFORMS_BT]
+        index = {m.tobytes(): i for i, m in enumerate(mats)}
+        achiral = True
+        # Per piece: its voxels' normal form per rotation -> (rotation, min corner), and per
+        # transform A (of the 48): the first rotation giving A's orientation and the shift
+        # from A's min corner to that rotation's.
+        self.find: dict[str, dict[bytes, tuple[int, np.ndarray]]] = {}
+        self.norm: dict[str, list[tuple[int, np.ndarray]]] = {}
+        for n in names:
+            g = np.asarray(grids[n], dtype=np.int64)
+            first: dict[bytes, tuple[int, np.ndarray]] = {}
+            for t in range(24):
+                rot = g @ mats[t].T
+                first.setdefault(_normal(rot), (t, rot.min(axis=0)))
+            table = []
+            for m in mats:
+                img = g @ m.T
+                hit = first.get(_normal(img))
+                if hit is None:
+                    table.append((-1, np.zeros(3, dtype=np.int64)))
+                    achiral = False
+                else:
+                    table.append((hit[0], img.min(axis=0) - hit[1]))
+            self.find[n], self.norm[n] = first, table
+        proper = [s for s in symmetries if round(float(np.linalg.det(s[0]))) > 0]
+        self.symmetries = list(symmetries) if achiral else proper
+        self.compose = [
+            [index[(np.asarray(m, dtype=np.int64) @ mats[t]).tobytes()] for t in range(24)]
+            for m, _ in self.symmetries
+        ]
+        res_syms = symmetries_of(result)
+        self.shared = {}  # symmetries a piece shares with the result: the pivot has fewest
+        for n in names:
+            g = np.asarray(grids[n], dtype=np.int64)
+            self.shared[n] = sum(_normal(g @ m.T) == _normal(g) for m, _ in res_syms)
+
+    def __call__(
+        self, placed: Mapping[str, Shape], parts: Sequence[Sequence[str]]
+    ) -> tuple[dict[str, Shape], np.ndarray]:
+        """The image of ``placed`` BurrTools disassembles, pieces in its order, and the
+        symmetry's matrix (the identity when the assembly stays as it is). ``parts``: the
+        pieces of each part of the problem in order (copies of a shape together)."""
+        names = [n for p in parts for n in p]
+        eye = np.eye(3, dtype=np.int64)
+        if len(names) < 2 or len(self.symmetries) < 2:
+            return {n: placed[n] for n in names}, eye
+        counts = [self.shared[p[0]] for p in parts]
+        at = int(np.argmin(counts))
+        pivot = sum(len(p) for p in parts[:at]) if all(len(p) == 1 for p in parts) else -1
+        t0 = []
+        pos0 = np.empty((len(names), 3), dtype=np.int64)
+        for i, n in enumerate(names):
+            vox = placed[n].voxels
+            hit = self.find[n].get(_normal(vox))
+            if hit is None:
+                raise ValueError(f"piece {n} is not its shape (rotated)")
+            t0.append(hit[0])
+            pos0[i] = vox.min(axis=0) - hit[1]
+        best: tuple[list[Key], int] | None = None
+        for g, (m, shift) in enumerate(self.symmetries):
+            pos = pos0 @ np.asarray(m).T + shift
+            keys: list[Key] = []
+            i = 0
+            for part in parts:
+                got = []
+                for n in part:
+                    t, off = self.norm[n][self.compose[g][t0[i]]]
+                    p = pos[i] + off
+                    got.append((t, int(p[0]), int(p[1]), int(p[2])))
+                    i += 1
+                keys.extend(sorted(got))
+            if pivot >= 0:
+                keys = [keys[pivot], *keys[:pivot], *keys[pivot + 1 :]]
+            if best is None or keys < best[0]:
+                best = (keys, g)
+        assert best is not None
+        m, shift = self.symmetries[best[1]]
         image: dict[str, Shape] = {}
-        keys: list[Key] = []
-        ok = True
         for part in parts:
-            got = []
-            for n in part:
-                vox = placed[n].voxels @ np.asarray(m).T + shift
-                key = placement(grids[n], vox)
-                if key is None:
-                    ok = False
-                    break
-                got.append((key, vox))
-            if not ok:
-                break
-            got.sort(key=lambda kv: kv[0])
-            for n, (key, vox) in zip(part, got, strict=True):
-                image[n] = Shape(vox)
-                keys.append(key)
-        if not ok:
-            continue
-        order = keys if pivot < 0 else [keys[pivot], *keys[:pivot], *keys[pivot + 1 :]]
-        if best is None or order < best[0]:
-            best = (order, image, np.asarray(m))
-    if best is None:
-        return {n: placed[n] for n in names}, eye
-    return best[1], best[2]
+            moved = [placed[n].voxels @ np.asarray(m).T + shift for n in part]
+            ranked = sorted(moved, key=lambda v: self._key(part[0], v))
+            for n, v in zip(part, ranked, strict=True):
+                image[n] = Shape(v)
+        return image, np.asarray(m, dtype=np.int64)
+
+    def _key(self, name: str, vox: np.ndarray) -> Key:
+        t, low = self.find[name][_normal(vox)]
+        p = vox.min(axis=0) - low
+        return (t, int(p[0]), int(p[1]), int(p[2]))

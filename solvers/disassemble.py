@@ -32,7 +32,7 @@ from chaingeo.core.turns import TurnMove
 from solvers import btsearch as bt
 from solvers import levelsearch as ls
 from solvers import movement as mv
-from solvers.btorient import bt_image, symmetries_of
+from solvers.btorient import BTImage, symmetries_of
 from solvers.deadline import Deadline
 from solvers.partsearch import DIRECTION_NAMES, PartSearch, PieceTable, SearchLimits
 
@@ -427,12 +427,12 @@ class _Solver:
 def _bt_frame_tree(shapes: Mapping[str, Shape], solver: _Solver) -> Separation | None:
     """BurrTools' tree of the puzzle as :func:`chaingeo.core.formats.bt_write.assembled_puzzle`
     writes it (each piece its own shape, the union the result): searched in the symmetric image
-    BurrTools' assembler reports (:func:`solvers.btorient.bt_image`), its moves turned back
+    BurrTools' assembler reports (:class:`solvers.btorient.BTImage`), its moves turned back
     into the puzzle's own frame."""
     names = sorted(shapes)
     grids = {k: shapes[k].normalized().voxels for k in names}
     union = np.concatenate([shapes[k].voxels for k in names])
-    image, m = bt_image(shapes, grids, [[k] for k in names], symmetries_of(union))
+    image, m = BTImage(grids, symmetries_of(union), union)(shapes, [[k] for k in names])
     if np.array_equal(m, np.eye(3, dtype=np.int64)):
         return solver.level_tree()
     other = _Solver(
