@@ -77,15 +77,47 @@ def parse(text: str) -> Figures:
     return Figures(int(total[1]), int(total[2]), tuple(_LEVEL.findall(text)))
 
 
-def run(binary: Path, path: Path, seconds: float) -> Figures | None:
-    """``burrTxt -d -r FILE`` (problem 0); None past ``seconds``."""
+def run(binary: Path, path: Path, seconds: float, problem: int = 0) -> Figures | None:
+    """``burrTxt -d -r -o PROBLEM FILE``; None past ``seconds``."""
+    args = [str(binary), "-d", "-r", "-o", str(problem), str(path)]
     try:
-        out = subprocess.run(
-            [str(binary), "-d", "-r", str(path)], capture_output=True, text=True, timeout=seconds
-        )
+        out = subprocess.run(args, capture_output=True, text=True, timeout=seconds)
     except subprocess.TimeoutExpired:
         return None
     return parse(out.stdout)
+
+
+# -- what the differential tests found (printed at the end of the session by conftest) -------
+
+
+@dataclass(frozen=True)
+class Outcome:
+    group: str  # random, level, generator, file
+    case: str
+    status: str  # agree, disagree, skip
+    why: str = ""
+
+
+OUTCOMES: list[Outcome] = []
+
+
+def summary_lines() -> list[str]:
+    """Per group: cases, agreeing, disagreeing, skipped (with the reasons counted)."""
+    lines = []
+    for group in sorted({o.group for o in OUTCOMES}):
+        mine = [o for o in OUTCOMES if o.group == group]
+        count = {k: sum(o.status == k for o in mine) for k in ("agree", "disagree", "skip")}
+        reasons: dict[str, int] = {}
+        for o in mine:
+            if o.status == "skip":
+                reasons[o.why] = reasons.get(o.why, 0) + 1
+        why = "; ".join(f"{n} {r}" for r, n in sorted(reasons.items()))
+        lines.append(
+            f"{group}: {len(mine)} cases, {count['agree']} agree, {count['disagree']} disagree, "
+            f"{count['skip']} skipped" + (f" ({why})" if why else "")
+        )
+        lines.extend(f"  disagree: {o.case}: {o.why}" for o in mine if o.status == "disagree")
+    return lines
 
 
 # -- random puzzles ------------------------------------------------------------------------------
