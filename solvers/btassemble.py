@@ -349,6 +349,8 @@ def count_bt(
             continue
         asm = named_assembly(packing, rows)
         if frame is not None:
+            if len(asm) < 2:
+                continue  # BurrTools: one piece is no disassembly (disassembler_a.cpp)
             asm = frame(asm)
         result = disassemble(
             packing, asm, max_group=max_group, limits=limits, groups=groups, deadline=deadline,

@@ -311,3 +311,21 @@ def test_bench_burrtools_quick(capsys: pytest.CaptureFixture[str]) -> None:
     assert rows["ring_maze"]["ours"]["solutions"] == 2
     assert rows["ring_maze"]["previous"]["assemblies"] == 0  # the ring lies on variable cells
     assert all(r["speedup"] is not None for r in rows.values())
+
+
+def test_one_piece_is_no_solution_burrtools_way() -> None:
+    """BurrTools does not disassemble an assembly of one piece (``disassembler_a.cpp``,
+    ``disassemble``): of the 3 assemblies here (the domino alone on the fixed cells; the domino
+    and the cube, the cube at either end) burrTxt counts 2 solutions."""
+    from chaingeo.core.formats.burrtools import BTPart, BTProblem, colored_shape
+
+    domino = colored_shape("a", Shape([(0, 0, 0), (1, 0, 0)]))
+    cube = colored_shape("b", Shape([(0, 0, 0)]))
+    result = colored_shape("r", Shape([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), Shape([(2, 0, 0)]))
+    puzzle = BTPuzzle(
+        (domino, cube, result), (BTProblem("p", (BTPart(0, 1, 1), BTPart(1, 0, 1)), 2),)
+    )
+    packing = compile_packing(bt_packing_spec(puzzle, 0))
+    first = count_bt(packing, mirrors="drop")
+    assert (first.assemblies, first.solutions) == (3, 2)
+    assert count_bt(packing, mirrors="drop", separations="any").solutions == 3
