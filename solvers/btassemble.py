@@ -281,7 +281,7 @@ def disassemble(
         )  # fmt: skip
     return analyze(
         assembly, max_group=max_group, limits=limits, optimal=False, deadline=deadline,
-        separations=separations, order=order,
+        separations=separations, order=order, fallback=False,
     )  # fmt: skip
 
 

@@ -112,6 +112,8 @@ class Analysis:
     tree: Separation | None = None
     states: int = 0  # states visited, over every search
     first_level: int | None = field(default=None)  # moves until the first part comes free
+    #: True when ``level`` is BurrTools' own figure (its first separation took it apart).
+    burrtools: bool = False
 
 
 PartKey = tuple[tuple[int, ...], bytes]
@@ -500,6 +502,7 @@ def analyze(
     deadline: Deadline | None = None,
     separations: Separations = "first",
     order: Sequence[str] | None = None,
+    fallback: bool = True,
 ) -> Analysis:
     """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
     state (every piece at offset zero, one part). ``lower_bound``: a *proven* lower bound on
@@ -509,7 +512,10 @@ def analyze(
     piece, which spin in place). ``deadline``: shared with the caller's other searches (default:
     one of ``limits.seconds`` for this analysis alone). ``separations``: BurrTools' level
     (``"first"``, the default; with turns or ``max_group`` always ``"any"``) or ``"any"``;
-    ``order``: the pieces in BurrTools' order (default: sorted names)."""
+    ``order``: the pieces in BurrTools' order (default: sorted names). Where BurrTools' first
+    separation leaves a part that cannot come apart, ``fallback`` answers with any separation
+    (``Analysis.burrtools`` False: the puzzle still comes apart, o_i is still searched); without
+    it the analysis says it does not come apart, as BurrTools does."""
     solver = _Solver(
         shapes, max_group, limits or SearchLimits(), turns, rods, deadline, separations, order
     )
@@ -518,24 +524,35 @@ def analyze(
     offsets = np.zeros((n, 4 if turns else 3), dtype=np.int64)
     if n == 1:
         return Analysis(True, "0", 0, 0)
+    bt_level = solver.separations == "first"
     if turns:
         tree = solver.greedy(members, offsets)
-    elif solver.separations == "first" and order is None:
+    elif bt_level and order is None:
         tree = _bt_frame_tree(shapes, solver)
     else:
+        tree = solver.level_tree()
+    if tree is None and bt_level and fallback:
+        # BurrTools would give up; whether (and how fast) it comes apart is still asked.
+        solver.separations, bt_level = "any", False
         tree = solver.level_tree()
     if tree is None:
         return Analysis(False, None, None, None, states=solver.states)
     total = tree.total_moves()
-    plan = tree.all_moves()
+    seed = tree
+    if optimal and bt_level:
+        # o_i is its own question: seeded, as it always was, by any separation's tree.
+        solver.separations = "any"
+        seed = solver.level_tree() or tree
+    plan = seed.all_moves()
     steps: int | None = None
     if optimal:
         floor = lower_bound or 0
-        if total > floor:
-            found, better = solver.optimal(members, offsets, total, floor)
-            steps, plan = (found, better) if better is not None else (total, plan)
+        bound = seed.total_moves()
+        if bound > floor:
+            found, better = solver.optimal(members, offsets, bound, floor)
+            steps, plan = (found, better) if better is not None else (bound, plan)
         else:
-            steps = total
+            steps = bound
         if steps < floor:
             raise ValueError(f"a plan of {steps} moves is below the lower bound {floor}")
     return Analysis(
@@ -547,6 +564,7 @@ def analyze(
         tree=tree,
         states=solver.states,
         first_level=len(tree.moves),
+        burrtools=bt_level,
     )
 
 

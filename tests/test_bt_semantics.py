@@ -222,7 +222,7 @@ def test_stuck_check_is_exactly_no_first_move() -> None:
     stuck = StuckCheck(packing)
     verdicts = []
     for rows in iter_classes(packing):
-        found = analyze(named_assembly(packing, rows), optimal=False)
+        found = analyze(named_assembly(packing, rows), optimal=False, fallback=False)
         verdicts.append((stuck(rows), not found.disassemblable and found.states == 1))
     assert all(s == one for s, one in verdicts)
     assert sum(s for s, _ in verdicts) == 745
