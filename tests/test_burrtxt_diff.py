@@ -118,6 +118,29 @@ def test_shipped_levels_agree_given_time(binary: Path, path: Path, tmp_path: Pat
     _level_case(binary, path, 150, tmp_path)
 
 
+#: What burrTxt (built from ``../shared/burrtools-src``) printed for these levels written with
+#: ``assembled_puzzle``: assemblies, solutions, sorted levels. Checked without burrTxt, so
+#: that a run without g++ still pins BurrTools' semantics on real designs.
+RECORDED = {
+    "puzzle-mid-04-burr12": (2, 1, ["1.2.2"]),
+    "puzzle-mid-05-burr6": (2, 2, ["2", "3.1.2"]),
+    "puzzle-mid-07-burr6": (2, 2, ["4.4.2", "4.4.2"]),
+    "puzzle-mid-12-cube4": (1, 1, ["3.2.2.1.2"]),
+    "puzzle-hard-10-cube4": (1, 1, ["5.1.2.1.2"]),
+    "puzzle-easy-04-burr6": (2, 2, ["2.2", "2.2"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(RECORDED))
+def test_recorded_burrtxt_figures(name: str, tmp_path: Path) -> None:
+    level = load_level(ROOT / "levels" / "puzzle" / f"{name}.json")
+    file = write_xmpuzzle(assembled_puzzle(level.shapes), tmp_path / f"{name}.xmpuzzle")
+    levels: list[str] = []
+    packing = compile_packing(bt_packing_spec(read_xmpuzzle(file), 0))
+    report = count_bt(packing, mirrors="drop", levels=levels)
+    assert (report.assemblies, report.solutions, sorted(levels)) == RECORDED[name]
+
+
 def test_a_level_string_is_the_one_burrtxt_prints_for_its_assembly() -> None:
     """The level's own assembly (written as BurrTools gets it) has BurrTools' level, which the
     stored ``level`` stat must be (puzzle-hard-10-cube4: burrTxt prints 5.1.2.1.2)."""
