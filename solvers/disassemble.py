@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from chaingeo.core.geometry import Cell, Shape
-from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
+from chaingeo.core.kinematics import DIRECTIONS, Move, SearchLimitError
 from chaingeo.core.turns import TurnMove
 from solvers import btsearch as bt
 from solvers import levelsearch as ls
@@ -35,6 +35,10 @@ from solvers import movement as mv
 from solvers.btorient import BTImage, symmetries_of
 from solvers.deadline import Deadline
 from solvers.partsearch import DIRECTION_NAMES, PartSearch, PieceTable, SearchLimits
+
+# Per-state helpers, at home in solvers.partsearch, still importable from here.
+from solvers.partsearch import fast_legal_moves as fast_legal_moves
+from solvers.partsearch import move_rows as move_rows
 
 if TYPE_CHECKING:  # imported when a puzzle turns: most never do
     from solvers.turnmoves import TurnTable
@@ -47,6 +51,7 @@ __all__ = [
     "Separation",
     "analyze",
     "fast_legal_moves",
+    "move_rows",
 ]
 
 _UNSOLVABLE = 1 << 30
@@ -575,63 +580,3 @@ def translations(plan: Sequence[Move | TurnMove]) -> list[Move]:
     if len(out) != len(plan):
         raise ValueError("the plan turns pieces; expected translations only")
     return out
-
-
-# -------------------------------------------------------------------------------------------
-# Per-state helpers (for environments and for the conformance tests against the reference)
-# -------------------------------------------------------------------------------------------
-
-
-def move_rows(
-    state: Assembly,
-    max_group: int | None = None,
-    group_limit: int = 4096,
-    table: PieceTable | None = None,
-) -> list[tuple[tuple[str, ...], np.ndarray]]:
-    """The legal moves of ``state`` in the movement kernel's raw form: per part of two or
-    more pieces, its piece names (sorted) and int64 rows ``(mask, direction index, kmax,
-    removable)`` (bit ``i`` of ``mask``: the part's ``i``-th piece; direction index into
-    :data:`chaingeo.core.kinematics.DIRECTIONS`; finite moves ``1..kmax``; ``removable``: it can
-    also leave for good). Raises :class:`SearchLimitError` past ``group_limit`` groups along a
-    direction."""
-    table = PieceTable(state.shapes) if table is None else table
-    out: list[tuple[tuple[str, ...], np.ndarray]] = []
-    for part in sorted(state.parts, key=lambda p: sorted(p)):
-        if len(part) < 2:
-            continue
-        names = tuple(sorted(part))
-        members = tuple(table.index(p) for p in names)
-        vox, starts, lo, hi = table.part_arrays(members)
-        off = np.array([state.offsets[n] for n in names], dtype=np.int64)
-        n = len(members)
-        gaps = np.empty((3, n, n), dtype=np.int64)
-        groups = np.zeros(group_limit + 1, dtype=np.uint64)
-        buf = np.zeros((1024, 4), dtype=np.int64)
-        while True:
-            rows = mv.node_moves(
-                vox, starts, lo, hi, off, -1 if max_group is None else max_group,
-                group_limit, True, gaps, groups, buf,
-            )  # fmt: skip
-            if rows != -1:
-                break
-            buf = np.zeros((2 * buf.shape[0], 4), dtype=np.int64)
-        if rows == -2:
-            raise SearchLimitError(f"more than {group_limit} movable groups along one direction")
-        out.append((names, buf[:rows].copy()))
-    return out
-
-
-def fast_legal_moves(
-    state: Assembly, max_group: int | None = None, group_limit: int = 4096
-) -> list[Move]:
-    """Every legal move of ``state``, as :func:`chaingeo.core.kinematics.legal_moves` lists them,
-    computed by the numba movement analysis."""
-    dirs = list(DIRECTIONS)
-    moves: list[Move] = []
-    for names, rows in move_rows(state, max_group, group_limit):
-        for mask, d, kmax, removable in rows.tolist():
-            pieces = tuple(names[i] for i in range(len(names)) if mask >> i & 1)
-            moves.extend(Move(pieces, dirs[d], k) for k in range(1, kmax + 1))
-            if removable:
-                moves.append(Move(pieces, dirs[d], None))
-    return sorted(moves, key=lambda m: (m.pieces, m.direction, m.distance is None, m.distance or 0))
