@@ -33,6 +33,7 @@ import numpy as np
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
 from solvers import movement as mv
+from solvers.btorient import BTImage
 from solvers.constrained import (
     ColoredPiece,
     ColorRules,
@@ -42,7 +43,7 @@ from solvers.constrained import (
     canonical_keys,
 )
 from solvers.deadline import Deadline
-from solvers.disassemble import Analysis, analyze
+from solvers.disassemble import Analysis, Separations, analyze
 from solvers.groups import PieceGroups, analyze_grouped
 from solvers.partsearch import SearchLimits
 from solvers.placements import Int32Array
@@ -52,10 +53,13 @@ from solvers.search import CoverSearch
 Mirrors = Literal["keep", "drop"]
 
 
-def bt_packing_spec(puzzle: BTPuzzle, index: int) -> PackingSpec:
+def bt_packing_spec(puzzle: BTPuzzle, index: int, *, merge_congruent: bool = False) -> PackingSpec:
     """Problem ``index`` of a BurrTools puzzle as a packing: parts named ``s<shape id>``
     (``s<shape id>p<part>`` when a shape is listed twice), colours, variable result cells,
-    colour rules and hole cap. A piece with variable voxels is refused, as BurrTools does."""
+    colour rules and hole cap. A piece with variable voxels is refused, as BurrTools does.
+    Congruent shapes listed separately stay distinguishable pieces unless ``merge_congruent``
+    (BurrTools counts their permutations: ``assembler_0.cpp`` places each shape of the
+    problem as its own piece)."""
     prob = puzzle.problem(index)
     res = puzzle.shapes[prob.result]
     ids = [p.shape for p in prob.parts]
@@ -78,6 +82,7 @@ def bt_packing_spec(puzzle: BTPuzzle, index: int) -> PackingSpec:
         frozenset(res.variable.cells),
         ColorRules(len(puzzle.colors), frozenset(prob.color_pairs)),
         prob.max_holes,
+        merge_congruent,
     )
 
 
@@ -201,7 +206,9 @@ def iter_classes(
 
 
 def named_assembly(packing: Packing, rows: Int32Array) -> dict[str, Shape]:
-    """``{piece name: placed voxels}``: copies of a type are ``name``, ``name_2``, ..."""
+    """``{piece name: placed voxels}``: copies of a type are ``name``, ``name_2``, ...; in
+    BurrTools' piece order (the problem's parts in order, a part's copies together), the order
+    its disassembler lists moves in."""
     used: dict[int, int] = {}
     out: dict[str, Shape] = {}
     for r in rows.tolist():
@@ -211,6 +218,31 @@ def named_assembly(packing: Packing, rows: Int32Array) -> dict[str, Shape]:
         used[t] = used.get(t, 0) + 1
         out[packing.problem.types[t].slots[used[t] - 1]] = packing.placed(r)
     return out
+
+
+class BTFrame:
+    """Turns an assembly into the symmetric image BurrTools' assembler reports
+    (:class:`solvers.btorient.BTImage`), whose disassembly BurrTools prints."""
+
+    def __init__(self, packing: Packing) -> None:
+        spec = packing.spec
+        by_name = {p.name: np.asarray(p.piece.voxels, dtype=np.int64) for p in spec.parts}
+        self.types = [(t, info) for t, info in enumerate(packing.types) if t != packing.hole_type]
+        self.grids: dict[str, np.ndarray] = {}
+        for t, info in self.types:
+            grid = by_name.get(info.parts[0]) if len(info.parts) == 1 else None
+            for slot in packing.problem.types[t].slots:
+                self.grids[slot] = grid if grid is not None else info.piece.shape.voxels
+        self.slots = [packing.problem.types[t].slots for t, _ in self.types]
+        symmetries = [(sym.matrix, sym.shift) for sym in packing.symmetries]
+        result = np.asarray(spec.result.voxels, dtype=np.int64)
+        self.image = BTImage(self.grids, symmetries, result)
+
+    def __call__(self, assembly: dict[str, Shape]) -> dict[str, Shape]:
+        parts = [[n for n in slots if n in assembly] for slots in self.slots]
+        parts = [p for p in parts if p]
+        image, _ = self.image(assembly, parts)
+        return image
 
 
 def piece_groups(packing: Packing) -> PieceGroups:
@@ -233,16 +265,24 @@ def disassemble(
     limits: SearchLimits | None = None,
     groups: PieceGroups | None = None,
     deadline: Deadline | None = None,
+    separations: Separations = "first",
 ) -> Analysis:
     """The disassembler's verdict on one assembly (level and moves), groups honoured
     (``groups``: :func:`piece_groups` of the packing, when the caller has it already;
-    ``deadline``: the analysis' shared one, else one of ``limits.seconds``)."""
+    ``deadline``: the analysis' shared one, else one of ``limits.seconds``;
+    ``separations``: see :func:`solvers.disassemble.analyze`). Pieces are searched in the
+    assembly's order (:func:`named_assembly`: BurrTools')."""
     groups = piece_groups(packing) if groups is None else groups
+    order = list(assembly)
     if groups.any():
         return analyze_grouped(
-            assembly, groups, max_group=max_group, limits=limits, deadline=deadline
-        )
-    return analyze(assembly, max_group=max_group, limits=limits, optimal=False, deadline=deadline)
+            assembly, groups, max_group=max_group, limits=limits, deadline=deadline,
+            separations=separations, order=order,
+        )  # fmt: skip
+    return analyze(
+        assembly, max_group=max_group, limits=limits, optimal=False, deadline=deadline,
+        separations=separations, order=order, fallback=False,
+    )  # fmt: skip
 
 
 class StuckCheck:
@@ -281,10 +321,14 @@ def count_bt(
     limits: SearchLimits | None = None,
     node_limit: int | None = None,
     deadline: Deadline | None = None,
+    separations: Separations = "first",
+    levels: list[str] | None = None,
 ) -> BTReport:
     """BurrTools' assemblies and solutions of a packing, and the first solution. The search
     and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
-    ``limits`` the enumeration has no time limit and each disassembly the default one)."""
+    ``limits`` the enumeration has no time limit and each disassembly the default one).
+    ``separations``: see :func:`solvers.disassemble.analyze`; ``levels``, when given, gets
+    every solution's level string in the order found."""
     start = time.perf_counter()
     if deadline is None and limits is not None:
         deadline = Deadline(limits.seconds)
@@ -298,16 +342,24 @@ def count_bt(
     classes = iter_classes(
         packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor, deadline=deadline
     )
+    frame = BTFrame(packing) if separations == "first" else None
     for rows in classes:
         n_asm += 1
         if stuck is not None and stuck(rows):
             continue
         asm = named_assembly(packing, rows)
+        if frame is not None:
+            if len(asm) < 2:
+                continue  # BurrTools: one piece is no disassembly (disassembler_a.cpp)
+            asm = frame(asm)
         result = disassemble(
-            packing, asm, max_group=max_group, limits=limits, groups=groups, deadline=deadline
-        )
+            packing, asm, max_group=max_group, limits=limits, groups=groups, deadline=deadline,
+            separations=separations,
+        )  # fmt: skip
         if result.disassemblable:
             n_sol += 1
+            if levels is not None:
+                levels.append(result.level or "")
             if first is None:
                 first, first_an = asm, result
     label = None if anchor is None else anchor.label

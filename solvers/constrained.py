@@ -156,13 +156,17 @@ class PartSpec:
 @dataclass(frozen=True)
 class PackingSpec:
     """The pieces, the result (coloured cells, the variable ones may stay empty), the colour
-    rules and an optional cap on the variable cells left empty."""
+    rules and an optional cap on the variable cells left empty. ``merge_congruent``: parts of
+    the same coloured shape (and groups) become one type whose copies are interchangeable;
+    off, each part is its own type and swapping two congruent parts is another assembly (as
+    BurrTools counts shapes listed separately)."""
 
     parts: tuple[PartSpec, ...]
     result: ColoredPiece
     variable: frozenset[Cell] = frozenset()
     rules: ColorRules = ColorRules()
     max_holes: int | None = None
+    merge_congruent: bool = True
 
 
 @dataclass(frozen=True)
@@ -301,17 +305,18 @@ def _same_row(a: IntArray, i: int, b: IntArray, j: int) -> bool:
     return bool(p == a.shape[1])
 
 
-def _merge(parts: Sequence[PartSpec]) -> list[TypeInfo]:
-    groups: dict[tuple[ColoredPiece, tuple[tuple[int, int], ...]], list[PartSpec]] = {}
+def _merge(parts: Sequence[PartSpec], merge: bool = True) -> list[TypeInfo]:
+    """One type per coloured shape and groups (``merge``), else one per part."""
+    groups: dict[tuple[ColoredPiece, tuple[tuple[int, int], ...], str], list[PartSpec]] = {}
     for p in parts:
         if len(p.piece.voxels) == 0:
             raise CoverError(f"part {p.name}: a piece needs at least one voxel")
         if not 0 <= p.lo <= p.hi:
             raise CoverError(f"part {p.name}: need 0 <= min <= max, got {p.lo}, {p.hi}")
-        key = (p.piece.canonical(), tuple(sorted(p.groups)))
+        key = (p.piece.canonical(), tuple(sorted(p.groups)), "" if merge else p.name)
         groups.setdefault(key, []).append(p)
     out = []
-    for (canon, _groups), members in groups.items():
+    for (canon, _groups, _name), members in groups.items():
         lo = sum(m.lo for m in members)
         hi = sum(m.hi for m in members)
         if hi == 0:
@@ -420,7 +425,7 @@ def compile_packing(spec: PackingSpec) -> Packing:
     top = max([*cell_color.tolist(), *(c for p in spec.parts for c in p.piece.colors), 0])
     if top > spec.rules.n_colors:
         raise CoverError(f"colour {top} is used but only {spec.rules.n_colors} are defined")
-    infos = _merge(spec.parts)
+    infos = _merge(spec.parts, spec.merge_congruent)
     tables, codes = [], []
     for info in infos:
         table, c = _type_rows(info.piece, target, cell_color, ok)
@@ -457,16 +462,23 @@ def compile_packing(spec: PackingSpec) -> Packing:
         for info in infos
     )
     problem = CoverProblem(target, optional, types, tuple(tables), row_type, row_start, False)
-    by_key: dict[tuple[ColoredPiece, tuple[tuple[int, int], ...]], int] = {}
-    by_piece: dict[ColoredPiece, int] = {}
+    # Congruent types kept apart (merge_congruent off) pair with their mirror types in order:
+    # the k-th type of a piece with the k-th of its mirror piece (itself when achiral).
+    by_key: dict[tuple[ColoredPiece, tuple[tuple[int, int], ...]], list[int]] = {}
+    by_piece: dict[ColoredPiece, list[int]] = {}
     for i, info in enumerate(infos):
         if i != hole_type:
-            by_key[(info.piece, info.groups)] = i
-            by_piece.setdefault(info.piece, i)
+            by_key.setdefault((info.piece, info.groups), []).append(i)
+            by_piece.setdefault(info.piece, []).append(i)
     mirror = []
     for i, info in enumerate(infos):
         m = info.piece.mirror_canonical
-        mirror.append(i if i == hole_type else by_key.get((m, info.groups), by_piece.get(m, -1)))
+        if i == hole_type or m == info.piece:
+            mirror.append(i)
+            continue
+        rank = by_key[(info.piece, info.groups)].index(i)
+        same = by_key.get((m, info.groups)) or by_piece.get(m) or []
+        mirror.append(same[rank] if rank < len(same) else -1)
     syms = _result_symmetries(spec, target)
     return Packing(spec, problem, tuple(infos), tuple(codes), syms, tuple(mirror), hole_type)
 

@@ -3,11 +3,15 @@
 Semantics are those of :mod:`chaingeo.core.kinematics` (the reference); the search itself runs on
 :mod:`solvers.movement` (numba). Two questions are answered:
 
-* **Level** (BurrTools' notation, e.g. ``"4.9.3"``): breadth first to the first removal whose two
-  parts can both be taken apart in turn, then the same in each part. The first number is the
-  fewest moves until something comes free; the text lists the moves of each separation, the
-  part left behind before the part removed, omitting sub-trees made only of one-move
-  separations (BurrTools' rule). ``moves`` is the total of the whole tree.
+* **Level** (BurrTools' notation, e.g. ``"4.9.3"``): by default BurrTools' own answer
+  (``separations="first"``, :mod:`solvers.btsearch`): breadth first in its search order to the
+  first separation, then the same in each part; if a part cannot be taken apart, the assembly
+  cannot either (``disassembler_a.cpp``, ``checkSubproblems``). ``separations="any"``: breadth
+  first to the first removal whose two parts can both be taken apart in turn (single pieces
+  first), a stuck part's whole component remembered so that no state is searched twice. The
+  first number is the fewest moves until something comes free; the text lists the moves of
+  each separation, the part left behind before the part removed, omitting sub-trees made only
+  of one-move separations (``disassembly.cpp``, ``movesText``). ``moves`` is the tree's total.
 * **Optimal plan**: the fewest moves that take *every* piece apart, over all ways of doing it.
   Parts never interact after a removal, so ``f(part) = min over reachable states s and removals
   r at s of dist(s) + 1 + f(removed) + f(left)``; a part of ``m`` pieces needs at least
@@ -16,19 +20,25 @@ Semantics are those of :mod:`chaingeo.core.kinematics` (the reference); the sear
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
 from chaingeo.core.geometry import Cell, Shape
-from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
+from chaingeo.core.kinematics import DIRECTIONS, Move, SearchLimitError
 from chaingeo.core.turns import TurnMove
+from solvers import btsearch as bt
 from solvers import levelsearch as ls
 from solvers import movement as mv
+from solvers.btorient import BTImage, symmetries_of
 from solvers.deadline import Deadline
 from solvers.partsearch import DIRECTION_NAMES, PartSearch, PieceTable, SearchLimits
+
+# Per-state helpers, at home in solvers.partsearch, still importable from here.
+from solvers.partsearch import fast_legal_moves as fast_legal_moves
+from solvers.partsearch import move_rows as move_rows
 
 if TYPE_CHECKING:  # imported when a puzzle turns: most never do
     from solvers.turnmoves import TurnTable
@@ -41,6 +51,7 @@ __all__ = [
     "Separation",
     "analyze",
     "fast_legal_moves",
+    "move_rows",
 ]
 
 _UNSOLVABLE = 1 << 30
@@ -106,9 +117,14 @@ class Analysis:
     tree: Separation | None = None
     states: int = 0  # states visited, over every search
     first_level: int | None = field(default=None)  # moves until the first part comes free
+    #: True when ``level`` is BurrTools' own figure (its first separation took it apart).
+    burrtools: bool = False
 
 
 PartKey = tuple[tuple[int, ...], bytes]
+#: ``"first"``: BurrTools' disassembler (its first separation or nothing); ``"any"``: any
+#: separation whose parts come apart.
+Separations = Literal["first", "any"]
 
 
 #: Round rods of each piece: cell (assembled frame) -> the rod's axis (0, 1, 2).
@@ -131,8 +147,15 @@ class _Solver:
         turns: bool = False,
         rods: Rods | None = None,
         deadline: Deadline | None = None,
+        separations: Separations = "first",
+        order: Sequence[str] | None = None,
     ) -> None:
-        self.table = PieceTable(shapes)
+        if separations not in ("first", "any"):
+            raise ValueError(f"separations: 'first' or 'any', got {separations!r}")
+        self.table = PieceTable(shapes, order)
+        # BurrTools has neither turns nor a cap on the pieces a move carries: with either, the
+        # level is searched over any separation (our rules, not a BurrTools figure).
+        self.separations: Separations = "any" if turns or max_group is not None else separations
         self.turn_table: TurnTable | None = None
         if turns:
             from solvers.turnmoves import TurnTable
@@ -142,6 +165,7 @@ class _Solver:
         self.limits = limits
         self.deadline = Deadline(limits.seconds) if deadline is None else deadline
         self.greedy_memo: dict[PartKey, Separation | None] = {}
+        self.first_memo: dict[PartKey, Separation | None] = {}
         self.opt_memo: dict[PartKey, tuple[int, bool, list[Move | TurnMove]]] = {}
         self.states = 0
 
@@ -151,13 +175,16 @@ class _Solver:
         rel = np.asarray(offsets, dtype=np.int64) - np.asarray(offsets[0], dtype=np.int64)
         return members, rel.astype(np.int16).tobytes()
 
-    def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch | TurnPartSearch:
+    def check_total(self) -> None:
         cap = self.limits.max_total_states
         if cap is not None and self.states > cap:
             raise SearchLimitError(
                 f"total state cap of {cap} reached over all searches; "
                 "raise SearchLimits(max_total_states=...)"
             )
+
+    def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch | TurnPartSearch:
+        self.check_total()
         if self.turn_table is not None:
             from solvers.turnsearch import TurnPartSearch
 
@@ -202,16 +229,117 @@ class _Solver:
                 break
         self.states += s.n_states
         self.greedy_memo[k] = result
+        if result is None and isinstance(s, PartSearch):
+            # Every state of the component was seen and none of them comes apart.
+            for node in range(1, s.n_states):
+                self.greedy_memo.setdefault(self.key(members, s.offsets_of(node)), None)
         return result
 
+    def first(self, members: tuple[int, ...], offsets: np.ndarray) -> Separation | None:
+        """BurrTools' tree of a part: its first separation in BurrTools' order
+        (:func:`solvers.btsearch.first_split`), then the part left and the part removed, each
+        through :meth:`subpart`; None when either cannot be done (``checkSubproblems``)."""
+        k = self.key(members, offsets)
+        if k in self.first_memo:
+            return self.first_memo[k]
+        self.check_total()
+        split, n_states = bt.first_split(self.table, members, offsets, self.limits, self.deadline)
+        self.states += n_states
+        result: Separation | None = None
+        if split is not None:
+            done, left = self.subpart(split.left, split.left_offsets)
+            if done:
+                done, removed = self.subpart(split.removed, split.removed_offsets)
+                if done:
+                    result = Separation(split.moves, removed, left)
+        self.first_memo[k] = result
+        return result
+
+    def part_tree(self, members: tuple[int, ...], offsets: np.ndarray) -> Separation | None:
+        """The tree of a part under :attr:`separations`."""
+        if self.separations == "first":
+            return self.first(members, offsets)
+        return self.greedy(members, offsets)
+
     def level_tree(self) -> Separation | None:
+        """:meth:`part_tree` of the whole assembled puzzle (translations only, no piece
+        groups) in one kernel call, decoded into a tree; past :data:`_KERNEL_NODES` expanded
+        nodes the Python search takes over, reading the clock between chunks."""
+        n = len(self.table.names)
+        if n > mv.MAX_PIECES:
+            raise ValueError(f"at most {mv.MAX_PIECES} pieces per part, got {n}")
+        if self.separations == "any":
+            return self.any_tree()
+        lim = self.limits
+        params = np.array(
+            [
+                lim.max_states,
+                lim.group_limit,
+                _KERNEL_NODES,
+                -1 if lim.max_total_states is None else lim.max_total_states,
+            ],
+            dtype=np.int64,
+        )
+        t = self.table
+        start = np.zeros((n, 3), dtype=np.int64)
+
+        def call(cap: int, ctx: np.ndarray, nodes: np.ndarray, moves: np.ndarray) -> int:
+            return int(bt.first_tree(t.vox, t.starts, t.lo, t.hi, start, params, ctx, nodes, moves))
+
+        return self.kernel_tree(call, lambda: self.first(tuple(range(n)), start))
+
+    def kernel_tree(
+        self,
+        call: Callable[[int, np.ndarray, np.ndarray, np.ndarray], int],
+        fallback: Callable[[], Separation | None],
+    ) -> Separation | None:
+        """Run a level kernel (``call(cap, ctx, nodes, moves)``), again with larger buffers
+        while it asks for them, and decode its tree; past its node budget, ``fallback()``."""
+        self.deadline.check()
+        cap = _TREE_ROWS
+        while True:  # rerun with larger buffers in the rare tree that outgrows them
+            ctx = np.zeros(7, dtype=np.int64)
+            nodes = np.zeros((cap, 4), dtype=np.int64)
+            moves = np.zeros((4 * cap, 3), dtype=np.int64)
+            root = call(cap, ctx, nodes, moves)
+            if ctx[ls.STATUS] != ls.NEED_BUFFERS:
+                break
+            cap *= 4
+        status = int(ctx[ls.STATUS])
+        if status == ls.OVER_BUDGET:
+            return fallback()
+        self.states += int(ctx[ls.STATES])
+        self.raise_status(status, int(ctx[ls.INFO]))
+        used = int(ctx[ls.N_MOVES])
+        names = self.table.names
+        return _decode(names, nodes[: ctx[ls.N_NODES]].tolist(), moves[:used].tolist(), root)
+
+    def raise_status(self, status: int, info: int) -> None:
+        """The :class:`SearchLimitError` of a level kernel's cap status (both kernels use
+        :mod:`solvers.levelsearch`'s codes)."""
+        lim = self.limits
+        if status == ls.TOTAL_CAP:
+            raise SearchLimitError(
+                f"total state cap of {lim.max_total_states} reached over all searches; "
+                "raise SearchLimits(max_total_states=...)"
+            )
+        if status == ls.STATE_CAP:
+            raise SearchLimitError(
+                f"state cap of {lim.max_states} reached in a {info}-piece part; "
+                "raise SearchLimits(max_states=...) or --max-states"
+            )
+        if status == ls.GROUP_CAP:
+            raise SearchLimitError(
+                f"more than {lim.group_limit} movable groups along one direction "
+                "in one state; raise SearchLimits(group_limit=...)"
+            )
+
+    def any_tree(self) -> Separation | None:
         """:meth:`greedy` of the whole assembled puzzle (translations only, no piece groups)
         in one kernel call (:func:`solvers.levelsearch.greedy`), decoded into a tree. Past
         :data:`_KERNEL_NODES` expanded nodes it hands over to :meth:`greedy`, which checks
         the deadline between chunks (the kernel cannot read the clock)."""
         n = len(self.table.names)
-        if n > mv.MAX_PIECES:
-            raise ValueError(f"at most {mv.MAX_PIECES} pieces per part, got {n}")
         lim = self.limits
         params = np.array(
             [
@@ -223,45 +351,20 @@ class _Solver:
             ],
             dtype=np.int64,
         )
-        self.deadline.check()
         t = self.table
-        cap = _TREE_ROWS
-        while True:  # rerun with larger buffers in the rare tree that outgrows them
-            ctx = np.zeros(7, dtype=np.int64)
-            nodes = np.zeros((cap, 4), dtype=np.int64)
-            moves = np.zeros((4 * cap, 3), dtype=np.int64)
+        start = np.zeros((n, 3), dtype=np.int64)
+
+        def call(cap: int, ctx: np.ndarray, nodes: np.ndarray, moves: np.ndarray) -> int:
             keys = np.zeros((cap, 4 + 3 * n), dtype=np.int16)
             table = np.full(4 * cap, -1, dtype=np.int64)
             memo = np.full(cap, -3, dtype=np.int64)
             root = ls.greedy(
-                t.vox, t.starts, t.lo, t.hi, np.arange(n, dtype=np.int64),
-                np.zeros((n, 3), dtype=np.int64), params, ctx, nodes, moves, keys, table,
-                memo,
+                t.vox, t.starts, t.lo, t.hi, np.arange(n, dtype=np.int64), start, params, ctx,
+                nodes, moves, keys, table, memo,
             )  # fmt: skip
-            if ctx[ls.STATUS] != ls.NEED_BUFFERS:
-                break
-            cap *= 4
-        status = int(ctx[ls.STATUS])
-        if status == ls.OVER_BUDGET:
-            return self.greedy(tuple(range(n)), np.zeros((n, 3), dtype=np.int64))
-        self.states += int(ctx[ls.STATES])
-        if status == ls.TOTAL_CAP:
-            raise SearchLimitError(
-                f"total state cap of {lim.max_total_states} reached over all searches; "
-                "raise SearchLimits(max_total_states=...)"
-            )
-        if status == ls.STATE_CAP:
-            raise SearchLimitError(
-                f"state cap of {lim.max_states} reached in a {int(ctx[ls.INFO])}-piece part; "
-                "raise SearchLimits(max_states=...) or --max-states"
-            )
-        if status == ls.GROUP_CAP:
-            raise SearchLimitError(
-                f"more than {lim.group_limit} movable groups along one direction "
-                "in one state; raise SearchLimits(group_limit=...)"
-            )
-        used = int(ctx[ls.N_MOVES])
-        return _decode(t.names, nodes[: ctx[ls.N_NODES]].tolist(), moves[:used].tolist(), root)
+            return int(root)
+
+        return self.kernel_tree(call, lambda: self.greedy(tuple(range(n)), start))
 
     def subpart(
         self, members: tuple[int, ...], offsets: np.ndarray
@@ -270,7 +373,7 @@ class _Solver:
         left to do). The hook :mod:`solvers.groups` overrides for BurrTools' piece groups."""
         if len(members) == 1:
             return True, None
-        tree = self.greedy(members, offsets)
+        tree = self.part_tree(members, offsets)
         return tree is not None, tree
 
     # -- optimal full disassembly --------------------------------------------------------------
@@ -328,6 +431,45 @@ class _Solver:
         return budget, None
 
 
+def _bt_frame_tree(shapes: Mapping[str, Shape], solver: _Solver) -> Separation | None:
+    """BurrTools' tree of the puzzle as :func:`chaingeo.core.formats.bt_write.assembled_puzzle`
+    writes it (each piece its own shape, the union the result): searched in the symmetric image
+    BurrTools' assembler reports (:class:`solvers.btorient.BTImage`), its moves turned back
+    into the puzzle's own frame."""
+    names = sorted(shapes)
+    grids = {k: shapes[k].normalized().voxels for k in names}
+    union = np.concatenate([shapes[k].voxels for k in names])
+    image, m = BTImage(grids, symmetries_of(union), union)(shapes, [[k] for k in names])
+    if np.array_equal(m, np.eye(3, dtype=np.int64)):
+        return solver.level_tree()
+    other = _Solver(
+        image, None, solver.limits, deadline=solver.deadline, separations="first", order=names
+    )
+    tree = other.level_tree()
+    solver.states += other.states
+    return None if tree is None else _turn_back(tree, m)
+
+
+def _turn_back(tree: Separation, m: np.ndarray) -> Separation:
+    """The tree with every move's direction mapped by ``m``'s inverse (its transpose)."""
+    dirs = {tuple(int(v) for v in vec): name for name, vec in DIRECTIONS.items()}
+
+    def move(mv_: Move | TurnMove) -> Move | TurnMove:
+        if not isinstance(mv_, Move):
+            return mv_
+        vec = np.asarray(DIRECTIONS[mv_.direction]) @ m  # m.T @ vec
+        return Move(mv_.pieces, dirs[tuple(int(v) for v in vec)], mv_.distance)
+
+    def walk(t: Separation | None) -> Separation | None:
+        if t is None:
+            return None
+        return Separation(tuple(move(x) for x in t.moves), walk(t.removed), walk(t.left))
+
+    out = walk(tree)
+    assert out is not None
+    return out
+
+
 def _decode(
     names: tuple[str, ...], nodes: list[list[int]], moves: list[list[int]], root: int
 ) -> Separation | None:
@@ -363,6 +505,9 @@ def analyze(
     turns: bool = False,
     rods: Rods | None = None,
     deadline: Deadline | None = None,
+    separations: Separations = "first",
+    order: Sequence[str] | None = None,
+    fallback: bool = True,
 ) -> Analysis:
     """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
     state (every piece at offset zero, one part). ``lower_bound``: a *proven* lower bound on
@@ -370,26 +515,49 @@ def analyze(
     meets it, and a plan below it raises ``ValueError`` (the bound was not a bound). With
     ``turns`` groups may also turn (:mod:`solvers.turnsearch`; ``rods``: the round rods of each
     piece, which spin in place). ``deadline``: shared with the caller's other searches (default:
-    one of ``limits.seconds`` for this analysis alone)."""
-    solver = _Solver(shapes, max_group, limits or SearchLimits(), turns, rods, deadline)
+    one of ``limits.seconds`` for this analysis alone). ``separations``: BurrTools' level
+    (``"first"``, the default; with turns or ``max_group`` always ``"any"``) or ``"any"``;
+    ``order``: the pieces in BurrTools' order (default: sorted names). Where BurrTools' first
+    separation leaves a part that cannot come apart, ``fallback`` answers with any separation
+    (``Analysis.burrtools`` False: the puzzle still comes apart, o_i is still searched); without
+    it the analysis says it does not come apart, as BurrTools does."""
+    solver = _Solver(
+        shapes, max_group, limits or SearchLimits(), turns, rods, deadline, separations, order
+    )
     n = len(solver.table.names)
     members = tuple(range(n))
     offsets = np.zeros((n, 4 if turns else 3), dtype=np.int64)
     if n == 1:
         return Analysis(True, "0", 0, 0)
-    tree = solver.greedy(members, offsets) if turns else solver.level_tree()
+    bt_level = solver.separations == "first"
+    if turns:
+        tree = solver.greedy(members, offsets)
+    elif bt_level and order is None:
+        tree = _bt_frame_tree(shapes, solver)
+    else:
+        tree = solver.level_tree()
+    if tree is None and bt_level and fallback:
+        # BurrTools would give up; whether (and how fast) it comes apart is still asked.
+        solver.separations, bt_level = "any", False
+        tree = solver.level_tree()
     if tree is None:
         return Analysis(False, None, None, None, states=solver.states)
     total = tree.total_moves()
-    plan = tree.all_moves()
+    seed = tree
+    if optimal and bt_level:
+        # o_i is its own question: seeded, as it always was, by any separation's tree.
+        solver.separations = "any"
+        seed = solver.level_tree() or tree
+    plan = seed.all_moves()
     steps: int | None = None
     if optimal:
         floor = lower_bound or 0
-        if total > floor:
-            found, better = solver.optimal(members, offsets, total, floor)
-            steps, plan = (found, better) if better is not None else (total, plan)
+        bound = seed.total_moves()
+        if bound > floor:
+            found, better = solver.optimal(members, offsets, bound, floor)
+            steps, plan = (found, better) if better is not None else (bound, plan)
         else:
-            steps = total
+            steps = bound
         if steps < floor:
             raise ValueError(f"a plan of {steps} moves is below the lower bound {floor}")
     return Analysis(
@@ -401,6 +569,7 @@ def analyze(
         tree=tree,
         states=solver.states,
         first_level=len(tree.moves),
+        burrtools=bt_level,
     )
 
 
@@ -411,63 +580,3 @@ def translations(plan: Sequence[Move | TurnMove]) -> list[Move]:
     if len(out) != len(plan):
         raise ValueError("the plan turns pieces; expected translations only")
     return out
-
-
-# -------------------------------------------------------------------------------------------
-# Per-state helpers (for environments and for the conformance tests against the reference)
-# -------------------------------------------------------------------------------------------
-
-
-def move_rows(
-    state: Assembly,
-    max_group: int | None = None,
-    group_limit: int = 4096,
-    table: PieceTable | None = None,
-) -> list[tuple[tuple[str, ...], np.ndarray]]:
-    """The legal moves of ``state`` in the movement kernel's raw form: per part of two or
-    more pieces, its piece names (sorted) and int64 rows ``(mask, direction index, kmax,
-    removable)`` (bit ``i`` of ``mask``: the part's ``i``-th piece; direction index into
-    :data:`chaingeo.core.kinematics.DIRECTIONS`; finite moves ``1..kmax``; ``removable``: it can
-    also leave for good). Raises :class:`SearchLimitError` past ``group_limit`` groups along a
-    direction."""
-    table = PieceTable(state.shapes) if table is None else table
-    out: list[tuple[tuple[str, ...], np.ndarray]] = []
-    for part in sorted(state.parts, key=lambda p: sorted(p)):
-        if len(part) < 2:
-            continue
-        names = tuple(sorted(part))
-        members = tuple(table.index(p) for p in names)
-        vox, starts, lo, hi = table.part_arrays(members)
-        off = np.array([state.offsets[n] for n in names], dtype=np.int64)
-        n = len(members)
-        gaps = np.empty((3, n, n), dtype=np.int64)
-        groups = np.zeros(group_limit + 1, dtype=np.uint64)
-        buf = np.zeros((1024, 4), dtype=np.int64)
-        while True:
-            rows = mv.node_moves(
-                vox, starts, lo, hi, off, -1 if max_group is None else max_group,
-                group_limit, True, gaps, groups, buf,
-            )  # fmt: skip
-            if rows != -1:
-                break
-            buf = np.zeros((2 * buf.shape[0], 4), dtype=np.int64)
-        if rows == -2:
-            raise SearchLimitError(f"more than {group_limit} movable groups along one direction")
-        out.append((names, buf[:rows].copy()))
-    return out
-
-
-def fast_legal_moves(
-    state: Assembly, max_group: int | None = None, group_limit: int = 4096
-) -> list[Move]:
-    """Every legal move of ``state``, as :func:`chaingeo.core.kinematics.legal_moves` lists them,
-    computed by the numba movement analysis."""
-    dirs = list(DIRECTIONS)
-    moves: list[Move] = []
-    for names, rows in move_rows(state, max_group, group_limit):
-        for mask, d, kmax, removable in rows.tolist():
-            pieces = tuple(names[i] for i in range(len(names)) if mask >> i & 1)
-            moves.extend(Move(pieces, dirs[d], k) for k in range(1, kmax + 1))
-            if removable:
-                moves.append(Move(pieces, dirs[d], None))
-    return sorted(moves, key=lambda m: (m.pieces, m.direction, m.distance is None, m.distance or 0))

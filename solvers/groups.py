@@ -13,8 +13,8 @@ The whole puzzle is always searched (a first separation is needed). :class:`Grou
 the plain disassembler (:mod:`solvers.disassemble`) with that rule at its one hook
 (``subpart``); rule 2's counts are shared by everything one analysis accepts, and a part
 accepted on a branch that is later abandoned keeps its share (BurrTools never abandons one: it
-stops at the first separation). The optimal full disassembly (o_i) is not searched with groups:
-its lower bounds assume every piece comes apart.
+stops at the first separation, the default here too). The optimal full disassembly (o_i) is not
+searched with groups: its lower bounds assume every piece comes apart.
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 
 from chaingeo.core.geometry import Shape
 from solvers.deadline import Deadline
-from solvers.disassemble import Analysis, Separation, _Solver
+from solvers.disassemble import Analysis, Separation, Separations, _Solver
 from solvers.partsearch import SearchLimits
 
 #: A piece's groups: ``(group id, count)`` pairs of its shape (the count is the shape's).
@@ -95,8 +95,12 @@ class GroupedSolver(_Solver):
         max_group: int | None,
         limits: SearchLimits,
         deadline: Deadline | None = None,
+        separations: Separations = "first",
+        order: Sequence[str] | None = None,
     ) -> None:
-        super().__init__(shapes, max_group, limits, deadline=deadline)
+        super().__init__(
+            shapes, max_group, limits, deadline=deadline, separations=separations, order=order
+        )
         self.groups = groups
         self.grouped: list[list[str]] = []  # the parts accepted by rule 2
 
@@ -108,7 +112,7 @@ class GroupedSolver(_Solver):
         names = [self.table.names[m] for m in members]
         if self.groups.single_group(names):
             return True, None
-        tree = self.greedy(members, offsets)
+        tree = self.part_tree(members, offsets)
         if tree is not None:
             return True, tree
         if assignable([*self.grouped, names], self.groups):
@@ -124,14 +128,18 @@ def analyze_grouped(
     max_group: int | None = None,
     limits: SearchLimits | None = None,
     deadline: Deadline | None = None,
+    separations: Separations = "first",
+    order: Sequence[str] | None = None,
 ) -> Analysis:
     """Level and moves of an assembly under the group rule (``optimal_steps`` is None;
-    ``deadline``: as in :func:`solvers.disassemble.analyze`)."""
-    solver = GroupedSolver(shapes, groups, max_group, limits or SearchLimits(), deadline)
+    ``deadline``, ``separations``, ``order``: as in :func:`solvers.disassemble.analyze`)."""
+    solver = GroupedSolver(
+        shapes, groups, max_group, limits or SearchLimits(), deadline, separations, order
+    )
     n = len(solver.table.names)
     if n == 1:
         return Analysis(True, "0", 0, None)
-    tree = solver.greedy(tuple(range(n)), np.zeros((n, 3), dtype=np.int64))
+    tree = solver.part_tree(tuple(range(n)), np.zeros((n, 3), dtype=np.int64))
     if tree is None:
         return Analysis(False, None, None, None, states=solver.states)
     return Analysis(

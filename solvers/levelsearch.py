@@ -68,15 +68,22 @@ def _global(mask: np.int64, members: I64) -> np.int64:
 
 
 @njit(cache=True)
-def _memo_slot(members: I64, offsets: I64, ctx: I64, memo_keys: I16, memo_table: I64) -> int:
-    """The memo entry of the part (its pieces, and offsets relative to its first piece):
-    ``-1 - index`` when new, -(2**40) when the memo is full."""
+def _memo_row(members: I64, width: int) -> I16:
+    """A memo key with the part's pieces (a 64-bit mask in four int16) filled in."""
     g = np.int64(0)
     for i in range(members.shape[0]):
         g |= np.int64(1) << members[i]
-    row = np.zeros(memo_keys.shape[1], dtype=np.int16)
+    row = np.zeros(width, dtype=np.int16)
     for t in range(4):
         row[t] = np.int16((g >> (16 * t)) & 0xFFFF)
+    return row
+
+
+@njit(cache=True)
+def _memo_slot(members: I64, offsets: I64, ctx: I64, memo_keys: I16, memo_table: I64) -> int:
+    """The memo entry of the part (its pieces, and offsets relative to its first piece):
+    ``-1 - index`` when new, -(2**40) when the memo is full."""
+    row = _memo_row(members, memo_keys.shape[1])
     for i in range(members.shape[0]):
         for t in range(3):
             row[4 + 3 * i + t] = offsets[i, t] - offsets[0, t]
@@ -170,24 +177,11 @@ def greedy(
                         ctx[INFO] = k
                         return -2
                     new_cap = min(2 * cap, max_states)
-                    grown = np.zeros((new_cap, w), dtype=np.int16)
-                    grown[:cap] = states
-                    states = grown
-                    grown_parent = np.full(new_cap, -1, dtype=np.int64)
-                    grown_parent[:cap] = parent
-                    parent = grown_parent
-                    grown_move = np.zeros((new_cap, 3), dtype=np.int64)
-                    grown_move[:cap] = move
-                    move = grown_move
+                    states, parent, move = mv.grow_search(states, parent, move, new_cap)
                     grown_layers = np.zeros(new_cap + 2, dtype=np.int64)
                     grown_layers[: cap + 2] = layers
                     layers = grown_layers
-                if table.shape[0] < 4 * states.shape[0]:
-                    size = 1
-                    while size < 4 * states.shape[0]:
-                        size *= 2
-                    table = np.full(size, -1, dtype=np.int64)
-                    mv.rebuild_table(states, n_states, table)
+                table = mv.fit_table(table, states, n_states)
             elif status == mv.NEED_MOVES:
                 moves_buf = np.zeros((2 * moves_buf.shape[0], 4), dtype=np.int64)
             elif status == mv.NEED_SEPS:
@@ -250,7 +244,33 @@ def greedy(
             break
     ctx[STATES] += n_states
     memo_val[slot] = result
+    if result == -1 and not _remember_stuck(members, states, n_states, ctx, memo_keys, memo_table,
+                                            memo_val):  # fmt: skip
+        return -2
     return result
+
+
+@njit(cache=True)
+def _remember_stuck(
+    members: I64, states: I16, n_states: int, ctx: I64, memo_keys: I16, memo_table: I64,
+    memo_val: I64,
+) -> bool:  # fmt: skip
+    """Every state of a part's component that cannot come apart goes into the memo as stuck
+    (from any of them the search would see the same component), so that no state of it is
+    searched again; False (NEED_BUFFERS) when the memo is full."""
+    row = _memo_row(members, memo_keys.shape[1])
+    w = states.shape[1]
+    for node in range(1, n_states):
+        for t in range(w):
+            row[4 + t] = states[node, t]
+        n_memo = ctx[N_MEMO]
+        if 2 * (n_memo + 1) > memo_table.shape[0] or n_memo >= memo_keys.shape[0]:
+            ctx[STATUS] = NEED_BUFFERS
+            return False
+        if mv.find_or_insert(memo_keys, n_memo, memo_table, row) < 0:
+            memo_val[n_memo] = -1
+            ctx[N_MEMO] = n_memo + 1
+    return True
 
 
 @njit(cache=True)

@@ -404,6 +404,35 @@ def rebuild_table(states: I16, n_states: int, table: I64) -> None:
 
 
 @njit(cache=True)
+def grow_search(
+    states: I16, parent: I64, move: I64, new_cap: int
+) -> tuple[I16, I64, I64]:  # fmt: skip
+    """A search's state rows, parents and moves copied into room for ``new_cap`` states."""
+    cap = states.shape[0]
+    grown = np.zeros((new_cap, states.shape[1]), dtype=np.int16)
+    grown[:cap] = states
+    grown_parent = np.full(new_cap, -1, dtype=np.int64)
+    grown_parent[:cap] = parent
+    grown_move = np.zeros((new_cap, 3), dtype=np.int64)
+    grown_move[:cap] = move
+    return grown, grown_parent, grown_move
+
+
+@njit(cache=True)
+def fit_table(table: I64, states: I16, n_states: int) -> I64:
+    """``table``, or a new one rebuilt over ``states`` once it has fewer than four slots per
+    state row (open addressing stays short)."""
+    if table.shape[0] >= 4 * states.shape[0]:
+        return table
+    size = 1
+    while size < 4 * states.shape[0]:
+        size *= 2
+    out = np.full(size, -1, dtype=np.int64)
+    rebuild_table(states, n_states, out)
+    return out
+
+
+@njit(cache=True)
 def expand(
     states: I16,
     n_states: int,

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
-from chaingeo.core.kinematics import DIRECTIONS, Move, SearchLimitError
+from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from solvers import movement as mv
 from solvers.deadline import Deadline as Deadline  # re-exported: its historical home
 
@@ -42,8 +42,12 @@ class PieceTable:
     Built once per analysis in one kernel call (``vox[a]``: piece by piece, each sorted by the
     two other axes, then ``a``); a part's arrays are a gather."""
 
-    def __init__(self, shapes: Mapping[str, Shape]) -> None:
-        self.names: tuple[str, ...] = tuple(sorted(shapes))
+    def __init__(self, shapes: Mapping[str, Shape], order: Sequence[str] | None = None) -> None:
+        # BurrTools lists moves piece by piece: ``order`` is its piece order (default: sorted
+        # names, the order chaingeo.core.formats.bt_write.assembled_puzzle writes them in).
+        self.names: tuple[str, ...] = tuple(sorted(shapes)) if order is None else tuple(order)
+        if sorted(self.names) != sorted(shapes):
+            raise ValueError("order: every piece name exactly once")
         if not self.names:
             raise ValueError("a puzzle needs at least one piece")
         self.voxels = [np.ascontiguousarray(shapes[n].voxels, dtype=np.int64) for n in self.names]
@@ -275,3 +279,63 @@ class PartSearch:
             tuple(self.members[i] for i in outside),
             off[outside],
         )
+
+
+# -------------------------------------------------------------------------------------------
+# Per-state helpers (for environments and for the conformance tests against the reference)
+# -------------------------------------------------------------------------------------------
+
+
+def move_rows(
+    state: Assembly,
+    max_group: int | None = None,
+    group_limit: int = 4096,
+    table: PieceTable | None = None,
+) -> list[tuple[tuple[str, ...], np.ndarray]]:
+    """The legal moves of ``state`` in the movement kernel's raw form: per part of two or
+    more pieces, its piece names (sorted) and int64 rows ``(mask, direction index, kmax,
+    removable)`` (bit ``i`` of ``mask``: the part's ``i``-th piece; direction index into
+    :data:`chaingeo.core.kinematics.DIRECTIONS`; finite moves ``1..kmax``; ``removable``: it can
+    also leave for good). Raises :class:`SearchLimitError` past ``group_limit`` groups along a
+    direction."""
+    table = PieceTable(state.shapes) if table is None else table
+    out: list[tuple[tuple[str, ...], np.ndarray]] = []
+    for part in sorted(state.parts, key=lambda p: sorted(p)):
+        if len(part) < 2:
+            continue
+        names = tuple(sorted(part))
+        members = tuple(table.index(p) for p in names)
+        vox, starts, lo, hi = table.part_arrays(members)
+        off = np.array([state.offsets[n] for n in names], dtype=np.int64)
+        n = len(members)
+        gaps = np.empty((3, n, n), dtype=np.int64)
+        groups = np.zeros(group_limit + 1, dtype=np.uint64)
+        buf = np.zeros((1024, 4), dtype=np.int64)
+        while True:
+            rows = mv.node_moves(
+                vox, starts, lo, hi, off, -1 if max_group is None else max_group,
+                group_limit, True, gaps, groups, buf,
+            )  # fmt: skip
+            if rows != -1:
+                break
+            buf = np.zeros((2 * buf.shape[0], 4), dtype=np.int64)
+        if rows == -2:
+            raise SearchLimitError(f"more than {group_limit} movable groups along one direction")
+        out.append((names, buf[:rows].copy()))
+    return out
+
+
+def fast_legal_moves(
+    state: Assembly, max_group: int | None = None, group_limit: int = 4096
+) -> list[Move]:
+    """Every legal move of ``state``, as :func:`chaingeo.core.kinematics.legal_moves` lists them,
+    computed by the numba movement analysis."""
+    dirs = list(DIRECTIONS)
+    moves: list[Move] = []
+    for names, rows in move_rows(state, max_group, group_limit):
+        for mask, d, kmax, removable in rows.tolist():
+            pieces = tuple(names[i] for i in range(len(names)) if mask >> i & 1)
+            moves.extend(Move(pieces, dirs[d], k) for k in range(1, kmax + 1))
+            if removable:
+                moves.append(Move(pieces, dirs[d], None))
+    return sorted(moves, key=lambda m: (m.pieces, m.direction, m.distance is None, m.distance or 0))

@@ -26,7 +26,7 @@ from solvers.btassemble import (
     named_assembly,
 )
 from solvers.constrained import compile_packing
-from solvers.disassemble import _Solver, analyze
+from solvers.disassemble import Separation, Separations, _Solver, analyze
 from solvers.groups import PieceGroups, assignable
 from solvers.partsearch import SearchLimits
 from tests import bt_reference as ref
@@ -62,13 +62,16 @@ def oracle(puzzle: BTPuzzle, index: int = 0, *, solutions: bool = False) -> dict
 
 
 def ours(puzzle: BTPuzzle, index: int = 0, *, solutions: bool = False) -> dict[str, int]:
-    packing = compile_packing(bt_packing_spec(puzzle, index))
+    """Our counts under the oracle's semantics: congruent shapes merged, any separation whose
+    parts come apart (the named options; BurrTools' own defaults are checked against burrTxt
+    in tests/test_burrtxt_diff.py)."""
+    packing = compile_packing(bt_packing_spec(puzzle, index, merge_congruent=True))
     out: dict[str, int] = {}
     for mirrors in ("keep", "drop"):
         m: Mirrors = "keep" if mirrors == "keep" else "drop"
         out[mirrors] = sum(1 for _ in iter_classes(packing, mirrors=m))
     if solutions:
-        out["solutions"] = count_bt(packing).solutions
+        out["solutions"] = count_bt(packing, separations="any").solutions
     return out
 
 
@@ -128,10 +131,13 @@ def test_linked_rings_need_not_come_apart_in_their_group() -> None:
     assembly is not one."""
     puzzle = EXAMPLES["linked_rings"]()
     assert ours(puzzle, solutions=True) == oracle(puzzle, solutions=True)
-    packing = compile_packing(bt_packing_spec(puzzle, 0))
+    packing = compile_packing(bt_packing_spec(puzzle, 0, merge_congruent=True))
     report = count_bt(packing)
     assert (report.assemblies, report.solutions) == (2, 2)
     assert report.first_analysis is not None and report.first_analysis.level == "1"
+    # BurrTools tells the two congruent rings apart (burrTxt: 6 assemblies, 6 solutions).
+    distinct = count_bt(compile_packing(bt_packing_spec(puzzle, 0)), mirrors="drop")
+    assert (distinct.assemblies, distinct.solutions) == (6, 6)
     without_lid = next(
         named_assembly(packing, rows)
         for rows in iter_classes(packing)
@@ -216,29 +222,37 @@ def test_stuck_check_is_exactly_no_first_move() -> None:
     stuck = StuckCheck(packing)
     verdicts = []
     for rows in iter_classes(packing):
-        found = analyze(named_assembly(packing, rows), optimal=False)
+        found = analyze(named_assembly(packing, rows), optimal=False, fallback=False)
         verdicts.append((stuck(rows), not found.disassemblable and found.states == 1))
     assert all(s == one for s, one in verdicts)
     assert sum(s for s, _ in verdicts) == 745
 
 
+@pytest.mark.parametrize("separations", ["first", "any"])
 @pytest.mark.parametrize("total", [None, 20])
-def test_level_kernel_matches_python_search_on_solid_burrs(total: int | None) -> None:
+def test_level_kernel_matches_python_search_on_solid_burrs(
+    total: int | None, separations: Separations
+) -> None:
     """Every solid six-piece burr assembly that can move gets the same tree and state count
     (or, under a total state cap, the same error) from the level kernel as from the Python
-    search; the cap fires once a finished sub-part search has counted its states."""
+    search, BurrTools' way and the way of any separation (whose stuck components both
+    remember); the cap fires once a finished sub-part search has counted its states."""
     packing = compile_packing(bt_packing_spec(EXAMPLES["solid_burrs"](), 0))
     stuck = StuckCheck(packing)
     limits = SearchLimits(max_total_states=total)
-    errors = 0
+    errors = solved = 0
     for rows in iter_classes(packing):
         if stuck(rows):
             continue
         shapes = named_assembly(packing, rows)
-        fast = _level_or_error(_Solver(shapes, None, limits), True)
-        assert fast == _level_or_error(_Solver(shapes, None, limits), False)
+        fast = _level_or_error(_Solver(shapes, None, limits, separations=separations), True)
+        slow = _level_or_error(_Solver(shapes, None, limits, separations=separations), False)
+        assert fast == slow
         errors += fast[1] == -1
+        solved += isinstance(fast[0], Separation)
     assert (errors > 0) == (total is not None)
+    if total is None:  # BurrTools' figure with mirror images kept: 314; any way finds more
+        assert solved == 314 if separations == "first" else solved >= 314
 
 
 def test_state_caps_are_reported_not_swallowed() -> None:
@@ -297,3 +311,21 @@ def test_bench_burrtools_quick(capsys: pytest.CaptureFixture[str]) -> None:
     assert rows["ring_maze"]["ours"]["solutions"] == 2
     assert rows["ring_maze"]["previous"]["assemblies"] == 0  # the ring lies on variable cells
     assert all(r["speedup"] is not None for r in rows.values())
+
+
+def test_one_piece_is_no_solution_burrtools_way() -> None:
+    """BurrTools does not disassemble an assembly of one piece (``disassembler_a.cpp``,
+    ``disassemble``): of the 3 assemblies here (the domino alone on the fixed cells; the domino
+    and the cube, the cube at either end) burrTxt counts 2 solutions."""
+    from chaingeo.core.formats.burrtools import BTPart, BTProblem, colored_shape
+
+    domino = colored_shape("a", Shape([(0, 0, 0), (1, 0, 0)]))
+    cube = colored_shape("b", Shape([(0, 0, 0)]))
+    result = colored_shape("r", Shape([(0, 0, 0), (1, 0, 0), (2, 0, 0)]), Shape([(2, 0, 0)]))
+    puzzle = BTPuzzle(
+        (domino, cube, result), (BTProblem("p", (BTPart(0, 1, 1), BTPart(1, 0, 1)), 2),)
+    )
+    packing = compile_packing(bt_packing_spec(puzzle, 0))
+    first = count_bt(packing, mirrors="drop")
+    assert (first.assemblies, first.solutions) == (3, 2)
+    assert count_bt(packing, mirrors="drop", separations="any").solutions == 3

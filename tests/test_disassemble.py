@@ -20,7 +20,7 @@ from chaingeo.core.kinematics import (
     state_key,
 )
 from solvers import disassemble
-from solvers.disassemble import Separation, _Solver, analyze, fast_legal_moves
+from solvers.disassemble import Separation, Separations, _Solver, analyze, fast_legal_moves
 from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
 from tests.puzzle_strategies import small_scenes
 
@@ -123,7 +123,7 @@ def _level_or_error(solver: _Solver, fast: bool) -> tuple[object, int]:
     try:
         if fast:
             return solver.level_tree(), solver.states
-        return solver.greedy(tuple(range(n)), np.zeros((n, 3), dtype=np.int64)), solver.states
+        return solver.part_tree(tuple(range(n)), np.zeros((n, 3), dtype=np.int64)), solver.states
     except SearchLimitError as err:
         return str(err), -1
 
@@ -134,13 +134,19 @@ def _level_or_error(solver: _Solver, fast: bool) -> tuple[object, int]:
     st.sampled_from([None, 1, 2]),
     st.sampled_from([1, 3, 20000]),
     st.sampled_from([None, 0, 3, 10]),
+    st.sampled_from(["first", "any"]),
 )
 def test_level_kernel_matches_python_search(
-    shapes: dict[str, Shape], max_group: int | None, budget: int, total: int | None
+    shapes: dict[str, Shape],
+    max_group: int | None,
+    budget: int,
+    total: int | None,
+    separations: Separations,
 ) -> None:
-    """The one-call level kernel finds the same tree, with the same state count (or the same
-    cap error), as the Python search it stands for, also when it outgrows its buffers or its
-    node budget."""
+    """The one-call level kernels (BurrTools' first separation, :mod:`solvers.btsearch`, and
+    any separation, :mod:`solvers.levelsearch`) find the same tree, with the same state count
+    (or the same cap error), as the Python searches they stand for, also when they outgrow
+    their buffers or their node budget."""
     if len(shapes) < 2:
         return
     limits = SearchLimits(max_total_states=total)
@@ -148,10 +154,11 @@ def test_level_kernel_matches_python_search(
     mp.setattr(disassemble, "_KERNEL_NODES", budget)
     mp.setattr(disassemble, "_TREE_ROWS", 1)
     try:
-        fast = _level_or_error(_Solver(shapes, max_group, limits), True)
+        fast = _level_or_error(_Solver(shapes, max_group, limits, separations=separations), True)
     finally:
         mp.undo()
-    assert fast == _level_or_error(_Solver(shapes, max_group, limits), False)
+    slow = _level_or_error(_Solver(shapes, max_group, limits, separations=separations), False)
+    assert fast == slow
 
 
 def test_level_notation_follows_burrtools() -> None:
@@ -171,8 +178,12 @@ def test_limits_raise_clear_errors() -> None:
     }
     with pytest.raises(SearchLimitError, match="time limit"):
         analyze(shapes, limits=SearchLimits(seconds=0.0))
-    with pytest.raises(SearchLimitError, match="state cap"):
-        analyze(SCENE | {"yellow": Shape([(5, 5, 5)])}, limits=SearchLimits(max_states=4))
+    with pytest.raises(SearchLimitError, match="state cap"):  # BurrTools' way needs 3 states
+        analyze(
+            SCENE | {"yellow": Shape([(5, 5, 5)])},
+            limits=SearchLimits(max_states=4),
+            separations="any",
+        )
 
 
 @settings(max_examples=40)
