@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
+from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Move, SearchLimitError
 from solvers import movement as mv
 from solvers.deadline import Deadline
