@@ -24,14 +24,13 @@ from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.rules import PuzzleRules
-from solvers.btassemble import Mirrors, bt_packing_spec, count_bt, piece_groups
-from solvers.constrained import compile_packing
+from solvers.btassemble import BTReport, Mirrors, bt_packing_spec, count_bt, piece_groups
+from solvers.constrained import Packing, compile_packing
 from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, Rods, analyze
 from solvers.groups import PieceGroups, analyze_grouped
 from solvers.movement import MAX_PIECES
 from solvers.partsearch import SearchLimits
-from solvers.problem import PieceSpec
 
 if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imports
     from chaingeo.core.level import Level
@@ -182,9 +181,12 @@ def level_figures(
     mirrors: Mirrors = "keep",
     deadline: Deadline | None = None,
 ) -> dict[str, Any]:
-    """What ``chain analyze`` prints for one of our puzzle levels (``mirrors="drop"`` also
-    identifies an assembly with its mirror image when the piece set maps to itself), all of it
-    within ``deadline`` (default: one of ``limits.seconds``)."""
+    """What ``chain analyze`` prints for one of our puzzle levels: BurrTools' assemblies and
+    solutions of the level written as a BurrTools file (:func:`level_puzzle`: each piece its
+    own shape, so the counts are burrTxt's on that file; with the level's ``max_group``), then
+    level, moves and o_i of the level's own assembly under its rules. All of it within
+    ``deadline`` (default: one of ``limits.seconds``); counts cut short by a cap are kept as
+    lower bounds (see :func:`count_figures`)."""
     if level.family != "puzzle":
         raise ValueError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
     if deadline is None:
@@ -192,19 +194,11 @@ def level_figures(
     max_group = level_max_group(level)
     out: dict[str, Any] = {"assemblies": None, "solutions": None}
     if assemble:
-        from solvers.assemble import count_solutions  # the placement engine of our levels
+        from chaingeo.core.formats.bt_level import level_puzzle
 
-        deadline.progress.stage = "counting assemblies"
-        target = Shape([c for p in level.pieces for c in p.shape.cells])
-        rep = count_solutions(
-            [PieceSpec(p.shape.normalized(), p.name) for p in level.pieces],
-            target,
-            mirror_distinct=mirrors == "keep",
-            max_group=max_group,
-            limits=limits,
-            deadline=deadline,
-        )
-        out.update(assemblies=rep.assemblies, solutions=rep.solutions)
+        packing = compile_packing(bt_packing_spec(level_puzzle(level), 0))
+        rep = count_figures(packing, out, mirrors, max_group, limits, deadline, "")
+        deadline = deadline if rep.complete else grace_deadline(limits)
     out.update(
         disassembly_figures(
             level.shapes,
@@ -218,6 +212,44 @@ def level_figures(
         )
     )
     return out
+
+
+#: Seconds the figures of a known assembly get when counting spent the analysis' time.
+GRACE_SECONDS = 10.0
+
+
+def grace_deadline(limits: SearchLimits) -> Deadline:
+    """The time the level, moves and o_i of a known assembly get after counting was cut short
+    (the analysis' own time is spent): at most :data:`GRACE_SECONDS`."""
+    seconds = GRACE_SECONDS if limits.seconds is None else min(GRACE_SECONDS, limits.seconds)
+    return Deadline(seconds)
+
+
+def count_figures(
+    packing: Packing,
+    out: dict[str, Any],
+    mirrors: Mirrors,
+    max_group: int | None,
+    limits: SearchLimits,
+    deadline: Deadline,
+    label: str,
+) -> BTReport:
+    """Count BurrTools' assemblies and solutions into ``out``; a cap reached ends the count,
+    and ``out`` then says so: ``counts_complete`` false, the counts lower bounds, ``limit``
+    the cap's reason and ``limit_cap`` the field of ``SearchLimits`` it names."""
+    deadline.progress.stage = f"{label}counting assemblies"
+    rep = count_bt(
+        packing,
+        mirrors=mirrors,
+        max_group=max_group,
+        limits=limits,
+        deadline=deadline,
+        partial=True,
+    )
+    out.update(assemblies=rep.assemblies, solutions=rep.solutions)
+    if rep.limit is not None:
+        out.update(counts_complete=False, limit=rep.limit.reason, limit_cap=rep.limit.cap)
+    return rep
 
 
 def _stored_assembly(puzzle: BTPuzzle, index: int) -> tuple[dict[str, Shape], PieceGroups] | None:
@@ -255,12 +287,13 @@ def problem_figures(
     found: tuple[dict[str, Shape], PieceGroups] | None = None
     first: Analysis | None = None
     if assemble:
-        deadline.progress.stage = f"problem {index}: counting assemblies"
         packing = compile_packing(bt_packing_spec(puzzle, index))
-        rep = count_bt(packing, mirrors=mirrors, limits=limits, deadline=deadline)
-        out.update(assemblies=rep.assemblies, solutions=rep.solutions)
+        rep = count_figures(packing, out, mirrors, None, limits, deadline, f"problem {index}: ")
         if rep.first_solution is not None:
             found, first = (rep.first_solution, piece_groups(packing)), rep.first_analysis
+        if not rep.complete:
+            deadline = grace_deadline(limits)
+            found = found or _stored_assembly(puzzle, index)
     else:
         found = _stored_assembly(puzzle, index)
     if found is None:

@@ -32,6 +32,7 @@ import numpy as np
 
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import SearchLimitError
 from solvers import movement as mv
 from solvers.btorient import BTImage
 from solvers.constrained import (
@@ -311,6 +312,12 @@ class BTReport:
     first_analysis: Analysis | None
     seconds: float
     anchor: str | None
+    limit: SearchLimitError | None = None  # the cap that ended a partial count
+
+    @property
+    def complete(self) -> bool:
+        """Whether every assembly was counted (else the counts are lower bounds)."""
+        return self.limit is None
 
 
 def count_bt(
@@ -323,12 +330,16 @@ def count_bt(
     deadline: Deadline | None = None,
     separations: Separations = "first",
     levels: list[str] | None = None,
+    partial: bool = False,
 ) -> BTReport:
     """BurrTools' assemblies and solutions of a packing, and the first solution. The search
     and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
     ``limits`` the enumeration has no time limit and each disassembly the default one).
     ``separations``: see :func:`solvers.disassemble.analyze`; ``levels``, when given, gets
-    every solution's level string in the order found."""
+    every solution's level string in the order found. A cap reached raises its
+    :class:`SearchLimitError`, or with ``partial`` ends the count: the report then holds what
+    was counted (lower bounds) and the error. The running counts are kept in the deadline's
+    :class:`solvers.deadline.Progress` as the search goes."""
     start = time.perf_counter()
     if deadline is None and limits is not None:
         deadline = Deadline(limits.seconds)
@@ -343,24 +354,34 @@ def count_bt(
         packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor, deadline=deadline
     )
     frame = BTFrame(packing) if separations == "first" else None
-    for rows in classes:
-        n_asm += 1
-        if stuck is not None and stuck(rows):
-            continue
-        asm = named_assembly(packing, rows)
-        if frame is not None:
-            if len(asm) < 2:
-                continue  # BurrTools: one piece is no disassembly (disassembler_a.cpp)
-            asm = frame(asm)
-        result = disassemble(
-            packing, asm, max_group=max_group, limits=limits, groups=groups, deadline=deadline,
-            separations=separations,
-        )  # fmt: skip
-        if result.disassemblable:
-            n_sol += 1
-            if levels is not None:
-                levels.append(result.level or "")
-            if first is None:
-                first, first_an = asm, result
+    counts = deadline.progress.counts if deadline is not None else {}
+    limit: SearchLimitError | None = None
+    try:
+        for rows in classes:
+            n_asm += 1
+            counts["assemblies"] = n_asm
+            if stuck is not None and stuck(rows):
+                continue
+            asm = named_assembly(packing, rows)
+            if frame is not None:
+                if len(asm) < 2:
+                    continue  # BurrTools: one piece is no disassembly (disassembler_a.cpp)
+                asm = frame(asm)
+            result = disassemble(
+                packing, asm, max_group=max_group, limits=limits, groups=groups,
+                deadline=deadline, separations=separations,
+            )  # fmt: skip
+            if result.disassemblable:
+                n_sol += 1
+                counts["solutions"] = n_sol
+                if levels is not None:
+                    levels.append(result.level or "")
+                if first is None:
+                    first, first_an = asm, result
+    except SearchLimitError as e:
+        if not partial:
+            raise
+        limit = e  # an assembly being taken apart then is counted, its verdict is not
     label = None if anchor is None else anchor.label
-    return BTReport(n_asm, n_sol, first, first_an, time.perf_counter() - start, label)
+    seconds = time.perf_counter() - start
+    return BTReport(n_asm, n_sol, first, first_an, seconds, label, limit)

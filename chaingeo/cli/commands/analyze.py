@@ -18,8 +18,14 @@ the file fails with the limit's message, except that a spent optimal search alon
 more than the work (:mod:`chaingeo.core.jit`); if the work takes more than
 :data:`INTERPRETED_SECONDS` of CPU time, the command starts again with numba.
 
-Exit status: 0, or 2 when some file failed (its line carries ``error``; the message is also on
-standard error).
+When a cap (``--seconds``, ``--max-states``) stops the counting of assemblies, nothing finished
+is thrown away: the line keeps the counts so far with ``"counts_complete": false`` (they are
+lower bounds) and ``limit`` naming the cap and its flag, and still gives level, moves and o_i of
+the known assembly (the first solution found, a ``.xmpuzzle``'s stored assembly, or a level's
+own), which get a further :data:`solvers.analysis.GRACE_SECONDS` at most.
+
+Exit status: 0 when every figure is complete; 1 when counting was cut short by a cap; 2 when
+some file failed (its line carries ``error``; the message is also on standard error).
 """
 
 from __future__ import annotations
@@ -116,12 +122,32 @@ def _run_all(args: argparse.Namespace) -> int:
     for spec in args.files:
         try:
             out = analyze_file(spec, args)
+            status = max(status, _cut_short(spec, out))
         except CommandError as e:
             if len(args.files) == 1:
                 raise
             print(f"chain analyze: {spec}: error: {e}", file=sys.stderr)
             out, status = {"file": str(spec), "error": str(e)}, 2
         print(json.dumps(out, sort_keys=True), flush=True)
+    return status
+
+
+def _cut_short(spec: str, out: dict[str, Any]) -> int:
+    """Name the flag of every cap that cut counting short (``limit``), say so on stderr, and
+    return the exit status: 1 when some count is a lower bound, else 0."""
+    status = 0
+    for row in [out, *out.get("problems", [])]:
+        if "limit_cap" not in row:
+            continue
+        flag = LIMIT_FLAGS.get(row.pop("limit_cap") or "")
+        if flag:
+            row["limit"] = f"{row['limit']}; raise it with {flag}"
+        print(
+            f"chain analyze: {spec}: counting stopped ({row['limit']}); the counts are lower "
+            "bounds, the other figures are those of the known assembly",
+            file=sys.stderr,
+        )
+        status = 1
     return status
 
 
@@ -249,8 +275,9 @@ def _run_interpreted(args: argparse.Namespace) -> int:
         _restart_with_numba(args.command_line)
     finally:
         signal.signal(signal.SIGPROF, previous)
+    status = _cut_short(args.files[0], out)
     print(json.dumps(out, sort_keys=True), flush=True)
-    return 0
+    return status
 
 
 def _restart_with_numba(argv: list[str]) -> None:
