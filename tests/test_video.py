@@ -13,7 +13,7 @@ import pytest
 from PIL import Image
 
 from chaingeo.cli.main import main
-from chaingeo.core.level import Level, load_level
+from chaingeo.core.level import Level, StackingSolution, load_level
 from chaingeo.envs.legend import legend_layout
 from chaingeo.envs.raster import SHADE, Posed, parse_color
 from chaingeo.envs.render import render_frame
@@ -29,6 +29,7 @@ from chaingeo.envs.video import (
 
 LEVELS = Path(__file__).resolve().parent.parent / "levels"
 TURNS = LEVELS / "puzzle" / "puzzle-easy-01-luban-3-piece.json"  # disassembly with a turn
+SLIDES = LEVELS / "puzzle" / "puzzle-easy-04-burr6.json"  # disassembly, slides only
 ASSEMBLE = LEVELS / "puzzle" / "puzzle-easy-07-burr3.json"
 STACK = LEVELS / "stacking" / "stacking-2x2x3-easy-s103-000000.json"
 SIZE = 256
@@ -93,22 +94,36 @@ def test_an_assembly_video_starts_apart_and_ends_assembled() -> None:
     assert video.frames[-1].tobytes() == _still(level, video, video.captions[-1]).tobytes()
 
 
-def test_stacking_pieces_come_down_one_by_one() -> None:
+def test_stacking_pieces_are_carried_into_the_box_and_never_vanish() -> None:
     level = load_level(STACK)
     video = plan_video(level, size=SIZE)
-    assert _shown(level, video.frames[0]) == set()
-    assert _shown(level, video.frames[-1]) == {p.name for p in level.pieces}
+    everyone = {p.name for p in level.pieces}
+    assert all(_shown(level, f) == everyone for f in video.frames[::7])
     assert video.captions[-1] == "done: the box full"
-    seen = [len(_shown(level, f)) for f in video.frames[::3]]
-    assert seen == sorted(seen)  # pieces arrive and stay
+    sol = level.solution
+    assert isinstance(sol, StackingSolution) and level.box is not None
+    legend = [(p.name, parse_color(p.rgb)) for p in sorted(level.pieces, key=lambda p: p.name)]
+    colors = dict(legend)
+    parts = [
+        Posed(sol.placements[n].voxels, colors[n], np.eye(3), np.zeros(3))
+        for n in sorted(sol.placements)
+    ]
+    packed = render_frame(parts, legend, video.frame, "iso", SIZE, video.captions[-1], level.box)
+    assert video.frames[-1].tobytes() == packed.tobytes()
+    assert video.frames[0].tobytes() != packed.tobytes()
 
 
 def test_a_plan_from_text_is_checked_by_the_level() -> None:
-    level = load_level(TURNS)
-    partial = plan_video(level, "# first two steps\nrotate forest y +90 about (6,1,6)\n", SIZE)
+    level = load_level(SLIDES)
+    text = "# two steps\nmove blue+green+purple +z 1\n\nmove blue+green+orange +x inf\nfinish\nx"
+    partial = plan_video(level, text, 128)
     assert partial.captions[-1] == "end of the plan (goal not reached)"
+    assert {c for c in partial.captions if c.startswith("step")} == {
+        "step 1/2: move blue+green+purple +z 1",
+        "step 2/2: move blue+green+orange +x inf",
+    }
     with pytest.raises(VideoError, match="plan line 1"):
-        plan_video(level, "move rust +y inf", SIZE)
+        plan_video(level, "move yellow +z inf", 128)
     with pytest.raises(VideoError, match="must assemble"):
         plan_video(load_level(ASSEMBLE), "", SIZE)
 
@@ -120,7 +135,7 @@ def _runs(video: PlanVideo) -> int:
 
 def test_gif_reads_back(tmp_path: Path) -> None:
     level = load_level(STACK)
-    video = plan_video(level, size=SIZE)
+    video = plan_video(level, size=128)
     path = write_gif(video, tmp_path / "v.gif")
     with Image.open(path) as gif:
         count = int(getattr(gif, "n_frames", 1))
@@ -136,21 +151,21 @@ def test_gif_reads_back(tmp_path: Path) -> None:
 def test_mp4_reads_back_with_every_frame(tmp_path: Path) -> None:
     import imageio.v2 as imageio
 
-    video = plan_video(load_level(STACK), size=SIZE)
+    video = plan_video(load_level(STACK), size=128)
     path = write_mp4(video, tmp_path / "v.mp4")
     frames = imageio.mimread(str(path), format="FFMPEG", memtest=False)
-    assert len(frames) == len(video.frames) and frames[0].shape == (SIZE, SIZE, 3)
+    assert len(frames) == len(video.frames) and frames[0].shape == (128, 128, 3)
     assert write_mp4(video, tmp_path / "w.mp4").read_bytes() == path.read_bytes()
 
 
 def test_chain_video_command(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     plan = tmp_path / "plan.txt"
-    plan.write_text("rotate forest y +90 about (6,1,6)\nmove rust -y inf\n", encoding="utf-8")
+    plan.write_text("move blue+green+purple +z 1\nmove blue+green+orange +x inf\n", "utf-8")
     out = tmp_path / "v.gif"
-    args = ["video", str(TURNS), "--plan", str(plan), "--out", str(out), "--size", "128"]
+    args = ["video", str(SLIDES), "--plan", str(plan), "--out", str(out), "--size", "128"]
     assert main(args) == 0
     assert out.is_file() and "frames" in capsys.readouterr().out
-    plan.write_text("move rust +y inf\n", encoding="utf-8")
+    plan.write_text("move yellow +z inf\n", encoding="utf-8")
     assert main(args) == 2
     assert "plan line 1" in capsys.readouterr().err
     assert main(["video", str(TURNS), "--out", str(tmp_path / "v.avi")]) == 2

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Final
 
 import numpy as np
@@ -359,9 +359,10 @@ def _render_view(
     size: int,
     faces: Faces | None = None,
     title: str | None = None,
+    outline: _Scene | None = None,
 ) -> Image.Image:
     """One view; ``faces`` (else the scene's cells) are drawn, ``title`` replaces the camera's
-    first title line."""
+    first title line, ``outline`` is a box drawn as a wire frame inside the frame."""
     lay = _Layout.of(size)
     # Axis views have only axis-parallel edges: no aliasing, so no supersampling needed.
     k = _SUPERSAMPLE if cam.depth_axis is None else 1
@@ -372,12 +373,15 @@ def _render_view(
     _draw_walls(draw, scene, cam, big_proj, k)
     for p, q in _frame_edges(scene, cam, back=True):
         line(draw, big_proj(p), big_proj(q), _FRAME, k)
+    for p, q in _frame_edges(outline, cam, back=True) if outline else ():
+        line(draw, big_proj(p), big_proj(q), _FRAME, 2 * k)
     if faces is None:
         faces = visible_faces(scene.cells, scene.colors, cam)
     draw_faces(draw, faces, big_proj, lay.edge_px(k))
-    if scene.has_box:
-        for p, q in _frame_edges(scene, cam, back=False):
-            line(draw, big_proj(p), big_proj(q), _FRAME, k)
+    for p, q in _frame_edges(scene, cam, back=False) if scene.has_box else ():
+        line(draw, big_proj(p), big_proj(q), _FRAME, k)
+    for p, q in _frame_edges(outline, cam, back=False) if outline else ():
+        line(draw, big_proj(p), big_proj(q), _FRAME, 2 * k)
     image = big.reduce(k) if k > 1 else big
     titles = _view_titles(cam, scene)
     _title(image, titles if title is None else [title, *titles[1:]], lay)
@@ -517,11 +521,12 @@ def render_frame(
     view: str = "iso",
     size: int = DEFAULT_SIZE,
     title: str | None = None,
-    has_box: bool = False,
+    box: Sequence[int] | None = None,
 ) -> Image.Image:
     """One picture of rigid parts at real poses inside a fixed frame (``lo``, ``hi``: a video's
-    camera does not follow the pieces). At lattice poses it is the still picture of the same
-    cells in the same frame (:func:`chaingeo.envs.raster.posed_faces`)."""
+    camera does not follow the pieces), with ``box`` (from the origin) as a wire frame. At
+    lattice poses it is the still picture of the same cells in the same frame
+    (:func:`chaingeo.envs.raster.posed_faces`)."""
     _check_size(size)
     _check_views([view])
     lo, hi = (tuple(int(v) for v in frame[0]), tuple(int(v) for v in frame[1]))
@@ -532,11 +537,14 @@ def render_frame(
         np.zeros((0, 3)),
         (lo[0], lo[1], lo[2]),
         (hi[0], hi[1], hi[2]),
-        has_box,
+        False,
         tuple(legend),
     )
+    outline = None
+    if box is not None:
+        outline = replace(scene, lo=(0, 0, 0), hi=(int(box[0]), int(box[1]), int(box[2])))
     cam = CAMERAS[view]
-    return _render_view(scene, cam, size, posed_faces(parts, cam), title)
+    return _render_view(scene, cam, size, posed_faces(parts, cam), title, outline)
 
 
 def view_projector(

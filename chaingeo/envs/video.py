@@ -4,9 +4,9 @@ One fixed camera (the iso view of a frame that holds every position of the plan)
 eased over a few frames, quarter turns rotate through their 90 degrees about the turn's axis
 (:mod:`chaingeo.core.turns`), a group that leaves the puzzle is carried out of the picture and
 stays gone, and each frame's title is the current step. An assembly plan is shown as the
-disassembly that undoes it, played backwards; stacking pieces are lowered into the box one by
-one from above. Every step's end pose is checked against the reference kinematics, so what the
-video shows is what the engine does.
+disassembly that undoes it, played backwards. Stacking pieces wait in a row beside the box and
+are carried in one by one: up, over the box, down into place. Every step's end pose of a puzzle
+is checked against the reference kinematics, so what the video shows is what the engine does.
 
 Frames are drawn by :func:`chaingeo.envs.render.render_frame`: the same level and plan give the
 same pixels; at a step's end the frame is the still picture of that position. GIF is written by
@@ -47,6 +47,7 @@ SLIDE_FRAMES: Final = 8
 TURN_FRAMES: Final = 12
 OUT_FRAMES: Final = 10
 DROP_FRAMES: Final = 8
+LIFT_FRAMES: Final = 4
 STEP_HOLD: Final = 2
 END_HOLD: Final = 6
 FPS: Final = 10  # 100 ms a frame: GIF counts time in hundredths of a second
@@ -178,7 +179,8 @@ def _captioned(
     start, end = ends
     n = len(texts)
     shots = [start] * END_HOLD
-    captions = [f"start: {_start_words(level)} ({n} steps)"] * END_HOLD
+    # no step count: the first frame is also the reference image a video model is given
+    captions = [f"start: {_start_words(level)}"] * END_HOLD
     for i, (seg, text) in enumerate(zip(segments, texts, strict=True)):
         body = seg[1:] + [seg[-1]] * STEP_HOLD
         shots += body
@@ -224,25 +226,53 @@ def _puzzle_shots(
 def _stacking_shots(
     level: Level, order: Sequence[tuple[str, Shape]]
 ) -> tuple[list[_Shot], list[str], tuple[Cell, Cell]]:
-    """Each piece, already turned as it will lie, lowered from above the box into place."""
+    """The pieces wait on the floor in a row beside the box (+x), already turned as they will
+    lie, in placing order; each in turn rises above everything, travels over the box and is
+    lowered into place (nothing appears from nowhere or passes through a piece)."""
     assert level.box is not None
     bx, by, bz = level.box
     eye = np.eye(3)
-    placed: list[tuple[str, FloatArray, FloatArray]] = []
-    tallest = max(s.extent[2] for _, s in order) if order else 0
+    # a grid beside the box: about sqrt(n) pieces a row along +x, rows one behind another
+    per_row = max(1, math.ceil(math.sqrt(len(order))))
+    waiting: dict[str, FloatArray] = {}
+    x, y, row_depth, width = bx + 1, 0, 0, bx
+    for i, (name, cells) in enumerate(order):
+        if i and i % per_row == 0:
+            x, y, row_depth = bx + 1, y + row_depth + 1, 0
+        lo = cells.min_corner
+        waiting[name] = np.array([x - lo[0], y - lo[1], -lo[2]], dtype=np.float64)
+        x += cells.extent[0] + 1
+        row_depth = max(row_depth, cells.extent[1])
+        width = max(width, x - 1)
+    tallest = max((s.extent[2] for _, s in order), default=0)
+    clear = max(bz, tallest) + 1  # the height a carried piece's bottom rises to
+    at: dict[str, FloatArray] = dict(waiting)
     segments: list[list[_Shot]] = []
+
+    def shot() -> _Shot:
+        return tuple((n, eye, at[n]) for n in sorted(at))
+
     for name, cells in order:
-        lift = float(bz + 1 - int(cells.min_corner[2]))
-        seg = []
-        for i in range(DROP_FRAMES + 1):
-            t = np.array([0.0, 0.0, lift * (1.0 - _ease(i, DROP_FRAMES))])
-            seg.append(tuple(sorted([*placed, (name, eye, t)], key=lambda e: e[0])))
-        placed.append((name, eye, np.zeros(3)))
+        start = waiting[name]
+        above = np.array([start[0], start[1], clear - cells.min_corner[2]], dtype=np.float64)
+        over = np.array([0.0, 0.0, above[2]])
+        seg = [shot()]
+        for a, b, frames in ((start, above, LIFT_FRAMES), (above, over, DROP_FRAMES)):
+            for i in range(1, frames + 1):
+                at[name] = a + (b - a) * _ease(i, frames)
+                seg.append(shot())
+        for i in range(1, DROP_FRAMES + 1):
+            at[name] = over * (1.0 - _ease(i, DROP_FRAMES))
+            seg.append(shot())
+        at[name] = np.zeros(3)
+        seg[-1] = shot()
         segments.append(seg)
     texts = [f"place {name}" for name, _ in order]
     full = len(order) == len(level.pieces)
-    shots, captions = _captioned(level, segments, texts, ((), tuple(sorted(placed))), full)
-    return shots, captions, ((0, 0, 0), (bx, by, bz + 1 + tallest))
+    first = tuple((n, eye, waiting[n]) for n in sorted(waiting))
+    shots, captions = _captioned(level, segments, texts, (first, shot()), full)
+    depth = max(by, y + row_depth)
+    return shots, captions, ((0, 0, 0), (width, depth, clear + tallest))
 
 
 def _draw(
@@ -258,7 +288,7 @@ def _draw(
     out = []
     for shot, caption in zip(shots, captions, strict=True):
         parts = [Posed(shapes[n].voxels, colors[n], rot, t) for n, rot, t in shot]
-        out.append(render_frame(parts, legend, frame, "iso", size, caption))
+        out.append(render_frame(parts, legend, frame, "iso", size, caption, level.box))
     return tuple(out)
 
 
