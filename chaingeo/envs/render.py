@@ -532,17 +532,10 @@ def render_frame(
     lo, hi = (tuple(int(v) for v in frame[0]), tuple(int(v) for v in frame[1]))
     if len(lo) != 3 or len(hi) != 3 or any(a >= b for a, b in zip(lo, hi, strict=True)):
         raise ValueError(f"a frame is two corners lo < hi, got {list(lo)} and {list(hi)}")
-    scene = _Scene(
-        np.zeros((0, 3), dtype=np.int64),
-        np.zeros((0, 3)),
-        (lo[0], lo[1], lo[2]),
-        (hi[0], hi[1], hi[2]),
-        False,
-        tuple(legend),
-    )
-    outline = None
-    if box is not None:
-        outline = replace(scene, lo=(0, 0, 0), hi=(int(box[0]), int(box[1]), int(box[2])))
+    empty = np.zeros((0, 3), dtype=np.int64)
+    scene = _Scene(empty, np.zeros((0, 3)), lo, hi, False, tuple(legend))
+    corner = (0, 0, 0) if box is None else (int(box[0]), int(box[1]), int(box[2]))
+    outline = None if box is None else replace(scene, lo=(0, 0, 0), hi=corner)
     cam = CAMERAS[view]
     return _render_view(scene, cam, size, posed_faces(parts, cam), title, outline)
 
