@@ -334,7 +334,8 @@ def posed_faces(parts: Sequence[Posed], cam: Camera) -> Faces:
     When every pose is on the lattice this is exactly :func:`visible_faces` of the world cells
     (so a still frame of a video is the still picture, bytes and all). Otherwise each part's
     outer faces are moved, turned-away ones dropped, and all sorted by the depth of their
-    centres: exact for separated parts, and close enough for parts in mid-motion.
+    centres: not exact (two unit faces close together at an angle, as in the middle of a
+    turn, can be drawn in the wrong order for a frame), which only in-between frames use.
     """
     lattice = [_on_lattice(p) for p in parts]
     if all(c is not None for c in lattice):
