@@ -240,8 +240,17 @@ def render_state(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> dict[str, 
     if state.level.family == "stacking":
         images["tray"] = render.render_tray(tray, size)
     else:
-        images["target"] = render.render_views(target_scene(state), None, ("iso",), size)["iso"]
+        title = TARGET_TITLES[state.level.goal]
+        target = render.render_views(target_scene(state), None, ("iso",), size, title)
+        images["target"] = target["iso"]
     return images
+
+
+#: The first title line of a puzzle's ``target`` picture (not the current view's title).
+TARGET_TITLES: Final[dict[str, str]] = {
+    "assemble": "TARGET: the puzzle assembled (3D view)",
+    "disassemble": "TARGET: every piece apart (3D view)",
+}
 
 
 def target_scene(state: BaseState) -> PieceMap:

@@ -293,3 +293,88 @@ def png_bytes(image: Image.Image) -> bytes:
             _png_chunk(b"IEND", b""),
         )
     )
+
+
+@dataclass(frozen=True)
+class Posed:
+    """A rigid part drawn at a real pose: its cells (frame of the part), one fill colour, and
+    the map ``p -> rotation @ p + translation`` of world points (cube corners)."""
+
+    cells: npt.NDArray[np.int64]
+    color: RGB
+    rotation: FloatArray  # (3, 3)
+    translation: FloatArray  # (3,)
+
+
+def _on_lattice(part: Posed) -> npt.NDArray[np.int64] | None:
+    """The part's world cells when its pose keeps cubes on cubes (a signed permutation and a
+    whole translation), else None."""
+    r = np.rint(part.rotation)
+    t = np.rint(part.translation)
+    if np.abs(part.rotation - r).max() > 1e-9 or np.abs(part.translation - t).max() > 1e-9:
+        return None
+    if not np.array_equal(np.abs(r).sum(axis=0), np.ones(3)) or len(part.cells) == 0:
+        return None
+    centres = (part.cells + 0.5) @ r.T + t
+    return np.asarray(np.rint(centres - 0.5), dtype=np.int64)
+
+
+def _shade_of(normals: FloatArray) -> FloatArray:
+    """Brightness of turned faces: the axis faces' :data:`SHADE` mixed by the squared normal
+    components (a convex mix, exact on the axes, so a turn fades smoothly between tones)."""
+    pos, neg = np.clip(normals, 0, None) ** 2, np.clip(-normals, 0, None) ** 2
+    mix = np.stack([pos[:, 0], neg[:, 0], pos[:, 1], neg[:, 1], pos[:, 2], neg[:, 2]], axis=1)
+    out: FloatArray = mix @ SHADE
+    return out
+
+
+def posed_faces(parts: Sequence[Posed], cam: Camera) -> Faces:
+    """Visible faces of rigid parts at real poses, far to near.
+
+    When every pose is on the lattice this is exactly :func:`visible_faces` of the world cells
+    (so a still frame of a video is the still picture, bytes and all). Otherwise each part's
+    outer faces are moved, turned-away ones dropped, and all sorted by the depth of their
+    centres: not exact (two unit faces close together at an angle, as in the middle of a
+    turn, can be drawn in the wrong order for a frame), which only in-between frames use.
+    """
+    lattice = [_on_lattice(p) for p in parts]
+    if all(c is not None for c in lattice):
+        cells = [c for c in lattice if c is not None]
+        colors = [np.tile(np.array(p.color, dtype=np.float64), (len(p.cells), 1)) for p in parts]
+        if not cells:
+            return visible_faces(np.zeros((0, 3), np.int64), np.zeros((0, 3)), cam)
+        return visible_faces(np.concatenate(cells), np.concatenate(colors), cam)
+    v = np.array(cam.toward_viewer)
+    chunks: list[tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.int64]]] = []
+    for part in parts:
+        if len(part.cells) == 0:
+            continue
+        own = set(map(tuple, part.cells.tolist()))
+        for f in range(6):
+            open_side = [
+                i
+                for i, c in enumerate(part.cells.tolist())
+                if (c[0] + NORMALS[f][0], c[1] + NORMALS[f][1], c[2] + NORMALS[f][2]) not in own
+            ]
+            if not open_side:
+                continue
+            normal = part.rotation @ NORMALS[f].astype(np.float64)
+            if float(normal @ v) <= 1e-9:
+                continue
+            local = part.cells[open_side][:, None, :] + FACE_CORNERS[f]
+            world = local @ part.rotation.T + part.translation
+            fill = np.tile(np.array(part.color, dtype=np.float64), (len(open_side), 1))
+            tone = 1.0 if cam.depth_axis is not None else float(_shade_of(normal[None, :])[0])
+            shade = np.full(len(open_side), tone)
+            near = np.asarray(np.floor(world.mean(axis=1)), dtype=np.int64)
+            chunks.append((world, fill * shade[:, None], np.full(len(open_side), f), near))
+    if not chunks:
+        return visible_faces(np.zeros((0, 3), np.int64), np.zeros((0, 3)), cam)
+    world = np.concatenate([c[0] for c in chunks])
+    fills = np.concatenate([c[1] for c in chunks])
+    normals = np.concatenate([c[2] for c in chunks]).astype(np.int64)
+    near = np.concatenate([c[3] for c in chunks])
+    order = np.argsort(world.mean(axis=1) @ v, kind="stable")
+    world, fills, normals, near = world[order], fills[order], normals[order], near[order]
+    proj = np.stack([world @ np.array(cam.right), world @ np.array(cam.up)], axis=-1)
+    return Faces(proj, np.clip(np.rint(fills), 0, 255).astype(np.uint8), near, normals)

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Final
 
 import numpy as np
@@ -26,23 +26,28 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from chaingeo.core.geometry import Shape
+from chaingeo.envs.legend import draw_legend, legend_layout
 from chaingeo.envs.raster import (
+    EDGE,
     RGB,
     Camera,
     ColorLike,
     Faces,
     FloatArray,
+    Posed,
     Projector,
     arrow,
     draw_faces,
     fit,
     fit_centre,
+    font,
     frame_corners,
     line,
     oblique_camera,
     parse_color,
     png_bytes,
     polygon,
+    posed_faces,
     put_text,
     scaled,
     text_color,
@@ -131,6 +136,7 @@ class _Scene:
     lo: tuple[int, int, int]
     hi: tuple[int, int, int]  # exclusive
     has_box: bool
+    legend: tuple[tuple[str, RGB], ...] = ()  # (name, colour) of every piece, by name
 
 
 def _scene(pieces: PieceMap, box: Sequence[int] | None) -> _Scene:
@@ -168,6 +174,7 @@ def _scene(pieces: PieceMap, box: Sequence[int] | None) -> _Scene:
         (int(lo[0]), int(lo[1]), int(lo[2])),
         (int(hi[0]), int(hi[1]), int(hi[2])),
         box is not None,
+        tuple((n, parse_color(pieces[n][1])) for n in sorted(pieces)),
     )
 
 
@@ -337,14 +344,25 @@ def _view_titles(cam: Camera, scene: _Scene) -> list[str]:
 
 
 def _view_projector(scene: _Scene, cam: Camera, lay: _Layout) -> Projector:
-    """The frame fitted into the picture, leaving room for the title and the axis labels."""
+    """The frame fitted into the picture, leaving room for the title, the axis labels and the
+    legend."""
     top = lay.title_px * 2.6 + lay.tick_px * 1.9 + 8
     side = lay.tick_px * 2.8
-    content = (side, top, lay.size - side, lay.size - lay.tick_px * 2.8)
+    bottom = lay.size - lay.tick_px * 2.8 - legend_layout(scene.legend, lay.size)[1]
+    content = (side, top, lay.size - side, bottom)
     return fit(frame_corners(scene.lo, scene.hi), cam, content)
 
 
-def _render_view(scene: _Scene, cam: Camera, size: int) -> Image.Image:
+def _render_view(
+    scene: _Scene,
+    cam: Camera,
+    size: int,
+    faces: Faces | None = None,
+    title: str | None = None,
+    outline: _Scene | None = None,
+) -> Image.Image:
+    """One view; ``faces`` (else the scene's cells) are drawn, ``title`` replaces the camera's
+    first title line, ``outline`` is a box drawn as a wire frame inside the frame."""
     lay = _Layout.of(size)
     # Axis views have only axis-parallel edges: no aliasing, so no supersampling needed.
     k = _SUPERSAMPLE if cam.depth_axis is None else 1
@@ -355,16 +373,22 @@ def _render_view(scene: _Scene, cam: Camera, size: int) -> Image.Image:
     _draw_walls(draw, scene, cam, big_proj, k)
     for p, q in _frame_edges(scene, cam, back=True):
         line(draw, big_proj(p), big_proj(q), _FRAME, k)
-    faces = visible_faces(scene.cells, scene.colors, cam)
+    for p, q in _frame_edges(outline, cam, back=True) if outline else ():
+        line(draw, big_proj(p), big_proj(q), _FRAME, 2 * k)
+    if faces is None:
+        faces = visible_faces(scene.cells, scene.colors, cam)
     draw_faces(draw, faces, big_proj, lay.edge_px(k))
-    if scene.has_box:
-        for p, q in _frame_edges(scene, cam, back=False):
-            line(draw, big_proj(p), big_proj(q), _FRAME, k)
+    for p, q in _frame_edges(scene, cam, back=False) if scene.has_box else ():
+        line(draw, big_proj(p), big_proj(q), _FRAME, k)
+    for p, q in _frame_edges(outline, cam, back=False) if outline else ():
+        line(draw, big_proj(p), big_proj(q), _FRAME, 2 * k)
     image = big.reduce(k) if k > 1 else big
-    _title(image, _view_titles(cam, scene), lay)
+    titles = _view_titles(cam, scene)
+    _title(image, titles if title is None else [title, *titles[1:]], lay)
     _draw_ticks(image, scene, cam, proj, lay)
     if cam.depth_axis is not None and len(faces.cells):
         _draw_depth_labels(image, faces, cam, proj)
+    draw_legend(image, scene.legend)
     return image
 
 
@@ -373,52 +397,83 @@ def _render_view(scene: _Scene, cam: Camera, size: int) -> Image.Image:
 # ---------------------------------------------------------------------------------------------
 
 
-def _render_tray(pieces: PieceMap, size: int) -> Image.Image:
-    """Every piece on its own square, at one common scale, labelled with its name and size."""
+#: The piece sheet draws each piece from the iso corner and from the opposite one, so that
+#: every face of a piece (and every notch in it) is seen once.
+BACK_CAMERA: Final = oblique_camera(
+    "iso-back", "3D view from back-left-below", ISO_AZIMUTH + 180.0, -ISO_ELEVATION
+)
+SHEET_CAMERAS: Final[tuple[Camera, Camera]] = (CAMERAS["iso"], BACK_CAMERA)
+TRAY_TITLE: Final = "TRAY: pieces not yet placed"
+PIECES_TITLE: Final = "PIECES: the puzzle's parts"
+_SHEET_NOTE: Final = "each from front-right-above (left) and back-left-below (right)"
+
+
+def _sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: FloatArray) -> int:
+    """Columns of the piece grid that draw the pieces largest (fewest columns on a tie)."""
+    best, best_scale = 1, -1.0
+    for cols in range(1, n + 1):
+        rows = math.ceil(n / cols)
+        cell_w, cell_h = size / cols, (size - title_h) / rows
+        scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
+        if scale > best_scale + 1e-9:
+            best, best_scale = cols, scale
+    return best
+
+
+def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
+    """Every piece in its own cell, drawn twice (see :data:`SHEET_CAMERAS`) at one common
+    scale, labelled with a colour swatch, its name and its number of cubes."""
     lay = _Layout.of(size)
     k = _SUPERSAMPLE
-    cam = CAMERAS["iso"]
     names = sorted(pieces)
-    title_h = lay.title_px * 1.6 + 6
+    title_h = lay.title_px * 2.85 + 6
     if not names:
         image = Image.new("RGB", (size, size), _BACKGROUND)
-        _title(image, ["TRAY: pieces not yet placed"], lay)
-        put_text(image, (size / 2, size / 2), "(the tray is empty)", lay.tick_px, _TEXT)
+        _title(image, [title], lay)
+        put_text(image, (size / 2, size / 2), "(no pieces)", lay.tick_px, _TEXT)
         return image
     big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
-    cols = math.ceil(math.sqrt(len(names)))
-    rows = math.ceil(len(names) / cols)
-    cell_w = size / cols
-    cell_h = (size - title_h) / rows
-    label_px = int(min(lay.tick_px, max(9, cell_w / 7)))
+    label_px = max(9, min(lay.tick_px, size // 40))
     label_h = label_px * 1.7
     shapes = {n: pieces[n][0].normalized() for n in names}
-    r, u = np.array(cam.right), np.array(cam.up)
-    spans = []
+    spans = np.array([1e-9, 1e-9])
     for n in names:
         corners = frame_corners((0, 0, 0), shapes[n].extent)
-        spans.append((np.ptp(corners @ r), np.ptp(corners @ u)))
-    max_w = max(max(w for w, _ in spans), 1e-9)
-    max_h = max(max(h for _, h in spans), 1e-9)
-    scale = min(cell_w * 0.84 / max_w, (cell_h - label_h) * 0.84 / max_h)
+        for cam in SHEET_CAMERAS:
+            r, u = np.array(cam.right), np.array(cam.up)
+            spans = np.maximum(spans, (np.ptp(corners @ r), np.ptp(corners @ u)))
+    cols = _sheet_grid(len(names), size, title_h, label_h, spans)
+    rows = math.ceil(len(names) / cols)
+    cell_w, cell_h = size / cols, (size - title_h) / rows
+    scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
     draw = ImageDraw.Draw(big)
-    slots: list[tuple[str, float, float]] = []
+    slots: list[tuple[str, RGB, float, float]] = []
     for i, n in enumerate(names):
         col, row = i % cols, i // cols
         x0, y0 = col * cell_w, title_h + row * cell_h
-        box = (x0, y0, x0 + cell_w, y0 + cell_h - label_h)
-        corners = frame_corners((0, 0, 0), shapes[n].extent)
-        proj = Projector(r, u, scale, fit_centre(corners, cam, box, scale))
         rgb = parse_color(pieces[n][1])
         colors = np.tile(np.array(rgb, dtype=np.float64), (len(shapes[n]), 1))
-        faces = visible_faces(shapes[n].voxels, colors, cam)
-        draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
-        slots.append((f"{n} ({len(shapes[n])})", x0 + cell_w / 2, y0 + cell_h - label_h / 2))
+        corners = frame_corners((0, 0, 0), shapes[n].extent)
+        for j, cam in enumerate(SHEET_CAMERAS):
+            box = (x0 + j * cell_w / 2, y0, x0 + (j + 1) * cell_w / 2, y0 + cell_h - label_h)
+            proj = Projector(
+                np.array(cam.right), np.array(cam.up), scale, fit_centre(corners, cam, box, scale)
+            )
+            faces = visible_faces(shapes[n].voxels, colors, cam)
+            draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
+        cubes = len(shapes[n])
+        label = f"{n} ({cubes} cube{'s' if cubes != 1 else ''})"
+        slots.append((label, rgb, x0 + cell_w / 2, y0 + cell_h - label_h / 2))
     image = big.reduce(k)
     small = ImageDraw.Draw(image)
-    _title(image, ["TRAY: pieces not yet placed (name, number of cubes)"], lay)
-    for text, x, y in slots:
-        put_text(image, (x, y), text, label_px, _TEXT)
+    _title(image, [title, _SHEET_NOTE], lay)
+    for text, rgb, x, y in slots:
+        width = float(font(label_px).getlength(text))
+        left = x - (width + label_px * 1.4) / 2
+        small.rectangle(
+            [left, y - label_px / 2, left + label_px, y + label_px / 2], fill=rgb, outline=EDGE
+        )
+        put_text(image, (left + label_px * 1.4, y), text, label_px, _TEXT, anchor="lm")
     for c in range(1, cols):
         small.line([(c * cell_w, title_h), (c * cell_w, size)], fill=_GRID, width=1)
     for rr in range(1, rows):
@@ -437,12 +492,14 @@ def render_images(
     box: Sequence[int] | None = None,
     views: Sequence[str] = VIEWS,
     size: int = DEFAULT_SIZE,
+    title: str | None = None,
 ) -> dict[str, Image.Image]:
-    """The pictures of a scene (pieces at their cells) as RGB images, one per view name."""
+    """The pictures of a scene (pieces at their cells) as RGB images, one per view name;
+    ``title`` replaces each view's first title line (say, to call it the target)."""
     _check_size(size)
     _check_views(views)
     scene = _scene(pieces, box)
-    return {v: _render_view(scene, CAMERAS[v], size) for v in views}
+    return {v: _render_view(scene, CAMERAS[v], size, title=title) for v in views}
 
 
 def render_views(
@@ -450,9 +507,37 @@ def render_views(
     box: Sequence[int] | None = None,
     views: Sequence[str] = VIEWS,
     size: int = DEFAULT_SIZE,
+    title: str | None = None,
 ) -> dict[str, bytes]:
     """PNG bytes per view of a scene; ``box`` is drawn as a wire frame (stacking) if given."""
-    return {v: png_bytes(img) for v, img in render_images(pieces, box, views, size).items()}
+    images = render_images(pieces, box, views, size, title)
+    return {v: png_bytes(img) for v, img in images.items()}
+
+
+def render_frame(
+    parts: Sequence[Posed],
+    legend: Sequence[tuple[str, RGB]],
+    frame: tuple[Sequence[int], Sequence[int]],
+    view: str = "iso",
+    size: int = DEFAULT_SIZE,
+    title: str | None = None,
+    box: Sequence[int] | None = None,
+) -> Image.Image:
+    """One picture of rigid parts at real poses inside a fixed frame (``lo``, ``hi``: a video's
+    camera does not follow the pieces), with ``box`` (from the origin) as a wire frame. At
+    lattice poses it is the still picture of the same cells in the same frame
+    (:func:`chaingeo.envs.raster.posed_faces`)."""
+    _check_size(size)
+    _check_views([view])
+    lo, hi = (tuple(int(v) for v in frame[0]), tuple(int(v) for v in frame[1]))
+    if len(lo) != 3 or len(hi) != 3 or any(a >= b for a, b in zip(lo, hi, strict=True)):
+        raise ValueError(f"a frame is two corners lo < hi, got {list(lo)} and {list(hi)}")
+    empty = np.zeros((0, 3), dtype=np.int64)
+    scene = _Scene(empty, np.zeros((0, 3)), lo, hi, False, tuple(legend))
+    corner = (0, 0, 0) if box is None else (int(box[0]), int(box[1]), int(box[2]))
+    outline = None if box is None else replace(scene, lo=(0, 0, 0), hi=corner)
+    cam = CAMERAS[view]
+    return _render_view(scene, cam, size, posed_faces(parts, cam), title, outline)
 
 
 def view_projector(
@@ -465,19 +550,22 @@ def view_projector(
     return _view_projector(_scene(pieces, box), CAMERAS[view], _Layout.of(size))
 
 
-def render_tray_image(pieces: PieceMap, size: int = DEFAULT_SIZE) -> Image.Image:
-    """The unplaced pieces (only their shapes matter, not where they are), each labelled."""
+def render_tray_image(
+    pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE
+) -> Image.Image:
+    """The piece sheet: each piece (only its shape matters, not where it is) from two opposite
+    corners, labelled; titled the tray (stacking) or :data:`PIECES_TITLE` (puzzles)."""
     _check_size(size)
     for shape, color in pieces.values():
         parse_color(color)
         if len(shape) == 0:
             raise ValueError("a piece needs at least one cell")
-    return _render_tray(pieces, size)
+    return _render_tray(pieces, size, title)
 
 
-def render_tray(pieces: PieceMap, size: int = DEFAULT_SIZE) -> bytes:
-    """PNG bytes of the tray picture."""
-    return png_bytes(render_tray_image(pieces, size))
+def render_tray(pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE) -> bytes:
+    """PNG bytes of the piece sheet."""
+    return png_bytes(render_tray_image(pieces, size, title))
 
 
 def solution_pieces(level: Level) -> dict[str, tuple[Shape, ColorLike]]:
@@ -504,5 +592,7 @@ def render_solution_views(
 
 
 def render_level_tray(level: Level, size: int = DEFAULT_SIZE) -> bytes:
-    """PNG of all of a level's pieces as handed out."""
-    return render_tray(handed_pieces(level), size)
+    """PNG of all of a level's pieces as handed out: the tray a stacking level starts with, or
+    a puzzle's pieces (a puzzle has no tray)."""
+    title = TRAY_TITLE if level.family == "stacking" else PIECES_TITLE
+    return render_tray(handed_pieces(level), size, title)

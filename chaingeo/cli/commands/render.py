@@ -1,4 +1,5 @@
-"""``chain render LEVEL``: pictures of a level solved (four views) and of its pieces (tray)."""
+"""``chain render LEVEL``: pictures of a level solved (four views), of its pieces (each from two
+opposite corners) and, with ``--exploded``, of the solved level pushed apart."""
 
 from __future__ import annotations
 
@@ -9,19 +10,28 @@ from typing import Any
 
 def register(sub: Any) -> None:
     p = sub.add_parser("render", help="write PNG pictures of a level, solved, and of its pieces")
-    p.add_argument("level", type=Path, help="a chain-level/1 file")
+    p.add_argument("level", help="a chain-level/1 file or the id of a shipped level")
     p.add_argument("--out", type=Path, default=Path("."), help="folder for the PNGs (default .)")
     p.add_argument("--size", type=int, default=512, help="picture size in pixels (default 512)")
+    p.add_argument(
+        "--exploded",
+        action="store_true",
+        help="also write LEVEL-exploded.png: the solved level, each piece pushed out along its "
+        "first slide in the optimal plan (or radially)",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.core.level import load_level
+    from chaingeo.cli.level_arg import find_level
+    from chaingeo.envs.pictures import render_exploded
     from chaingeo.envs.render import render_level_tray, render_solution_views
 
-    level = load_level(args.level)
+    level = find_level(args.level)
     pictures = dict(render_solution_views(level, size=args.size))
     pictures["pieces"] = render_level_tray(level, args.size)
+    if args.exploded:
+        pictures["exploded"] = render_exploded(level, args.size)
     args.out.mkdir(parents=True, exist_ok=True)
     for view, data in pictures.items():
         target = args.out / f"{level.id}-{view}.png"

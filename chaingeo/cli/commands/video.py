@@ -1,0 +1,53 @@
+"""``chain video LEVEL [--plan optimal|FILE] --out FILE.mp4|.gif``: a plan as continuous motion
+from one fixed camera (see :mod:`chaingeo.envs.video`)."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+from typing import Any
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser("video", help="render a level's plan as an MP4 or GIF video")
+    p.add_argument("level", help="a chain-level/1 file or the id of a shipped level")
+    p.add_argument(
+        "--plan",
+        default="optimal",
+        help="'optimal' (the level's own plan, default) or a text file of actions, one a line, "
+        "as an agent would type them",
+    )
+    p.add_argument("--out", type=Path, required=True, help="FILE.mp4 or FILE.gif")
+    p.add_argument("--size", type=int, default=384, help="frame size in pixels (default 384)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from chaingeo.cli.errors import CommandError
+    from chaingeo.cli.level_arg import find_level
+    from chaingeo.envs.video import VideoError, plan_video, write_video
+
+    if args.out.suffix.lower() not in (".mp4", ".gif"):
+        raise CommandError(f"--out must end in .mp4 or .gif, got {str(args.out)!r}")
+    if args.size < 128 or args.size % 16:
+        raise CommandError(f"--size must be a multiple of 16, at least 128; got {args.size}")
+    level = find_level(args.level)
+    start = time.perf_counter()
+    try:
+        text = None
+        if args.plan != "optimal":
+            path = Path(args.plan)
+            if not path.is_file():
+                raise CommandError(f"--plan: no file {args.plan!r} (or say 'optimal')")
+            text = path.read_text(encoding="utf-8")
+        video = plan_video(level, text, args.size)
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = args.out.with_name(f".{args.out.stem}.tmp{args.out.suffix}")
+        write_video(video, tmp)
+        tmp.replace(args.out)
+    except VideoError as e:
+        raise CommandError(str(e)) from None
+    seconds = time.perf_counter() - start
+    print(f"{args.out}: {len(video.frames)} frames at {video.fps} fps, rendered in {seconds:.1f} s")
+    return 0

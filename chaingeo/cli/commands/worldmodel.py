@@ -1,0 +1,45 @@
+"""``chain worldmodel LEVEL --out DIR``: what a video model is given for a level (reference
+image and prompt) and the ground-truth video of its optimal plan (see
+:mod:`chaingeo.envs.worldmodel`)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser(
+        "worldmodel",
+        help="write a level's reference image, video-model prompt and ground-truth video",
+    )
+    p.add_argument("level", help="a chain-level/1 file or the id of a shipped level")
+    p.add_argument("--out", type=Path, required=True, help="folder for the files")
+    p.add_argument(
+        "--format",
+        choices=("mp4", "gif"),
+        default=None,
+        help="ground-truth video format (default mp4 with the extra 'video', else gif)",
+    )
+    p.add_argument("--size", type=int, default=384, help="frame size in pixels (default 384)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from chaingeo.cli.errors import CommandError
+    from chaingeo.cli.level_arg import find_level
+    from chaingeo.envs.video import VideoError, mp4_available
+    from chaingeo.envs.worldmodel import write_worldmodel
+
+    if args.size < 128 or args.size % 16:
+        raise CommandError(f"--size must be a multiple of 16, at least 128; got {args.size}")
+    fmt = args.format or ("mp4" if mp4_available() else "gif")
+    level = find_level(args.level)
+    try:
+        files = write_worldmodel(level, args.out, fmt, args.size)
+    except VideoError as e:
+        raise CommandError(str(e)) from None
+    for path in files.values():
+        print(path)
+    return 0
