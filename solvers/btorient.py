@@ -69,8 +69,13 @@ class BTImage:
         # from A's min corner to that rotation's.
         self.find: dict[str, dict[bytes, tuple[int, np.ndarray]]] = {}
         self.norm: dict[str, list[tuple[int, np.ndarray]]] = {}
+        done: dict[bytes, str] = {}  # copies of a shape share one grid: tables built once
         for n in names:
             g = np.asarray(grids[n], dtype=np.int64)
+            same = done.setdefault(g.tobytes(), n)
+            if same != n:
+                self.find[n], self.norm[n] = self.find[same], self.norm[same]
+                continue
             first: dict[bytes, tuple[int, np.ndarray]] = {}
             for t in range(24):
                 rot = g @ mats[t].T
@@ -92,10 +97,13 @@ class BTImage:
             for m, _ in self.symmetries
         ]
         res_syms = symmetries_of(result)
-        self.shared = {}  # symmetries a piece shares with the result: the pivot has fewest
+        self.shared: dict[str, int] = {}  # symmetries a piece shares with the result: the pivot has fewest
         for n in names:
-            g = np.asarray(grids[n], dtype=np.int64)
-            self.shared[n] = sum(_normal(g @ m.T) == _normal(g) for m, _ in res_syms)
+            same = done[np.asarray(grids[n], dtype=np.int64).tobytes()]
+            if same not in self.shared:
+                g = np.asarray(grids[same], dtype=np.int64)
+                self.shared[same] = sum(_normal(g @ m.T) == _normal(g) for m, _ in res_syms)
+            self.shared[n] = self.shared[same]
 
     def __call__(
         self, placed: Mapping[str, Shape], parts: Sequence[Sequence[str]]
