@@ -18,6 +18,7 @@ swapping with a mirror partner are not modelled: their classes keep the image fo
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from functools import lru_cache
 
 import numpy as np
 
@@ -46,6 +47,41 @@ def symmetries_of(cells: np.ndarray) -> list[Symmetry]:
     return out
 
 
+_MATS = [np.asarray(m, dtype=np.int64) for m in TRANSFORMS_BT]
+_INDEX = {m.tobytes(): i for i, m in enumerate(_MATS)}
+
+
+@lru_cache(maxsize=64)
+def _compose(matrix: bytes) -> list[int]:
+    """Per rotation ``t``: the index among the 48 transforms of ``matrix @ ROTATIONS_BT[t]``."""
+    m = np.frombuffer(matrix, dtype=np.int64).reshape(3, 3)
+    return [_INDEX[(m @ _MATS[t]).tobytes()] for t in range(24)]
+
+
+@lru_cache(maxsize=4096)
+def _piece_tables(
+    grid: bytes, size: int
+) -> tuple[dict[bytes, tuple[int, np.ndarray]], list[tuple[int, np.ndarray]]]:
+    """A shape's tables (voxels ``grid`` in its own grid, ``size`` of them): its normal form per
+    rotation -> (the first rotation giving it, that rotation's min corner); and per transform
+    A of the 48, that first rotation (-1: none, A mirrors a chiral shape) and the shift from
+    A's min corner to the rotation's. Cached: a problem's shapes recur in every analysis."""
+    g = np.frombuffer(grid, dtype=np.int64).reshape(size, 3)
+    first: dict[bytes, tuple[int, np.ndarray]] = {}
+    for t in range(24):
+        rot = g @ _MATS[t].T
+        first.setdefault(_normal(rot), (t, rot.min(axis=0)))
+    table = []
+    for m in _MATS:
+        img = g @ m.T
+        hit = first.get(_normal(img))
+        if hit is None:
+            table.append((-1, np.zeros(3, dtype=np.int64)))
+        else:
+            table.append((hit[0], img.min(axis=0) - hit[1]))
+    return first, table
+
+
 class BTImage:
     """Chooses BurrTools' image of assemblies of one problem (the shapes, parts and result
     symmetries fixed; tables built once, about 1 ms an assembly).
@@ -61,49 +97,27 @@ class BTImage:
         result: np.ndarray,
     ) -> None:
         names = list(grids)
-        mats = [np.asarray(m, dtype=np.int64) for m in TRANSFORMS_BT]
-        index = {m.tobytes(): i for i, m in enumerate(mats)}
-        achiral = True
-        # Per piece: its voxels' normal form per rotation -> (rotation, min corner), and per
-        # transform A (of the 48): the first rotation giving A's orientation and the shift
-        # from A's min corner to that rotation's.
         self.find: dict[str, dict[bytes, tuple[int, np.ndarray]]] = {}
         self.norm: dict[str, list[tuple[int, np.ndarray]]] = {}
-        done: dict[bytes, str] = {}  # copies of a shape share one grid: tables built once
         for n in names:
-            g = np.asarray(grids[n], dtype=np.int64)
-            same = done.setdefault(g.tobytes(), n)
-            if same != n:
-                self.find[n], self.norm[n] = self.find[same], self.norm[same]
-                continue
-            first: dict[bytes, tuple[int, np.ndarray]] = {}
-            for t in range(24):
-                rot = g @ mats[t].T
-                first.setdefault(_normal(rot), (t, rot.min(axis=0)))
-            table = []
-            for m in mats:
-                img = g @ m.T
-                hit = first.get(_normal(img))
-                if hit is None:
-                    table.append((-1, np.zeros(3, dtype=np.int64)))
-                    achiral = False
-                else:
-                    table.append((hit[0], img.min(axis=0) - hit[1]))
-            self.find[n], self.norm[n] = first, table
+            g = np.ascontiguousarray(grids[n], dtype=np.int64)
+            self.find[n], self.norm[n] = _piece_tables(g.tobytes(), g.shape[0])
+        achiral = all(t >= 0 for n in names for t, _ in self.norm[n])
         proper = [s for s in symmetries if round(float(np.linalg.det(s[0]))) > 0]
         self.symmetries = list(symmetries) if achiral else proper
         self.compose = [
-            [index[(np.asarray(m, dtype=np.int64) @ mats[t]).tobytes()] for t in range(24)]
-            for m, _ in self.symmetries
+            _compose(np.ascontiguousarray(m, dtype=np.int64).tobytes()) for m, _ in self.symmetries
         ]
         res_syms = symmetries_of(result)
-        self.shared: dict[str, int] = {}  # symmetries a piece shares with the result: the pivot has fewest
+        # Symmetries a piece shares with the result (the pivot has fewest), once per shape.
+        self.shared: dict[str, int] = {}
+        by_grid: dict[bytes, int] = {}
         for n in names:
-            same = done[np.asarray(grids[n], dtype=np.int64).tobytes()]
-            if same not in self.shared:
-                g = np.asarray(grids[same], dtype=np.int64)
-                self.shared[same] = sum(_normal(g @ m.T) == _normal(g) for m, _ in res_syms)
-            self.shared[n] = self.shared[same]
+            g = np.ascontiguousarray(grids[n], dtype=np.int64)
+            key = g.tobytes()
+            if key not in by_grid:
+                by_grid[key] = sum(_normal(g @ m.T) == _normal(g) for m, _ in res_syms)
+            self.shared[n] = by_grid[key]
 
     def __call__(
         self, placed: Mapping[str, Shape], parts: Sequence[Sequence[str]]

@@ -232,7 +232,7 @@ def run_part(
     group_limit: int,
 ) -> tuple[int, I16, I64, I64, I64]:  # fmt: skip
     """:func:`part_search` from ``start`` with buffers grown as needed, up to ``max_states``
-    states: ``(status, states, parent, move, ctx)`` (status STATE_CAP past the cap)."""
+    states: ``(status, states, parent, move, ctx)`` (status ``-STATE_CAP`` past the cap)."""
     w = start.shape[0]
     cap = max(2, min(64, max_states))
     states = np.zeros((cap, w), dtype=np.int16)

@@ -439,7 +439,10 @@ def _bt_frame_tree(shapes: Mapping[str, Shape], solver: _Solver) -> Separation |
     names = sorted(shapes)
     grids = {k: shapes[k].normalized().voxels for k in names}
     union = np.concatenate([shapes[k].voxels for k in names])
-    image, m = BTImage(grids, symmetries_of(union), union)(shapes, [[k] for k in names])
+    symmetries = symmetries_of(union)
+    if len(symmetries) < 2:  # nothing to choose from: the assembly as it lies
+        return solver.level_tree()
+    image, m = BTImage(grids, symmetries, union)(shapes, [[k] for k in names])
     if np.array_equal(m, np.eye(3, dtype=np.int64)):
         return solver.level_tree()
     other = _Solver(
