@@ -1,17 +1,17 @@
 """Observation pictures as ``uint8`` arrays straight from the renderer, without PNG in between.
 
-The Gymnasium environments hand out pixels, not files: encoding every view to PNG and decoding
-it back cost about half of an image step. :func:`render_frames` takes the renderer's images
-(:func:`chaingeo.envs.render.render_images` and ``render_tray_image``, the very images
-:func:`chaingeo.envs.observation.render_state` encodes) as arrays; PNG is lossless, so they are
-pixel-equal to decoding today's PNG (tested). PNG stays where bytes are wanted (the harness'
-logs and agents call ``render_state``). :func:`png_frames` keeps that round trip callable as
-the reference of ``chain bench env``.
+The Gymnasium environments hand out pixels, not files: encoding every picture to PNG and
+decoding it back cost about a third of the time spent on an observation's pictures.
+:func:`render_frames` takes the renderer's images (:func:`chaingeo.envs.render.render_images`
+and ``render_tray_image``, the very images :func:`chaingeo.envs.observation.render_state`
+encodes) as arrays; PNG is lossless, so they are pixel-equal to decoding today's PNG (tested).
+PNG stays where bytes are wanted (the harness' logs and agents call ``render_state``);
+:func:`png_frames` keeps the round trip callable as the reference of ``chain bench env``.
 
 A picture depends only on what it shows, so :class:`FrameCache` keeps recent ones: the four views
-by the position (``state.key()``), the tray by the pieces still in it, a puzzle's target by the
-level alone. A refused action, an undo or a position seen before then costs a copy, not a render.
-This module only calls the renderer's public entry points; it does not change how pictures look.
+by the cells drawn, the tray by the pieces still in it, a puzzle's target by the level alone. A
+refused action, an undo or a position seen before then costs a copy, not a render. This module
+only calls the renderer's public entry points; it does not change how pictures look.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
-from chaingeo.envs.observation import VIEWS, render_state, scene, target_scene
+from chaingeo.envs.observation import VIEWS, PieceMap, render_state, scene, target_scene
 from chaingeo.envs.stacking import StackingState
 from chaingeo.envs.state import BaseState
 
@@ -46,9 +46,13 @@ def _array(image: Image.Image) -> Frame:
 
 
 def _views(state: BaseState, size: int) -> dict[str, Frame]:
+    pieces, box, _ = scene(state)
+    return _draw_views(pieces, box, size)
+
+
+def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
     import chaingeo.envs.render as render
 
-    pieces, box, _ = scene(state)
     return {v: _array(img) for v, img in render.render_images(pieces, box, VIEWS, size).items()}
 
 
@@ -114,8 +118,13 @@ class FrameCache:
     def frames(self, state: BaseState) -> dict[str, Frame]:
         """Every picture of ``state`` (as :func:`render_frames` draws them), copied."""
         level = state.level.id
+        pieces, box, _ = scene(state)
+        # Keyed by what is drawn, not by state.key(): a puzzle's key holds each part up to
+        # translation, while the views draw (and label) where the largest part really is.
+        drawn = tuple(sorted((n, shape.cells, str(color)) for n, (shape, color) in pieces.items()))
         views = self._get(
-            ("views", level, state.key()), lambda: tuple(_views(state, self.size).values())
+            ("views", level, box, drawn),
+            lambda: tuple(_draw_views(pieces, box, self.size).values()),
         )
         if isinstance(state, StackingState):
             extra_key: Hashable = ("tray", level, tuple(sorted(state.tray)))
