@@ -57,6 +57,24 @@ def test_frames_are_the_pixels_of_todays_png_and_the_cache_is_exact(level: Level
     assert cache.hits > 0 and cache.misses > len(states)  # the target (or tray) was reused
 
 
+@pytest.mark.parametrize("level", [drop_level(), puzzles()[0]], ids=["drop", "lock3"])
+def test_a_seeded_random_walk_through_one_cache_draws_what_a_fresh_render_draws(
+    level: Level,
+) -> None:
+    rng = np.random.default_rng(23)
+    state = new_state(level)
+    cache = FrameCache(SIZE, max_bytes=SIZE * SIZE * 3 * 40)
+    for _ in range(25):
+        assert data_equivalence(cache.frames(state), render_frames(state, SIZE), exact=True)
+        legal = state.legal_actions()
+        choice = legal[int(rng.integers(len(legal) - 1))] if len(legal) > 1 else None
+        if choice is None or state.is_success():
+            state = new_state(level)
+        else:
+            state.apply(choice)
+    assert cache.hits > 0
+
+
 def test_the_cache_keys_what_is_drawn_not_the_position_key() -> None:
     """Two puzzle states with one position key (parts up to translation) whose pictures differ:
     the largest part is drawn, and labelled, where it really is."""
