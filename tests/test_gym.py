@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
+from chaingeo.core.limits import MAX_STACKING_ACTIONS
 from chaingeo.envs.actions import PlaceAction, action_of_move
 from chaingeo.envs.gym import CHARSET, PuzzleEnv, StackingEnv
 from tests.env_levels import drop_level, puzzle_levels, soma_level, tiny_level
@@ -67,7 +68,8 @@ def test_stacking_episode_mask_reward_and_termination() -> None:
     obs, info = env.reset(options={"level": "soma-test"})
     assert set(obs["text"]) <= CHARSET and "Pack all 7 pieces" in obs["text"]
     catalogue = env.action_catalogue()
-    assert len(info["action_mask"]) == len(catalogue) and info["action_mask"].dtype == np.int8
+    assert info["action_mask"].shape == (MAX_STACKING_ACTIONS,)
+    assert info["action_mask"].dtype == np.int8 and not info["action_mask"][len(catalogue) :].any()
     level = soma_level()
     placements = level.solution.placements  # type: ignore[union-attr]
     for i, name in enumerate(level.solution.order):  # type: ignore[union-attr]

@@ -211,3 +211,19 @@ MAX_WINDING_PAIRS: Final = 300_000_000
 #: Magnitude of a number in a URDF (``origin xyz``, ``rpy``, mesh ``scale``) or of an OBJ
 #: vertex coordinate (CHAIN's stay under 100).
 MAX_MODEL_NUMBER: Final = 1e6
+
+
+# ---------------------------------------------------------------------------------------------
+# Gymnasium environments: fixed observation sizes (chaingeo/envs/gym.py)
+# ---------------------------------------------------------------------------------------------
+# A vector environment batches every sub-environment's observation into one array per key, so
+# nothing an environment hands out may change shape with the level drawn. These are the fixed
+# sizes; a level past one is refused with a LimitError when it is drawn.
+
+#: Characters of one text observation (``Text`` space; shorter text is not padded by us, the
+#: space's ``max_length`` is the bound). The shipped suite peaks at 13,871 with the text state.
+MAX_OBSERVATION_CHARS: Final = 1 << 16
+#: Length of the stacking ``action_mask`` (every action that can ever be legal in a level: each
+#: piece's placements, the pickups, ``finish``), zero-padded past the level's own catalogue.
+#: The shipped suite peaks at 5,234.
+MAX_STACKING_ACTIONS: Final = 1 << 14

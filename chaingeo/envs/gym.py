@@ -12,22 +12,31 @@ state machine of :mod:`chaingeo.envs.state`, so its steps are the agents' and th
   printable ASCII plus newline, long enough for a placement of 64 cells; a sampled string is
   almost always unparseable, which the environment answers like any other unreadable action.
 * Observations are a dict: ``text`` (instruction, pieces, recent turns, steps left, and with
-  ``text_state=True`` every piece's cells; characters outside the charset become ``?``) and,
-  with ``images=True``, ``images``: one ``uint8`` array ``(H, W, 3)`` per view.
+  ``text_state=True`` every piece's cells; characters outside the charset become ``?``; at most
+  :data:`~chaingeo.core.limits.MAX_OBSERVATION_CHARS`) and, with ``images=True``, ``images``:
+  one ``uint8`` array ``(image_size, image_size, 3)`` per picture (``front side top iso`` and
+  ``tray`` or ``target``), drawn straight to arrays (:mod:`chaingeo.envs.frames`; pixel-equal
+  to decoding the PNG ``render_state`` gives) and cached by what they show.
+* The spaces are fixed per environment id and constructor arguments, whatever level is drawn,
+  so ``gymnasium.make_vec(id, num_envs=8, vectorization_mode="sync" | "async")`` batches them;
+  a vector environment autoresets as Gymnasium 1.x defines it (next step by default).
+  :class:`chaingeo.envs.vector.SeedSequenceSeeds` seeds sub-environment ``i`` of a batch from
+  ``SeedSequence([seed, i])``.
 * Reward 1 on the step that solves the level, else 0. ``terminated`` when the level is solved
   or ``finish`` was played; ``truncated`` when the step budget is spent.
 * ``info``: ``legal``, ``error`` (None, "unparseable", "illegal", "ambiguous"), ``code``
   (CHAIN's error name of an illegal stacking action, else None), ``feedback``,
   ``steps_used``, ``level_id``, ``optimal_steps``, ``success``. Stacking levels also give
-  ``action_mask`` (``int8``) over :meth:`ChainEnv.action_catalogue`, every action that can
-  ever be legal in the level, in sorted order. Puzzle moves are not enumerable up front (the
-  distances depend on the position), so the puzzle environment gives ``legal_actions`` (their
-  texts) instead when built with ``list_legal_actions=True``.
+  ``action_mask`` (``int8``, length :data:`~chaingeo.core.limits.MAX_STACKING_ACTIONS`): entry
+  ``i`` is 1 when the ``i``-th action of :meth:`ChainEnv.action_catalogue` (every action that
+  can ever be legal in the level, in sorted order) is legal now; past the catalogue, 0. Puzzle
+  moves are not enumerable up front (the distances depend on the position), so the puzzle
+  environment gives ``legal_actions`` (their texts) instead when built with
+  ``list_legal_actions=True``.
 """
 
 from __future__ import annotations
 
-import io
 import string
 from collections.abc import Sequence
 from pathlib import Path
@@ -38,27 +47,25 @@ import numpy as np
 from gymnasium import spaces
 
 from chaingeo.core.level import Level, load_levels
+from chaingeo.core.limits import MAX_OBSERVATION_CHARS, MAX_STACKING_ACTIONS, LimitError
 from chaingeo.core.suite import shipped_levels
+from chaingeo.envs.actions import Action
+from chaingeo.envs.frames import Frame, FrameCache, picture_names
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.observation import DEFAULT_HISTORY, VIEWS, observe, render_state
+from chaingeo.envs.observation import DEFAULT_HISTORY, VIEWS, observe
+from chaingeo.envs.render import MIN_SIZE
 from chaingeo.envs.state import BaseState
+from chaingeo.envs.text_space import ObservationText
 
 #: Characters of text actions and observations: printable ASCII and newline.
 CHARSET: Final = frozenset(c for c in string.printable if c not in "\x0b\x0c\r")
 ACTION_MAX_LENGTH: Final = 1024
-OBSERVATION_MAX_LENGTH: Final = 1 << 16
+OBSERVATION_MAX_LENGTH: Final = MAX_OBSERVATION_CHARS
 DEFAULT_LEVELS: Final = shipped_levels()
 
 
 def _ascii(text: str) -> str:
     return "".join(c if c in CHARSET else "?" for c in text)
-
-
-def _decode_png(data: bytes) -> np.ndarray[Any, np.dtype[np.uint8]]:
-    from PIL import Image
-
-    with Image.open(io.BytesIO(data)) as img:
-        return np.asarray(img.convert("RGB"), dtype=np.uint8).copy()
 
 
 class ChainEnv(gymnasium.Env[dict[str, Any], str]):
@@ -90,26 +97,42 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
         self.images = images
         self.image_size = image_size
         self.list_legal_actions = list_legal_actions
+        if images and image_size < MIN_SIZE:
+            raise ValueError(f"image_size must be at least {MIN_SIZE} pixels, got {image_size}")
         self._templates: dict[str, BaseState] = {}
+        self._catalogues: dict[str, tuple[list[str], dict[Action, int]]] = {}
+        self._frames = FrameCache(image_size)
         self._state: BaseState | None = None
         self.action_space = spaces.Text(ACTION_MAX_LENGTH, min_length=0, charset=CHARSET)
         obs: dict[str, spaces.Space[Any]] = {
-            "text": spaces.Text(OBSERVATION_MAX_LENGTH, min_length=0, charset=CHARSET)
+            "text": ObservationText(OBSERVATION_MAX_LENGTH, CHARSET)
         }
         if images:
-            probe = self._start(next(iter(self.levels)))
-            shapes = {
-                v: _decode_png(png).shape for v, png in render_state(probe, image_size).items()
-            }
+            shape = (image_size, image_size, 3)
             obs["images"] = spaces.Dict(
-                {v: spaces.Box(0, 255, shape=s, dtype=np.uint8) for v, s in shapes.items()}
+                {
+                    v: spaces.Box(0, 255, shape=shape, dtype=np.uint8)
+                    for v in picture_names(self.family)
+                }
             )
         self.observation_space = spaces.Dict(obs)
 
     # -- helpers ------------------------------------------------------------------------------
     def _start(self, level_id: str) -> BaseState:
+        from chaingeo.envs.stacking import StackingState
+
         if level_id not in self._templates:
-            self._templates[level_id] = new_state(self.levels[level_id])
+            template = new_state(self.levels[level_id])
+            if isinstance(template, StackingState):
+                actions = template.catalogue()
+                if len(actions) > MAX_STACKING_ACTIONS:
+                    raise LimitError(
+                        f"level {level_id!r} has {len(actions)} possible actions; the action "
+                        f"mask holds at most {MAX_STACKING_ACTIONS} (MAX_STACKING_ACTIONS)"
+                    )
+                index = {a: i for i, a in enumerate(actions)}
+                self._catalogues[level_id] = ([a.to_text() for a in actions], index)
+            self._templates[level_id] = template
         return self._templates[level_id].clone()
 
     @property
@@ -121,27 +144,35 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
     def action_catalogue(self) -> list[str]:
         """Stacking: every action that can ever be legal in the current level (the mask's
         index); puzzles: empty (not enumerable up front)."""
-        from chaingeo.envs.stacking import StackingState
+        texts, _ = self._catalogues.get(self.state.level.id, ([], {}))
+        return list(texts)
 
-        state = self.state
-        if isinstance(state, StackingState):
-            return [a.to_text() for a in state.catalogue()]
-        return []
+    def clear_picture_cache(self) -> None:
+        """Forget the pictures drawn so far (benchmarks time drawing with it; vector
+        environments reach it through ``envs.call("clear_picture_cache")``)."""
+        self._frames.clear()
+
+    def _draw(self, state: BaseState) -> dict[str, Frame]:
+        """The pictures of ``state`` (the benchmark swaps in today's PNG round trip here)."""
+        return self._frames.frames(state)
 
     def _observation(self) -> dict[str, Any]:
         obs = observe(
             self.state,
             history_window=self.history_window,
             text_state=self.text_state,
-            images=self.images,
-            image_size=self.image_size,
+            images=False,
         )
-        text = _ascii(obs.to_text())
+        names = picture_names(self.family) if self.images else ()
+        text = _ascii(obs.to_text(views=names))
         if len(text) > OBSERVATION_MAX_LENGTH:
-            raise RuntimeError(f"observation text of {len(text)} characters exceeds the space")
+            raise LimitError(
+                f"observation text of {len(text)} characters exceeds MAX_OBSERVATION_CHARS "
+                f"({OBSERVATION_MAX_LENGTH})"
+            )
         out: dict[str, Any] = {"text": text}
         if self.images:
-            out["images"] = {v: _decode_png(png) for v, png in obs.images.items()}
+            out["images"] = self._draw(self.state)
         return out
 
     def _info(self, result: Any | None) -> dict[str, Any]:
@@ -159,8 +190,10 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
             "feedback": "" if result is None else result.feedback,
         }
         if isinstance(state, StackingState):
-            legal = set(state.legal_actions())
-            info["action_mask"] = np.array([a in legal for a in state.catalogue()], dtype=np.int8)
+            _, index = self._catalogues[state.level.id]
+            mask = np.zeros(MAX_STACKING_ACTIONS, dtype=np.int8)
+            mask[[index[a] for a in state.legal_actions()]] = 1
+            info["action_mask"] = mask
         elif self.list_legal_actions:
             info["legal_actions"] = [a.to_text() for a in state.legal_actions()]
         return info

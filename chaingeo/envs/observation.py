@@ -10,6 +10,7 @@ every piece apart (disassembly).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Final
 
@@ -38,8 +39,11 @@ class Observation:
     text_state: str | None = None
     images: dict[str, bytes] = field(default_factory=dict)
 
-    def to_text(self) -> str:
-        """Everything but the pictures, as one prompt text."""
+    def to_text(self, views: Sequence[str] | None = None) -> str:
+        """Everything but the pictures, as one prompt text. ``views`` names the pictures shown
+        beside it when they are not in ``images`` (the Gymnasium environments draw them as
+        arrays); by default the names of ``images``."""
+        shown = list(self.images) if views is None else list(views)
         parts = [
             self.instruction,
             "Pieces:\n" + "\n".join(f"  {k}: {v}" for k, v in self.color_table.items()),
@@ -49,8 +53,8 @@ class Observation:
         if self.text_state:
             parts.append("Current state:\n" + self.text_state)
         parts.append(f"Steps left: {self.steps_left}")
-        if self.images:
-            parts.append("Views: " + ", ".join(self.images))
+        if shown:
+            parts.append("Views: " + ", ".join(shown))
         return "\n\n".join(parts)
 
 

@@ -1,0 +1,56 @@
+"""``chain demos``: demonstrations from each level's stored optimal plan, as JSONL.
+
+Each line is one step of a level's plan replayed through its Gymnasium environment: the
+observation text shown before the action, the action text, the reward, the episode flags and the
+feedback (:mod:`chaingeo.envs.demos`). Canonical JSON, levels sorted by id: the same levels give
+the same bytes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+from pathlib import Path
+from typing import Any
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser("demos", help="write demonstrations (optimal plans replayed) as JSONL")
+    p.add_argument(
+        "levels", nargs="*", help="level files or ids (default: every level under --folder)"
+    )
+    p.add_argument("--folder", type=Path, default=None, help="levels folder (default: shipped)")
+    p.add_argument("--out", default="-", help="JSONL file to write (default -, standard output)")
+    p.add_argument("--text-state", action="store_true", help="show every piece's cells too")
+    p.add_argument("--history", type=int, default=5, help="recent turns shown (default 5)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from chaingeo.cli.errors import CommandError
+    from chaingeo.cli.level_arg import find_level
+    from chaingeo.core.level import load_levels
+    from chaingeo.core.suite import shipped_levels
+    from chaingeo.envs.demos import DemonstrationError, demonstration_lines
+
+    if args.levels:
+        levels = [find_level(spec, args.folder) for spec in args.levels]
+    else:
+        levels = load_levels(args.folder if args.folder is not None else shipped_levels())
+    options = {"text_state": args.text_state, "history_window": args.history}
+    count = 0
+    with contextlib.ExitStack() as files:
+        out = (
+            sys.stdout
+            if args.out == "-"
+            else files.enter_context(Path(args.out).open("w", encoding="ascii", newline="\n"))
+        )
+        try:
+            for line in demonstration_lines(levels, **options):
+                out.write(line + "\n")
+                count += 1
+        except DemonstrationError as e:
+            raise CommandError(str(e)) from e
+    print(f"{count} steps of {len(levels)} level(s)", file=sys.stderr)
+    return 0
