@@ -25,7 +25,14 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
-from chaingeo.envs.observation import VIEWS, PieceMap, render_state, scene, target_scene
+from chaingeo.envs.observation import (
+    VIEWS,
+    PieceMap,
+    extra_image,
+    extra_picture_of,
+    render_state,
+    scene,
+)
 from chaingeo.envs.stacking import StackingState
 from chaingeo.envs.state import BaseState
 
@@ -37,7 +44,7 @@ CACHE_BYTES: Final = 32 * 1024 * 1024
 def picture_names(family: str) -> tuple[str, ...]:
     """The pictures of every observation of a family, in order: the four views, then ``tray``
     (stacking) or ``target`` (puzzles). Fixed per family, so a Gymnasium space can name them."""
-    return (*VIEWS, "tray" if family == "stacking" else "target")
+    return (*VIEWS, extra_picture_of(family))
 
 
 def _array(image: Image.Image) -> Frame:
@@ -57,12 +64,8 @@ def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -
 
 
 def _extra(state: BaseState, size: int) -> Frame:
-    """The tray (stacking) or the target (puzzles), drawn as :func:`render_state` draws it."""
-    import chaingeo.envs.render as render
-
-    if state.level.family == "stacking":
-        return _array(render.render_tray_image(scene(state)[2], size))
-    return _array(render.render_images(target_scene(state), None, ("iso",), size)["iso"])
+    """The tray (stacking) or the target (puzzles), as :func:`render_state` draws it."""
+    return _array(extra_image(state, size))
 
 
 def render_frames(state: BaseState, size: int) -> dict[str, Frame]:

@@ -12,13 +12,16 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Final
+from typing import TYPE_CHECKING, Final
 
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.rules import PuzzleRules, StackingRules
 from chaingeo.envs import text_state
 from chaingeo.envs.actions import cells_text
 from chaingeo.envs.state import BaseState
+
+if TYPE_CHECKING:  # pictures are drawn only when asked for
+    from PIL import Image
 
 #: The views rendered for every state (the tray and the target are added where they apply).
 VIEWS: Final[tuple[str, ...]] = ("front", "side", "top", "iso")
@@ -237,17 +240,39 @@ def scene(state: BaseState) -> tuple[PieceMap, tuple[int, int, int] | None, Piec
 
 def render_state(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> dict[str, bytes]:
     """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (puzzles)."""
+    from chaingeo.envs.raster import png_bytes
+
+    return {name: png_bytes(img) for name, img in state_images(state, size).items()}
+
+
+def state_images(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> dict[str, Image.Image]:
+    """The pictures of an observation as images (:func:`render_state` encodes them; the
+    Gymnasium environments take their pixels): the four views, then the extra picture."""
     import chaingeo.envs.render as render
 
-    pieces, box, tray = scene(state)
-    images = dict(render.render_views(pieces, box, VIEWS, size))
-    if state.level.family == "stacking":
-        images["tray"] = render.render_tray(tray, size)
-    else:
-        title = TARGET_TITLES[state.level.goal]
-        target = render.render_views(target_scene(state), None, ("iso",), size, title)
-        images["target"] = target["iso"]
+    pieces, box, _ = scene(state)
+    images = dict(render.render_images(pieces, box, VIEWS, size))
+    images[extra_picture(state)] = extra_image(state, size)
     return images
+
+
+def extra_picture(state: BaseState) -> str:
+    """The name of the picture after the four views: ``tray`` (stacking) or ``target``."""
+    return extra_picture_of(state.level.family)
+
+
+def extra_picture_of(family: str) -> str:
+    return "tray" if family == "stacking" else "target"
+
+
+def extra_image(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> Image.Image:
+    """The tray (stacking: the pieces not yet placed) or the target (puzzles: the goal)."""
+    import chaingeo.envs.render as render
+
+    if state.level.family == "stacking":
+        return render.render_tray_image(scene(state)[2], size)
+    title = TARGET_TITLES[state.level.goal]
+    return render.render_images(target_scene(state), None, ("iso",), size, title)["iso"]
 
 
 #: The first title line of a puzzle's ``target`` picture (not the current view's title).
