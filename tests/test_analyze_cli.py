@@ -100,6 +100,8 @@ def test_auto_runs_a_small_file_interpreted_and_a_large_one_with_numba() -> None
     small = _chain(str(DATA / "linked_rings.xmpuzzle"))
     assert small.returncode == 0, small.stderr
     assert _lines(small.stdout)[0]["kernels"] == "python"
+    by_id = _chain("puzzle-easy-07-burr3")  # a level id is looked at too
+    assert _lines(by_id.stdout)[0]["kernels"] == "python", by_id.stderr
     # Small by its size, but seconds of work interpreted: the command starts again with numba.
     slow = _chain(str(DATA / "deep_maze.xmpuzzle"), "--no-optimal")
     assert slow.returncode == 0, slow.stderr
