@@ -259,7 +259,8 @@ def _stored_assembly(puzzle: BTPuzzle, index: int) -> tuple[dict[str, Shape], Pi
         return None
     prob = puzzle.problem(index)
     part_of = [k for k, p in enumerate(prob.parts) for _ in range(p.max)]
-    shapes = {f"p{slot}": s for slot, s in stored[0].items()}
+    # Named so that sorted names are slot order: BurrTools searches the pieces in that order.
+    shapes = {f"p{slot:04d}": s for slot, s in stored[0].items()}
     shape_of = {n: f"part{part_of[int(n[1:])]}" for n in shapes}
     groups_of = {n: prob.parts[part_of[int(n[1:])]].groups for n in shapes}
     return shapes, PieceGroups(shape_of, groups_of)

@@ -9,9 +9,6 @@ differential tests draw (boxes cut into connected pieces, written as ``.xmpuzzle
 
 from __future__ import annotations
 
-import os
-import re
-import shutil
 import subprocess
 from dataclasses import dataclass
 from functools import cache
@@ -19,13 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
+from chaingeo.benchmarks import burrtxt as oracle
 from chaingeo.core.formats.bt_model import BTPart, BTProblem, BTPuzzle, colored_shape
 from chaingeo.core.geometry import Shape
-from tests.shared_files import shared_dir
-
-SRC = shared_dir("burrtools-src", "CHAIN_BURRTOOLS_SRC")
-_LEVEL = re.compile(r"^level: (\S+)$", re.M)
-_TOTAL = re.compile(r"^(\d+) assemblies and (\d+) solutions found", re.M)
 
 
 @dataclass
@@ -38,26 +31,17 @@ REASON = _Why()
 
 @cache
 def burrtxt() -> Path | None:
-    """The burrTxt binary, built if needed; None (and :data:`REASON`) when it cannot be."""
-    if SRC is None:
-        REASON.text = "../shared/burrtools-src (or $CHAIN_BURRTOOLS_SRC) is not present"
+    """The burrTxt binary, built if needed (:mod:`chaingeo.benchmarks.burrtxt`); None, and
+    :data:`REASON`, when it cannot be had here."""
+    reason = oracle.why_unavailable()
+    if reason is not None:
+        REASON.text = reason
         return None
-    if shutil.which("g++") is None:
-        REASON.text = "g++ is not installed (CI installs g++ and zlib1g-dev)"
-        return None
-    args = [str(SRC / "build-burrtxt")]
-    if os.environ.get("CHAIN_BURRTXT_CACHE"):
-        args.append(os.environ["CHAIN_BURRTXT_CACHE"])
     try:
-        out = subprocess.run(args, capture_output=True, text=True, timeout=900, check=True)
-    except (subprocess.SubprocessError, OSError) as e:
-        REASON.text = f"building burrTxt failed: {e}"
+        return oracle.burrtxt_binary()
+    except oracle.BurrTxtError as e:
+        REASON.text = str(e)
         return None
-    path = Path(out.stdout.strip().splitlines()[-1])
-    if not os.access(path, os.X_OK):
-        REASON.text = f"build-burrtxt printed {path}, which is not an executable"
-        return None
-    return path
 
 
 @dataclass(frozen=True)
@@ -69,22 +53,13 @@ class Figures:
     levels: tuple[str, ...]
 
 
-def parse(text: str) -> Figures:
-    """burrTxt's output (``-d``): ``level: a.b.c`` per solution, then the totals line."""
-    total = _TOTAL.search(text)
-    if total is None:
-        raise ValueError(f"no totals line in burrTxt's output: {text[-300:]!r}")
-    return Figures(int(total[1]), int(total[2]), tuple(_LEVEL.findall(text)))
-
-
 def run(binary: Path, path: Path, seconds: float, problem: int = 0) -> Figures | None:
     """``burrTxt -d -r -o PROBLEM FILE``; None past ``seconds``."""
-    args = [str(binary), "-d", "-r", "-o", str(problem), str(path)]
     try:
-        out = subprocess.run(args, capture_output=True, text=True, timeout=seconds)
+        done = oracle.run_burrtxt(binary, path, timeout=seconds, problem=problem)
     except subprocess.TimeoutExpired:
         return None
-    return parse(out.stdout)
+    return Figures(done.assemblies, done.solutions, done.levels)
 
 
 # -- what the differential tests found (printed at the end of the session by conftest) -------
@@ -101,11 +76,12 @@ class Outcome:
 OUTCOMES: list[Outcome] = []
 
 
-def summary_lines() -> list[str]:
+def summary_lines(outcomes: list[Outcome] | None = None) -> list[str]:
     """Per group: cases, agreeing, disagreeing, skipped (with the reasons counted)."""
+    outcomes = OUTCOMES if outcomes is None else outcomes
     lines = []
-    for group in sorted({o.group for o in OUTCOMES}):
-        mine = [o for o in OUTCOMES if o.group == group]
+    for group in sorted({o.group for o in outcomes}):
+        mine = [o for o in outcomes if o.group == group]
         count = {k: sum(o.status == k for o in mine) for k in ("agree", "disagree", "skip")}
         reasons: dict[str, int] = {}
         for o in mine:

@@ -1,21 +1,51 @@
-"""Shared fixtures; hypothesis runs derandomised so CI is repeatable."""
+"""Shared fixtures; hypothesis runs derandomised so CI is repeatable. Also the burrTxt
+differential tests' counts, gathered from every pytest-xdist worker and printed once."""
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from typing import Any
 
+import pytest
 from hypothesis import settings
 
 settings.register_profile("ci", derandomize=True, deadline=None, max_examples=100)
 settings.load_profile("ci")
 
+#: Outcomes the workers sent back (the controller's list; empty without xdist).
+_FROM_WORKERS: list[dict[str, str]] = []
+
+
+def _local_outcomes() -> list[Any]:
+    module = sys.modules.get("tests.burrtxt")
+    return list(module.OUTCOMES) if module is not None else []
+
+
+def pytest_sessionfinish(session: pytest.Session) -> None:
+    """A worker hands its differential outcomes to the controller."""
+    output = getattr(session.config, "workeroutput", None)
+    if output is not None:
+        output["burrtxt"] = [dataclasses.asdict(o) for o in _local_outcomes()]
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node: Any, error: Any) -> None:
+    """The controller keeps what a finished worker sent (pytest-xdist's hook)."""
+    _FROM_WORKERS.extend(getattr(node, "workeroutput", {}).get("burrtxt", []))
+
 
 def pytest_terminal_summary(terminalreporter: Any) -> None:
     """The burrTxt differential tests' counts (tests/test_burrtxt_diff.py), when they ran."""
-    module = sys.modules.get("tests.burrtxt")
-    lines = module.summary_lines() if module is not None else []
-    if lines:
-        terminalreporter.write_sep("-", "BurrTools (burrTxt) differential")
-        for line in lines:
-            terminalreporter.write_line(line)
+    outcomes = _local_outcomes()
+    if _FROM_WORKERS:
+        from tests.burrtxt import Outcome
+
+        outcomes += [Outcome(**o) for o in _FROM_WORKERS]
+    if not outcomes:
+        return
+    from tests.burrtxt import summary_lines
+
+    terminalreporter.write_sep("-", "BurrTools (burrTxt) differential")
+    for line in summary_lines(outcomes):
+        terminalreporter.write_line(line)

@@ -24,6 +24,7 @@ from typing import Any, Final
 #: The folder beside the checkout that holds BurrTools' sources (``CHAIN_BURRTOOLS_SRC``).
 SOURCES_ENV: Final = "CHAIN_BURRTOOLS_SRC"
 BINARY_ENV: Final = "CHAIN_BURRTXT"
+CACHE_ENV: Final = "CHAIN_BURRTXT_CACHE"
 _FINAL = re.compile(r"(\d+) assemblies and (\d+) solutions found with (\d+) iterations")
 _LEVEL = re.compile(r"^level: ([0-9.]+)\s*$", re.MULTILINE)
 
@@ -55,12 +56,13 @@ def why_unavailable() -> str | None:
     if sources_dir() is None:
         return "BurrTools' sources (../shared/burrtools-src) are not present"
     if shutil.which("g++") is None:
-        return "g++ is not installed (needed to build burrTxt)"
+        return "g++ is not installed (needed to build burrTxt; CI installs g++ and zlib1g-dev)"
     return None
 
 
-def burrtxt_binary(timeout: float = 600.0) -> Path:
-    """The burrTxt binary: ``$CHAIN_BURRTXT``, else built (once, cached) from the sources."""
+def burrtxt_binary(timeout: float = 900.0) -> Path:
+    """The burrTxt binary: ``$CHAIN_BURRTXT``, else built (once, cached; into
+    ``$CHAIN_BURRTXT_CACHE`` when set) from the sources. :class:`BurrTxtError` says why not."""
     env = os.environ.get(BINARY_ENV)
     if env:
         return Path(env)
@@ -68,16 +70,16 @@ def burrtxt_binary(timeout: float = 600.0) -> Path:
     src = sources_dir()
     if reason is not None or src is None:
         raise BurrTxtError(reason or "no sources")
-    build = subprocess.run(
-        ["bash", str(src / "build-burrtxt")],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        check=False,
-    )
+    args = ["bash", str(src / "build-burrtxt")]
+    if os.environ.get(CACHE_ENV):
+        args.append(os.environ[CACHE_ENV])
+    try:
+        build = subprocess.run(args, capture_output=True, text=True, timeout=timeout, check=False)
+    except (subprocess.SubprocessError, OSError) as e:
+        raise BurrTxtError(f"building burrTxt failed: {e}") from None
     lines = build.stdout.strip().splitlines()
-    if build.returncode != 0 or not lines or not Path(lines[-1]).is_file():
-        raise BurrTxtError(f"build-burrtxt failed: {build.stderr.strip()[-500:]}")
+    if build.returncode != 0 or not lines or not os.access(lines[-1], os.X_OK):
+        raise BurrTxtError(f"building burrTxt failed: {build.stderr.strip()[-500:]}")
     return Path(lines[-1])
 
 
