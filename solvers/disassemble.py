@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -473,6 +474,14 @@ def _turn_back(tree: Separation, m: np.ndarray) -> Separation:
     return out
 
 
+@lru_cache(maxsize=1 << 16)
+def _move(names: tuple[str, ...], group: int, direction: int, k: int) -> Move:
+    """A kernel's move row as a :class:`Move` (moves recur across the assemblies of one
+    problem, whose pieces keep their names: built and checked once)."""
+    pieces = tuple(names[b] for b in range(len(names)) if group >> b & 1)
+    return Move(pieces, DIRECTION_NAMES[direction], None if k < 0 else k)
+
+
 def _decode(
     names: tuple[str, ...], nodes: list[list[int]], moves: list[list[int]], root: int
 ) -> Separation | None:
@@ -484,14 +493,7 @@ def _decode(
             return None
         if i not in built:
             first, length, removed, left = nodes[i]
-            seq = tuple(
-                Move(
-                    tuple(names[b] for b in range(len(names)) if g >> b & 1),
-                    DIRECTION_NAMES[d],
-                    None if k < 0 else k,
-                )
-                for g, d, k in moves[first : first + length]
-            )
+            seq = tuple(_move(names, g, d, k) for g, d, k in moves[first : first + length])
             built[i] = Separation(seq, build(removed), build(left))
         return built[i]
 
