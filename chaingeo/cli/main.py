@@ -14,6 +14,7 @@ import importlib
 import pkgutil
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 import chaingeo.cli.commands
 from chaingeo import __version__
@@ -31,13 +32,36 @@ COMMANDS: tuple[str, ...] = tuple(
 )
 
 
+class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
+    """Every option's default in its help (none for flags and options without one);
+    descriptions kept as written."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = action.help or ""
+        default = action.default
+        hidden = text == argparse.SUPPRESS or default in (None, False, argparse.SUPPRESS)
+        if "%(default)" in text or hidden or default == [] or not text:
+            return action.help
+        if action.option_strings or action.nargs in ("?", "*"):
+            return f"{text} (default: %(default)s)"
+        return action.help
+
+
+class CommandParser(argparse.ArgumentParser):
+    """A subcommand's parser: its ``--help`` shows every default."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", _HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="chain",
         description="CHAIN-geo: exact discrete-geometry levels, solvers and agent evaluation.",
     )
     parser.add_argument("--version", action="version", version=f"chain {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=CommandParser)
     for name in COMMANDS:
         importlib.import_module(name).register(sub)
     return parser

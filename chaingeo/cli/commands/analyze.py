@@ -64,7 +64,6 @@ def register(sub: Any) -> None:
     p = sub.add_parser(
         "analyze",
         help="assemblies, solutions, level and optimal steps of puzzles (one JSON line each)",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     p.add_argument(
         "files",

@@ -38,7 +38,6 @@ def register(sub: Any) -> None:
         "eval",
         help="evaluate agents on a level suite (no arguments: the baselines on the shipped suite)",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
         "--levels",

@@ -28,11 +28,8 @@ if TYPE_CHECKING:
 
 
 def register(sub: Any) -> None:
-    # 'import' is a Python keyword, so the module is import_model; the alias keeps the rule
-    # that every command module's name is also a command (tests/test_colors_cli.py)
-    p = sub.add_parser(
-        "import", aliases=["import_model"], help="import a CHAIN URDF/OBJ puzzle model as a level"
-    )
+    # 'import' is a Python keyword, so the module is import_model; the command is 'import'
+    p = sub.add_parser("import", help="import a CHAIN URDF/OBJ puzzle model as a level")
     p.add_argument("model", type=Path, help="a model folder (PART/urdf/*.urdf), or with "
                    "--report a folder of model folders")  # fmt: skip
     p.add_argument("--out", type=Path, help="level file or folder (default: print the level)")
