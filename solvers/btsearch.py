@@ -401,16 +401,16 @@ def first_split(
             if ctx[0] + 1 >= states.shape[0]:
                 if states.shape[0] >= max_states:
                     raise SearchLimitError(
-                        f"state cap of {max_states} reached in a {k}-piece part; "
-                        "raise SearchLimits(max_states=...) or --max-states"
+                        f"state cap of {max_states} reached in a {k}-piece part",
+                        "max_states",
                     )
                 new = min(2 * states.shape[0], max_states)
                 states, parent, move = mv.grow_search(states, parent, move, new)
             hash_table = mv.fit_table(hash_table, states, int(ctx[0]))
         elif status == TOO_MANY_GROUPS:
             raise SearchLimitError(
-                f"more than {limits.group_limit} movable groups along one direction "
-                "in one state; raise SearchLimits(group_limit=...)"
+                f"more than {limits.group_limit} movable groups along one direction in one state",
+                "group_limit",
             )
         elif status != PAUSED:
             break

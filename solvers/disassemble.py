@@ -180,8 +180,8 @@ class _Solver:
         cap = self.limits.max_total_states
         if cap is not None and self.states > cap:
             raise SearchLimitError(
-                f"total state cap of {cap} reached over all searches; "
-                "raise SearchLimits(max_total_states=...)"
+                f"total state cap of {cap} reached over all searches",
+                "max_total_states",
             )
 
     def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch | TurnPartSearch:
@@ -321,18 +321,18 @@ class _Solver:
         lim = self.limits
         if status == ls.TOTAL_CAP:
             raise SearchLimitError(
-                f"total state cap of {lim.max_total_states} reached over all searches; "
-                "raise SearchLimits(max_total_states=...)"
+                f"total state cap of {lim.max_total_states} reached over all searches",
+                "max_total_states",
             )
         if status == ls.STATE_CAP:
             raise SearchLimitError(
-                f"state cap of {lim.max_states} reached in a {info}-piece part; "
-                "raise SearchLimits(max_states=...) or --max-states"
+                f"state cap of {lim.max_states} reached in a {info}-piece part",
+                "max_states",
             )
         if status == ls.GROUP_CAP:
             raise SearchLimitError(
-                f"more than {lim.group_limit} movable groups along one direction "
-                "in one state; raise SearchLimits(group_limit=...)"
+                f"more than {lim.group_limit} movable groups along one direction in one state",
+                "group_limit",
             )
 
     def any_tree(self) -> Separation | None:

@@ -180,8 +180,8 @@ class PartSearch:
         if need >= cap:
             if cap >= self.limits.max_states:
                 raise SearchLimitError(
-                    f"state cap of {self.limits.max_states} reached in a {self.n}-piece part; "
-                    "raise SearchLimits(max_states=...) or --max-states"
+                    f"state cap of {self.limits.max_states} reached in a {self.n}-piece part",
+                    "max_states",
                 )
             new_cap = min(2 * cap, self.limits.max_states)
             self.states = np.concatenate([self.states, np.zeros_like(self.states)])[:new_cap]
@@ -222,7 +222,8 @@ class PartSearch:
             elif status == mv.TOO_MANY_GROUPS:
                 raise SearchLimitError(
                     f"more than {self.limits.group_limit} movable groups along one direction "
-                    "in one state; raise SearchLimits(group_limit=...)"
+                    "in one state",
+                    "group_limit",
                 )
         d = self.n_layers - 3  # the layer just completed (only it can have removals)
         return [

@@ -93,8 +93,8 @@ class TurnPartSearch:
         if self.n_states + 1 >= cap:
             if cap >= self.limits.max_states:
                 raise SearchLimitError(
-                    f"state cap of {self.limits.max_states} reached in a {self.n}-piece part; "
-                    "raise SearchLimits(max_states=...) or --max-states"
+                    f"state cap of {self.limits.max_states} reached in a {self.n}-piece part",
+                    "max_states",
                 )
             new_cap = min(2 * cap, self.limits.max_states)
             self.states = np.concatenate([self.states, np.zeros_like(self.states)])[:new_cap]
@@ -147,8 +147,8 @@ class TurnPartSearch:
                 )
             elif status == mv.TOO_MANY_GROUPS:
                 raise SearchLimitError(
-                    f"more than {self.limits.group_limit} movable groups of one move in one "
-                    "state; raise SearchLimits(group_limit=...)"
+                    f"more than {self.limits.group_limit} movable groups of one move in one state",
+                    "group_limit",
                 )
         self.layers.append(self.n_states)
         return [

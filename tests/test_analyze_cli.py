@@ -160,3 +160,23 @@ def test_counting_cut_short_keeps_the_known_assembly_s_figures() -> None:
     whole = problem_figures(level_puzzle(level), 0, limits, False, True, "drop")
     assert "counts_complete" not in whole
     assert (whole["assemblies"], whole["solutions"], whole["level"]) == (2, 1, "1.2.2")
+
+
+def test_a_state_cap_names_its_flag_not_a_python_field(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    status = main(
+        [
+            "analyze",
+            "puzzle-hard-01-liliput",
+            "--no-assemble",
+            "--max-states",
+            "2",
+            "--jit",
+            "numba",
+        ]
+    )
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert "state cap of 2 reached" in err and "raise it with --max-states" in err
+    assert "SearchLimits(" not in err

@@ -10,9 +10,8 @@ solver prints (588 / 179 there).
 
 A file that takes more than a few seconds reports on standard error what it is doing
 (:mod:`chaingeo.cli.progress`). ``--seconds`` bounds the whole analysis of one file: the
-enumeration of assemblies, every disassembly and the optimal search share one deadline; past it
-the file fails with the limit's message, except that a spent optimal search alone is reported as
-``optimal_error``.
+enumeration of assemblies, every disassembly and the optimal search share one deadline (a spent
+optimal search alone is reported as ``optimal_error``).
 
 ``--jit auto`` (default) runs a single small file with interpreted kernels: starting numba costs
 more than the work (:mod:`chaingeo.core.jit`); if the work takes more than
@@ -138,9 +137,7 @@ def _cut_short(spec: str, out: dict[str, Any]) -> int:
     for row in [out, *out.get("problems", [])]:
         if "limit_cap" not in row:
             continue
-        flag = LIMIT_FLAGS.get(row.pop("limit_cap") or "")
-        if flag:
-            row["limit"] = f"{row['limit']}; raise it with {flag}"
+        row["limit"] = with_flag(row["limit"], row.pop("limit_cap"))
         print(
             f"chain analyze: {spec}: counting stopped ({row['limit']}); the counts are lower "
             "bounds, the other figures are those of the known assembly",
@@ -200,8 +197,13 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
 
 def limit_message(e: SearchLimitError) -> str:
     """The limit's reason, naming the flag that raises it (not the Python field)."""
-    flag = LIMIT_FLAGS.get(e.cap or "")
-    return f"{e.reason}; raise it with {flag}" if flag else str(e)
+    return with_flag(e.reason, e.cap) if e.cap in LIMIT_FLAGS else str(e)
+
+
+def with_flag(reason: str, cap: str | None) -> str:
+    """``reason`` and the flag that raises cap ``cap`` (a ``SearchLimits`` field), if any."""
+    flag = LIMIT_FLAGS.get(cap or "")
+    return f"{reason}; raise it with {flag}" if flag else reason
 
 
 # -- interpreted kernels for one small file ---------------------------------------------------
