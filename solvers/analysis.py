@@ -24,7 +24,8 @@ from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.rules import PuzzleRules
-from solvers.btassemble import BTReport, Mirrors, bt_packing_spec, count_bt, piece_groups
+from solvers.btassemble import Mirrors, bt_packing_spec, piece_groups
+from solvers.btcount import BTReport, count_bt
 from solvers.constrained import Packing, compile_packing
 from solvers.deadline import Deadline
 from solvers.disassemble import Analysis, Rods, analyze

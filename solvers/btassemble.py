@@ -23,7 +23,6 @@ takes apart (:func:`solvers.disassemble.analyze`; with piece groups
 
 from __future__ import annotations
 
-import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Literal
@@ -32,8 +31,6 @@ import numpy as np
 
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
-from chaingeo.core.kinematics import SearchLimitError
-from solvers import movement as mv
 from solvers.btorient import BTImage
 from solvers.constrained import (
     ColoredPiece,
@@ -284,104 +281,3 @@ def disassemble(
         assembly, max_group=max_group, limits=limits, optimal=False, deadline=deadline,
         separations=separations, order=order, fallback=False,
     )  # fmt: skip
-
-
-class StuckCheck:
-    """:func:`solvers.movement.stuck` on a packing's rows: an assembly in which nothing can
-    move is no solution, so its disassembly search (~0.1 ms of setup) is never built."""
-
-    def __init__(self, packing: Packing) -> None:
-        problem = packing.problem
-        vox = problem.target.voxels.astype(np.int64)
-        lo = vox.min(axis=0) if len(vox) else np.zeros(3, dtype=np.int64)
-        self.box = (vox.max(axis=0) - lo + 1) if len(vox) else np.ones(3, dtype=np.int64)
-        self.pos = (vox - lo) @ np.array([self.box[1] * self.box[2], self.box[2], 1])
-        self.row_ptr = problem.row_ptr
-        self.cells = problem.flat_cells
-        self.piece = problem.row_type != packing.hole_type
-
-    def __call__(self, rows: Int32Array) -> bool:
-        return bool(mv.stuck(self.pos, self.box, self.row_ptr, self.cells, rows[self.piece[rows]]))
-
-
-@dataclass(frozen=True)
-class BTReport:
-    assemblies: int
-    solutions: int
-    first_solution: dict[str, Shape] | None
-    first_analysis: Analysis | None
-    seconds: float
-    anchor: str | None
-    limit: SearchLimitError | None = None  # the cap that ended a partial count
-
-    @property
-    def complete(self) -> bool:
-        """Whether every assembly was counted (else the counts are lower bounds)."""
-        return self.limit is None
-
-
-def count_bt(
-    packing: Packing,
-    *,
-    mirrors: Mirrors = "keep",
-    max_group: int | None = None,
-    limits: SearchLimits | None = None,
-    node_limit: int | None = None,
-    deadline: Deadline | None = None,
-    separations: Separations = "first",
-    levels: list[str] | None = None,
-    partial: bool = False,
-) -> BTReport:
-    """BurrTools' assemblies and solutions of a packing, and the first solution. The search
-    and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
-    ``limits`` the enumeration has no time limit and each disassembly the default one).
-    ``separations``: see :func:`solvers.disassemble.analyze`; ``levels``, when given, gets
-    every solution's level string in the order found. A cap reached raises its
-    :class:`SearchLimitError`, or with ``partial`` ends the count: the report then holds what
-    was counted (lower bounds) and the error. The running counts are kept in the deadline's
-    :class:`solvers.deadline.Progress` as the search goes."""
-    start = time.perf_counter()
-    if deadline is None and limits is not None:
-        deadline = Deadline(limits.seconds)
-    n_asm = n_sol = 0
-    first: dict[str, Shape] | None = None
-    first_an: Analysis | None = None
-    anchor = choose_anchor(packing) if packing.n_rows else None
-    groups = piece_groups(packing)
-    # With piece groups a part may be done without moving (pieces of one group stay together).
-    stuck = None if groups.any() else StuckCheck(packing)
-    classes = iter_classes(
-        packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor, deadline=deadline
-    )
-    frame = BTFrame(packing) if separations == "first" else None
-    counts = deadline.progress.counts if deadline is not None else {}
-    limit: SearchLimitError | None = None
-    try:
-        for rows in classes:
-            n_asm += 1
-            counts["assemblies"] = n_asm
-            if stuck is not None and stuck(rows):
-                continue
-            asm = named_assembly(packing, rows)
-            if frame is not None:
-                if len(asm) < 2:
-                    continue  # BurrTools: one piece is no disassembly (disassembler_a.cpp)
-                asm = frame(asm)
-            result = disassemble(
-                packing, asm, max_group=max_group, limits=limits, groups=groups,
-                deadline=deadline, separations=separations,
-            )  # fmt: skip
-            if result.disassemblable:
-                n_sol += 1
-                counts["solutions"] = n_sol
-                if levels is not None:
-                    levels.append(result.level or "")
-                if first is None:
-                    first, first_an = asm, result
-    except SearchLimitError as e:
-        if not partial:
-            raise
-        limit = e  # an assembly being taken apart then is counted, its verdict is not
-    label = None if anchor is None else anchor.label
-    seconds = time.perf_counter() - start
-    return BTReport(n_asm, n_sol, first, first_an, seconds, label, limit)

@@ -39,7 +39,6 @@ from solvers.levelsearch import (
     STATES,
     STATUS,
     TOTAL_CAP,
-    _part_arrays,
     _record,
 )
 from solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits, part_size
@@ -101,11 +100,27 @@ def _child(
 
 
 @njit(cache=True)
+def _leaving(gaps: I64, k: int) -> tuple[np.int64, int]:
+    """The first group that can leave a state with pair gaps ``gaps`` and its direction, in
+    BurrTools' order (single pieces first, then groups of at most half); ``(0, -1)``: none."""
+    for limit in (1, k // 2):
+        for d in range(6):
+            for i in range(k):
+                m = _reach(gaps, d, i, mv.INF, k, limit)
+                if m != 0:
+                    return m, d
+    return np.int64(0), -1
+
+
+@njit(cache=True)
 def part_search(
     vox: I64,
     starts: I64,
     lo: I64,
     hi: I64,
+    members: I64,
+    memo_rel: I64,
+    memo_gap: I64,
     states: I16,
     parent: I64,
     move: I64,
@@ -120,8 +135,11 @@ def part_search(
     separating node, its mask, its direction]``, updated in place so that a call that returns
     PAUSED or NEED_STATES can be repeated (the node being expanded starts over; the states it
     added stay, as BurrTools would have added them in the same order). ``move`` rows: mask,
-    direction, distance of the move that found each state. Returns a status code."""
-    k = starts.shape[0] - 1
+    direction, distance of the move that found each state. The part's pieces are the table
+    rows ``members`` (``vox`` ... ``hi``: the whole puzzle's :class:`PieceTable` arrays), their
+    pair gaps kept in ``memo_rel``/``memo_gap`` (:func:`solvers.movement.memo_pair_gaps`).
+    Returns a status code."""
+    k = members.shape[0]
     half = k // 2
     gaps = np.empty((3, k, k), dtype=np.int64)
     off = np.empty((k, 3), dtype=np.int64)
@@ -138,17 +156,14 @@ def part_search(
         for p in range(k):
             for t in range(3):
                 off[p, t] = states[node, 3 * p + t]
-        mv.pair_gaps(vox, starts, lo, hi, off, gaps)
-        for limit in (1, half):  # single pieces first, then groups of at most half
-            for d in range(6):
-                for i in range(k):
-                    m = _reach(gaps, d, i, mv.INF, k, limit)
-                    if m != 0:
-                        ctx[1] = node
-                        ctx[2] = node
-                        ctx[3] = m
-                        ctx[4] = d
-                        return SEPARATED
+        mv.memo_pair_gaps(vox, starts, lo, hi, members, off, gaps, memo_rel, memo_gap)
+        m, d = _leaving(gaps, k)
+        if m != 0:
+            ctx[1] = node
+            ctx[2] = node
+            ctx[3] = m
+            ctx[4] = d
+            return SEPARATED
         for d in range(6):
             nf = 0
             for i in range(k):
@@ -228,8 +243,8 @@ MAX_STATES, GROUP_LIMIT, BUDGET, MAX_TOTAL = 0, 1, 2, 3
 
 @njit(cache=True)
 def run_part(
-    vox: I64, starts: I64, lo: I64, hi: I64, start: I16, max_states: int, budget: int,
-    group_limit: int,
+    vox: I64, starts: I64, lo: I64, hi: I64, members: I64, memo_rel: I64, memo_gap: I64,
+    start: I16, max_states: int, budget: int, group_limit: int,
 ) -> tuple[int, I16, I64, I64, I64]:  # fmt: skip
     """:func:`part_search` from ``start`` with buffers grown as needed, up to ``max_states``
     states: ``(status, states, parent, move, ctx)`` (status ``-STATE_CAP`` past the cap)."""
@@ -244,8 +259,8 @@ def run_part(
     ctx[0] = 1
     while True:
         before = ctx[1]
-        status = part_search(vox, starts, lo, hi, states, parent, move, table, ctx, budget,
-                             group_limit)  # fmt: skip
+        status = part_search(vox, starts, lo, hi, members, memo_rel, memo_gap, states, parent,
+                             move, table, ctx, budget, group_limit)  # fmt: skip
         budget -= ctx[1] - before
         if status != NEED_STATES:
             return status, states, parent, move, ctx
@@ -289,6 +304,11 @@ def first_tree(
     top = 1
     root = -1
     no_sides = np.full(2, -1, dtype=np.int64)  # filled in when the parts are done
+    memo_rel = np.full((n, n, 3), mv.NO_OFFSET, dtype=np.int64)  # mv.gap_memo: shared by parts
+    memo_gap = np.zeros((3, n, n), dtype=np.int64)
+    gaps = np.empty((3, n, n), dtype=np.int64)
+    no_parent = np.full(1, -1, dtype=np.int64)  # a separation at the start: no moves before
+    no_move = np.zeros((1, 3), dtype=np.int64)
     while top > 0:
         top -= 1
         gmask = p_mask[top]
@@ -308,11 +328,18 @@ def first_tree(
         if params[MAX_TOTAL] >= 0 and ctx[STATES] > params[MAX_TOTAL]:
             ctx[STATUS] = TOTAL_CAP
             return -2
-        vox, starts, lo, hi = _part_arrays(vox_all, starts_all, lo_all, hi_all, members)
-        status, states, parent, move, pctx = run_part(
-            vox, starts, lo, hi, row, params[MAX_STATES], params[BUDGET] - ctx[EXPANDED],
-            params[GROUP_LIMIT],
-        )  # fmt: skip
+        # Most parts come apart at once: their start state is tried before any search is set up.
+        mv.memo_pair_gaps(vox_all, starts_all, lo_all, hi_all, members, p_off[top], gaps,
+                          memo_rel, memo_gap)  # fmt: skip
+        mask, direction = _leaving(gaps, k)
+        if mask != 0:
+            status, states, parent, move = SEPARATED, row.reshape(1, 3 * k), no_parent, no_move
+            pctx = np.array([1, 0, 0, mask, direction], dtype=np.int64)
+        else:
+            status, states, parent, move, pctx = run_part(
+                vox_all, starts_all, lo_all, hi_all, members, memo_rel, memo_gap, row,
+                params[MAX_STATES], params[BUDGET] - ctx[EXPANDED], params[GROUP_LIMIT],
+            )  # fmt: skip
         ctx[EXPANDED] += pctx[1]
         ctx[STATES] += pctx[0]
         if status == PAUSED:
@@ -382,7 +409,8 @@ def first_split(
     states searched. Checks ``deadline`` every :data:`CHUNK` nodes; caps raise
     :class:`SearchLimitError`."""
     k = part_size(members)
-    vox, starts, lo, hi = table.part_arrays(members)
+    local = np.asarray(members, dtype=np.int64)
+    memo_rel, memo_gap = mv.gap_memo(len(table.names))
     off = np.asarray(offsets, dtype=np.int64).reshape(k, 3)
     start = (off - off[0]).reshape(-1).astype(np.int16)
     max_states = limits.max_states
@@ -395,8 +423,9 @@ def first_split(
     ctx = np.array([1, 0, 0, 0, 0], dtype=np.int64)
     while True:
         deadline.check()
-        status = part_search(vox, starts, lo, hi, states, parent, move, hash_table, ctx,
-                             CHUNK, limits.group_limit)  # fmt: skip
+        status = part_search(table.vox, table.starts, table.lo, table.hi, local, memo_rel,
+                             memo_gap, states, parent, move, hash_table, ctx, CHUNK,
+                             limits.group_limit)  # fmt: skip
         if status == NEED_STATES:
             if ctx[0] + 1 >= states.shape[0]:
                 if states.shape[0] >= max_states:

@@ -34,7 +34,7 @@ _FIRST_CAP = 64
 
 
 @njit(cache=True)
-def _part_arrays(
+def part_arrays(
     vox_all: I64, starts_all: I64, lo_all: I64, hi_all: I64, members: I64
 ) -> tuple[I64, I64, I64, I64]:
     """The part's rows of the piece table (:meth:`solvers.partsearch.PieceTable.part_arrays`)."""
@@ -130,7 +130,7 @@ def greedy(
     k = members.shape[0]
     w = 3 * k
     max_states = params[MAX_STATES]
-    vox, starts, lo, hi = _part_arrays(vox_all, starts_all, lo_all, hi_all, members)
+    vox, starts, lo, hi = part_arrays(vox_all, starts_all, lo_all, hi_all, members)
     cap = max(2, min(_FIRST_CAP, max_states))
     states = np.zeros((cap, w), dtype=np.int16)
     parent = np.full(cap, -1, dtype=np.int64)

@@ -33,6 +33,67 @@ MAX_PIECES = 63
 
 
 @njit(cache=True)
+def _pair_gap(
+    vox: I64, starts: I64, lo: I64, hi: I64, a: int, i: int, j: int, rel: I64
+) -> tuple[int, int]:  # fmt: skip
+    """``(g[a, i, j], g[a, j, i])`` of pieces ``i`` and ``j`` (rows of the table arrays), ``j``
+    displaced by ``rel`` from ``i``: one merge of the two pieces' voxel runs along ``a``."""
+    u = (a + 1) % 3
+    v = (a + 2) % 3
+    ru = rel[u]
+    rv = rel[v]
+    ra = rel[a]
+    gij = INF
+    gji = INF
+    if (
+        lo[j, u] + ru > hi[i, u]
+        or hi[j, u] + ru < lo[i, u]
+        or lo[j, v] + rv > hi[i, v]
+        or hi[j, v] + rv < lo[i, v]
+    ):
+        return gij, gji
+    p = starts[i]
+    pe = starts[i + 1]
+    q = starts[j]
+    qe = starts[j + 1]
+    while p < pe and q < qe:
+        iu = vox[a, p, u]
+        iv = vox[a, p, v]
+        ju = vox[a, q, u] + ru
+        jv = vox[a, q, v] + rv
+        if iu < ju or (iu == ju and iv < jv):
+            p += 1
+            continue
+        if iu > ju or (iu == ju and iv > jv):
+            q += 1
+            continue
+        # The same line: walk both runs in order; an i-voxel followed by a j-voxel is a gap
+        # for i moving +a, and the other way round for j.
+        last_owner = -1
+        last_val = 0
+        while True:
+            p_in = p < pe and vox[a, p, u] == iu and vox[a, p, v] == iv
+            q_in = q < qe and vox[a, q, u] + ru == iu and vox[a, q, v] + rv == iv
+            if not p_in and not q_in:
+                break
+            if p_in and (not q_in or vox[a, p, a] < vox[a, q, a] + ra):
+                val = vox[a, p, a]
+                owner = 0
+                p += 1
+            else:
+                val = vox[a, q, a] + ra
+                owner = 1
+                q += 1
+            if last_owner == 0 and owner == 1:
+                gij = min(gij, val - last_val - 1)
+            elif last_owner == 1 and owner == 0:
+                gji = min(gji, val - last_val - 1)
+            last_owner = owner
+            last_val = val
+    return gij, gji
+
+
+@njit(cache=True)
 def pair_gaps(vox: I64, starts: I64, lo: I64, hi: I64, off: I64, out: I64) -> None:
     """Fill ``out[a, i, j]``: how far piece ``i`` can move along ``+a`` with ``j`` fixed.
 
@@ -41,64 +102,59 @@ def pair_gaps(vox: I64, starts: I64, lo: I64, hi: I64, off: I64, out: I64) -> No
     offsets. One merge per pair and axis finds the nearest voxel of the other piece ahead.
     """
     n = starts.shape[0] - 1
+    rel = np.empty(3, dtype=np.int64)
     for a in range(3):
-        u = (a + 1) % 3
-        v = (a + 2) % 3
         for i in range(n):
             out[a, i, i] = INF
         for i in range(n):
             for j in range(i + 1, n):
-                ru = off[j, u] - off[i, u]
-                rv = off[j, v] - off[i, v]
-                ra = off[j, a] - off[i, a]
-                gij = INF
-                gji = INF
-                if not (
-                    lo[j, u] + ru > hi[i, u]
-                    or hi[j, u] + ru < lo[i, u]
-                    or lo[j, v] + rv > hi[i, v]
-                    or hi[j, v] + rv < lo[i, v]
-                ):
-                    p = starts[i]
-                    pe = starts[i + 1]
-                    q = starts[j]
-                    qe = starts[j + 1]
-                    while p < pe and q < qe:
-                        iu = vox[a, p, u]
-                        iv = vox[a, p, v]
-                        ju = vox[a, q, u] + ru
-                        jv = vox[a, q, v] + rv
-                        if iu < ju or (iu == ju and iv < jv):
-                            p += 1
-                            continue
-                        if iu > ju or (iu == ju and iv > jv):
-                            q += 1
-                            continue
-                        # The same line: walk both runs in order; an i-voxel followed by a
-                        # j-voxel is a gap for i moving +a, and the other way round for j.
-                        last_owner = -1
-                        last_val = 0
-                        while True:
-                            p_in = p < pe and vox[a, p, u] == iu and vox[a, p, v] == iv
-                            q_in = q < qe and vox[a, q, u] + ru == iu and vox[a, q, v] + rv == iv
-                            if not p_in and not q_in:
-                                break
-                            if p_in and (not q_in or vox[a, p, a] < vox[a, q, a] + ra):
-                                val = vox[a, p, a]
-                                owner = 0
-                                p += 1
-                            else:
-                                val = vox[a, q, a] + ra
-                                owner = 1
-                                q += 1
-                            if last_owner == 0 and owner == 1:
-                                gij = min(gij, val - last_val - 1)
-                            elif last_owner == 1 and owner == 0:
-                                gji = min(gji, val - last_val - 1)
-                            last_owner = owner
-                            last_val = val
-                out[a, i, j] = gij
-                out[a, j, i] = gji
+                for t in range(3):
+                    rel[t] = off[j, t] - off[i, t]
+                out[a, i, j], out[a, j, i] = _pair_gap(vox, starts, lo, hi, a, i, j, rel)
+
+
+#: An offset no pair of pieces is ever at: marks an empty entry of a :func:`gap_memo`.
+NO_OFFSET = -(1 << 50)
+
+
+def gap_memo(n: int) -> tuple[I64, I64]:
+    """An empty memo for :func:`memo_pair_gaps` over a table of ``n`` pieces."""
+    return np.full((n, n, 3), NO_OFFSET, dtype=np.int64), np.zeros((3, n, n), dtype=np.int64)
+
+
+@njit(cache=True)
+def memo_pair_gaps(
+    vox: I64, starts: I64, lo: I64, hi: I64, members: I64, off: I64, out: I64,
+    memo_rel: I64, memo_gap: I64,
+) -> None:  # fmt: skip
+    """:func:`pair_gaps` of the part ``members`` (pieces of the whole table) at ``off``,
+    remembering each pair's gaps at its last relative offset: a pair's gaps depend only on
+    that offset, and most pairs keep theirs from one state to the next and from a part to the
+    parts it splits into. ``memo_rel[p, q]`` (``p < q``, table pieces): the offset of ``q``
+    from ``p`` whose gaps ``memo_gap[a, p, q]`` and ``memo_gap[a, q, p]`` hold."""
+    k = members.shape[0]
+    rel = np.empty(3, dtype=np.int64)
+    for i in range(k):
+        for a in range(3):
+            out[a, i, i] = INF
+        for j in range(i + 1, k):
+            p, q, x, y = members[i], members[j], i, j
+            if p > q:
+                p, q, x, y = q, p, j, i
+            hit = True
+            for t in range(3):
+                rel[t] = off[y, t] - off[x, t]
+                hit = hit and memo_rel[p, q, t] == rel[t]
+            if not hit:
+                for a in range(3):
+                    memo_gap[a, p, q], memo_gap[a, q, p] = _pair_gap(
+                        vox, starts, lo, hi, a, p, q, rel
+                    )
+                for t in range(3):
+                    memo_rel[p, q, t] = rel[t]
+            for a in range(3):
+                out[a, x, y] = memo_gap[a, p, q]
+                out[a, y, x] = memo_gap[a, q, p]
 
 
 @njit(cache=True)

@@ -18,13 +18,12 @@ from generator.bt_examples import EXAMPLES, staircase
 from generator.maze import runs, with_exit
 from solvers.btassemble import (
     Mirrors,
-    StuckCheck,
     bt_packing_spec,
-    count_bt,
     disassemble,
     iter_classes,
     named_assembly,
 )
+from solvers.btcount import StuckCheck, count_bt
 from solvers.constrained import compile_packing
 from solvers.disassemble import Separation, Separations, _Solver, analyze
 from solvers.groups import PieceGroups, assignable

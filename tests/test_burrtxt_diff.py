@@ -25,7 +25,8 @@ from chaingeo.core.formats.burrtools import read_xmpuzzle
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.rules import PuzzleRules
-from solvers.btassemble import bt_packing_spec, count_bt
+from solvers.btassemble import bt_packing_spec
+from solvers.btcount import count_bt
 from solvers.constrained import compile_packing
 from solvers.partsearch import SearchLimits
 from tests import burrtxt as bt

@@ -29,7 +29,8 @@ from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.piecesets import SOMA
 from solvers import assemble
-from solvers.btassemble import bt_packing_spec, count_bt, iter_classes
+from solvers.btassemble import bt_packing_spec, iter_classes
+from solvers.btcount import count_bt
 from solvers.constrained import compile_packing
 from solvers.cover import (
     CoverLimitError,
