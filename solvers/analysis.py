@@ -167,10 +167,10 @@ def disassembly_figures(
                 blocks=blocks,
                 turns=turns,
                 rods=rods,
-                deadline=deadline,
+                deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
             ).optimal_steps
         except SearchLimitError as e:
-            out["optimal_error"] = str(e)
+            out.update(optimal_error_of(e))
     return out
 
 
@@ -213,6 +213,13 @@ def level_figures(
         )
     )
     return out
+
+
+def optimal_error_of(e: SearchLimitError) -> dict[str, Any]:
+    """The figures' entries for an optimal search stopped by a cap: ``optimal_error`` (the
+    reason) and ``optimal_limit_cap`` (the field of ``SearchLimits`` reached, for a front end
+    to name its own option: ``chain analyze`` names the flag and drops this key)."""
+    return {"optimal_error": e.reason, "optimal_limit_cap": e.cap}
 
 
 #: Seconds the figures of a known assembly get when counting spent the analysis' time.
@@ -319,10 +326,13 @@ def problem_figures(
             deadline.progress.stage = f"problem {index}: searching for the optimal plan"
             try:
                 out["optimal_steps"] = analyze_puzzle(
-                    shapes, max_group=None, limits=limits, deadline=deadline
+                    shapes,
+                    max_group=None,
+                    limits=limits,
+                    deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
                 ).optimal_steps
             except SearchLimitError as e:
-                out["optimal_error"] = str(e)
+                out.update(optimal_error_of(e))
     return out
 
 

@@ -34,13 +34,25 @@ class Deadline:
     with the analysis' :class:`Progress`. ``ValueError`` for a negative or NaN number of
     seconds (NaN would never expire)."""
 
-    def __init__(self, seconds: float | None) -> None:
+    def __init__(self, seconds: float | None, cap: str = "seconds") -> None:
         if seconds is not None and (math.isnan(seconds) or seconds < 0):
             raise ValueError(f"seconds: a time limit must be >= 0, got {seconds}")
         self.seconds = seconds
+        self.cap = cap  # the field of SearchLimits this time limit is
         self.start = time.monotonic()
         self.end = None if seconds is None else self.start + seconds
         self.progress = Progress()
+
+    def within(self, seconds: float | None, cap: str) -> Deadline:
+        """A deadline of at most ``seconds`` (None: this one's) that never outlasts this one,
+        sharing its progress; when it is the shorter, its error names ``cap``."""
+        if seconds is None:
+            return self
+        if self.end is not None and self.end - time.monotonic() <= seconds:
+            return self
+        inner = Deadline(seconds, cap)
+        inner.progress = self.progress
+        return inner
 
     @property
     def bounded(self) -> bool:
@@ -53,7 +65,7 @@ class Deadline:
     def error(self, where: str = "") -> SearchLimitError:
         """The error that names this cap (``where``: what was running, for the message)."""
         at = f" in {where}" if where else ""
-        return SearchLimitError(f"time limit of {self.seconds:g} s reached{at}", "seconds")
+        return SearchLimitError(f"time limit of {self.seconds:g} s reached{at}", self.cap)
 
     def check(self) -> None:
         if self.expired():

@@ -8,6 +8,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -180,3 +181,39 @@ def test_a_state_cap_names_its_flag_not_a_python_field(
     assert status == 2, err
     assert "state cap of 2 reached" in err and "raise it with --max-states" in err
     assert "SearchLimits(" not in err
+
+
+def test_an_optimal_search_stopped_by_a_cap_names_its_flag(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The level is found within the cap, o_i is not: the line says which flag raises it."""
+    status = main(["analyze", "puzzle-mid-04-burr12", "--no-assemble", "--max-states", "30"])
+    row = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert status == 0
+    assert (row["level"], row["optimal_steps"]) == ("1.2.2", None)
+    assert row["optimal_error"].endswith("; raise it with --max-states")
+    assert "optimal_limit_cap" not in row and "SearchLimits(" not in row["optimal_error"]
+
+
+def test_a_hard_optimal_search_stops_at_its_own_time_limit(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """o_i past --optimal-seconds is unknown, with its flag; level and counts still stand, and
+    the analysis ends well before --seconds."""
+    start = time.monotonic()
+    status = main(
+        ["analyze", "puzzle-mid-04-burr12", "--no-assemble", "--optimal-seconds", "0.001"]
+    )
+    row = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
+    assert status == 0 and time.monotonic() - start < 30
+    assert (row["level"], row["moves"], row["optimal_steps"]) == ("1.2.2", 13, None)
+    assert row["optimal_error"] == "time limit of 0.001 s reached; raise it with --optimal-seconds"
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "nan", "inf"])
+def test_a_bad_optimal_time_limit_is_refused(
+    value: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["analyze", "puzzle-mid-04-burr12", "--optimal-seconds", value]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and "--optimal-seconds: expected a positive number" in captured.err

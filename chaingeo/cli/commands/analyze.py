@@ -56,7 +56,11 @@ SMALL_VOXELS: Final = 160
 
 
 #: The flags that set the fields of ``SearchLimits`` a search may reach.
-LIMIT_FLAGS: Final = {"seconds": "--seconds", "max_states": "--max-states"}
+LIMIT_FLAGS: Final = {
+    "seconds": "--seconds",
+    "max_states": "--max-states",
+    "optimal_seconds": "--optimal-seconds",
+}
 
 
 def register(sub: Any) -> None:
@@ -89,6 +93,13 @@ def register(sub: Any) -> None:
         default=120.0,
         help="time limit of one file's analysis (assemblies, disassembly and optimal search)",
     )
+    p.add_argument(
+        "--optimal-seconds",
+        type=float,
+        default=10.0,
+        help="time limit of the search for o_i within a file's analysis (past it o_i is "
+        "reported unknown, with the reason; the other figures stand)",
+    )
     p.add_argument("--max-states", type=int, default=2_000_000, help="state cap per part")
     p.add_argument("--no-optimal", action="store_true", help="skip the optimal-plan search")
     p.add_argument(
@@ -104,8 +115,9 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if not (math.isfinite(args.seconds) and args.seconds > 0):
-        raise CommandError(f"--seconds: expected a positive number of seconds, got {args.seconds}")
+    for flag, value in (("--seconds", args.seconds), ("--optimal-seconds", args.optimal_seconds)):
+        if not (math.isfinite(value) and value > 0):
+            raise CommandError(f"{flag}: expected a positive number of seconds, got {value}")
     if args.max_states < 1:
         raise CommandError(f"--max-states: expected a positive number, got {args.max_states}")
     if _interpreted_first(args):
@@ -131,10 +143,13 @@ def _run_all(args: argparse.Namespace) -> int:
 
 
 def _cut_short(spec: str, out: dict[str, Any]) -> int:
-    """Name the flag of every cap that cut counting short (``limit``), say so on stderr, and
+    """Name the flag of every cap that cut counting short (``limit``) or the optimal search
+    (``optimal_error``), say so on stderr for counting, and
     return the exit status: 1 when some count is a lower bound, else 0."""
     status = 0
     for row in [out, *out.get("problems", [])]:
+        if "optimal_limit_cap" in row:
+            row["optimal_error"] = with_flag(row["optimal_error"], row.pop("optimal_limit_cap"))
         if "limit_cap" not in row:
             continue
         row["limit"] = with_flag(row["limit"], row.pop("limit_cap"))
@@ -156,7 +171,9 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
     from solvers.deadline import Deadline
     from solvers.partsearch import SearchLimits
 
-    limits = SearchLimits(max_states=args.max_states, seconds=args.seconds)
+    limits = SearchLimits(
+        max_states=args.max_states, seconds=args.seconds, optimal_seconds=args.optimal_seconds
+    )
     deadline = Deadline(limits.seconds)
     start = time.perf_counter()
     try:
