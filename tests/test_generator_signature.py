@@ -1,4 +1,4 @@
-"""Split signatures (generator/signature.py) and the train split that holds out the shipped suite."""
+"""Split signatures (generator/signature.py) and the train split that holds out the suite."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from chaingeo.cli.main import main
-from chaingeo.core.geometry import Shape
+from chaingeo.core.geometry import IntArray, Shape
 from chaingeo.core.level import load_levels
 from chaingeo.core.suite import shipped_levels
 from generator.batch import HELD_OUT, GenerationJob, run
@@ -44,7 +44,7 @@ def test_stacking_signature_ignores_each_pieces_pose_their_order_and_the_box_tur
 @settings(max_examples=40, deadline=None)
 @given(pieces, rotations, offsets, st.data())
 def test_puzzle_signature_ignores_a_common_turn_shift_and_order_but_not_a_piece_moved(
-    shapes: list[Shape], rotation: object, offset: tuple[int, int, int], data: st.DataObject
+    shapes: list[Shape], rotation: IntArray, offset: tuple[int, int, int], data: st.DataObject
 ) -> None:
     # Lay the pieces side by side along x (apart, never overlapping): the "assembly".
     laid, x = [], 0
