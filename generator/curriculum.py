@@ -33,7 +33,7 @@ _BURR3: Final[dict[str, object]] = {"shape": "burr3", "hole_rate": 0.8, "hill_st
 
 #: Puzzle steps: PuzzleConfig fields, easy to hard (first-removal level grows with K).
 PUZZLE_STEPS: Final[tuple[dict[str, object], ...]] = (
-    {**_BURR3, "min_level": 1},
+    {**_BURR3, "min_level": 1, "hill_steps": 0},  # random designs, no climbing: mostly level 1
     {**_BURR3, "min_level": 2},
     {**_BURR3, "min_level": 3},
     {**_BURR3, "min_level": 4},
