@@ -167,3 +167,31 @@ def test_load_dataset_round_trips_both_configs(exported: Path, tmp_path: Path) -
     demos = datasets.load_dataset(str(exported), DEMONSTRATIONS, cache_dir=str(tmp_path))["test"]
     assert demos["action"] == [r["action"] for r in rows(exported, DEMONSTRATIONS)]
     assert demos[0]["images"][4].size == (SIZE, SIZE)
+
+
+def test_the_step_bound_is_checked_before_any_picture_is_drawn(
+    tmp_path: Path, levels: list[Level], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from chaingeo.core import limits
+    from chaingeo.core.limits import LimitError
+
+    monkeypatch.setattr(limits, "MAX_DATASET_STEPS", 4)
+    with pytest.raises(LimitError, match="5 plan steps; at most 4"):
+        export_dataset(levels, tmp_path / "out", image_size=SIZE)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.slow
+def test_the_whole_shipped_suite_exports_and_loads(tmp_path: Path) -> None:
+    datasets = pytest.importorskip("datasets")
+    from chaingeo.core.level import load_levels
+    from generator.signature import level_signature
+
+    suite = load_levels(shipped_levels())
+    assert main(["export-dataset", "--out", str(tmp_path), "--image-size", "128"]) == 0
+    got = datasets.load_dataset(str(tmp_path), LEVELS, cache_dir=str(tmp_path / "c"))["test"]
+    assert got["id"] == sorted(lv.id for lv in suite)
+    by_id = {lv.id: lv for lv in suite}
+    assert got["signature"] == [level_signature(by_id[i]) for i in got["id"]]
+    demos = datasets.load_dataset(str(tmp_path), DEMONSTRATIONS, cache_dir=str(tmp_path / "c"))
+    assert demos["test"].num_rows == sum(lv.optimal_steps for lv in suite)
