@@ -108,6 +108,11 @@ def test_demonstrations_are_the_plan_as_chat_turns_with_the_views_shown(
             views = ", ".join(row["image_names"])
             assert text["text"] == f"{record['observation']}\n\nViews: {views}"
         assert [r["reward"] for r in mine][-1] == 1.0 and mine[-1]["terminated"]
+        # The first step shows the start state: the very pictures of the level's row.
+        (start,) = [r for r in rows(exported, LEVELS) if r["id"] == level.id]
+        assert [im["bytes"] for im in mine[0]["images"]] == [
+            im["bytes"] for im in start["images"][:5]
+        ]
 
 
 def test_the_card_has_the_hubs_header_and_lists_every_split(exported: Path, tmp_path: Path) -> None:
