@@ -283,12 +283,10 @@ class _ShardWriter:
 def write_config(
     rows: Iterable[dict[str, Any]], folder: Path, config: str, split: str, shard_bytes: int
 ) -> tuple[int, list[Path]]:
-    """Write ``rows`` as the shards of ``folder/config/split-*.parquet`` (older shards of that
-    split removed first); returns the row count and the files."""
+    """Write ``rows`` as the shards of ``folder/config/split-*.parquet``; the split's older
+    shards are replaced only once every new one is written. Returns the row count and files."""
     target = folder / config
     target.mkdir(parents=True, exist_ok=True)
-    for old in target.glob(f"{split}-*.parquet"):
-        old.unlink()
     writer = _ShardWriter(target, config, split, shard_bytes)
     count = 0
     try:
@@ -300,6 +298,8 @@ def write_config(
         raise
     parts = writer.close()
     files = [target / f"{split}-{i:05d}-of-{len(parts):05d}.parquet" for i in range(len(parts))]
+    for old in set(target.glob(f"{split}-*.parquet")) - set(files):
+        old.unlink()
     for part, final in zip(parts, files, strict=True):
         part.replace(final)
     return count, files
