@@ -30,12 +30,15 @@ from chaingeo.core.files import atomic_write
 from chaingeo.core.level import Level, level_bytes
 from generator.dedup import Reservation, SignatureStore
 from generator.result import ATTEMPTS_KEY, Rejection
+from generator.signature import level_signature
 
 MakeFn = Callable[[Any, int, int], "Level | Rejection"]
 PictureFn = Callable[[Level], dict[str, bytes]]
 SUMMARY_FILE = "summary.jsonl"
 PICTURES_DIR = "pictures"
 DUPLICATE = "duplicate-signature"
+#: The outcome of a level whose split signature is held out (a shipped level, for a train split).
+HELD_OUT = "held-out-signature"
 
 
 class GenerationError(RuntimeError):
@@ -47,6 +50,8 @@ class GenerationJob:
     """What to generate: ``count`` levels of ``family`` from items ``first_index`` onwards.
 
     ``make`` and ``pictures`` must be module-level functions (they travel to workers by name).
+    ``held_out``: split signatures (:mod:`generator.signature`) never accepted, each such level
+    counted as :data:`HELD_OUT` (a train split holds out the shipped suite).
     """
 
     family: str
@@ -57,6 +62,7 @@ class GenerationJob:
     max_items: int | None = None
     first_index: int = 0
     pictures: PictureFn | None = None
+    held_out: frozenset[str] = frozenset()
 
     def __post_init__(self) -> None:
         if self.count < 1:
@@ -82,6 +88,7 @@ class ItemResult:
     index: int
     level_id: str | None = None
     signature: str | None = None
+    split_signature: str | None = None
     level: bytes | None = None
     pictures: dict[str, bytes] = field(default_factory=dict)
     reason: str | None = None
@@ -107,6 +114,7 @@ def run_item(
         index,
         level_id=out.id,
         signature=out.provenance.signature,
+        split_signature=level_signature(out),
         level=level_bytes(out),
         pictures=pics,
         attempts=dict(out.stats.get(ATTEMPTS_KEY, {})),
@@ -313,6 +321,8 @@ def run(
             summary.attempt_rejections.update(res.attempts)
             if res.level is None:
                 summary.outcomes[res.reason or "rejected"] += 1
+            elif res.split_signature in job.held_out:
+                summary.outcomes[HELD_OUT] += 1
             elif _store(folder, store, res):
                 summary.outcomes["accepted"] += 1
                 summary.accepted.append(res.level_id or "")

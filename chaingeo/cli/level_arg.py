@@ -3,6 +3,7 @@ default the shipped suite). One resolver, so every command that takes a level ta
 
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -35,3 +36,21 @@ def find_level(spec: str | Path, folder: Path | None = None) -> Level:
         if level.id == str(spec):
             return level
     raise CommandError(f"no level file or level id {str(spec)!r} (looked in {root})")
+
+
+def add_level_list(p: argparse.ArgumentParser) -> None:
+    """``[LEVELS...] --folder DIR``: level files or ids, by default every level of the folder."""
+    p.add_argument(
+        "levels", nargs="*", help="level files or ids (default: every level under --folder)"
+    )
+    p.add_argument("--folder", type=Path, default=None, help="levels folder (default: shipped)")
+
+
+def levels_of(args: argparse.Namespace) -> list[Level]:
+    """The levels named by :func:`add_level_list`'s arguments."""
+    from chaingeo.core.level import load_levels
+    from chaingeo.core.suite import shipped_levels
+
+    if args.levels:
+        return [find_level(spec, args.folder) for spec in args.levels]
+    return load_levels(args.folder if args.folder is not None else shipped_levels())

@@ -227,3 +227,18 @@ MAX_OBSERVATION_CHARS: Final = 1 << 16
 #: piece's placements, the pickups, ``finish``), zero-padded past the level's own catalogue.
 #: The shipped suite peaks at 5,234.
 MAX_STACKING_ACTIONS: Final = 1 << 14
+
+
+# ---------------------------------------------------------------------------------------------
+# chain export-dataset: the Hugging Face dataset folder (chaingeo/envs/dataset.py)
+# ---------------------------------------------------------------------------------------------
+
+#: Levels in one export, and plan steps (demonstration rows) over all of them, counted from the
+#: levels' ``optimal_steps`` before anything is drawn (the shipped suite: 109 levels, 907 steps).
+MAX_DATASET_LEVELS: Final = 100_000
+MAX_DATASET_STEPS: Final = 1_000_000
+#: Pixels of a side of one exported picture (the renderer's default is 512).
+MAX_DATASET_IMAGE_SIZE: Final = 2048
+#: Bytes of one Parquet shard (about, counted over the rows' pictures and texts): the Hub's
+#: viewer and ``datasets`` stream shards of a few hundred MB best.
+MAX_DATASET_SHARD_BYTES: Final = 256 * 1024 * 1024

@@ -4,8 +4,9 @@ A level's ``solution`` is a plan of ``optimal_steps`` actions (stacking: the pla
 stored order; puzzles: the stored moves and turns). Replayed through :class:`ChainEnv`, it gives
 the (observation, action text, reward) trajectory an imitation learner wants, with the exact
 text an agent is shown and writes. Records are canonical JSON lines (sorted keys, no
-whitespace), one per step, so the same levels give the same bytes. Pictures are left out (logs
-never hold images); ``views`` names them, and ``chain play`` or ``render_state`` draws them.
+whitespace), one per step, so the same levels give the same bytes. Pictures are left out of the
+JSON lines (logs never hold images); ``demonstration(level, picture_size=N)`` adds the PNG of
+every view shown with each step, for the dataset export (:mod:`chaingeo.envs.dataset`).
 """
 
 from __future__ import annotations
@@ -33,21 +34,26 @@ def plan_texts(level: Level) -> list[str]:
     raise DemonstrationError(f"level {level.id!r} stores no plan")
 
 
-def demonstration(level: Level, **env_kwargs: Any) -> Iterator[dict[str, Any]]:
+def demonstration(
+    level: Level, *, picture_size: int | None = None, **env_kwargs: Any
+) -> Iterator[dict[str, Any]]:
     """One record per step of the level's plan: ``level_id``, ``step`` (1-based),
     ``observation`` (the text shown before the action), ``action``, ``reward``,
     ``terminated``, ``truncated``, ``feedback``. ``env_kwargs`` go to the environment (for
-    example ``text_state=True``); images are never drawn here."""
+    example ``text_state=True``). With ``picture_size``, ``images`` too: view name -> PNG bytes
+    of the pictures shown with the text (which then names them), in the environment's order."""
     from chaingeo.envs.gym import PuzzleEnv, StackingEnv
 
     cls = StackingEnv if level.family == "stacking" else PuzzleEnv
-    env = cls([level], **{**env_kwargs, "images": False})
+    drawn = {"images": True, "image_size": picture_size} if picture_size else {"images": False}
+    env = cls([level], **{**env_kwargs, **drawn})
     obs, _ = env.reset(options={"level": level.id})
     plan = plan_texts(level)
     for step, action in enumerate(plan, start=1):
         shown = obs["text"]
+        pictures = _pngs(obs["images"]) if picture_size else None
         obs, reward, terminated, truncated, info = env.step(action)
-        yield {
+        record = {
             "level_id": level.id,
             "step": step,
             "observation": shown,
@@ -57,6 +63,7 @@ def demonstration(level: Level, **env_kwargs: Any) -> Iterator[dict[str, Any]]:
             "truncated": truncated,
             "feedback": info["feedback"],
         }
+        yield record if pictures is None else {**record, "images": pictures}
         if not info["legal"] or ((terminated or truncated) and step < len(plan)):
             raise DemonstrationError(
                 f"level {level.id!r}: step {step} of its plan ({action!r}) was refused or "
@@ -64,6 +71,15 @@ def demonstration(level: Level, **env_kwargs: Any) -> Iterator[dict[str, Any]]:
             )
     if not env.state.is_success():
         raise DemonstrationError(f"level {level.id!r}: its plan does not solve it")
+
+
+def _pngs(frames: dict[str, Any]) -> dict[str, bytes]:
+    """PNG bytes of the environment's pixel arrays (pixel-equal to ``render_state``'s PNGs)."""
+    from PIL import Image
+
+    from chaingeo.envs.raster import png_bytes
+
+    return {name: png_bytes(Image.fromarray(frame)) for name, frame in frames.items()}
 
 
 def demonstration_lines(levels: Iterable[Level], **env_kwargs: Any) -> Iterator[str]:

@@ -16,11 +16,10 @@ from typing import Any
 
 
 def register(sub: Any) -> None:
+    from chaingeo.cli.level_arg import add_level_list
+
     p = sub.add_parser("demos", help="write demonstrations (optimal plans replayed) as JSONL")
-    p.add_argument(
-        "levels", nargs="*", help="level files or ids (default: every level under --folder)"
-    )
-    p.add_argument("--folder", type=Path, default=None, help="levels folder (default: shipped)")
+    add_level_list(p)
     p.add_argument("--out", default="-", help="JSONL file to write (default -, standard output)")
     p.add_argument("--text-state", action="store_true", help="show every piece's cells too")
     p.add_argument("--history", type=int, default=5, help="recent turns shown (default 5)")
@@ -29,15 +28,10 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
-    from chaingeo.cli.level_arg import find_level
-    from chaingeo.core.level import load_levels
-    from chaingeo.core.suite import shipped_levels
+    from chaingeo.cli.level_arg import levels_of
     from chaingeo.envs.demos import DemonstrationError, demonstration_lines
 
-    if args.levels:
-        levels = [find_level(spec, args.folder) for spec in args.levels]
-    else:
-        levels = load_levels(args.folder if args.folder is not None else shipped_levels())
+    levels = levels_of(args)
     options = {"text_state": args.text_state, "history_window": args.history}
     count = 0
     with contextlib.ExitStack() as files:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -41,16 +42,38 @@ def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
         )
         p.add_argument("--first-index", type=int, default=0, help="first item index (default 0)")
         p.add_argument("--no-pictures", action="store_true", help="skip the PNG pictures")
+        p.add_argument(
+            "--split",
+            choices=("any", "train"),
+            default="any",
+            help="train: skip (and count) every level whose split signature matches a level of "
+            "the shipped suite, so training data never holds a test level",
+        )
     p.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on the Dask cluster at ADDRESS")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
+def add_curriculum_option(p: argparse.ArgumentParser, family: str) -> None:
+    """``--curriculum K``: step K of the family's easy-to-hard list (generator.curriculum)."""
+    from generator.curriculum import CURRICULA
+
+    p.add_argument(
+        "--curriculum",
+        type=int,
+        metavar="K",
+        help=f"difficulty step 0 (easiest) .. {CURRICULA[family] - 1} (hardest) instead of the "
+        "shape options; explicit options still override it",
+    )
+
+
 def run_job(args: argparse.Namespace, family: str, make: Any, config: Any) -> int:
     """Run one generation job from parsed options; print the summary as one JSON line."""
     from chaingeo.envs.pictures import level_pictures
-    from generator.batch import GenerationError, GenerationJob, run
+    from generator.batch import HELD_OUT, GenerationError, GenerationJob, run
+    from generator.signature import shipped_signatures
 
+    held_out = shipped_signatures() if args.split == "train" else frozenset()
     try:
         job = GenerationJob(
             family,
@@ -61,10 +84,14 @@ def run_job(args: argparse.Namespace, family: str, make: Any, config: Any) -> in
             max_items=args.max_items,
             first_index=args.first_index,
             pictures=None if args.no_pictures else level_pictures,
+            held_out=held_out,
         )
         summary = run(job, args.out, jobs=args.jobs, dask=args.dask, progress=not args.no_progress)
     except GenerationError as e:
         raise CommandError(str(e)) from None
+    if args.split == "train":
+        skipped = summary.outcomes[HELD_OUT]
+        print(f"split train: skipped {skipped} level(s) of the shipped suite", file=sys.stderr)
     print(json.dumps(summary.to_json(), sort_keys=True))
     return 0 if summary.complete else 1
 
@@ -85,6 +112,7 @@ def _register_stacking(fam: Any) -> None:
     p.add_argument(
         "--no-linear-assembly", action="store_true", help="do not require a linear assembly"
     )
+    add_curriculum_option(p, "stacking")
     add_run_options(p)
     p.set_defaults(func=_run_stacking)
 
@@ -104,6 +132,12 @@ def stacking_config_from_args(args: argparse.Namespace) -> Any:
             overrides[fld] = getattr(args, opt)
     if args.no_linear_assembly:
         overrides["linear_assembly"] = False
+    if args.curriculum is not None:
+        from generator.curriculum import stacking_step
+
+        if args.config or args.box or args.mode:
+            raise CommandError("give either --curriculum or --config or --box/--mode")
+        return stacking_step(args.curriculum).replace(**overrides)
     if args.config:
         if args.box or args.mode:
             raise CommandError("give either --config or --box/--mode, not both")
@@ -159,7 +193,6 @@ def _register_puzzle(fam: Any) -> None:
     p = fam.add_parser("puzzle", help="interlocking puzzles (burrs, plate burrs, cubes)")
     p.add_argument(
         "--shape",
-        default="burr6",
         help=(
             "burr3, plate3, burr6, burr6x8 / burr6x8u (Cutler's standard six-piece burr; u: "
             "unique assembly), burr12, burr18, burr24, burr36 (towers; with --max-group 1 "
@@ -167,7 +200,7 @@ def _register_puzzle(fam: Any) -> None:
             "default burr6"
         ),
     )
-    p.add_argument("--min-level", type=int, default=1, help="least moves to free the first part")
+    p.add_argument("--min-level", type=int, help="least moves to free the first part (default 1)")
     p.add_argument("--pieces", type=int, default=0, help="pieces of a cubeN partition")
     p.add_argument("--hole-rate", type=float, help="chance a shared cell starts empty")
     p.add_argument("--hill-steps", type=int, help="single-voxel improvement steps")
@@ -178,23 +211,22 @@ def _register_puzzle(fam: Any) -> None:
     p.add_argument(
         "--unique", action="store_true", help="only designs that assemble in one way (burr6x8)"
     )
+    add_curriculum_option(p, "puzzle")
     add_run_options(p)
     p.set_defaults(func=_run_puzzle)
 
 
 def _run_puzzle(args: argparse.Namespace) -> int:
     from generator.config import PuzzleConfig
+    from generator.curriculum import PUZZLE_STEPS, puzzle_step
     from generator.puzzle import make
 
-    fields: dict[str, Any] = {
-        "shape": args.shape,
-        "min_level": args.min_level,
-        "pieces": args.pieces,
-        "goal": args.goal,
-        "max_group": args.max_group,
-        "unique": args.unique,
-    }
-    for opt in ("hole_rate", "hill_steps", "seconds", "restarts"):
+    fields: dict[str, Any] = {"shape": "burr6", "min_level": 1}
+    if args.curriculum is not None:
+        puzzle_step(args.curriculum)  # checks the range
+        fields.update(PUZZLE_STEPS[args.curriculum])
+    fields.update(pieces=args.pieces, goal=args.goal, max_group=args.max_group, unique=args.unique)
+    for opt in ("shape", "min_level", "hole_rate", "hill_steps", "seconds", "restarts"):
         if getattr(args, opt) is not None:
             fields[opt] = getattr(args, opt)
     return run_job(args, "puzzle", make, PuzzleConfig(**fields))
