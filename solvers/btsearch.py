@@ -53,13 +53,13 @@ SEPARATED, STUCK, NEED_STATES, PAUSED, TOO_MANY_GROUPS = 0, 1, 2, 3, 4
 
 
 @njit(cache=True)
-def _reach(gaps: I64, d: int, i: int, s: int, k: int, limit: int) -> np.int64:
+def _reach(gaps: I64, d: int, i: int, s: int, k: int, limit: int, todo: I64) -> np.int64:
     """The pieces that must come along when piece ``i`` moves ``s`` along direction ``d``
-    (``s >= mv.INF``: leaves for good), as a mask; 0 when they are more than ``limit``."""
+    (``s >= mv.INF``: leaves for good), as a mask; 0 when they are more than ``limit``.
+    ``todo``: room for ``k`` pieces (the caller's, reused)."""
     a = d // 2
     neg = d % 2 == 1
     mask = np.int64(1) << i
-    todo = np.empty(k, dtype=np.int64)
     todo[0] = i
     top = 1
     count = 1
@@ -100,13 +100,13 @@ def _child(
 
 
 @njit(cache=True)
-def _leaving(gaps: I64, k: int) -> tuple[np.int64, int]:
+def _leaving(gaps: I64, k: int, todo: I64) -> tuple[np.int64, int]:
     """The first group that can leave a state with pair gaps ``gaps`` and its direction, in
     BurrTools' order (single pieces first, then groups of at most half); ``(0, -1)``: none."""
     for limit in (1, k // 2):
         for d in range(6):
             for i in range(k):
-                m = _reach(gaps, d, i, mv.INF, k, limit)
+                m = _reach(gaps, d, i, mv.INF, k, limit, todo)
                 if m != 0:
                     return m, d
     return np.int64(0), -1
@@ -144,6 +144,7 @@ def part_search(
     gaps = np.empty((3, k, k), dtype=np.int64)
     off = np.empty((k, 3), dtype=np.int64)
     child = np.empty(3 * k, dtype=np.int16)
+    todo = np.empty(k, dtype=np.int64)
     f_mask = np.empty(64, dtype=np.int64)
     f_step = np.empty(64, dtype=np.int64)
     n_states = ctx[0]
@@ -157,7 +158,7 @@ def part_search(
             for t in range(3):
                 off[p, t] = states[node, 3 * p + t]
         mv.memo_pair_gaps(vox, starts, lo, hi, members, off, gaps, memo_rel, memo_gap)
-        m, d = _leaving(gaps, k)
+        m, d = _leaving(gaps, k, todo)
         if m != 0:
             ctx[1] = node
             ctx[2] = node
@@ -169,7 +170,7 @@ def part_search(
             for i in range(k):
                 s = 1
                 while True:
-                    m = _reach(gaps, d, i, s, k, half)
+                    m = _reach(gaps, d, i, s, k, half, todo)
                     if m == 0:
                         break
                     pending = 1  # the group itself, then its unions
@@ -307,6 +308,7 @@ def first_tree(
     memo_rel = np.full((n, n, 3), mv.NO_OFFSET, dtype=np.int64)  # mv.gap_memo: shared by parts
     memo_gap = np.zeros((3, n, n), dtype=np.int64)
     gaps = np.empty((3, n, n), dtype=np.int64)
+    todo = np.empty(n, dtype=np.int64)
     no_parent = np.full(1, -1, dtype=np.int64)  # a separation at the start: no moves before
     no_move = np.zeros((1, 3), dtype=np.int64)
     while top > 0:
@@ -331,7 +333,7 @@ def first_tree(
         # Most parts come apart at once: their start state is tried before any search is set up.
         mv.memo_pair_gaps(vox_all, starts_all, lo_all, hi_all, members, p_off[top], gaps,
                           memo_rel, memo_gap)  # fmt: skip
-        mask, direction = _leaving(gaps, k)
+        mask, direction = _leaving(gaps, k, todo)
         if mask != 0:
             status, states, parent, move = SEPARATED, row.reshape(1, 3 * k), no_parent, no_move
             pctx = np.array([1, 0, 0, mask, direction], dtype=np.int64)
