@@ -46,6 +46,7 @@ from solvers.groups import PieceGroups, analyze_grouped
 from solvers.partsearch import SearchLimits
 from solvers.placements import Int32Array
 from solvers.problem import CoverError
+from solvers.rowreduce import live_rows
 from solvers.search import CoverSearch
 
 Mirrors = Literal["keep", "drop"]
@@ -169,12 +170,9 @@ def iter_classes(
         anchor = choose_anchor(packing)
     rot = packing.row_maps(False)
     full = packing.row_maps(True) if mirrors == "drop" else None
-    search = CoverSearch(
-        packing.problem,
-        None if anchor is None else anchor.rows,
-        node_limit=node_limit,
-        deadline=deadline,
-    )
+    # Rows no assembly can hold go first (BurrTools' -r): far fewer dead ends, same classes.
+    rows = live_rows(packing.problem, None if anchor is None else anchor.rows)
+    search = CoverSearch(packing.problem, rows, node_limit=node_limit, deadline=deadline)
     max_holes = packing.spec.max_holes if packing.hole_type < 0 else None  # else in the rows
     n_var = len(packing.problem.optional)
     seen: set[bytes] = set()

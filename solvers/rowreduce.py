@@ -1,0 +1,122 @@
+"""Placements that can take part in no cover, found before the search (BurrTools' ``-r``).
+
+A row is dead when placing it leaves some required column (a fixed cell of the target, or a
+piece that must be used exactly once) with no row compatible with it: rows that share a cell
+with it, or are the same single-use piece, are gone. No cover holds a dead row, so removing it
+changes no count; removing rows can kill others, so passes repeat until none dies. The depth-
+first search then meets far fewer dead ends: on a 36-piece burr it finds assemblies at once
+where the unreduced search found none in minutes. Each test is one trial placement with
+column counts kept as in dancing links (~rows sharing a cell x their cells), in numba.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from chaingeo.core.jit import njit
+from solvers.problem import CoverProblem
+
+I64 = npt.NDArray[np.int64]
+B1 = npt.NDArray[np.bool_]
+Int32Array = npt.NDArray[np.int32]
+
+#: Passes over the rows at most (each after the first only when some row died).
+MAX_PASSES = 16
+
+
+@njit(cache=True)
+def _dead_rows(
+    row_ptr: I64, cols: I64, col_ptr: I64, col_rows: I64, required: B1, alive: B1,
+    max_passes: int,
+) -> int:  # fmt: skip
+    """Clear ``alive`` for every dead row (row ``r`` covers ``cols[row_ptr[r]:row_ptr[r+1]]``;
+    column ``c`` is covered by ``col_rows[col_ptr[c]:col_ptr[c+1]]``); returns rows killed."""
+    n_rows = row_ptr.shape[0] - 1
+    n_cols = col_ptr.shape[0] - 1
+    count = np.zeros(n_cols, dtype=np.int64)
+    for r in range(n_rows):
+        if alive[r]:
+            for q in range(row_ptr[r], row_ptr[r + 1]):
+                count[cols[q]] += 1
+    mark = np.zeros(n_rows, dtype=np.int64)
+    own = np.zeros(n_cols, dtype=np.int64)
+    gone = np.empty(n_rows, dtype=np.int64)
+    stamp = 0
+    killed = 0
+    for _ in range(max_passes):
+        changed = False
+        for r in range(n_rows):
+            if not alive[r]:
+                continue
+            stamp += 1
+            for q in range(row_ptr[r], row_ptr[r + 1]):
+                own[cols[q]] = stamp
+            n_gone = 0
+            for q in range(row_ptr[r], row_ptr[r + 1]):
+                c = cols[q]
+                for p in range(col_ptr[c], col_ptr[c + 1]):
+                    r2 = col_rows[p]
+                    if alive[r2] and mark[r2] != stamp:
+                        mark[r2] = stamp
+                        gone[n_gone] = r2
+                        n_gone += 1
+            dead = False
+            for g in range(n_gone):
+                r2 = gone[g]
+                for q in range(row_ptr[r2], row_ptr[r2 + 1]):
+                    c = cols[q]
+                    count[c] -= 1
+                    if count[c] == 0 and required[c] and own[c] != stamp:
+                        dead = True
+            for g in range(n_gone):
+                r2 = gone[g]
+                for q in range(row_ptr[r2], row_ptr[r2 + 1]):
+                    count[cols[q]] += 1
+            if dead:
+                alive[r] = False
+                killed += 1
+                changed = True
+                for q in range(row_ptr[r], row_ptr[r + 1]):
+                    count[cols[q]] -= 1
+        if not changed:
+            break
+    return killed
+
+
+def live_rows(problem: CoverProblem, rows: Int32Array | None = None) -> Int32Array:
+    """``rows`` (default: all) without the rows no cover of ``problem`` can hold, in order.
+
+    Columns: every cell (required unless optional) and, for a piece used at most once, the
+    piece (required when it must be used); pieces that may be used several times add no
+    column (their rows stay compatible with each other), which only keeps more rows."""
+    n_rows, n_cells = problem.n_rows, problem.n_cells
+    alive = np.zeros(n_rows, dtype=np.bool_)
+    if rows is None:
+        alive[:] = True
+    else:
+        alive[np.asarray(rows, dtype=np.int64)] = True
+    if n_rows == 0:
+        return np.zeros(0, dtype=np.int32)
+    single = np.array([t.hi == 1 for t in problem.types], dtype=np.bool_)
+    must = np.array([t.lo == 1 for t in problem.types], dtype=np.bool_)
+    row_type = problem.row_type.astype(np.int64)
+    cell_ptr = np.asarray(problem.row_ptr, dtype=np.int64)
+    sizes = np.diff(cell_ptr) + single[row_type]
+    row_ptr = np.zeros(n_rows + 1, dtype=np.int64)
+    np.cumsum(sizes, out=row_ptr[1:])
+    cols = np.empty(int(row_ptr[-1]), dtype=np.int64)
+    ends = row_ptr[1:] - single[row_type]  # a row's cells, then its piece column
+    cell_of = np.arange(len(problem.flat_cells)) - np.repeat(cell_ptr[:-1], np.diff(cell_ptr))
+    cols[np.repeat(row_ptr[:-1], np.diff(cell_ptr)) + cell_of] = problem.flat_cells
+    with_piece = np.flatnonzero(single[row_type])
+    cols[ends[with_piece]] = n_cells + row_type[with_piece]
+    required = np.ones(n_cells + len(problem.types), dtype=np.bool_)
+    required[sorted(problem.optional)] = False
+    required[n_cells:] = single & must
+    order = np.argsort(cols, kind="stable")
+    col_rows = np.repeat(np.arange(n_rows), sizes)[order]
+    col_ptr = np.zeros(len(required) + 1, dtype=np.int64)
+    np.cumsum(np.bincount(cols, minlength=len(required)), out=col_ptr[1:])
+    _dead_rows(row_ptr, cols, col_ptr, col_rows, required, alive, MAX_PASSES)
+    return np.flatnonzero(alive).astype(np.int32)
