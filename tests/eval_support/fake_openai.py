@@ -38,6 +38,10 @@ class Script:
     problems: list[str] = field(default_factory=list)
     expect_key: str | None = None
     refuse_tools: bool = False
+    #: a chat that resends its whole conversation each turn (verifiers' harnesses): the messages
+    #: between the system prompt and the new turn alternate user and assistant, and the
+    #: sampling parameters are the caller's business
+    chat_history: bool = False
     #: the calls of the last answer (id, name, arguments), which the next request must answer
     pending: list[tuple[str, str, str]] = field(default_factory=list)
     lock: threading.Lock = field(default_factory=threading.Lock)
@@ -96,6 +100,17 @@ def _check_tool_history(middle: list[Any], script: Script, fresh: bool) -> str |
     return None
 
 
+def _check_chat_history(middle: list[Any]) -> str | None:
+    """Earlier turns, oldest first: user, assistant, user, assistant, ... (assistant text)."""
+    for i, m in enumerate(middle):
+        role = m.get("role") if isinstance(m, dict) else None
+        if role != ("user", "assistant")[i % 2]:
+            return f"history message {i} has role {role!r}; expected user and assistant in turn"
+        if role == "assistant" and not isinstance(m.get("content"), str):
+            return f"history message {i}: the assistant's reply did not come back as text"
+    return None if len(middle) % 2 == 0 else "the history ends on a user message"
+
+
 def _check_tools(tools: Any) -> str | None:
     if tools is None:
         return None
@@ -124,9 +139,12 @@ def _check_shape(body: Any, headers: Any, script: Script) -> str | None:
     if msgs[0].get("role") != "system" or msgs[-1].get("role") != "user":
         return "roles must be system, (tool history,) user"
     problem = _check_tools(body.get("tools"))
-    problem = problem or _check_tool_history(
-        msgs[1:-1], script, bool(script.peek().get("new_episode"))
-    )
+    if script.chat_history:
+        problem = problem or _check_chat_history(msgs[1:-1])
+    else:
+        problem = problem or _check_tool_history(
+            msgs[1:-1], script, bool(script.peek().get("new_episode"))
+        )
     if problem:
         return problem
     content = msgs[-1].get("content")
@@ -138,7 +156,7 @@ def _check_shape(body: Any, headers: Any, script: Script) -> str | None:
             if not url.startswith("data:image/png;base64,iVBOR"):
                 return "image is not a base64 PNG data URL"
     for k in ("temperature", "top_p"):
-        if not isinstance(body.get(k), int | float):
+        if not script.chat_history and not isinstance(body.get(k), int | float):
             return f"missing {k}"
     if script.expect_key is not None and headers.get("Authorization") != (
         f"Bearer {script.expect_key}"
@@ -210,6 +228,7 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
                 self._send(401, json.dumps({"error": {"message": f"bad key {key}"}}).encode())
                 return
             answer, script.pending = chat_answer(entry, body["model"], number)
+            answer.setdefault("created", 0)  # as OpenAI sends it (strict clients require it)
             self._send(200, json.dumps(answer).encode())
 
     return Handler

@@ -1,0 +1,71 @@
+"""A chat harness that runs in-process: one chat completion per segment, no program to install.
+
+verifiers' built-in ``null`` harness launches a script under ``uv`` (which it may download);
+ours posts the conversation straight to the rollout's interception endpoint, which is all a
+harness must do (``Harness.launch``: "a harness may run its loop in-process ... as long as every
+model call goes through endpoint + secret"). It offers the model no tools: actions are text in
+the harness dialect, read by :class:`~chaingeo.integrations.game.Game`. Any other harness
+(``--env.agent.harness.id null``) plays the same environment.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import httpx
+import verifiers.v1 as vf
+from verifiers.v1.dialects.chat import message_to_wire
+from verifiers.v1.errors import MODEL_TRANSPORT_ERROR_EXIT_CODE
+from verifiers.v1.runtimes import ProgramResult
+
+#: Seconds one model call may take (a reasoning model's long answer included).
+REQUEST_TIMEOUT = 600.0
+
+
+class ChainGeoHarnessConfig(vf.HarnessConfig):  # type: ignore[misc]
+    """No knobs beyond verifiers' own: sampling and limits are the agent's config."""
+
+
+class ChainGeoHarness(vf.Harness[ChainGeoHarnessConfig]):  # type: ignore[misc]
+    """Relaunched on the whole conversation each segment (``SUPPORTS_RESUME``)."""
+
+    APPENDS_SYSTEM_PROMPT = True
+    SUPPORTS_RESUME = True
+    EXECUTES_CODE = False
+    NEEDS_CONTAINER = False
+
+    async def launch(
+        self,
+        ctx: Any,
+        trace: Any,
+        runtime: Any,
+        endpoint: str,
+        secret: str,
+        mcp_urls: dict[str, str],
+        data: Any,
+        tool_interception_url: str | None = None,
+    ) -> ProgramResult:
+        system, prompt = self.resolve_prompt(data)
+        messages = wire_messages(system, prompt)
+        body = {"model": ctx.model, "messages": messages}
+        url = endpoint.rstrip("/") + "/chat/completions"
+        headers = {"Authorization": f"Bearer {secret}"}
+        try:
+            async with httpx.AsyncClient(timeout=REQUEST_TIMEOUT) as client:
+                answer = await client.post(url, json=body, headers=headers)
+        except httpx.TransportError as e:
+            return ProgramResult(MODEL_TRANSPORT_ERROR_EXIT_CODE, "", f"{type(e).__name__}: {e}")
+        if answer.is_success:
+            return ProgramResult(0, "", "")
+        return ProgramResult(1, "", f"HTTP {answer.status_code}: {answer.text[-2000:]}")
+
+
+def wire_messages(system: str | None, prompt: Any) -> list[dict[str, Any]]:
+    """The chat-completions messages of a segment: the system prompt, then the conversation
+    (verifiers messages or wire dicts) or the prompt text."""
+    out: list[dict[str, Any]] = [{"role": "system", "content": system}] if system else []
+    if isinstance(prompt, str):
+        return [*out, {"role": "user", "content": prompt}]
+    for m in prompt or []:
+        out.append(m if isinstance(m, dict) else message_to_wire(m))
+    return out
