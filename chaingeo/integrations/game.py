@@ -94,6 +94,20 @@ def system_prompt(protocol: Protocol) -> str:
     return SYSTEM_PROMPT if protocol == "interactive" else ONESHOT_PROMPT
 
 
+def scores(o: Outcome | None) -> dict[str, float]:
+    """Every reward of an episode, by name (the names of :data:`DEFAULT_WEIGHTS`)."""
+    return {
+        "success": success_reward(o),
+        "efficiency": efficiency_reward(o),
+        "format": format_reward(o),
+    }
+
+
+def total_reward(o: Outcome | None, weights: dict[str, float] = DEFAULT_WEIGHTS) -> float:
+    """The weighted sum of :func:`scores`, as a framework adds them up."""
+    return sum(weights[k] * v for k, v in scores(o).items())
+
+
 class Game:
     """A level's state machine behind a chat: :meth:`opening`, then :meth:`answer` per reply."""
 
