@@ -4,6 +4,7 @@ played through chat messages, and the rewards read off their outcomes."""
 from __future__ import annotations
 
 import base64
+import json
 from functools import cache
 
 import pytest
@@ -13,8 +14,10 @@ from hypothesis import strategies as st
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.suite import shipped_levels
 from chaingeo.evaluation.agents.baselines import oracle_plan
-from chaingeo.integrations.game import Game, Outcome, efficiency_reward
+from chaingeo.evaluation.agents.tools import skipped_result, translate
+from chaingeo.integrations.game import Game, Outcome, Protocol, efficiency_reward
 from chaingeo.integrations.game import total_reward as total
+from tests.eval_support.plans import place_calls
 
 
 @cache
@@ -53,7 +56,7 @@ def test_wasted_turns_cost_efficiency_not_success(data: st.DataObject) -> None:
     texts += [f"<action>{a}</action>" for a in plan]
     assert play(game, texts) == len(texts)
     o = game.outcome()
-    assert (o.success, o.steps, o.replies, o.readable) == (True, len(texts), len(texts), len(texts))
+    assert (o.success, o.steps, o.actions, o.readable) == (True, len(texts), len(texts), len(texts))
     want = max(0.0, 1 - wasted / max(1, level.optimal_steps))
     assert efficiency_reward(o) == pytest.approx(want)
     assert total(o) == pytest.approx(0.5 + 0.4 * want + 0.1)
@@ -89,7 +92,7 @@ def test_oneshot_runs_one_plan_on_one_view(images: bool) -> None:
     nothing = Game(level, "oneshot", images=False)
     assert nothing.answer("I give up.") is None
     o = nothing.outcome()
-    assert (o.steps, o.replies, total(o)) == (0, 1, 0.0)
+    assert (o.steps, o.actions, total(o)) == (0, 1, 0.0)
 
 
 def test_interactive_turns_show_the_views_and_the_feedback() -> None:
@@ -98,7 +101,7 @@ def test_interactive_turns_show_the_views_and_the_feedback() -> None:
     assert len(images_of(game.opening())) >= 4  # front, side, top, iso (and the tray)
     nxt = game.answer("no tags here")
     assert nxt is not None
-    first = nxt["content"][0]["text"]
+    first = nxt[-1]["content"][0]["text"]
     assert "Feedback on your last reply: no <action>" in first
     assert f"Steps left: {level.max_steps - 1}" in first
 
@@ -118,3 +121,43 @@ def test_a_puzzle_is_played_the_same_way() -> None:
     plan = oracle_plan(level)
     assert play(game, [f"<action>{a}</action>" for a in plan]) == len(plan)
     assert total(game.outcome()) == pytest.approx(1.0)
+
+
+def as_calls(made: list[tuple[str, dict[str, object]]]) -> list[tuple[str, str, str]]:
+    return [(f"call_{i}", name, json.dumps(args)) for i, (name, args) in enumerate(made)]
+
+
+@settings(max_examples=10, deadline=None)
+@given(level=st.sampled_from(stacking()), protocol=st.sampled_from(["interactive", "oneshot"]))
+def test_the_optimal_plan_as_tool_calls(level: Level, protocol: Protocol) -> None:
+    """One reply calling every action of the plan solves the level, in both protocols; the
+    calls read as the very text of the plan."""
+    made = place_calls(level)
+    game = Game(level, protocol, images=False, tools=True)
+    assert [t["function"]["name"] for t in game.tools][-1] == "finish"
+    assert [translate(n, a, game.tools).action for _, n, a in as_calls(made)] == oracle_plan(level)
+    game.opening()
+    assert game.answer("", as_calls(made)) is None
+    assert total(game.outcome()) == pytest.approx(1.0)
+
+
+def test_calls_stop_at_the_first_rejected_one_and_each_gets_a_result() -> None:
+    level = next(lv for lv in stacking() if len(lv.pieces) >= 3)
+    first, *rest = place_calls(level)
+    clash = (rest[0][0], {**rest[0][1], "cells": first[1]["cells"]})  # where the first one is
+    game = Game(level, images=False, tools=True)
+    game.opening()
+    made = as_calls([first, clash, rest[1]])
+    nxt = game.answer("Three at once.", made)
+    assert nxt is not None
+    tool, _, skipped, _ = nxt
+    assert [m["role"] for m in nxt] == ["tool", "tool", "tool", "user"]
+    assert [m["tool_call_id"] for m in nxt[:3]] == [c[0] for c in made]
+    assert tool["content"].startswith("OK")
+    assert skipped["content"] == skipped_result(1)
+    o = game.outcome()
+    assert (o.steps, o.actions, o.readable) == (2, 2, 2)  # the third call was never played
+    # text is still read when a reply calls nothing, and a malformed call is unreadable
+    assert game.answer("<action>state</action>") is not None
+    assert game.answer("", [("c", "place", '{"piece": 3}')]) is not None
+    assert (game.outcome().actions, game.outcome().readable) == (4, 3)

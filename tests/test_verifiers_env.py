@@ -21,7 +21,8 @@ pytest.importorskip(
 from chaingeo.core.level import load_level
 from chaingeo.evaluation.agents.baselines import oracle_plan
 from chaingeo.integrations.verifiers import TASKSET_ID, load_environment
-from tests.eval_support.fake_openai import Script, fake_openai, reply
+from tests.eval_support.fake_openai import Script, calls, fake_openai, reply
+from tests.eval_support.plans import place_calls
 
 KEY_VAR = "CHAINGEO_TEST_KEY"
 EASY: dict[str, Any] = {"family": "stacking", "difficulty": "easy"}
@@ -114,6 +115,34 @@ def test_wasted_turns_and_reward_weights(tmp_path: Path, monkeypatch: pytest.Mon
     efficiency = max(0.0, 1 - 2 / len(plan))
     assert trace.rewards["efficiency"].score == pytest.approx(efficiency)
     assert trace.reward == pytest.approx(1.0 + 2.0 * efficiency)
+
+
+@pytest.mark.parametrize("protocol", ["interactive", "oneshot"])
+def test_the_optimal_plan_as_tool_calls(
+    protocol: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With ``tools`` the harness offers our action functions; interactive: a ``state`` call
+    first (a wasted step, its result sent back), then the plan's calls in one reply."""
+    [task] = load_environment("stacking", "easy", tools=True).taskset.take(1)
+    made = place_calls(load_level(task.data.level_path))
+    if protocol == "interactive":
+        entries = [calls(("state", {})), calls(*made, text="The rest at once.")]
+    else:
+        entries = [calls(*made)]
+    script = Script(entries=list(entries), chat_history=True)
+    [trace] = evaluate(
+        script, tmp_path, 1, monkeypatch, protocol=protocol, tools=True, images=False, **EASY
+    )
+    offered = [t["function"]["name"] for t in script.requests[0]["body"]["tools"]]
+    assert offered == (["place", "pickup", "state", "finish"] if protocol == "interactive" else
+                       ["place", "pickup", "finish"])  # fmt: skip
+    wasted = 1 if protocol == "interactive" else 0
+    assert trace.metrics["steps"] == len(made) + wasted
+    assert trace.reward == pytest.approx(0.5 + 0.4 * (1 - wasted / len(made)) + 0.1)
+    assert len(script.requests) == len(entries)
+    if protocol == "interactive":  # the call's result came back before the next observation
+        roles = [m["role"] for m in script.requests[1]["body"]["messages"]]
+        assert roles == ["system", "user", "assistant", "tool", "user"]
 
 
 def test_load_environment_checks_its_arguments() -> None:

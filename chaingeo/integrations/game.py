@@ -9,7 +9,10 @@ adapter (:mod:`chaingeo.integrations.verifiers`) only moves its messages.
 
 Protocols, as in :mod:`chaingeo.evaluation.episode`: ``interactive`` takes one action per reply
 (an unreadable reply still costs its step); ``oneshot`` shows one view once and runs the whole
-``<plan>`` of the first reply with no feedback.
+``<plan>`` of the first reply with no feedback. With ``tools`` the agent may also act by native
+tool calls (:mod:`chaingeo.evaluation.agents.tools`: one function per action kind, translated to
+action text): a reply's calls are played in order, each a step, stopping at the first one
+rejected, and each gets its ``tool`` result before the next observation.
 
 Rewards (each in [0, 1], computed from :class:`Outcome` as :mod:`chaingeo.evaluation.metrics`
 does for a run): :func:`success_reward`, :func:`efficiency_reward` (``1 - NormDist`` of this
@@ -18,24 +21,32 @@ episode when solved) and :func:`format_reward` (the share of replies the environ
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any, Final, Literal
 
+from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.observation import observe
+from chaingeo.envs.state import StepResult
 from chaingeo.evaluation.agents.prompt import (
     ONESHOT_PROMPT,
+    ONESHOT_TOOLS_PROMPT,
     SYSTEM_PROMPT,
+    TOOLS_PROMPT,
     extract_action,
     extract_plan,
     user_content,
 )
+from chaingeo.evaluation.agents.tools import skipped_result, tool_specs, translate
 from chaingeo.evaluation.episode import AUXILIARY_VIEWS
 
 Protocol = Literal["interactive", "oneshot"]
 PROTOCOLS: Final[tuple[Protocol, ...]] = ("interactive", "oneshot")
 Message = dict[str, Any]
+#: A native tool call as a model made it: id, function name, arguments (JSON text).
+Call = tuple[str, str, str]
 
 #: Default reward weights: an optimal, well-formed episode sums to 1, a nonsense one to 0.
 DEFAULT_WEIGHTS: Final[dict[str, float]] = {"success": 0.5, "efficiency": 0.4, "format": 0.1}
@@ -49,7 +60,7 @@ class Outcome:
     optimal_steps: int
     success: bool
     steps: int
-    replies: int
+    actions: int
     readable: int
     finished: bool
     truncated: bool
@@ -82,16 +93,24 @@ def efficiency_reward(o: Outcome | None) -> float:
 
 
 def format_reward(o: Outcome | None) -> float:
-    """The share of the agent's actions the environment could read (the action tag was there
-    and the action parsed, legal or not); 0 with no reply."""
-    if o is None or o.replies == 0:
+    """The share of the agent's actions the environment could read (the action tag or tool call
+    was there and the action parsed, legal or not); 0 with no action at all."""
+    if o is None or o.actions == 0:
         return 0.0
-    return o.readable / o.replies
+    return o.readable / o.actions
 
 
-def system_prompt(protocol: Protocol) -> str:
-    """The harness's system prompt for ``protocol`` (the text dialect: ``<action>``/``<plan>``)."""
-    return SYSTEM_PROMPT if protocol == "interactive" else ONESHOT_PROMPT
+def system_prompt(protocol: Protocol, tools: bool = False) -> str:
+    """The harness's system prompt for ``protocol`` (text dialect, or tools with text as a
+    fallback)."""
+    if protocol == "interactive":
+        return TOOLS_PROMPT if tools else SYSTEM_PROMPT
+    return ONESHOT_TOOLS_PROMPT if tools else ONESHOT_PROMPT
+
+
+def offered_tools(level: Level, protocol: Protocol) -> list[dict[str, Any]]:
+    """The functions offered for ``level`` (no ``state`` in one-shot: it sees no result)."""
+    return tool_specs(level, state=protocol == "interactive")
 
 
 def scores(o: Outcome | None) -> dict[str, float]:
@@ -118,13 +137,15 @@ class Game:
         images: bool = True,
         history_window: int = 5,
         oneshot_view: str = "iso",
+        tools: bool = False,
     ) -> None:
         if protocol not in PROTOCOLS:
             raise ValueError(f"unknown protocol {protocol!r}; use interactive or oneshot")
         self.level, self.protocol, self.images = level, protocol, images
         self.history_window, self.oneshot_view = history_window, oneshot_view
+        self.tools = offered_tools(level, protocol) if tools else []
         self.state = new_state(level)
-        self.replies = 0
+        self.actions = 0
         self.readable = 0
         self.over = False
 
@@ -142,31 +163,61 @@ class Game:
         s = self.state
         return bool(s.is_success() or s.is_truncated() or s.finished)
 
-    def _step(self, text: str) -> None:
+    def _step(self, text: str) -> StepResult:
+        """Play one action text (one step, whatever it was)."""
         result = self.state.step_text(text)
+        self.actions += 1
         self.readable += int(result.error != "unparseable")
+        return result
 
-    def answer(self, reply: str) -> Message | None:
-        """Play ``reply``; the next user turn, or None once the episode is over."""
+    def _calls(self, calls: Sequence[Call]) -> list[str]:
+        """The action text of each call (a malformed one reads as unparseable)."""
+        return [translate(name, args, self.tools).action for _, name, args in calls]
+
+    def answer(self, reply: str, calls: Sequence[Call] = ()) -> list[Message] | None:
+        """Play ``reply`` (its tool calls, when tools are offered and it made any, else its
+        text); the next user turn's messages, or None once the episode is over."""
         if self.over:
             raise RuntimeError("the episode is over")
+        calls = calls[: limits.MAX_TOOL_CALLS] if self.tools else ()
         if self.protocol == "oneshot":
-            actions, _ = extract_plan(reply)
-            for text in actions:
+            for text in self._calls(calls) if calls else extract_plan(reply)[0]:
                 if self._ended():
                     break
                 self._step(text)
-                self.replies += 1
-            self.replies = max(1, self.replies)  # no plan at all is one unreadable reply
+            self.actions = max(1, self.actions)  # no plan at all is one unreadable action
             self.over = True
             return None
+        if calls:
+            return self._play_calls(calls)
         action, note = extract_action(reply)
-        self.replies += 1
         self._step(action or "")
+        return self._next([], note)
+
+    def _play_calls(self, calls: Sequence[Call]) -> list[Message] | None:
+        """Each call in order until one is rejected (or the game ends); one ``tool`` message per
+        call, played or not, then the next observation."""
+        feedback: list[str] = []
+        legal = True
+        for text in self._calls(calls):
+            if self._ended() or not legal:
+                break
+            result = self._step(text)
+            feedback.append(result.feedback)
+            legal = result.legal
+        rejected = None if legal else len(feedback) - 1
+        skipped = "Not executed. Nothing changed." if rejected is None else skipped_result(rejected)
+        answers = [
+            {"role": "tool", "tool_call_id": cid, "content": (feedback + [skipped] * len(calls))[i]}
+            for i, (cid, _, _) in enumerate(calls)
+        ]
+        return self._next(answers, None)
+
+    def _next(self, before: list[Message], note: str | None) -> list[Message] | None:
         if self._ended():
             self.over = True
             return None
-        return self._user(note)
+        return [*before, self._user(note)]
 
     def outcome(self) -> Outcome:
         s = self.state
@@ -175,7 +226,7 @@ class Game:
             optimal_steps=self.level.optimal_steps,
             success=bool(s.is_success()),
             steps=int(s.steps_used),
-            replies=self.replies,
+            actions=self.actions,
             readable=self.readable,
             finished=bool(s.finished),
             truncated=bool(s.is_truncated()) and not s.is_success(),

@@ -39,8 +39,8 @@ class Script:
     expect_key: str | None = None
     refuse_tools: bool = False
     #: a chat that resends its whole conversation each turn (verifiers' harnesses): the messages
-    #: between the system prompt and the new turn alternate user and assistant, and the
-    #: sampling parameters are the caller's business
+    #: between the system prompt and the new turn alternate user and assistant (with the tool
+    #: results of any calls), and the sampling parameters are the caller's business
     chat_history: bool = False
     #: the calls of the last answer (id, name, arguments), which the next request must answer
     pending: list[tuple[str, str, str]] = field(default_factory=list)
@@ -101,14 +101,27 @@ def _check_tool_history(middle: list[Any], script: Script, fresh: bool) -> str |
 
 
 def _check_chat_history(middle: list[Any]) -> str | None:
-    """Earlier turns, oldest first: user, assistant, user, assistant, ... (assistant text)."""
+    """Earlier turns, oldest first: user, assistant, user, ...; an assistant message that made
+    tool calls (its content may then be null) is followed by one ``tool`` message per call, in
+    order, before the next user message."""
+    expect: list[str] = ["user"]  # the roles (or tool call ids) the next message may take
     for i, m in enumerate(middle):
         role = m.get("role") if isinstance(m, dict) else None
-        if role != ("user", "assistant")[i % 2]:
-            return f"history message {i} has role {role!r}; expected user and assistant in turn"
-        if role == "assistant" and not isinstance(m.get("content"), str):
+        if role == "tool" and expect and expect[0] not in ("user", "assistant"):
+            if m.get("tool_call_id") != expect.pop(0) or not isinstance(m.get("content"), str):
+                return f"history message {i}: a tool result out of order or without text"
+            expect = expect or ["user"]
+            continue
+        if role != expect[0]:
+            return f"history message {i} has role {role!r}; expected {expect[0]!r}"
+        if role == "user":
+            expect = ["assistant"]
+            continue
+        calls = m.get("tool_calls") or []
+        if not calls and not isinstance(m.get("content"), str):
             return f"history message {i}: the assistant's reply did not come back as text"
-    return None if len(middle) % 2 == 0 else "the history ends on a user message"
+        expect = [c.get("id") for c in calls] or ["user"]
+    return None if expect == ["user"] else "the history ends before its turn is answered"
 
 
 def _check_tools(tools: Any) -> str | None:

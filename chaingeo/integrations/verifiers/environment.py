@@ -15,7 +15,7 @@ from typing import Any, Literal
 
 import verifiers.v1 as vf
 
-from chaingeo.integrations.game import DEFAULT_WEIGHTS
+from chaingeo.integrations.game import DEFAULT_WEIGHTS, Call
 from chaingeo.integrations.verifiers.harness import ChainGeoHarnessConfig
 from chaingeo.integrations.verifiers.taskset import INFO_KEY, TASKSET_ID, ChainGeoConfig
 
@@ -35,13 +35,20 @@ class ChainGeoEnv(vf.Env[ChainGeoEnvConfig]):  # type: ignore[misc]
         # The task carries no prompt: the first observation is rendered here, so the
         # environment opens the exchange.
         async with agents.agent.interaction(task) as interaction:
-            message: dict[str, Any] | None = game.opening()
-            while message is not None:
-                segment = await interaction.turn([message])
+            messages: list[dict[str, Any]] | None = [game.opening()]
+            while messages is not None:
+                segment = await interaction.turn(messages)
                 if segment.terminated:  # a limit or a stop ended the run first
                     break
-                message = game.answer(segment.last_reply)
+                messages = game.answer(segment.last_reply, calls_of(segment.messages))
             interaction.trace.info[INFO_KEY] = game.outcome().to_json()
+
+
+def calls_of(messages: Any) -> list[Call]:
+    """The tool calls of a segment's last assistant message (id, name, argument text)."""
+    replies = [m for m in messages if getattr(m, "role", None) == "assistant"]
+    made = (replies[-1].tool_calls or []) if replies else []
+    return [(str(c.id), str(c.name), str(c.arguments)) for c in made]
 
 
 def load_environment(
@@ -53,12 +60,14 @@ def load_environment(
     reward: Mapping[str, float] | None = None,
     level_dir: str | None = None,
     history_window: int = 5,
+    tools: bool = False,
     harness: str | None = None,
 ) -> Any:
     """A :class:`ChainGeoEnv` over the chosen levels (the shipped suite's ``split``, or the
     files in ``level_dir``). ``reward`` overrides the weights of ``success``, ``efficiency``
-    and ``format`` (default :data:`~chaingeo.integrations.game.DEFAULT_WEIGHTS`); ``harness``
-    names another verifiers harness than ours (e.g. ``null``)."""
+    and ``format`` (default :data:`~chaingeo.integrations.game.DEFAULT_WEIGHTS`); ``tools``
+    offers the actions as native tool calls too; ``harness`` names another verifiers harness
+    than ours (e.g. ``null``, text only)."""
     weights = dict(reward or {})
     unknown = sorted(set(weights) - set(DEFAULT_WEIGHTS))
     if unknown:
@@ -73,6 +82,7 @@ def load_environment(
         protocol=protocol,
         level_dir=level_dir,
         history_window=history_window,
+        tools=tools,
         task=task,
     )
     seat = vf.AgentConfig(runtime=vf.SubprocessConfig())

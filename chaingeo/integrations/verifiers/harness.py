@@ -3,9 +3,10 @@
 verifiers' built-in ``null`` harness launches a script under ``uv`` (which it may download);
 ours posts the conversation straight to the rollout's interception endpoint, which is all a
 harness must do (``Harness.launch``: "a harness may run its loop in-process ... as long as every
-model call goes through endpoint + secret"). It offers the model no tools: actions are text in
-the harness dialect, read by :class:`~chaingeo.integrations.game.Game`. Any other harness
-(``--env.agent.harness.id null``) plays the same environment.
+model call goes through endpoint + secret"). It offers the model the task's own tools (our
+action functions, when the taskset has ``tools``) and no MCP servers: the environment reads the
+calls and answers each with a ``tool`` message (:class:`~chaingeo.integrations.game.Game`).
+Any other harness (``--env.agent.harness.id null``) plays the same environment in text.
 """
 
 from __future__ import annotations
@@ -47,7 +48,10 @@ class ChainGeoHarness(vf.Harness[ChainGeoHarnessConfig]):  # type: ignore[misc]
     ) -> ProgramResult:
         system, prompt = self.resolve_prompt(data)
         messages = wire_messages(system, prompt)
-        body = {"model": ctx.model, "messages": messages}
+        body: dict[str, Any] = {"model": ctx.model, "messages": messages}
+        tools = getattr(data, "tools", None)
+        if tools:
+            body["tools"] = tools
         url = endpoint.rstrip("/") + "/chat/completions"
         headers = {"Authorization": f"Bearer {secret}"}
         try:

@@ -25,6 +25,7 @@ from chaingeo.integrations.game import (
     Outcome,
     efficiency_reward,
     format_reward,
+    offered_tools,
     success_reward,
     system_prompt,
 )
@@ -48,6 +49,8 @@ class ChainGeoConfig(vf.TasksetConfig):  # type: ignore[misc]
     images: bool = True
     protocol: Literal["interactive", "oneshot"] = "interactive"
     history_window: int = 5
+    tools: bool = False
+    """Offer the actions as native tool calls too (text ``<action>`` stays accepted)."""
 
 
 class ChainGeoData(vf.TaskData):  # type: ignore[misc]
@@ -61,6 +64,8 @@ class ChainGeoData(vf.TaskData):  # type: ignore[misc]
     protocol: Literal["interactive", "oneshot"] = "interactive"
     images: bool = True
     history_window: int = 5
+    tools: list[dict[str, Any]] | None = None
+    """The functions the harness offers the model (OpenAI tool specs), or None for text only."""
 
 
 def outcome_of(trace: Any) -> Outcome | None:
@@ -74,7 +79,7 @@ class ChainGeoTask(vf.Task[ChainGeoData, vf.State, vf.TaskConfig]):  # type: ign
     def game(self) -> Game:
         d: ChainGeoData = self.data
         level = load_level(d.level_path)
-        return Game(level, d.protocol, d.images, d.history_window)
+        return Game(level, d.protocol, d.images, d.history_window, tools=d.tools is not None)
 
     @reward(weight=DEFAULT_WEIGHTS["success"])
     async def success(self, trace: Any) -> float:
@@ -139,7 +144,8 @@ class ChainGeoTaskset(vf.Taskset[ChainGeoTask, ChainGeoConfig]):  # type: ignore
                     protocol=cfg.protocol,
                     images=cfg.images,
                     history_window=cfg.history_window,
-                    system_prompt=system_prompt(cfg.protocol),
+                    tools=offered_tools(level, cfg.protocol) if cfg.tools else None,
+                    system_prompt=system_prompt(cfg.protocol, cfg.tools),
                 ),
                 cfg.task,
             )
