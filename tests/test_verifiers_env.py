@@ -156,6 +156,19 @@ def test_load_environment_checks_its_arguments() -> None:
         load_environment(reward={"speed": 1.0})
     with pytest.raises(ValueError):
         load_environment(protocol="telepathy")  # type: ignore[arg-type]
+    with pytest.raises(ValueError):
+        load_environment(history_window=-1)
+
+
+def test_a_folder_of_levels_and_an_empty_selection(tmp_path: Path) -> None:
+    from chaingeo.core.level import LevelError, save_level
+
+    [task] = load_environment("stacking", "hard").taskset.take(1)
+    save_level(load_level(task.data.level_path), tmp_path / "mine" / "one.json")
+    [mine] = load_environment(level_dir=str(tmp_path / "mine")).taskset
+    assert (mine.data.id, mine.data.difficulty) == (task.data.id, "hard")
+    with pytest.raises(LevelError, match="no level matches family any, difficulty easy"):
+        list(load_environment(level_dir=str(tmp_path / "mine"), difficulty="easy").taskset)
 
 
 @pytest.mark.slow

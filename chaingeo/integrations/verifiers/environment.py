@@ -10,6 +10,7 @@ outcome goes on the trace before it closes, where the task's rewards read it.
 
 from __future__ import annotations
 
+import asyncio
 from collections.abc import Mapping
 from typing import Any, Literal
 
@@ -31,16 +32,18 @@ class ChainGeoEnv(vf.Env[ChainGeoEnvConfig]):  # type: ignore[misc]
     """An episode is one level played against the agent, our state machine answering."""
 
     async def run(self, task: Any, agents: Any) -> None:
-        game = task.game()
-        # The task carries no prompt: the first observation is rendered here, so the
-        # environment opens the exchange.
+        # Stepping and drawing run in a worker thread: the interception server of every
+        # rollout shares this event loop. The task carries no prompt: the first observation is
+        # rendered here, so the environment opens the exchange.
+        game = await asyncio.to_thread(task.game)
         async with agents.agent.interaction(task) as interaction:
-            messages: list[dict[str, Any]] | None = [game.opening()]
+            messages: list[dict[str, Any]] | None = [await asyncio.to_thread(game.opening)]
             while messages is not None:
                 segment = await interaction.turn(messages)
                 if segment.terminated:  # a limit or a stop ended the run first
                     break
-                messages = game.answer(segment.last_reply, calls_of(segment.messages))
+                calls = calls_of(segment.messages)
+                messages = await asyncio.to_thread(game.answer, segment.last_reply, calls)
             interaction.trace.info[INFO_KEY] = game.outcome().to_json()
 
 

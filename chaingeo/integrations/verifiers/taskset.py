@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import verifiers.v1 as vf
+from pydantic import Field
 
 from chaingeo.core.level import Level, LevelError, load_level
 from chaingeo.core.suite import FAMILIES, shipped_levels
@@ -48,7 +49,8 @@ class ChainGeoConfig(vf.TasksetConfig):  # type: ignore[misc]
     """A folder of level files (e.g. from ``chain generate``) instead of the shipped suite."""
     images: bool = True
     protocol: Literal["interactive", "oneshot"] = "interactive"
-    history_window: int = 5
+    history_window: int = Field(5, ge=0)
+    """Past turns shown in each observation (interactive)."""
     tools: bool = False
     """Offer the actions as native tool calls too (text ``<action>`` stays accepted)."""
 
@@ -123,6 +125,9 @@ def select_levels(config: ChainGeoConfig) -> list[tuple[Path, Level]]:
         for p, lv in found
         if config.family in (None, lv.family) and config.difficulty in (None, lv.difficulty)
     ]
+    if not keep:
+        wanted = f"family {config.family or 'any'}, difficulty {config.difficulty or 'any'}"
+        raise LevelError(str(folders[0]), "levels", f"no level matches {wanted}")
     return sorted(keep, key=lambda item: item[1].id)
 
 
