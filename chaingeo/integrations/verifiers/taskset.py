@@ -43,12 +43,17 @@ class ChainGeoConfig(vf.TasksetConfig):  # type: ignore[misc]
     """Which levels, and how they are played (``--env.taskset.*``)."""
 
     family: Literal["puzzle", "stacking"] | None = None
+    """Only this family's levels (None: both)."""
     difficulty: Literal["easy", "mid", "hard"] | None = None
+    """Only this tier (None: all)."""
     split: Literal["test"] = "test"
+    """The shipped suite is the test split (training splits: a ``level_dir``)."""
     level_dir: str | None = None
     """A folder of level files (e.g. from ``chain generate``) instead of the shipped suite."""
     images: bool = True
+    """Send the rendered views as image parts (False: text only)."""
     protocol: Literal["interactive", "oneshot"] = "interactive"
+    """One action per turn with feedback, or one whole plan from one view."""
     history_window: int = Field(5, ge=0)
     """Past turns shown in each observation (interactive)."""
     tools: bool = False
