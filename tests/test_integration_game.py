@@ -15,7 +15,7 @@ from chaingeo.core.level import Level, load_levels
 from chaingeo.core.suite import shipped_levels
 from chaingeo.evaluation.agents.baselines import oracle_plan
 from chaingeo.evaluation.agents.tools import skipped_result, translate
-from chaingeo.integrations.game import Game, Outcome, Protocol, efficiency_reward
+from chaingeo.integrations.game import Game, Outcome, Protocol, efficiency_reward, recent
 from chaingeo.integrations.game import total_reward as total
 from tests.eval_support.plans import place_calls
 
@@ -161,3 +161,26 @@ def test_calls_stop_at_the_first_rejected_one_and_each_gets_a_result() -> None:
     assert game.answer("<action>state</action>") is not None
     assert game.answer("", [("c", "place", '{"piece": 3}')]) is not None
     assert (game.outcome().actions, game.outcome().readable) == (4, 3)
+
+
+def test_recent_keeps_the_latest_observation_and_the_last_tool_exchange() -> None:
+    level = stacking()[0]
+    game = Game(level, tools=True)
+    said = [game.opening()]
+    said.append({"role": "assistant", "content": "<action>state</action>"})
+    nxt = game.answer("<action>state</action>")
+    assert nxt is not None
+    said += nxt
+    assert recent(said) == said[-1:]  # a text reply: the new observation says what it did
+    made = as_calls(place_calls(level)[:1])
+    said.append({"role": "assistant", "content": None, "tool_calls": made})
+    nxt = game.answer("", made)
+    assert nxt is not None
+    said += nxt
+    shown = recent(said)
+    assert [m["role"] for m in shown] == ["user", "assistant", "tool", "user"]
+    assert shown[1:] == said[-3:]
+    # the observation the calls answered, without its pictures
+    assert [p["type"] for p in shown[0]["content"]] == ["text"]
+    assert shown[0]["content"][0] == said[2]["content"][0]
+    assert len(images_of(said[2])) >= 4 and len(images_of(shown[-1])) >= 4

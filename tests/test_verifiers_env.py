@@ -35,18 +35,27 @@ def plans(limit: int, **taskset: Any) -> list[list[str]]:
 
 
 def evaluate(
-    script: Script, tmp_path: Path, limit: int, monkeypatch: pytest.MonkeyPatch, **taskset: Any
+    script: Script,
+    tmp_path: Path,
+    limit: int,
+    monkeypatch: pytest.MonkeyPatch,
+    agent: dict[str, Any] | None = None,
+    **taskset: Any,
 ) -> list[Any]:
     """verifiers' eval runner over the first ``limit`` tasks, one episode at a time (the
-    script is one sequence of answers); the traces, in task order."""
+    script is one sequence of answers), ``agent`` configuring the seat; the traces, in task
+    order."""
     from verifiers.v1.cli.eval.runner import run_eval
     from verifiers.v1.configs.cli.eval import EvalConfig
 
     monkeypatch.setenv(KEY_VAR, "sk-test")
+    env: dict[str, Any] = {"taskset": {"id": TASKSET_ID, **taskset}}
+    if agent is not None:
+        env["agent"] = agent
     with fake_openai(script) as url:
         config = EvalConfig.model_validate(
             {
-                "env": {"taskset": {"id": TASKSET_ID, **taskset}},
+                "env": env,
                 "model": "fake-model",
                 "client": {"base_url": url, "api_key_var": KEY_VAR},
                 "select": {"limit": limit},
@@ -96,10 +105,27 @@ def test_nonsense_scores_zero(
     outcome = trace.info["chaingeo"]
     assert outcome["success"] is False and outcome["readable"] == 0
     assert len(script.requests) == (budget if protocol == "interactive" else 1)
-    # the conversation grows by one exchange a turn and carries no pictures
-    last = script.requests[-1]["body"]["messages"]
-    assert len(last) == 1 + 2 * len(script.requests) - 1
-    assert all(isinstance(m["content"], str) or len(m["content"]) == 1 for m in last[1:])
+    # the model sees the latest observation only (its text keeps the last turns), no pictures
+    assert all(len(r["body"]["messages"]) == 2 for r in script.requests)
+    last = script.requests[-1]["body"]["messages"][-1]["content"]
+    assert [p["type"] for p in last] == ["text"]
+    if protocol == "interactive":
+        assert "Recent turns:" in last[0]["text"] and "Steps left: 1" in last[0]["text"]
+
+
+def test_the_whole_conversation_on_request(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """``context full``: each request resends every turn, pictures included."""
+    script = Script(entries=[reply("Hmm.")] * 3 + [reply("<action>finish</action>")])
+    script.chat_history = True
+    agent = {"harness": {"id": TASKSET_ID, "context": "full"}}
+    evaluate(script, tmp_path, 1, monkeypatch, agent=agent, **EASY)
+    sizes = [len(r["body"]["messages"]) for r in script.requests]
+    assert sizes == [2, 4, 6, 8]
+    pictures = [
+        sum(isinstance(m["content"], list) and "image_url" in str(m["content"]) for m in body)
+        for body in (r["body"]["messages"] for r in script.requests)
+    ]
+    assert pictures == [1, 2, 3, 4]
 
 
 def test_wasted_turns_and_reward_weights(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -127,6 +127,28 @@ def total_reward(o: Outcome | None, weights: dict[str, float] = DEFAULT_WEIGHTS)
     return sum(weights[k] * v for k, v in scores(o).items())
 
 
+def recent(conversation: Sequence[Message]) -> list[Message]:
+    """What a model is shown of a conversation, as :mod:`chaingeo.evaluation` shows it: the
+    latest observation (which carries the recent turns as text), preceded, when the last reply
+    made tool calls, by that reply and its tool results and the observation it answered, the
+    latter without its pictures."""
+    asked = [i for i, m in enumerate(conversation) if m.get("role") == "assistant"]
+    if not asked or not conversation[asked[-1]].get("tool_calls"):
+        return list(conversation[-1:])
+    start = asked[-1]
+    before = [m for m in conversation[:start] if m.get("role") == "user"][-1:]
+    return [*(_text_only(m) for m in before), *conversation[start:]]
+
+
+def _text_only(message: Message) -> Message:
+    content = message.get("content")
+    if not isinstance(content, list):
+        return message
+    texts = [p for p in content if p.get("type") == "text"]
+    kept = [p for p in texts if not str(p.get("text", "")).startswith("View: ")]
+    return {**message, "content": kept or texts}
+
+
 class Game:
     """A level's state machine behind a chat: :meth:`opening`, then :meth:`answer` per reply."""
 

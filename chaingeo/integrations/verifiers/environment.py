@@ -64,13 +64,15 @@ def load_environment(
     level_dir: str | None = None,
     history_window: int = 5,
     tools: bool = False,
+    context: Literal["recent", "full"] = "recent",
     harness: str | None = None,
 ) -> Any:
     """A :class:`ChainGeoEnv` over the chosen levels (the shipped suite's ``split``, or the
     files in ``level_dir``). ``reward`` overrides the weights of ``success``, ``efficiency``
     and ``format`` (default :data:`~chaingeo.integrations.game.DEFAULT_WEIGHTS`); ``tools``
-    offers the actions as native tool calls too; ``harness`` names another verifiers harness
-    than ours (e.g. ``null``, text only)."""
+    offers the actions as native tool calls too; ``context`` is what our harness shows the
+    model (:class:`~chaingeo.integrations.verifiers.harness.ChainGeoHarnessConfig`);
+    ``harness`` names another verifiers harness than ours (e.g. ``null``, text only)."""
     weights = dict(reward or {})
     unknown = sorted(set(weights) - set(DEFAULT_WEIGHTS))
     if unknown:
@@ -88,15 +90,13 @@ def load_environment(
         tools=tools,
         task=task,
     )
-    seat = vf.AgentConfig(runtime=vf.SubprocessConfig())
-    if harness:
-        seat = seat.model_copy(update={"harness": _harness(harness)})
+    seat = vf.AgentConfig(runtime=vf.SubprocessConfig(), harness=_harness(harness, context))
     return ChainGeoEnv(ChainGeoEnvConfig(taskset=taskset, agent=seat))
 
 
-def _harness(name: str) -> Any:
-    if name == TASKSET_ID:
-        return ChainGeoHarnessConfig(id=name)
+def _harness(name: str | None, context: str) -> Any:
+    if name in (None, TASKSET_ID):
+        return ChainGeoHarnessConfig(id=TASKSET_ID, context=context)
     from verifiers.v1.utils.loaders import harness_config_type
 
     return harness_config_type(name)(id=name)

@@ -11,7 +11,7 @@ Any other harness (``--env.agent.harness.id null``) plays the same environment i
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 import httpx
 import verifiers.v1 as vf
@@ -19,12 +19,19 @@ from verifiers.v1.dialects.chat import message_to_wire
 from verifiers.v1.errors import MODEL_TRANSPORT_ERROR_EXIT_CODE
 from verifiers.v1.runtimes import ProgramResult
 
+from chaingeo.integrations.game import recent
+
 #: Seconds one model call may take (a reasoning model's long answer included).
 REQUEST_TIMEOUT = 600.0
 
 
 class ChainGeoHarnessConfig(vf.HarnessConfig):  # type: ignore[misc]
-    """No knobs beyond verifiers' own: sampling and limits are the agent's config."""
+    """What the model is shown; sampling and limits are the agent's config."""
+
+    context: Literal["recent", "full"] = "recent"
+    """``recent``: the latest observation only (its text keeps the last turns), plus the last
+    reply's tool exchange, as ``chain eval`` asks; ``full``: the whole conversation, every
+    turn's pictures included (long levels then outgrow a model's context)."""
 
 
 class ChainGeoHarness(vf.Harness[ChainGeoHarnessConfig]):  # type: ignore[misc]
@@ -47,7 +54,7 @@ class ChainGeoHarness(vf.Harness[ChainGeoHarnessConfig]):  # type: ignore[misc]
         tool_interception_url: str | None = None,
     ) -> ProgramResult:
         system, prompt = self.resolve_prompt(data)
-        messages = wire_messages(system, prompt)
+        messages = wire_messages(system, prompt, self.config.context == "recent")
         body: dict[str, Any] = {"model": ctx.model, "messages": messages}
         tools = getattr(data, "tools", None)
         if tools:
@@ -64,12 +71,12 @@ class ChainGeoHarness(vf.Harness[ChainGeoHarnessConfig]):  # type: ignore[misc]
         return ProgramResult(1, "", f"HTTP {answer.status_code}: {answer.text[-2000:]}")
 
 
-def wire_messages(system: str | None, prompt: Any) -> list[dict[str, Any]]:
+def wire_messages(system: str | None, prompt: Any, window: bool = True) -> list[dict[str, Any]]:
     """The chat-completions messages of a segment: the system prompt, then the conversation
-    (verifiers messages or wire dicts) or the prompt text."""
+    (verifiers messages or wire dicts; only its :func:`~chaingeo.integrations.game.recent`
+    part with ``window``) or the prompt text."""
     out: list[dict[str, Any]] = [{"role": "system", "content": system}] if system else []
     if isinstance(prompt, str):
         return [*out, {"role": "user", "content": prompt}]
-    for m in prompt or []:
-        out.append(m if isinstance(m, dict) else message_to_wire(m))
-    return out
+    said = [m if isinstance(m, dict) else message_to_wire(m) for m in prompt or []]
+    return [*out, *(recent(said) if window else said)]
