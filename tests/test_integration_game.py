@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from chaingeo.core import limits
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.suite import shipped_levels
 from chaingeo.evaluation.agents.baselines import oracle_plan
@@ -184,3 +185,18 @@ def test_recent_keeps_the_latest_observation_and_the_last_tool_exchange() -> Non
     assert [p["type"] for p in shown[0]["content"]] == ["text"]
     assert shown[0]["content"][0] == said[2]["content"][0]
     assert len(images_of(said[2])) >= 4 and len(images_of(shown[-1])) >= 4
+
+
+def test_every_call_is_answered_even_past_the_limit() -> None:
+    """A rejected first call skips the rest, and each of them, past the limit too, is
+    answered (the chat protocol wants it); only the first was played."""
+    level = stacking()[0]
+    game = Game(level, images=False, tools=True)
+    game.opening()
+    unplaced = json.dumps({"piece": level.pieces[0].name})
+    made = [(f"c{i}", "pickup", unplaced) for i in range(limits.MAX_TOOL_CALLS + 3)]
+    nxt = game.answer("", made)
+    assert nxt is not None
+    assert [m.get("tool_call_id") for m in nxt[:-1]] == [c[0] for c in made]
+    assert nxt[1]["content"] == skipped_result(0)
+    assert game.outcome().steps == 1

@@ -201,9 +201,10 @@ class Game:
         text); the next user turn's messages, or None once the episode is over."""
         if self.over:
             raise RuntimeError("the episode is over")
-        calls = calls[: limits.MAX_TOOL_CALLS] if self.tools else ()
+        calls = calls if self.tools else ()
         if self.protocol == "oneshot":
-            for text in self._calls(calls) if calls else extract_plan(reply)[0]:
+            plan = self._calls(calls[: limits.MAX_TOOL_CALLS]) if calls else extract_plan(reply)[0]
+            for text in plan:
                 if self._ended():
                     break
                 self._step(text)
@@ -217,11 +218,12 @@ class Game:
         return self._next([], note)
 
     def _play_calls(self, calls: Sequence[Call]) -> list[Message] | None:
-        """Each call in order until one is rejected (or the game ends); one ``tool`` message per
-        call, played or not, then the next observation."""
+        """Each call in order until one is rejected (or the game ends; at most
+        :data:`~chaingeo.core.limits.MAX_TOOL_CALLS`); one ``tool`` message per call, played or
+        not (the chat protocol wants every call answered), then the next observation."""
         feedback: list[str] = []
         legal = True
-        for text in self._calls(calls):
+        for text in self._calls(calls[: limits.MAX_TOOL_CALLS]):
             if self._ended() or not legal:
                 break
             result = self._step(text)
