@@ -66,7 +66,7 @@ def load_environment(
     tools: bool = False,
     context: Literal["recent", "full"] = "recent",
     harness: str | None = None,
-) -> Any:
+) -> ChainGeoEnv:
     """A :class:`ChainGeoEnv` over the chosen levels (the shipped suite's ``split``, or the
     files in ``level_dir``). ``reward`` overrides the weights of ``success``, ``efficiency``
     and ``format`` (default :data:`~chaingeo.integrations.game.DEFAULT_WEIGHTS`); ``tools``

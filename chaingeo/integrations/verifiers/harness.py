@@ -35,7 +35,8 @@ class ChainGeoHarnessConfig(vf.HarnessConfig):  # type: ignore[misc]
 
 
 class ChainGeoHarness(vf.Harness[ChainGeoHarnessConfig]):  # type: ignore[misc]
-    """Relaunched on the whole conversation each segment (``SUPPORTS_RESUME``)."""
+    """Relaunched each segment on the conversation so far (``SUPPORTS_RESUME``), of which it
+    sends what its ``context`` says."""
 
     APPENDS_SYSTEM_PROMPT = True
     SUPPORTS_RESUME = True
