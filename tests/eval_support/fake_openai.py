@@ -38,6 +38,10 @@ class Script:
     problems: list[str] = field(default_factory=list)
     expect_key: str | None = None
     refuse_tools: bool = False
+    #: a chat that resends its whole conversation each turn (verifiers' harnesses): the messages
+    #: between the system prompt and the new turn alternate user and assistant (with the tool
+    #: results of any calls), and the sampling parameters are the caller's business
+    chat_history: bool = False
     #: the calls of the last answer (id, name, arguments), which the next request must answer
     pending: list[tuple[str, str, str]] = field(default_factory=list)
     lock: threading.Lock = field(default_factory=threading.Lock)
@@ -96,6 +100,30 @@ def _check_tool_history(middle: list[Any], script: Script, fresh: bool) -> str |
     return None
 
 
+def _check_chat_history(middle: list[Any]) -> str | None:
+    """Earlier turns, oldest first: user, assistant, user, ...; an assistant message that made
+    tool calls (its content may then be null) is followed by one ``tool`` message per call, in
+    order, before the next user message."""
+    expect: list[str] = ["user"]  # the roles (or tool call ids) the next message may take
+    for i, m in enumerate(middle):
+        role = m.get("role") if isinstance(m, dict) else None
+        if role == "tool" and expect and expect[0] not in ("user", "assistant"):
+            if m.get("tool_call_id") != expect.pop(0) or not isinstance(m.get("content"), str):
+                return f"history message {i}: a tool result out of order or without text"
+            expect = expect or ["user"]
+            continue
+        if role != expect[0]:
+            return f"history message {i} has role {role!r}; expected {expect[0]!r}"
+        if role == "user":
+            expect = ["assistant"]
+            continue
+        calls = m.get("tool_calls") or []
+        if not calls and not isinstance(m.get("content"), str):
+            return f"history message {i}: the assistant's reply did not come back as text"
+        expect = [c.get("id") for c in calls] or ["user"]
+    return None if expect == ["user"] else "the history ends before its turn is answered"
+
+
 def _check_tools(tools: Any) -> str | None:
     if tools is None:
         return None
@@ -124,9 +152,12 @@ def _check_shape(body: Any, headers: Any, script: Script) -> str | None:
     if msgs[0].get("role") != "system" or msgs[-1].get("role") != "user":
         return "roles must be system, (tool history,) user"
     problem = _check_tools(body.get("tools"))
-    problem = problem or _check_tool_history(
-        msgs[1:-1], script, bool(script.peek().get("new_episode"))
-    )
+    if script.chat_history:
+        problem = problem or _check_chat_history(msgs[1:-1])
+    else:
+        problem = problem or _check_tool_history(
+            msgs[1:-1], script, bool(script.peek().get("new_episode"))
+        )
     if problem:
         return problem
     content = msgs[-1].get("content")
@@ -138,7 +169,7 @@ def _check_shape(body: Any, headers: Any, script: Script) -> str | None:
             if not url.startswith("data:image/png;base64,iVBOR"):
                 return "image is not a base64 PNG data URL"
     for k in ("temperature", "top_p"):
-        if not isinstance(body.get(k), int | float):
+        if not script.chat_history and not isinstance(body.get(k), int | float):
             return f"missing {k}"
     if script.expect_key is not None and headers.get("Authorization") != (
         f"Bearer {script.expect_key}"
@@ -210,6 +241,7 @@ def _make_handler(script: Script) -> type[BaseHTTPRequestHandler]:
                 self._send(401, json.dumps({"error": {"message": f"bad key {key}"}}).encode())
                 return
             answer, script.pending = chat_answer(entry, body["model"], number)
+            answer.setdefault("created", 0)  # as OpenAI sends it (strict clients require it)
             self._send(200, json.dumps(answer).encode())
 
     return Handler
