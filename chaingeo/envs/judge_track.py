@@ -1,0 +1,270 @@
+"""Pieces tracked over a video's frames, and the changes no rigid piece can make.
+
+Per frame, each colour class's components are grouped into objects: two components of one
+colour are one piece seen round an occluder when the straight gap between their nearest points
+is mostly covered by other pieces (a beam behind a crossing beam shows as two parts); a gap of
+background between them is a break. Objects are compared frame to frame by the overlap of
+their (slightly grown) masks.
+
+Temporal smoothing: a class's object count is median-filtered over :data:`WINDOW` frames, so a
+single noisy frame changes nothing; an identity change must persist for :data:`PERSIST` frames.
+A piece that enters or leaves through the picture's border is not a violation (our own videos
+carry removed pieces out of the picture), and a piece that disappears behind another, which
+keeps its area, is reported as undecided rather than lost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Final
+
+import numpy as np
+
+from chaingeo.envs.judge_segment import BoolArray, components, dilate
+
+#: Frames of the median filter over object counts (odd), and frames an identity change must
+#: hold.
+WINDOW: Final = 5
+PERSIST: Final = 3
+#: Share of the gap between two same-coloured parts that other pieces must cover for the parts
+#: to count as one occluded piece.
+OCCLUDED_GAP: Final = 0.6
+#: Growth (share of the frame's longer side) of a mask when matching across one frame.
+MOTION_SHARE: Final = 0.03
+
+
+@dataclass(frozen=True)
+class Obj:
+    """One piece as seen in one frame: its colour class (0-based), pixels and parts."""
+
+    cls: int
+    mask: BoolArray
+    parts: int
+
+    @property
+    def area(self) -> int:
+        return int(self.mask.sum())
+
+    def touches_border(self) -> bool:
+        m = self.mask
+        return bool(m[0].any() or m[-1].any() or m[:, 0].any() or m[:, -1].any())
+
+
+@dataclass(frozen=True)
+class Event:
+    """A change between frames ``frame - 1`` and ``frame``: a violation kind (lost, added,
+    split, merge, recolor), or a note (entered, left, hidden)."""
+
+    kind: str
+    frame: int
+    piece: str
+    other: str | None = None
+    detail: str = ""
+    masks: tuple[BoolArray, ...] = field(default=(), compare=False, repr=False)
+
+
+VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "pass_through")
+
+
+def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
+    edge = mask & ~(
+        np.roll(mask, 1, 0) & np.roll(mask, -1, 0) & np.roll(mask, 1, 1) & np.roll(mask, -1, 1)
+    )
+    pts = np.argwhere(edge if edge.any() else mask)
+    step = max(1, len(pts) // limit)
+    return pts[::step]
+
+
+def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
+    """Whether the straight gap between the nearest points of ``a`` and ``b`` lies mostly on
+    other pieces (an occluder) rather than on background."""
+    pa, pb = _boundary_points(a), _boundary_points(b)
+    d = ((pa[:, None, :] - pb[None, :, :]) ** 2).sum(axis=2)
+    i, j = np.unravel_index(int(np.argmin(d)), d.shape)
+    p, q = pa[i].astype(np.float64), pb[j].astype(np.float64)
+    n = int(np.ceil(np.abs(q - p).max())) + 1
+    if n <= 4:
+        return True
+    pts = np.rint(p[None, :] + (q - p)[None, :] * np.linspace(0, 1, n)[:, None]).astype(np.int64)
+    inner = pts[1:-1]
+    on_other = others[inner[:, 0], inner[:, 1]] | a[inner[:, 0], inner[:, 1]]
+    on_other |= b[inner[:, 0], inner[:, 1]]
+    return float(on_other.mean()) >= OCCLUDED_GAP
+
+
+def frame_objects(masks: list[BoolArray], min_area: int) -> list[Obj]:
+    """Objects of one frame: each class's components grouped across occluders."""
+    solid = np.zeros_like(masks[0]) if masks else np.zeros((1, 1), bool)
+    for m in masks:
+        solid |= m
+    out: list[Obj] = []
+    for k, mask in enumerate(masks):
+        comps = components(mask, min_area)
+        group = list(range(len(comps)))
+
+        def root(i: int) -> int:
+            while group[i] != i:
+                i = group[i]
+            return i
+
+        others = solid & ~mask
+        for i in range(len(comps)):
+            for j in range(i + 1, len(comps)):
+                if root(i) != root(j) and _gap_covered(comps[i], comps[j], others):
+                    group[root(j)] = root(i)
+        for r in sorted({root(i) for i in range(len(comps))}):
+            members = [c for i, c in enumerate(comps) if root(i) == r]
+            out.append(Obj(k, np.logical_or.reduce(members), len(members)))
+    return out
+
+
+def _counts(frames: list[list[Obj]], classes: int) -> np.ndarray:
+    c = np.zeros((len(frames), classes), dtype=np.int64)
+    for t, objs in enumerate(frames):
+        for o in objs:
+            c[t, o.cls] += 1
+    return c
+
+
+def smoothed_counts(raw: np.ndarray) -> np.ndarray:
+    """Median of each class's count over WINDOW frames (clipped at the ends)."""
+    n = len(raw)
+    half = WINDOW // 2
+    out = np.empty_like(raw)
+    for t in range(n):
+        out[t] = np.median(raw[max(0, t - half) : min(n, t + half + 1)], axis=0).round()
+    return out
+
+
+class Tracker:
+    """Finds the events of a sequence of per-frame objects (see the module docstring)."""
+
+    def __init__(self, frames: list[list[Obj]], names: tuple[str, ...]) -> None:
+        self.frames = frames
+        self.names = names
+        shape = next((o.mask.shape for objs in frames for o in objs), (1, 1))
+        self.reach = max(2, round(MOTION_SHARE * max(shape)))
+        self.raw = _counts(frames, len(names))
+        self.smooth = smoothed_counts(self.raw)
+
+    def _of(self, t: int, k: int) -> list[Obj]:
+        return [o for o in self.frames[t] if o.cls == k]
+
+    def _change_frame(self, t: int, k: int) -> int:
+        """The raw frame pair nearest ``t`` where class ``k``'s count makes the smoothed step."""
+        old, new = self.smooth[t - 1, k], self.smooth[t, k]
+        for d in (0, -1, 1, -2, 2):
+            b = t + d
+            if 1 <= b < len(self.frames) and self.raw[b - 1, k] == old and self.raw[b, k] == new:
+                return b
+        return t
+
+    def events(self) -> list[Event]:
+        out: list[Event] = []
+        for t in range(1, len(self.frames)):
+            for k in range(len(self.names)):
+                if self.smooth[t, k] == self.smooth[t - 1, k]:
+                    continue
+                b = self._change_frame(t, k)
+                if self.smooth[t, k] > self.smooth[t - 1, k]:
+                    out.extend(self._more(b, k))
+                else:
+                    out.extend(self._fewer(b, k))
+        out.extend(self._swaps())
+        return sorted(out, key=lambda e: (e.frame, e.kind, e.piece))
+
+    def _touching(self, a: Obj, objs: list[Obj]) -> list[Obj]:
+        grown = dilate(a.mask, self.reach)
+        return [o for o in objs if (grown & o.mask).any()]
+
+    def _more(self, b: int, k: int) -> list[Event]:
+        before, now = self._of(b - 1, k), self._of(b, k)
+        name = self.names[k]
+        for p in before:
+            hit = self._touching(p, now)
+            if len(hit) >= 2:
+                detail = f"one {name} piece became {len(hit)} separate parts (background between)"
+                return [Event("split", b, name, None, detail, (p.mask, *[h.mask for h in hit]))]
+        out: list[Event] = []
+        for c in now:
+            if self._touching(c, before):
+                continue
+            if c.touches_border():
+                out.append(Event("entered", b, name, None, "came in through the border"))
+                continue
+            prior = [o for o in self.frames[b - 1] if o.cls != k and (o.mask & c.mask).any()]
+            gone = [o for o in prior if self.smooth[b, o.cls] < self.smooth[b - 1, o.cls]]
+            if gone:
+                other = self.names[gone[0].cls]
+                detail = f"the {other} piece turned {name}"
+                out.append(Event("recolor", b, other, name, detail, (gone[0].mask, c.mask)))
+            else:
+                detail = f"a {name} piece appeared away from the border"
+                out.append(Event("added", b, name, None, detail, (c.mask,)))
+        return out
+
+    def _fewer(self, b: int, k: int) -> list[Event]:
+        before, now = self._of(b - 1, k), self._of(b, k)
+        name = self.names[k]
+        for c in now:
+            hit = self._touching(c, before)
+            if len(hit) >= 2 and c.parts == 1:
+                detail = f"{len(hit)} separate {name} parts fused into one"
+                return [Event("merge", b, name, name, detail, (c.mask, *[h.mask for h in hit]))]
+        out: list[Event] = []
+        for p in before:
+            if self._touching(p, now):
+                continue
+            out.append(self._vanished(p, b))
+        return [e for e in out if e.kind != "recolor"]  # a recolour is reported by the new class
+
+    def _vanished(self, p: Obj, b: int) -> Event:
+        name = self.names[p.cls]
+        if p.touches_border():
+            return Event("left", b, name, None, "went out through the border")
+        others = [o for o in self.frames[b] if o.cls != p.cls]
+        covered = np.zeros_like(p.mask)
+        for o in others:
+            covered |= o.mask
+        if float((covered & p.mask).sum()) < 0.5 * p.area:
+            return Event("lost", b, name, None, f"the {name} piece vanished in view", (p.mask,))
+        cover = max(others, key=lambda o: int((o.mask & p.mask).sum()))
+        other = self.names[cover.cls]
+        was = [o for o in self.frames[b - 1] if o.cls == cover.cls]
+        was_there = [o for o in was if (dilate(o.mask, self.reach) & cover.mask).any()]
+        if not was_there:
+            return Event("recolor", b, name, other, f"the {name} piece turned {other}")
+        grew = cover.area - sum(o.area for o in was_there)
+        if grew >= 0.5 * p.area:
+            detail = f"the {name} piece fused into the {other} piece (its area grew by {grew} px)"
+            return Event("merge", b, name, other, detail, (p.mask, cover.mask))
+        detail = f"the {name} piece went out of sight behind the {other} piece"
+        return Event("hidden", b, name, other, detail, (p.mask, cover.mask))
+
+    def _swaps(self) -> list[Event]:
+        """Identity changes that keep every count: a colour now where another colour was,
+        nowhere near where it was itself, for PERSIST frames."""
+        out: list[Event] = []
+        for b in range(1, len(self.frames) - PERSIST + 1):
+            if not np.array_equal(self.raw[b - 1], self.raw[b]):
+                continue
+            for k in range(len(self.names)):
+                ev = self._swap_at(b, k)
+                if ev is not None and not any(e.piece == ev.piece for e in out):
+                    out.append(ev)
+        return out
+
+    def _swap_at(self, b: int, k: int) -> Event | None:
+        before, now = self._of(b - 1, k), self._of(b, k)
+        if len(now) != 1 or len(before) != 1 or self._touching(before[0], now):
+            return None
+        c = now[0]
+        for o in self.frames[b - 1]:
+            if o.cls == k or (o.mask & c.mask).sum() < 0.5 * min(c.area, o.area):
+                continue
+            later = [self._of(b + d, k) for d in range(1, PERSIST)]
+            if all(len(x) == 1 and (x[0].mask & o.mask).sum() > 0 for x in later):
+                other = self.names[o.cls]
+                detail = f"the {other} piece now shows as {self.names[k]}"
+                return Event("recolor", b, other, self.names[k], detail, (o.mask, c.mask))
+        return None
