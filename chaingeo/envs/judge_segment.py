@@ -16,13 +16,14 @@ area relative to the frame are dropped (legend swatches, axis arrows).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Final
 
 import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
-from chaingeo.core.colors import BY_NAME, PALETTE, ciede2000, srgb_to_lab
+from chaingeo.core.colors import PALETTE, ciede2000, srgb_to_lab
 from chaingeo.core.jit import njit
 
 U8 = npt.NDArray[np.uint8]
@@ -73,6 +74,11 @@ def _table_index(rgb: U8) -> npt.NDArray[np.int64]:
 
 def palette_model(colors: list[tuple[str, tuple[int, int, int]]]) -> ColorModel:
     """Classes for a level's piece colours (name, RGB), tried at every shade of SHADES."""
+    return _palette_model(tuple(colors))
+
+
+@lru_cache(maxsize=8)
+def _palette_model(colors: tuple[tuple[str, tuple[int, int, int]], ...]) -> ColorModel:
     if not colors or len(colors) > 255:
         raise ValueError(f"1 to 255 piece colours, got {len(colors)}")
     lab_table = srgb_to_lab(_table_rgb())
@@ -146,15 +152,6 @@ def _names(centres: FloatArray) -> tuple[str, ...]:
     return tuple(names)
 
 
-def level_colors(pieces: list[tuple[str, str]]) -> list[tuple[str, tuple[int, int, int]]]:
-    """(name, RGB) of a level's pieces given as (name, "#rrggbb")."""
-    out = []
-    for name, hexa in pieces:
-        h = hexa.lstrip("#")
-        out.append((name, (int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16))))
-    return out
-
-
 def shrink(frame: U8) -> U8:
     """The frame at WORK_SIZE on its longer side (box filter; smaller frames are kept)."""
     h, w = frame.shape[:2]
@@ -195,10 +192,14 @@ def dilate(mask: BoolArray, r: int) -> BoolArray:
     return _spread(mask, r, True)
 
 
+def close(mask: BoolArray, r: int = 2) -> BoolArray:
+    """Closing: gaps narrower than about 2r pixels filled."""
+    return _spread(dilate(mask, r), r, False) | mask
+
+
 def clean(mask: BoolArray) -> BoolArray:
-    """Opening (radius 1) then closing (radius 2)."""
-    opened = dilate(_spread(mask, 1, False), 1)
-    return _spread(dilate(opened, 2), 2, False) | opened
+    """Opening (radius 1: slivers and specks go) then closing (radius 2)."""
+    return close(dilate(_spread(mask, 1, False), 1))
 
 
 @njit(cache=True)
@@ -267,8 +268,3 @@ def class_masks(frame: U8, model: ColorModel) -> list[BoolArray]:
     """One cleaned mask per class (index i: class i + 1) of a working-size frame."""
     raw = classify(frame, model)
     return [clean(raw == i + 1) for i in range(len(model.names))]
-
-
-def palette_rgb(name: str) -> tuple[int, int, int] | None:
-    c = BY_NAME.get(name.split("-")[0])
-    return None if c is None else c.rgb

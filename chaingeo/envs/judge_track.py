@@ -20,7 +20,7 @@ from typing import Final
 
 import numpy as np
 
-from chaingeo.envs.judge_segment import BoolArray, components, dilate
+from chaingeo.envs.judge_segment import BoolArray, close, components, dilate
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
 #: hold.
@@ -92,11 +92,19 @@ def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
     return float(on_other.mean()) >= OCCLUDED_GAP
 
 
-def frame_objects(masks: list[BoolArray], min_area: int) -> list[Obj]:
-    """Objects of one frame: each class's components grouped across occluders."""
+def solid_of(masks: list[BoolArray]) -> BoolArray:
+    """Every piece pixel of a frame, closed so that the drawn edges between two pieces of
+    different colours count as piece, not background."""
     solid = np.zeros_like(masks[0]) if masks else np.zeros((1, 1), bool)
     for m in masks:
         solid |= m
+    return close(solid)
+
+
+def frame_objects(masks: list[BoolArray], min_area: int) -> tuple[list[Obj], BoolArray]:
+    """Objects of one frame (each class's components grouped across occluders), and the
+    frame's piece pixels (:func:`solid_of`)."""
+    solid = solid_of(masks)
     out: list[Obj] = []
     for k, mask in enumerate(masks):
         comps = components(mask, min_area)
@@ -115,7 +123,7 @@ def frame_objects(masks: list[BoolArray], min_area: int) -> list[Obj]:
         for r in sorted({root(i) for i in range(len(comps))}):
             members = [c for i, c in enumerate(comps) if root(i) == r]
             out.append(Obj(k, np.logical_or.reduce(members), len(members)))
-    return out
+    return out, solid
 
 
 def _counts(frames: list[list[Obj]], classes: int) -> np.ndarray:
@@ -139,12 +147,13 @@ def smoothed_counts(raw: np.ndarray) -> np.ndarray:
 class Tracker:
     """Finds the events of a sequence of per-frame objects (see the module docstring)."""
 
-    def __init__(self, frames: list[list[Obj]], names: tuple[str, ...]) -> None:
-        self.frames = frames
+    def __init__(self, frames: list[tuple[list[Obj], BoolArray]], names: tuple[str, ...]) -> None:
+        self.frames = [objs for objs, _ in frames]
+        self.solid = [solid for _, solid in frames]
         self.names = names
-        shape = next((o.mask.shape for objs in frames for o in objs), (1, 1))
+        shape = self.solid[0].shape if self.solid else (1, 1)
         self.reach = max(2, round(MOTION_SHARE * max(shape)))
-        self.raw = _counts(frames, len(names))
+        self.raw = _counts(self.frames, len(names))
         self.smooth = smoothed_counts(self.raw)
 
     def _of(self, t: int, k: int) -> list[Obj]:
@@ -177,6 +186,12 @@ class Tracker:
         grown = dilate(a.mask, self.reach)
         return [o for o in objs if (grown & o.mask).any()]
 
+    def _against_others(self, c: Obj, t: int) -> bool:
+        """Whether a part borders other pieces (so it may have come out from behind one)."""
+        ring = dilate(c.mask, 2) & ~c.mask
+        others = self.solid[t] & ~np.logical_or.reduce([o.mask for o in self._of(t, c.cls)])
+        return float((ring & others).sum()) >= 0.15 * max(1, int(ring.sum()))
+
     def _more(self, b: int, k: int) -> list[Event]:
         before, now = self._of(b - 1, k), self._of(b, k)
         name = self.names[k]
@@ -192,14 +207,22 @@ class Tracker:
             if c.touches_border():
                 out.append(Event("entered", b, name, None, "came in through the border"))
                 continue
-            prior = [o for o in self.frames[b - 1] if o.cls != k and (o.mask & c.mask).any()]
-            gone = [o for o in prior if self.smooth[b, o.cls] < self.smooth[b - 1, o.cls]]
+            gone = [
+                o
+                for o in self.frames[b - 1]
+                if o.cls != k
+                and (o.mask & c.mask).sum() >= 0.5 * min(o.area, c.area)
+                and not self._touching(o, self._of(b, o.cls))
+            ]
             if gone:
                 other = self.names[gone[0].cls]
                 detail = f"the {other} piece turned {name}"
                 out.append(Event("recolor", b, other, name, detail, (gone[0].mask, c.mask)))
+            elif self._against_others(c, b):
+                detail = f"a {name} part came into sight beside another piece"
+                out.append(Event("revealed", b, name, None, detail))
             else:
-                detail = f"a {name} piece appeared away from the border"
+                detail = f"a {name} piece appeared in open view, away from the border"
                 out.append(Event("added", b, name, None, detail, (c.mask,)))
         return out
 
@@ -211,23 +234,18 @@ class Tracker:
             if len(hit) >= 2 and c.parts == 1:
                 detail = f"{len(hit)} separate {name} parts fused into one"
                 return [Event("merge", b, name, name, detail, (c.mask, *[h.mask for h in hit]))]
-        out: list[Event] = []
-        for p in before:
-            if self._touching(p, now):
-                continue
-            out.append(self._vanished(p, b))
+        out = [self._vanished(p, b) for p in before if not self._touching(p, now)]
         return [e for e in out if e.kind != "recolor"]  # a recolour is reported by the new class
 
     def _vanished(self, p: Obj, b: int) -> Event:
         name = self.names[p.cls]
         if p.touches_border():
             return Event("left", b, name, None, "went out through the border")
+        if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
+            return Event("lost", b, name, None, f"the {name} piece vanished in open view", (p.mask,))
         others = [o for o in self.frames[b] if o.cls != p.cls]
-        covered = np.zeros_like(p.mask)
-        for o in others:
-            covered |= o.mask
-        if float((covered & p.mask).sum()) < 0.5 * p.area:
-            return Event("lost", b, name, None, f"the {name} piece vanished in view", (p.mask,))
+        if not others:
+            return Event("hidden", b, name, None, f"the {name} piece shrank out of sight")
         cover = max(others, key=lambda o: int((o.mask & p.mask).sum()))
         other = self.names[cover.cls]
         was = [o for o in self.frames[b - 1] if o.cls == cover.cls]
@@ -235,7 +253,7 @@ class Tracker:
         if not was_there:
             return Event("recolor", b, name, other, f"the {name} piece turned {other}")
         grew = cover.area - sum(o.area for o in was_there)
-        if grew >= 0.5 * p.area:
+        if grew >= 0.7 * p.area and not self._of(b, p.cls):
             detail = f"the {name} piece fused into the {other} piece (its area grew by {grew} px)"
             return Event("merge", b, name, other, detail, (p.mask, cover.mask))
         detail = f"the {name} piece went out of sight behind the {other} piece"
