@@ -85,7 +85,9 @@ def _palette_model(colors: tuple[tuple[str, tuple[int, int, int]], ...]) -> Colo
     best = np.full(len(lab_table), np.inf)
     label = np.zeros(len(lab_table), dtype=np.uint8)
     for i, (_, rgb) in enumerate(colors):
-        shades = np.clip(np.array(rgb, dtype=np.float64)[None, :] * np.array(SHADES)[:, None], 0, 255)
+        shades = np.clip(
+            np.array(rgb, dtype=np.float64)[None, :] * np.array(SHADES)[:, None], 0, 255
+        )
         d = ciede2000(lab_table[:, None, :], srgb_to_lab(shades)[None, :, :]).min(axis=1)
         closer = d < best
         best[closer] = d[closer]
@@ -96,7 +98,9 @@ def _palette_model(colors: tuple[tuple[str, tuple[int, int, int]], ...]) -> Colo
 
 
 def _hue_chroma(lab: FloatArray) -> tuple[FloatArray, FloatArray]:
-    return np.degrees(np.arctan2(lab[..., 2], lab[..., 1])) % 360, np.hypot(lab[..., 1], lab[..., 2])
+    return np.degrees(np.arctan2(lab[..., 2], lab[..., 1])) % 360, np.hypot(
+        lab[..., 1], lab[..., 2]
+    )
 
 
 def _hue_peaks(hues: FloatArray) -> list[float]:
@@ -216,7 +220,7 @@ def _label_kernel(flat: npt.NDArray[np.uint8], h: int, w: int) -> npt.NDArray[np
         k = 0
         for dy, dx in ((-1, -1), (-1, 0), (-1, 1), (0, -1)):
             yy, xx = y + dy, x + dx
-            if 0 <= yy and 0 <= xx < w and lab[yy * w + xx] > 0:
+            if yy >= 0 and 0 <= xx < w and lab[yy * w + xx] > 0:
                 r = lab[yy * w + xx]
                 while parent[r] != r:
                     r = parent[r]

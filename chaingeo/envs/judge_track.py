@@ -92,6 +92,12 @@ def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
     return float(on_other.mean()) >= OCCLUDED_GAP
 
 
+def _root(group: list[int], i: int) -> int:
+    while group[i] != i:
+        i = group[i]
+    return i
+
+
 def solid_of(masks: list[BoolArray]) -> BoolArray:
     """Every piece pixel of a frame, closed so that the drawn edges between two pieces of
     different colours count as piece, not background."""
@@ -109,19 +115,14 @@ def frame_objects(masks: list[BoolArray], min_area: int) -> tuple[list[Obj], Boo
     for k, mask in enumerate(masks):
         comps = components(mask, min_area)
         group = list(range(len(comps)))
-
-        def root(i: int) -> int:
-            while group[i] != i:
-                i = group[i]
-            return i
-
         others = solid & ~mask
         for i in range(len(comps)):
             for j in range(i + 1, len(comps)):
-                if root(i) != root(j) and _gap_covered(comps[i], comps[j], others):
-                    group[root(j)] = root(i)
-        for r in sorted({root(i) for i in range(len(comps))}):
-            members = [c for i, c in enumerate(comps) if root(i) == r]
+                ri, rj = _root(group, i), _root(group, j)
+                if ri != rj and _gap_covered(comps[i], comps[j], others):
+                    group[rj] = ri
+        for r in sorted({_root(group, i) for i in range(len(comps))}):
+            members = [c for i, c in enumerate(comps) if _root(group, i) == r]
             out.append(Obj(k, np.logical_or.reduce(members), len(members)))
     return out, solid
 
@@ -242,7 +243,9 @@ class Tracker:
         if p.touches_border():
             return Event("left", b, name, None, "went out through the border")
         if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
-            return Event("lost", b, name, None, f"the {name} piece vanished in open view", (p.mask,))
+            return Event(
+                "lost", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
+            )
         others = [o for o in self.frames[b] if o.cls != p.cls]
         if not others:
             return Event("hidden", b, name, None, f"the {name} piece shrank out of sight")
@@ -274,9 +277,11 @@ class Tracker:
 
     def _swap_at(self, b: int, k: int) -> Event | None:
         before, now = self._of(b - 1, k), self._of(b, k)
-        if len(now) != 1 or len(before) != 1 or self._touching(before[0], now):
+        if len(now) != 1 or len(before) != 1:
             return None
         c = now[0]
+        if (c.mask & before[0].mask).sum() >= 0.2 * c.area:
+            return None
         for o in self.frames[b - 1]:
             if o.cls == k or (o.mask & c.mask).sum() < 0.5 * min(c.area, o.area):
                 continue

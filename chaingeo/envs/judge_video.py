@@ -209,11 +209,15 @@ def _tinted(frame: U8, masks: tuple[BoolArray, ...], which: range) -> Image.Imag
         if i < len(masks):
             tint = np.array(_TINTS[min(i, len(_TINTS) - 1)], dtype=np.float64)
             m = masks[i]
-            edge = m & ~(np.roll(m, 1, 0) & np.roll(m, -1, 0) & np.roll(m, 1, 1) & np.roll(m, -1, 1))
+            edge = m & ~(
+                np.roll(m, 1, 0) & np.roll(m, -1, 0) & np.roll(m, 1, 1) & np.roll(m, -1, 1)
+            )
             out[m] = 0.6 * out[m] + 0.4 * tint
             out[edge] = tint
     img = Image.fromarray(np.clip(out, 0, 255).astype(np.uint8))
-    return img.resize((img.width * EVIDENCE_ZOOM, img.height * EVIDENCE_ZOOM), Image.Resampling.NEAREST)
+    return img.resize(
+        (img.width * EVIDENCE_ZOOM, img.height * EVIDENCE_ZOOM), Image.Resampling.NEAREST
+    )
 
 
 def write_evidence(verdict: Verdict, frames: tuple[U8, ...], folder: Path) -> dict[int, str]:
