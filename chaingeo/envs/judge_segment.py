@@ -107,10 +107,13 @@ def _hue_peaks(hues: FloatArray) -> list[float]:
     """Peaks of a circular hue histogram (5 degree bins, smoothed), strongest first, each
     holding MIN_PEAK_SHARE of the pixels within MERGE_DEGREES / 2, none closer than that."""
     hist = np.bincount((hues // 5).astype(np.int64) % 72, minlength=72).astype(np.float64)
-    kernel = np.array([1.0, 2.0, 3.0, 2.0, 1.0])
-    smooth = sum(k * np.roll(hist, s) for k, s in zip(kernel, range(-2, 3), strict=True))
+    smooth = np.zeros(72)
+    for k, s in zip((1.0, 2.0, 3.0, 2.0, 1.0), range(-2, 3), strict=True):
+        smooth += k * np.roll(hist, s)
     window = round(MERGE_DEGREES / 10)
-    mass = sum(np.roll(hist, s) for s in range(-window, window + 1))
+    mass = np.zeros(72)
+    for s in range(-window, window + 1):
+        mass += np.roll(hist, s)
     peaks: list[float] = []
     for b in np.argsort(-smooth, kind="stable").tolist():
         if smooth[b] < smooth[(b - 1) % 72] or smooth[b] < smooth[(b + 1) % 72]:

@@ -88,8 +88,8 @@ def _read_ffmpeg(path: Path) -> Clip:
         fps = float(meta.get("fps") or 0.0)
         duration = float(meta.get("duration") or 0.0)
         _check_header(duration * max(fps, 1.0), w, h)
-        out = []
-        for frame in reader:
+        out: list[U8] = []
+        for frame in reader:  # type: ignore[attr-defined]
             if len(out) >= limits.MAX_VIDEO_FRAMES:
                 raise VideoJudgeError(f"more than {limits.MAX_VIDEO_FRAMES} frames")
             arr = np.asarray(frame, dtype=np.uint8)
