@@ -76,20 +76,25 @@ def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
 
 
 def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
-    """Whether the straight gap between the nearest points of ``a`` and ``b`` lies mostly on
-    other pieces (an occluder) rather than on background."""
+    """Whether the gap between ``a`` and ``b`` (the pixels within half their distance plus a
+    little of both) lies mostly on other pieces (an occluder) rather than on background."""
     pa, pb = _boundary_points(a), _boundary_points(b)
-    d = ((pa[:, None, :] - pb[None, :, :]) ** 2).sum(axis=2)
-    i, j = np.unravel_index(int(np.argmin(d)), d.shape)
-    p, q = pa[i].astype(np.float64), pb[j].astype(np.float64)
-    n = int(np.ceil(np.abs(q - p).max())) + 1
-    if n <= 4:
+    gap = float(np.sqrt(((pa[:, None, :] - pb[None, :, :]) ** 2).sum(axis=2).min()))
+    if gap <= 4:
         return True
-    pts = np.rint(p[None, :] + (q - p)[None, :] * np.linspace(0, 1, n)[:, None]).astype(np.int64)
-    inner = pts[1:-1]
-    on_other = others[inner[:, 0], inner[:, 1]] | a[inner[:, 0], inner[:, 1]]
-    on_other |= b[inner[:, 0], inner[:, 1]]
-    return float(on_other.mean()) >= OCCLUDED_GAP
+    r = int(gap / 2) + 2
+    ys, xs = np.nonzero(a | b)
+    y0, y1 = max(0, int(ys.min()) - r), int(ys.max()) + r + 1
+    x0, x1 = max(0, int(xs.min()) - r), int(xs.max()) + r + 1
+    ca, cb, co = a[y0:y1, x0:x1], b[y0:y1, x0:x1], others[y0:y1, x0:x1]
+    lens = dilate(ca, r) & dilate(cb, r) & ~ca & ~cb
+    if not lens.any():
+        return False
+    return float((lens & co).sum()) >= OCCLUDED_GAP * float(lens.sum())
+
+
+def _centroid(mask: BoolArray) -> np.ndarray:
+    return np.argwhere(mask).mean(axis=0)
 
 
 def _root(group: list[int], i: int) -> int:
@@ -240,7 +245,7 @@ class Tracker:
 
     def _vanished(self, p: Obj, b: int) -> Event:
         name = self.names[p.cls]
-        if p.touches_border():
+        if p.touches_border() or self._heading_out(p, b - 1):
             return Event("left", b, name, None, "went out through the border")
         if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
             return Event(
@@ -262,6 +267,21 @@ class Tracker:
         detail = f"the {name} piece went out of sight behind the {other} piece"
         return Event("hidden", b, name, other, detail, (p.mask, cover.mask))
 
+    def _heading_out(self, p: Obj, t: int) -> bool:
+        """Whether ``p`` (seen at frame ``t``) moves fast enough to be out of the picture two
+        frames later (our videos carry removed pieces out at speed)."""
+        if t < 1:
+            return False
+        earlier = self._touching(p, self._of(t - 1, p.cls))
+        if len(earlier) != 1:
+            return False
+        d = _centroid(p.mask) - _centroid(earlier[0].mask)
+        ys, xs = np.nonzero(p.mask)
+        h, w = p.mask.shape
+        lo = np.array([ys.min(), xs.min()]) + 2 * d
+        hi = np.array([ys.max(), xs.max()]) + 2 * d
+        return bool(hi[0] < 0 or hi[1] < 0 or lo[0] >= h or lo[1] >= w)
+
     def _swaps(self) -> list[Event]:
         """Identity changes that keep every count: a colour now where another colour was,
         nowhere near where it was itself, for PERSIST frames."""
@@ -279,15 +299,24 @@ class Tracker:
         before, now = self._of(b - 1, k), self._of(b, k)
         if len(now) != 1 or len(before) != 1:
             return None
-        c = now[0]
-        if (c.mask & before[0].mask).sum() >= 0.2 * c.area:
+        c, was = now[0], before[0]
+        if (c.mask & was.mask).sum() >= 0.2 * c.area:
             return None
         for o in self.frames[b - 1]:
             if o.cls == k or (o.mask & c.mask).sum() < 0.5 * min(c.area, o.area):
                 continue
+            # mutual: where this piece was now shows the other colour, moved off its own place
+            partner = [x for x in self._of(b, o.cls) if _overlaps(x, was)]
+            if len(partner) != 1 or (partner[0].mask & o.mask).sum() >= 0.2 * partner[0].area:
+                continue
             later = [self._of(b + d, k) for d in range(1, PERSIST)]
             if all(len(x) == 1 and (x[0].mask & o.mask).sum() > 0 for x in later):
                 other = self.names[o.cls]
-                detail = f"the {other} piece now shows as {self.names[k]}"
+                detail = f"the {other} piece now shows as {self.names[k]} (and the reverse)"
                 return Event("recolor", b, other, self.names[k], detail, (o.mask, c.mask))
         return None
+
+
+def _overlaps(a: Obj, b: Obj) -> bool:
+    """At least half of the smaller of two objects lies on the other."""
+    return bool((a.mask & b.mask).sum() >= 0.5 * min(a.area, b.area))
