@@ -82,15 +82,27 @@ def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
     gap = float(np.sqrt(((pa[:, None, :] - pb[None, :, :]) ** 2).sum(axis=2).min()))
     if gap <= 4:
         return True
-    r = int(gap / 2) + 2
+    r = int(gap) + 3
     ys, xs = np.nonzero(a | b)
     y0, y1 = max(0, int(ys.min()) - r), int(ys.max()) + r + 1
     x0, x1 = max(0, int(xs.min()) - r), int(xs.max()) + r + 1
-    ca, cb, co = a[y0:y1, x0:x1], b[y0:y1, x0:x1], others[y0:y1, x0:x1]
-    lens = dilate(ca, r) & dilate(cb, r) & ~ca & ~cb
+    da, db = _distances(a[y0:y1, x0:x1], r), _distances(b[y0:y1, x0:x1], r)
+    lens = (da > 0) & (db > 0) & (da + db <= int(np.ceil(gap)) + 2)
     if not lens.any():
         return False
-    return float((lens & co).sum()) >= OCCLUDED_GAP * float(lens.sum())
+    return float((lens & others[y0:y1, x0:x1]).sum()) >= OCCLUDED_GAP * float(lens.sum())
+
+
+def _distances(mask: BoolArray, r: int) -> np.ndarray:
+    """Chessboard distance to ``mask`` (0 on it), capped at r + 1."""
+    out = np.full(mask.shape, r + 1, dtype=np.int64)
+    out[mask] = 0
+    grown = mask
+    for d in range(1, r + 1):
+        nxt = dilate(grown, 1)
+        out[nxt & ~grown] = d
+        grown = nxt
+    return out
 
 
 def _centroid(mask: BoolArray) -> np.ndarray:
@@ -204,8 +216,12 @@ class Tracker:
         for p in before:
             hit = self._touching(p, now)
             if len(hit) >= 2:
+                masks = (p.mask, *[h.mask for h in hit])
+                if self._under_others(p.mask, hit, b):
+                    detail = f"part of the {name} piece went behind another piece"
+                    return [Event("hidden", b, name, None, detail, masks)]
                 detail = f"one {name} piece became {len(hit)} separate parts (background between)"
-                return [Event("split", b, name, None, detail, (p.mask, *[h.mask for h in hit]))]
+                return [Event("split", b, name, None, detail, masks)]
         out: list[Event] = []
         for c in now:
             if self._touching(c, before):
@@ -232,14 +248,29 @@ class Tracker:
                 out.append(Event("added", b, name, None, detail, (c.mask,)))
         return out
 
+    def _under_others(self, whole: BoolArray, parts: list[Obj], t: int) -> bool:
+        """Whether what ``whole`` has beyond ``parts`` lies, at frame ``t``, mostly on other
+        pieces: the parts are one piece seen round an occluder, not a break or a fusion."""
+        rest = whole & ~dilate(np.logical_or.reduce([o.mask for o in parts]), 1)
+        if not rest.any():
+            return False
+        own = np.zeros_like(rest)
+        for o in self._of(t, parts[0].cls):
+            own |= o.mask
+        return float((rest & self.solid[t] & ~own).sum()) >= 0.5 * float(rest.sum())
+
     def _fewer(self, b: int, k: int) -> list[Event]:
         before, now = self._of(b - 1, k), self._of(b, k)
         name = self.names[k]
         for c in now:
             hit = self._touching(c, before)
             if len(hit) >= 2 and c.parts == 1:
+                masks = (c.mask, *[h.mask for h in hit])
+                if self._under_others(c.mask, hit, b - 1):
+                    detail = f"a hidden part of the {name} piece came into sight"
+                    return [Event("revealed", b, name, None, detail, masks)]
                 detail = f"{len(hit)} separate {name} parts fused into one"
-                return [Event("merge", b, name, name, detail, (c.mask, *[h.mask for h in hit]))]
+                return [Event("merge", b, name, name, detail, masks)]
         out = [self._vanished(p, b) for p in before if not self._touching(p, now)]
         return [e for e in out if e.kind != "recolor"]  # a recolour is reported by the new class
 
