@@ -20,7 +20,7 @@ from typing import Final
 
 import numpy as np
 
-from chaingeo.envs.judge_segment import BoolArray, close, components, dilate
+from chaingeo.envs.judge_segment import BoolArray, FloatArray, close, components, dilate
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
 #: hold.
@@ -105,8 +105,9 @@ def _distances(mask: BoolArray, r: int) -> np.ndarray:
     return out
 
 
-def _centroid(mask: BoolArray) -> np.ndarray:
-    return np.argwhere(mask).mean(axis=0)
+def _centroid(mask: BoolArray) -> FloatArray:
+    out: FloatArray = np.argwhere(mask).mean(axis=0)
+    return out
 
 
 def _root(group: list[int], i: int) -> int:
