@@ -335,14 +335,15 @@ class Tracker:
         if (c.mask & was.mask).sum() >= 0.2 * c.area:
             return None
         for o in self.frames[b - 1]:
-            if o.cls == k or (o.mask & c.mask).sum() < 0.5 * min(c.area, o.area):
+            near = dilate(o.mask, self.reach)  # the other piece may be moving
+            if o.cls == k or (near & c.mask).sum() < 0.5 * min(c.area, o.area):
                 continue
             # mutual: where this piece was now shows the other colour, moved off its own place
             partner = [x for x in self._of(b, o.cls) if _overlaps(x, was)]
             if len(partner) != 1 or (partner[0].mask & o.mask).sum() >= 0.2 * partner[0].area:
                 continue
             later = [self._of(b + d, k) for d in range(1, PERSIST)]
-            if all(len(x) == 1 and (x[0].mask & o.mask).sum() > 0 for x in later):
+            if all(len(x) == 1 and (x[0].mask & was.mask).sum() < 0.2 * x[0].area for x in later):
                 other = self.names[o.cls]
                 detail = f"the {other} piece now shows as {self.names[k]} (and the reverse)"
                 return Event("recolor", b, other, self.names[k], detail, (o.mask, c.mask))

@@ -30,7 +30,7 @@ from chaingeo.envs.judge_segment import (
     palette_model,
     shrink,
 )
-from chaingeo.envs.judge_track import VIOLATIONS, Event, Tracker, frame_objects
+from chaingeo.envs.judge_track import VIOLATIONS, Event, Obj, Tracker, frame_objects
 
 #: The evidence picture: the two frames around an event, each at this many times working size.
 EVIDENCE_ZOOM: Final = 2
@@ -188,7 +188,11 @@ def judge_frames(
     if level is not None:
         from chaingeo.envs.judge_pose import pass_through
 
-        found, why = pass_through(level, masks, model.names)
+        kept = [
+            [_union(objs, k, m[0].shape) for k in range(len(model.names))]
+            for (objs, _), m in zip(objects, masks, strict=True)
+        ]
+        found, why = pass_through(level, kept, model.names)
         events = sorted([*events, *found], key=lambda e: (e.frame, e.kind, e.piece))
         undecided.extend(why)
     else:
@@ -201,6 +205,15 @@ def judge_frames(
     violations = tuple(e for e in events if e.kind in VIOLATIONS)
     notes = tuple(e for e in events if e.kind not in VIOLATIONS)
     return Verdict(violations, notes, tuple(undecided), model, len(frames))
+
+
+def _union(objs: list[Obj], k: int, shape: tuple[int, ...]) -> BoolArray:
+    """Class ``k``'s pixels that belong to objects (components past the least area)."""
+    out = np.zeros(shape, dtype=bool)
+    for o in objs:
+        if o.cls == k:
+            out |= o.mask
+    return out
 
 
 def _tinted(frame: U8, masks: tuple[BoolArray, ...], which: range) -> Image.Image:
