@@ -311,7 +311,9 @@ def _follow(
                     blamed.add((i, j))
                     detail = f"the {names[i]} piece moved through the {names[j]} piece"
                     masks_ = (masks[shown][i], masks[shown][j])
-                    events.append(Event("pass_through", shown, names[i], names[j], detail, masks_))
+                    events.append(
+                        Event("pass_through", shown, names[i], names[j], detail, masks_, before=0)
+                    )
     return events, why
 
 

@@ -61,6 +61,9 @@ class Event:
     other: str | None = None
     detail: str = ""
     masks: tuple[BoolArray, ...] = field(default=(), compare=False, repr=False)
+    #: How many of ``masks`` (the first ones) are seen in frame ``frame - 1``; the rest in
+    #: ``frame``.
+    before: int = 1
 
 
 VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "pass_through")
@@ -246,7 +249,7 @@ class Tracker:
                 out.append(Event("revealed", b, name, None, detail))
             else:
                 detail = f"a {name} piece appeared in open view, away from the border"
-                out.append(Event("added", b, name, None, detail, (c.mask,)))
+                out.append(Event("added", b, name, None, detail, (c.mask,), before=0))
         return out
 
     def _under_others(self, whole: BoolArray, parts: list[Obj], t: int) -> bool:
@@ -266,12 +269,12 @@ class Tracker:
         for c in now:
             hit = self._touching(c, before)
             if len(hit) >= 2 and c.parts == 1:
-                masks = (c.mask, *[h.mask for h in hit])
+                masks = (*[h.mask for h in hit], c.mask)
                 if self._under_others(c.mask, hit, b - 1):
                     detail = f"a hidden part of the {name} piece came into sight"
                     return [Event("revealed", b, name, None, detail, masks)]
                 detail = f"{len(hit)} separate {name} parts fused into one"
-                return [Event("merge", b, name, name, detail, masks)]
+                return [Event("merge", b, name, name, detail, masks, before=len(hit))]
         out = [self._vanished(p, b) for p in before if not self._touching(p, now)]
         return [e for e in out if e.kind != "recolor"]  # a recolour is reported by the new class
 

@@ -234,15 +234,16 @@ def _tinted(frame: U8, masks: tuple[BoolArray, ...], which: range) -> Image.Imag
 
 
 def write_evidence(verdict: Verdict, frames: tuple[U8, ...], folder: Path) -> dict[int, str]:
-    """One PNG per violation: the frame before (the piece as it was, magenta) and the frame of
-    the event (what it became, cyan and further tints); returns index -> file path."""
+    """One PNG per violation: the frame before the event and the frame of the event side by
+    side, the pieces involved outlined and tinted (magenta, cyan, yellow, green in turn);
+    returns index -> file path."""
     from chaingeo.envs.raster import png_bytes
 
     folder.mkdir(parents=True, exist_ok=True)
     out: dict[int, str] = {}
     for i, e in enumerate(verdict.violations):
-        a = _tinted(frames[max(0, e.frame - 1)], e.masks, range(0, 1))
-        b = _tinted(frames[e.frame], e.masks, range(1, len(e.masks)))
+        a = _tinted(frames[max(0, e.frame - 1)], e.masks, range(0, e.before))
+        b = _tinted(frames[e.frame], e.masks, range(e.before, len(e.masks)))
         sheet = Image.new("RGB", (a.width + b.width + 4, a.height), (255, 255, 255))
         sheet.paste(a, (0, 0))
         sheet.paste(b, (a.width + 4, 0))
