@@ -326,3 +326,22 @@ def test_a_piece_teleporting_through_another_is_caught(name: str, data: st.DataO
         found,
         verdict.undecided,
     )
+
+
+def test_limits_are_checked_before_decoding(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from chaingeo.core import limits
+
+    level = _level("puzzle-easy-09-cube3")
+    gif = write_gif(puzzle_video(level, size=128), tmp_path / "v.gif")
+    monkeypatch.setattr(limits, "MAX_VIDEO_FRAMES", 3)
+    with pytest.raises(VideoJudgeError, match="frames"):
+        read_clip(gif)
+    monkeypatch.setattr(limits, "MAX_VIDEO_FRAMES", 10_000)
+    monkeypatch.setattr(limits, "MAX_VIDEO_FRAME_PIXELS", 100)
+    with pytest.raises(VideoJudgeError, match="pixels"):
+        read_clip(gif)
+    monkeypatch.setattr(limits, "MAX_VIDEO_BYTES", 10)
+    with pytest.raises(VideoJudgeError, match="bytes"):
+        read_clip(gif)
