@@ -25,7 +25,7 @@ from chaingeo.envs.judge_segment import (
     shrink,
 )
 from chaingeo.envs.judge_video import VideoJudgeError, judge_frames, judge_video, read_clip
-from chaingeo.envs.video import puzzle_video, write_gif
+from chaingeo.envs.video import puzzle_video, write_gif, write_mp4
 from tests.shared_files import shared_dir
 
 #: Levels whose optimal-plan videos the judge reads without a false alarm (see the report for
@@ -212,6 +212,14 @@ def test_a_gif_is_read_and_judged(tmp_path: Path) -> None:
     gif = write_gif(puzzle_video(level, size=192), tmp_path / "v.gif")
     report = judge_video(gif, level, tmp_path / "ev")
     assert report["valid"] is True and report["violations"] == []
+
+
+def test_an_mp4_is_read_and_judged(tmp_path: Path) -> None:
+    """H.264 compression noise does not make a legal video invalid."""
+    level = _level("puzzle-easy-09-cube3")
+    mp4 = write_mp4(puzzle_video(level, size=256), tmp_path / "v.mp4")
+    report = judge_video(mp4)
+    assert report["valid"] is True and report["colors"]["from"] == "first frame"
 
 
 def test_unreadable_input_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
