@@ -307,10 +307,13 @@ class Tracker:
         frames later (our videos carry removed pieces out at speed)."""
         if t < 1:
             return False
-        earlier = self._touching(p, self._of(t - 1, p.cls))
-        if len(earlier) != 1:
+        earlier = self._of(t - 1, p.cls)
+        if not earlier:
             return False
-        d = _centroid(p.mask) - _centroid(earlier[0].mask)
+        here = _centroid(p.mask)
+        d = here - min(
+            (_centroid(o.mask) for o in earlier), key=lambda c: float(((here - c) ** 2).sum())
+        )
         ys, xs = np.nonzero(p.mask)
         h, w = p.mask.shape
         lo = np.array([ys.min(), xs.min()]) + 2 * d
