@@ -242,3 +242,16 @@ MAX_DATASET_IMAGE_SIZE: Final = 2048
 #: Bytes of one Parquet shard (about, counted over the rows' pictures and texts): the Hub's
 #: viewer and ``datasets`` stream shards of a few hundred MB best.
 MAX_DATASET_SHARD_BYTES: Final = 256 * 1024 * 1024
+
+# ---------------------------------------------------------------------------------------------
+# chain judge-video: generated videos (untrusted files)
+# ---------------------------------------------------------------------------------------------
+
+#: Bytes of one video file (stat before opening; CHAIN's clips are at most 4 MB).
+MAX_VIDEO_BYTES: Final = 512 * 1024 * 1024
+#: Pixels of one frame (4K UHD), frames of one video (10 minutes at 30 fps) and pixels of all
+#: frames together, checked from the container's header before decoding and again while
+#: decoding (a header can lie). CHAIN's clips: 2.1 Mpx frames, 150 frames, 3.1e8 pixels.
+MAX_VIDEO_FRAME_PIXELS: Final = 3840 * 2160
+MAX_VIDEO_FRAMES: Final = 18_000
+MAX_VIDEO_TOTAL_PIXELS: Final = 4_000_000_000

@@ -1,0 +1,272 @@
+"""A judge for generated videos of a puzzle being taken apart (``chain judge-video``).
+
+Video models asked to show a Lu Ban lock come apart push beams through each other, break,
+fuse, add and lose pieces (CHAIN judged this by hand). This judge reads a video (bounded by
+:mod:`chaingeo.core.limits` before decoding), segments pieces by their hinted colours
+(:mod:`chaingeo.envs.judge_segment`), tracks them (:mod:`chaingeo.envs.judge_track`) and, when
+the level is given and the video is drawn by our own camera, checks every lattice move it can
+read against the kinematics (:mod:`chaingeo.envs.judge_pose`). What it cannot decide it says
+in ``undecided``, never as a verdict.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Final
+
+import numpy as np
+from PIL import Image
+
+from chaingeo.core import limits
+from chaingeo.envs.judge_segment import (
+    U8,
+    BoolArray,
+    ColorModel,
+    class_masks,
+    clustered_model,
+    min_area,
+    palette_model,
+    shrink,
+)
+from chaingeo.envs.judge_track import VIOLATIONS, Event, Obj, Tracker, frame_objects
+
+#: The evidence picture: the two frames around an event, each at this many times working size.
+EVIDENCE_ZOOM: Final = 2
+_TINTS: Final = ((255, 0, 255), (0, 255, 255), (255, 255, 0), (0, 255, 0))
+
+
+class VideoJudgeError(ValueError):
+    """A video that cannot be judged: missing, too large, or not a readable video."""
+
+
+@dataclass(frozen=True)
+class Clip:
+    """A decoded video at working size: frames, frame rate and original size (w, h)."""
+
+    frames: tuple[U8, ...]
+    fps: float
+    size: tuple[int, int]
+
+
+def _check_header(frames: float, w: int, h: int) -> None:
+    if w <= 0 or h <= 0:
+        raise VideoJudgeError(f"frames of {w}x{h} pixels")
+    if w * h > limits.MAX_VIDEO_FRAME_PIXELS:
+        raise VideoJudgeError(
+            f"frames of {w}x{h} pixels; at most {limits.MAX_VIDEO_FRAME_PIXELS} are read"
+        )
+    if frames > limits.MAX_VIDEO_FRAMES:
+        raise VideoJudgeError(f"{frames:.0f} frames; at most {limits.MAX_VIDEO_FRAMES} are read")
+    if frames * w * h > limits.MAX_VIDEO_TOTAL_PIXELS:
+        raise VideoJudgeError(
+            f"{frames:.0f} frames of {w}x{h}; at most {limits.MAX_VIDEO_TOTAL_PIXELS} pixels"
+        )
+
+
+def _read_gif(path: Path) -> Clip:
+    with Image.open(path) as im:
+        w, h = im.size
+        n = int(getattr(im, "n_frames", 1))
+        _check_header(n, w, h)
+        out = []
+        for i in range(n):
+            im.seek(i)
+            out.append(shrink(np.asarray(im.convert("RGB"), dtype=np.uint8)))
+        ms = float(im.info.get("duration", 100) or 100)
+    return Clip(tuple(out), 1000.0 / ms, (w, h))
+
+
+def _read_ffmpeg(path: Path) -> Clip:
+    import imageio.v2 as imageio
+
+    reader = imageio.get_reader(str(path), format="FFMPEG")
+    try:
+        meta = reader.get_meta_data()
+        w, h = (int(v) for v in meta.get("size", (0, 0)))
+        fps = float(meta.get("fps") or 0.0)
+        duration = float(meta.get("duration") or 0.0)
+        _check_header(duration * max(fps, 1.0), w, h)
+        out: list[U8] = []
+        for frame in reader:  # type: ignore[attr-defined]
+            if len(out) >= limits.MAX_VIDEO_FRAMES:
+                raise VideoJudgeError(f"more than {limits.MAX_VIDEO_FRAMES} frames")
+            arr = np.asarray(frame, dtype=np.uint8)
+            if arr.ndim != 3 or arr.shape[1] * arr.shape[0] > limits.MAX_VIDEO_FRAME_PIXELS:
+                raise VideoJudgeError(f"a frame of shape {arr.shape}")
+            out.append(shrink(np.ascontiguousarray(arr[..., :3])))
+    finally:
+        reader.close()
+    return Clip(tuple(out), fps or 25.0, (w, h))
+
+
+def read_clip(path: Path) -> Clip:
+    """The frames of a GIF (Pillow) or any video ffmpeg reads, each shrunk to working size;
+    :class:`VideoJudgeError` for a missing, oversized or unreadable file."""
+    try:
+        size = os.stat(path).st_size
+    except OSError as e:
+        raise VideoJudgeError(f"{path}: cannot open ({e.strerror or e})") from None
+    if not path.is_file():
+        raise VideoJudgeError(f"{path}: not a file")
+    if size > limits.MAX_VIDEO_BYTES:
+        raise VideoJudgeError(f"{path}: {size} bytes; at most {limits.MAX_VIDEO_BYTES} are read")
+    try:
+        with open(path, "rb") as f:
+            gif = f.read(6) in (b"GIF87a", b"GIF89a")
+        clip = _read_gif(path) if gif else _read_ffmpeg(path)
+    except VideoJudgeError as e:
+        raise VideoJudgeError(f"{path}: {e}") from None
+    except ImportError:
+        raise VideoJudgeError(
+            f"{path}: reading this format needs the extra 'video' (imageio, imageio-ffmpeg)"
+        ) from None
+    except Exception as e:  # decoders raise anything on a hostile file
+        raise VideoJudgeError(f"{path}: not a readable video ({type(e).__name__})") from None
+    if not clip.frames:
+        raise VideoJudgeError(f"{path}: no frames")
+    return clip
+
+
+# ---------------------------------------------------------------------------------------------
+# The verdict
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Violations (events of a kind in VIOLATIONS), notes (entered, left, hidden) and what
+    could not be decided, with the colour classes used."""
+
+    violations: tuple[Event, ...]
+    notes: tuple[Event, ...]
+    undecided: tuple[str, ...]
+    model: ColorModel
+    frames: int
+
+    @property
+    def valid(self) -> bool:
+        return not self.violations
+
+    def to_json(self, evidence: dict[int, str] | None = None) -> dict[str, Any]:
+        def row(i: int, e: Event) -> dict[str, Any]:
+            r: dict[str, Any] = {"kind": e.kind, "frame": e.frame, "piece": e.piece}
+            if e.other is not None:
+                r["other"] = e.other
+            r["detail"] = e.detail
+            if evidence and i in evidence:
+                r["evidence"] = evidence[i]
+            return r
+
+        return {
+            "valid": self.valid,
+            "frames": self.frames,
+            "colors": {"from": self.model.source, "pieces": list(self.model.names)},
+            "violations": [row(i, e) for i, e in enumerate(self.violations)],
+            "notes": [row(-1, e) for e in self.notes],
+            "undecided": list(self.undecided),
+        }
+
+
+def judge_frames(
+    frames: tuple[U8, ...] | list[U8],
+    colors: list[tuple[str, tuple[int, int, int]]] | None = None,
+    level: Any = None,
+) -> Verdict:
+    """The verdict on working-size frames; ``colors`` (name, RGB) of the pieces if known (else
+    clustered from the first frame); ``level`` enables the kinematic check of our renders."""
+    try:
+        model = palette_model(colors) if colors else clustered_model(frames[0])
+    except ValueError as e:
+        raise VideoJudgeError(str(e)) from None
+    area = min_area(frames[0].shape)
+    masks = [class_masks(f, model) for f in frames]
+    objects = [frame_objects(m, area) for m in masks]
+    events = Tracker(objects, model.names).events()
+    undecided: list[str] = []
+    if level is not None:
+        from chaingeo.envs.judge_pose import pass_through
+
+        kept = [
+            [_union(objs, k, m[0].shape) for k in range(len(model.names))]
+            for (objs, _), m in zip(objects, masks, strict=True)
+        ]
+        found, why = pass_through(level, kept, model.names)
+        events = sorted([*events, *found], key=lambda e: (e.frame, e.kind, e.piece))
+        undecided.extend(why)
+    else:
+        undecided.append(
+            "pass_through: motion through another piece is not decidable without the level's "
+            "geometry and a known camera (give --level for a video drawn by chain video)"
+        )
+    hidden = [e for e in events if e.kind == "hidden"]
+    undecided += [f"frame {e.frame}: {e.detail} (occluded, or lost)" for e in hidden]
+    violations = tuple(e for e in events if e.kind in VIOLATIONS)
+    notes = tuple(e for e in events if e.kind not in VIOLATIONS)
+    return Verdict(violations, notes, tuple(undecided), model, len(frames))
+
+
+def _union(objs: list[Obj], k: int, shape: tuple[int, ...]) -> BoolArray:
+    """Class ``k``'s pixels that belong to objects (components past the least area)."""
+    out = np.zeros(shape, dtype=bool)
+    for o in objs:
+        if o.cls == k:
+            out |= o.mask
+    return out
+
+
+def _tinted(frame: U8, masks: tuple[BoolArray, ...], which: range) -> Image.Image:
+    out = frame.astype(np.float64)
+    for i in which:
+        if i < len(masks):
+            tint = np.array(_TINTS[min(i, len(_TINTS) - 1)], dtype=np.float64)
+            m = masks[i]
+            edge = m & ~(
+                np.roll(m, 1, 0) & np.roll(m, -1, 0) & np.roll(m, 1, 1) & np.roll(m, -1, 1)
+            )
+            out[m] = 0.6 * out[m] + 0.4 * tint
+            out[edge] = tint
+    img = Image.fromarray(np.clip(out, 0, 255).astype(np.uint8))
+    return img.resize(
+        (img.width * EVIDENCE_ZOOM, img.height * EVIDENCE_ZOOM), Image.Resampling.NEAREST
+    )
+
+
+def write_evidence(verdict: Verdict, frames: tuple[U8, ...], folder: Path) -> dict[int, str]:
+    """One PNG per violation: the frame before the event and the frame of the event side by
+    side, the pieces involved outlined and tinted (magenta, cyan, yellow, green in turn);
+    returns index -> file path."""
+    from chaingeo.envs.raster import png_bytes
+
+    folder.mkdir(parents=True, exist_ok=True)
+    out: dict[int, str] = {}
+    for i, e in enumerate(verdict.violations):
+        a = _tinted(frames[max(0, e.frame - 1)], e.masks, range(0, e.before))
+        b = _tinted(frames[e.frame], e.masks, range(e.before, len(e.masks)))
+        sheet = Image.new("RGB", (a.width + b.width + 4, a.height), (255, 255, 255))
+        sheet.paste(a, (0, 0))
+        sheet.paste(b, (a.width + 4, 0))
+        path = folder / f"{i:02d}-{e.kind}-f{e.frame:04d}-{e.piece}.png"
+        path.write_bytes(png_bytes(sheet))
+        out[i] = str(path)
+    return out
+
+
+def judge_video(path: Path, level: Any = None, evidence: Path | None = None) -> dict[str, Any]:
+    """The JSON report on a video file (see :func:`judge_frames`), evidence PNGs written to
+    ``evidence`` when given."""
+    clip = read_clip(path)
+    colors = None
+    if level is not None:
+        colors = [(p.name, _rgb(p.rgb)) for p in level.pieces]
+    verdict = judge_frames(clip.frames, colors, level)
+    files = write_evidence(verdict, clip.frames, evidence) if evidence is not None else None
+    report = {"video": str(path), "fps": clip.fps, "size": list(clip.size)}
+    report.update(verdict.to_json(files))
+    return report
+
+
+def _rgb(hexa: str) -> tuple[int, int, int]:
+    h = hexa.lstrip("#")
+    return int(h[0:2], 16), int(h[2:4], 16), int(h[4:6], 16)
