@@ -227,3 +227,16 @@ MAX_OBSERVATION_CHARS: Final = 1 << 16
 #: piece's placements, the pickups, ``finish``), zero-padded past the level's own catalogue.
 #: The shipped suite peaks at 5,234.
 MAX_STACKING_ACTIONS: Final = 1 << 14
+
+
+# ---------------------------------------------------------------------------------------------
+# chain check-trajectory: pose trajectory files (issue #22)
+# ---------------------------------------------------------------------------------------------
+
+#: Bytes of one trajectory file (checked before reading), its frames, its poses in all (frames
+#: times pieces) and the magnitude of a translation or cell coordinate in it. A plan's own
+#: trajectory of the shipped suite stays under 2,000 frames and 4 MB.
+MAX_TRAJECTORY_BYTES: Final = 64 * 1024 * 1024
+MAX_TRAJECTORY_FRAMES: Final = 50_000
+MAX_TRAJECTORY_POSES: Final = 1_000_000
+MAX_TRAJECTORY_COORD: Final = 1e6

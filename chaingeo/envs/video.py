@@ -15,6 +15,7 @@ Pillow; MP4 needs the optional extra ``video`` (imageio with its own ffmpeg).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -223,12 +224,32 @@ def _puzzle_shots(
     return shots, captions, ((lo[0], lo[1], lo[2]), (hi[0], hi[1], hi[2]))
 
 
+def _approach(cells: Shape, filled: set[Cell], box: Cell | None) -> tuple[Cell, int]:
+    """The last leg into place: straight down (the first way whose path no placed cell
+    blocks), else in from the -x, -y or +y side of the box at the piece's own height (the
+    waiting row lies on the +x side); (direction, length of the leg, 0 for down)."""
+    assert box is not None
+    own = cells.cell_set
+    ways: tuple[Cell, ...] = ((0, 0, -1), (1, 0, 0), (0, 1, 0), (0, -1, 0))
+    for d in ways:
+        axis = next(i for i in range(3) if d[i])
+        reach = box[axis] + 1 if d[2] == 0 else 0
+        back = reach if reach else box[2] + 1
+        if all(
+            tuple(c[i] - d[i] * j for i in range(3)) not in filled
+            for c in own
+            for j in range(1, back + 1)
+        ):
+            return d, reach
+    return (0, 0, -1), 0  # blocked every way: shown falling through (a checker says so)
+
+
 def _stacking_shots(
     level: Level, order: Sequence[tuple[str, Shape]]
 ) -> tuple[list[_Shot], list[str], tuple[Cell, Cell]]:
     """The pieces wait on the floor in a row beside the box (+x), already turned as they will
-    lie, in placing order; each in turn rises above everything, travels over the box and is
-    lowered into place (nothing appears from nowhere or passes through a piece)."""
+    lie, in placing order; each in turn rises above everything, travels over the box (along x,
+    then y) and is lowered into place (nothing appears from nowhere or passes through a piece)."""
     assert level.box is not None
     bx, by, bz = level.box
     eye = np.eye(3)
@@ -252,27 +273,41 @@ def _stacking_shots(
     def shot() -> _Shot:
         return tuple((n, eye, at[n]) for n in sorted(at))
 
+    filled: set[Cell] = set()
+    low, high = np.zeros(3, dtype=np.int64), np.zeros(3, dtype=np.int64)  # sides entered from
     for name, cells in order:
         start = waiting[name]
-        above = np.array([start[0], start[1], clear - cells.min_corner[2]], dtype=np.float64)
-        over = np.array([0.0, 0.0, above[2]])
+        lift = np.array([start[0], start[1], clear - cells.min_corner[2]], dtype=np.float64)
+        d, back = _approach(cells, filled, level.box)
+        entry = np.array([-back * d[0], -back * d[1], 0.0])  # where the last leg starts
+        low = np.minimum(low, entry.astype(np.int64) + cells.min_corner)
+        high = np.maximum(high, entry.astype(np.int64) + cells.max_corner + 1)
+        path = [
+            start,
+            lift,
+            np.array([entry[0], lift[1], lift[2]]),  # along x, then y: axis-aligned slides
+            np.array([entry[0], entry[1], lift[2]]),
+            entry,
+            np.zeros(3),
+        ]
         seg = [shot()]
-        for a, b, frames in ((start, above, LIFT_FRAMES), (above, over, DROP_FRAMES)):
+        for a, b in itertools.pairwise(path):
+            if np.array_equal(a, b):
+                continue
+            frames = LIFT_FRAMES if a is start else DROP_FRAMES
             for i in range(1, frames + 1):
                 at[name] = a + (b - a) * _ease(i, frames)
                 seg.append(shot())
-        for i in range(1, DROP_FRAMES + 1):
-            at[name] = over * (1.0 - _ease(i, DROP_FRAMES))
-            seg.append(shot())
         at[name] = np.zeros(3)
         seg[-1] = shot()
         segments.append(seg)
+        filled |= cells.cell_set
     texts = [f"place {name}" for name, _ in order]
     full = len(order) == len(level.pieces)
     first = tuple((n, eye, waiting[n]) for n in sorted(waiting))
     shots, captions = _captioned(level, segments, texts, (first, shot()), full)
-    depth = max(by, y + row_depth)
-    return shots, captions, ((0, 0, 0), (width, depth, clear + tallest))
+    depth = max(by, y + row_depth, int(high[1]))
+    return shots, captions, ((int(low[0]), int(low[1]), 0), (width, depth, clear + tallest))
 
 
 def _draw(

@@ -1,0 +1,408 @@
+"""The verdict on a pose trajectory: its segments checked (:mod:`chaingeo.envs.trajectory_check`),
+its lattice motions replayed as a plan by the reference kinematics (puzzles: the engine of
+:mod:`chaingeo.core.kinematics`, then the level's state machine; stacking: the state machine),
+and the goal tested on the last frame.
+
+An assembly level's trajectory is checked backwards, as the disassembly it undoes (the same
+motions, the same sweeps), and reported with forward frame numbers.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from chaingeo.core.geometry import Cell
+from chaingeo.core.kinematics import (
+    disassembly_of_assembly_plan,
+)
+from chaingeo.core.level import Level
+from chaingeo.core.turns import AXES
+from chaingeo.envs.trajectory import Trajectory
+from chaingeo.envs.trajectory_check import (
+    TOL,
+    Findings,
+    Motion,
+    Poses,
+    cells_at,
+    classify,
+    direction_name,
+    jump,
+    read_poses,
+    slide_hit,
+    spinning_of,
+    turn_swept,
+)
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """``valid``: no violation and nothing undecided; ``plan``: the actions the trajectory
+    realises (None when it realises none); ``goal``: whether the last frame meets the level's
+    goal (None: not known)."""
+
+    valid: bool
+    violations: list[dict[str, Any]]
+    undecided: list[dict[str, Any]]
+    plan: list[str] | None
+    goal: bool | None
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "valid": self.valid,
+            "violations": self.violations,
+            "undecided": self.undecided,
+            "plan": self.plan,
+            "goal": self.goal,
+        }
+
+
+class _Segments:
+    """Walks the lattice frames, checking each segment's motions and each lattice frame."""
+
+    def __init__(self, level: Level, ps: Poses, found: Findings, max_jump: float | None) -> None:
+        self.level, self.ps, self.found, self.max_jump = level, ps, found, max_jump
+        self.turns = level.family == "stacking" or bool(getattr(level.rules, "turns", False))
+        self.voxels = {n: level.piece(n).shape.voxels for n in ps.names}
+        self.overlapping: set[tuple[str, str]] = set()
+        self.motions: list[list[Motion]] = []
+
+    def run(self) -> None:
+        ps = self.ps
+        n_f, n_p = ps.ok.shape
+        lattice = [i for i in range(n_f) if bool((ps.lat[i] | ~ps.ok[i]).all())]
+        for f, why in ((0, "starts"), (n_f - 1, "ends")):
+            if not lattice or lattice[0 if f == 0 else -1] != f:
+                for j in range(n_p):
+                    if ps.ok[f, j] and not ps.lat[f, j]:
+                        self.found.add("off-lattice", f, ps.names[j], f"it {why} off the lattice")
+        if not lattice:
+            return
+        self.overlap(lattice[0])
+        for a, b in itertools.pairwise(lattice):
+            self.motions.append(self.segment(a, b))
+            self.overlap(b)
+        self.motions = _merged([s for s in self.motions if s])
+
+    def overlap(self, f: int) -> None:
+        """Pieces that share a cell at lattice frame ``f`` (each pair once while it lasts)."""
+        ps = self.ps
+        owner: dict[Cell, str] = {}
+        now: dict[tuple[str, str], Cell] = {}
+        for j, n in enumerate(ps.names):
+            if not ps.ok[f, j]:
+                continue
+            for c in sorted(cells_at(self.level, ps, f, j)):
+                other = owner.setdefault(c, n)
+                if other != n:
+                    now.setdefault((other, n), c)
+        for (a, b), c in sorted(now.items()):
+            if (a, b) not in self.overlapping:
+                self.found.add("overlap", f, b, f"it overlaps {a} at cell {list(c)}", other=a)
+        self.overlapping = set(now)
+
+    def first_move(self, a: int, b: int, j: int) -> int:
+        ps = self.ps
+        for i in range(a + 1, b + 1):
+            if (
+                np.abs(ps.rot[i, j] - ps.rot[a, j]).max() > TOL
+                or np.abs(ps.tr[i, j] - ps.tr[a, j]).max() > TOL
+            ):
+                return i
+        return b
+
+    def segment(self, a: int, b: int) -> list[Motion]:
+        ps = self.ps
+        js = [j for j in range(len(ps.names)) if bool(ps.ok[a : b + 1, j].all())]
+        moving: list[tuple[int, Motion]] = []
+        still: list[int] = []
+        for j in js:
+            motion, why = classify(ps, a, b, j, self.turns)
+            size = jump(ps, a, b, j, self.voxels[ps.names[j]])
+            at = self.first_move(a, b, j)
+            if self.max_jump is not None and size > self.max_jump + TOL:
+                self.found.add(
+                    "teleport",
+                    at,
+                    ps.names[j],
+                    f"it moves {size:.3g} units in one frame (at most {self.max_jump:g})",
+                )
+            if why is not None:
+                self.not_allowed(a, b, j, at, why, size)
+            elif motion is None:
+                still.append(j)
+            else:
+                moving.append((j, motion))
+        groups = self.grouped(a, b, moving)
+        fixed = {c: ps.names[j] for j in still for c in cells_at(self.level, ps, a, j)}
+        boxes = [self.sweep(a, js_, m, fixed, still) for js_, m in groups]
+        for (g1, b1), (g2, b2) in itertools.combinations(
+            zip([m for _, m in groups], boxes, strict=True), 2
+        ):
+            if b1 is None or b2 is None or _boxes_meet(b1, b2):
+                self.found.undecided.append(
+                    {
+                        "frame": a,
+                        "pieces": sorted(g1.pieces + g2.pieces),
+                        "reason": "two groups move at once and their swept regions may meet",
+                    }
+                )
+        return [m for _, m in groups]
+
+    def not_allowed(self, a: int, b: int, j: int, at: int, why: str, size: float) -> None:
+        ps = self.ps
+        name = ps.names[j]
+        if ps.ok[b, j] and ps.lat[b, j]:
+            for o in range(len(ps.names)):
+                if (
+                    o != j
+                    and ps.ok[a, o]
+                    and ps.ok[b, o]
+                    and _same(ps, b, j, a, o)
+                    and _same(ps, b, o, a, j)
+                ):
+                    self.found.add(
+                        "swap",
+                        at,
+                        name,
+                        f"it takes {ps.names[o]}'s place and {ps.names[o]} takes its "
+                        "(identities swapped)",
+                        other=ps.names[o],
+                    )
+                    return
+        if "drifts" in why or "overshoots" in why:
+            self.found.add("off-lattice", at, name, why)
+        elif size > 1 + TOL:
+            self.found.add(
+                "teleport", at, name, f"it jumps {size:.3g} units in one frame and {why}"
+            )
+        else:
+            self.found.add("motion", at, name, f"not an allowed motion: {why}")
+
+    def grouped(
+        self, a: int, b: int, moving: list[tuple[int, Motion]]
+    ) -> list[tuple[list[int], Motion]]:
+        """Pieces moving with the same motion, as one group each (relative poses equal at
+        every frame of the segment)."""
+        ps = self.ps
+        groups: list[tuple[list[int], Motion]] = []
+        for j, m in moving:
+            for js_, g in groups:
+                k = js_[0]
+                if (g.kind, g.axis, g.k, g.quarter) == (
+                    m.kind,
+                    m.axis,
+                    m.k,
+                    m.quarter,
+                ) and _same_motion(ps, a, b, j, k):
+                    js_.append(j)
+                    break
+            else:
+                groups.append(([j], m))
+        return [
+            (
+                js_,
+                Motion(
+                    tuple(sorted(ps.names[j] for j in js_)),
+                    a,
+                    b,
+                    m.kind,
+                    m.axis,
+                    m.k,
+                    m.quarter,
+                    m.pivot,
+                ),
+            )
+            for js_, m in groups
+        ]
+
+    def sweep(
+        self, a: int, js: list[int], m: Motion, fixed: dict[Cell, str], still: list[int]
+    ) -> tuple[Cell, Cell] | None:
+        """Test the group's swept region against the pieces at rest; its bounding box (None:
+        not known)."""
+        ps = self.ps
+        cells = [c for j in js for c in cells_at(self.level, ps, a, j)]
+        size = max(jump(ps, a, m.b, j, self.voxels[ps.names[j]]) for j in js)
+        at = min(self.first_move(a, m.b, j) for j in js)
+        kind = "teleport" if size > 1 + TOL else "collision"
+        verb = (
+            f"jumps {size:.3g} units in one frame, through"
+            if kind == "teleport"
+            else "passes through"
+        )
+        if m.kind == "slide":
+            hit = slide_hit(cells, fixed, m.axis, m.k)
+            if hit is not None:
+                self.found.add(
+                    kind,
+                    at,
+                    m.pieces[0],
+                    f"sliding {direction_name(m.axis, m.k)} {abs(m.k)} it {verb} {hit[0]} "
+                    f"at cell {list(hit[1])}",
+                    other=hit[0],
+                    group=list(m.pieces),
+                )
+            arr = np.array(cells)
+            shifted = arr.copy()
+            shifted[:, m.axis] += m.k
+            both = np.concatenate([arr, shifted])
+            return _box(both)
+        swept = turn_swept(self.level, ps, a, js, m)
+        if swept is None:
+            self.found.undecided.append(
+                {
+                    "frame": at,
+                    "pieces": list(m.pieces),
+                    "reason": "a turn too wide to sweep exactly",
+                }
+            )
+            return None
+        spin = {c for j in still for c in spinning_of(self.level, ps, a, j, m)}
+        hits = sorted(c for c in swept if c in fixed and c not in spin)
+        if hits:
+            other = fixed[hits[0]]
+            self.found.add(
+                kind,
+                at,
+                m.pieces[0],
+                f"turning about {AXES[m.axis]} it {verb} {other} at cell {list(hits[0])}",
+                other=other,
+                group=list(m.pieces),
+            )
+        return _box(np.array(sorted(swept))) if swept else None
+
+
+def _merged(segments: list[list[Motion]]) -> list[list[Motion]]:
+    """One slide passing a lattice pose without stopping (a lone group going on the same
+    way in the next segment) is one move, not two."""
+    out: list[list[Motion]] = []
+    for seg in segments:
+        if out and len(seg) == len(out[-1]) == 1:
+            p, m = out[-1][0], seg[0]
+            if (
+                p.kind == m.kind == "slide"
+                and p.b == m.a
+                and (p.pieces, p.axis) == (m.pieces, m.axis)
+                and p.k * m.k > 0
+            ):
+                out[-1] = [Motion(p.pieces, p.a, m.b, "slide", p.axis, k=p.k + m.k)]
+                continue
+        out.append(seg)
+    return out
+
+
+def _box(arr: Any) -> tuple[Cell, Cell]:
+    lo, hi = arr.min(axis=0), arr.max(axis=0)
+    return (int(lo[0]), int(lo[1]), int(lo[2])), (int(hi[0]), int(hi[1]), int(hi[2]))
+
+
+def _boxes_meet(p: tuple[Cell, Cell], q: tuple[Cell, Cell]) -> bool:
+    return all(p[0][i] <= q[1][i] and q[0][i] <= p[1][i] for i in range(3))
+
+
+def _same(ps: Poses, f: int, j: int, g: int, o: int) -> bool:
+    return bool(
+        ps.lat[f, j]
+        and ps.lat[g, o]
+        and ps.ridx[f, j] == ps.ridx[g, o]
+        and (ps.off[f, j] == ps.off[g, o]).all()
+    )
+
+
+def _same_motion(ps: Poses, a: int, b: int, j: int, k: int) -> bool:
+    from chaingeo.envs.trajectory_check import _relative
+
+    rj, tj = _relative(ps, a, b, j)
+    rk, tk = _relative(ps, a, b, k)
+    return bool(np.abs(rj - rk).max() <= 1e-5 and np.abs(tj - tk).max() <= 1e-5)
+
+
+_FORWARD = {"appear": "disappear", "disappear": "appear"}
+
+
+def _forward(found: Findings, n_frames: int) -> None:
+    """Frame numbers (and appear/disappear) of a backwards check, as the file runs: its start
+    is the assembly's goal."""
+    for v in found.violations:
+        v["frame"] = n_frames - 1 - v["frame"]
+        v["kind"] = _FORWARD.get(v["kind"], v["kind"])
+        if v["kind"] == "start" and v["frame"] == n_frames - 1 and v["piece"] is None:
+            v["kind"], v["reason"] = (
+                "goal",
+                "the last frame misses the goal: it is not the assembled puzzle",
+            )
+    for u in found.undecided:
+        u["frame"] = n_frames - 1 - u["frame"]
+
+
+def check_trajectory(level: Level, traj: Trajectory, max_jump: float | None = None) -> Verdict:
+    """Check a trajectory against a level (see the module docstrings)."""
+    found = Findings()
+    backwards = level.family == "puzzle" and level.goal == "assemble"
+    n_f = len(traj.frames)
+    if backwards:
+        traj = Trajectory(
+            traj.level, traj.frames[::-1], tuple((n_f - 1 - f, n) for f, n in traj.duplicates)
+        )
+    if traj.level is not None and traj.level != level.id:
+        found.add("level", 0, None, f"the trajectory names level {traj.level!r}, not {level.id!r}")
+    ps = read_poses(level, traj, found)
+    walk = _Segments(level, ps, found, max_jump)
+    walk.run()
+    plan: list[str] | None = None
+    goal: bool | None = None
+    structural = {
+        "appear",
+        "disappear",
+        "duplicate",
+        "shape",
+        "motion",
+        "teleport",
+        "off-lattice",
+        "swap",
+    }
+    if not any(v["kind"] in structural for v in found.violations):
+        plan, goal = _replayed(level, ps, walk.motions, found)
+        if backwards and goal is False:  # the disassembly does not end apart
+            found.add("start", n_f - 1, None, "the first frame is not the pieces apart")
+    if backwards:
+        _forward(found, n_f)
+        goal = None if goal is None else not any(v["kind"] == "goal" for v in found.violations)
+    elif goal is False:
+        words = (
+            "the box is not full" if level.family == "stacking" else "the pieces are not all apart"
+        )
+        found.add("goal", n_f - 1, None, f"the last frame misses the goal: {words}")
+    valid = not found.violations and not found.undecided
+    return Verdict(valid, found.violations, found.undecided, plan, goal)
+
+
+def _replayed(
+    level: Level, ps: Poses, motions: list[list[Motion]], found: Findings
+) -> tuple[list[str] | None, bool | None]:
+    from chaingeo.envs.actions import action_of_move
+    from chaingeo.envs.trajectory_plan import machine_problem, replay_puzzle, replay_stacking
+
+    if level.family == "stacking":
+        return replay_stacking(level, ps, motions, found)
+    steps, goal = replay_puzzle(level, ps, motions, found)
+    if steps is None:
+        return None, None
+    moves = steps if level.goal == "disassemble" else disassembly_of_assembly_plan(steps)
+    texts = [action_of_move(m).to_text() for m in moves]
+    if level.goal == "disassemble":
+        problem = machine_problem(level, texts)
+        if problem is not None:
+            found.add(
+                "illegal",
+                0,
+                None,
+                f"the state machine refuses action {problem[0] + 1} "
+                f"({texts[problem[0]]!r}): {problem[1]}",
+            )
+            return texts, goal
+    return texts, goal
