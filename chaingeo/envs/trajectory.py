@@ -21,14 +21,17 @@ its own, far from every other part, where its own disassembly goes on.
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Final
 
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.files import atomic_write
 from chaingeo.core.geometry import ROTATIONS, Cell, Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, disassembly_of_assembly_plan
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
@@ -135,8 +138,6 @@ def parse_trajectory(text: str) -> Trajectory:
         raise TrajectoryError(str(e)) from None
     except ValueError as e:
         raise TrajectoryError(f"not JSON: {e}") from None
-    import json
-
     data = json.loads(text, object_pairs_hook=_pairs)
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise TrajectoryError(f'expected an object with "format": "{FORMAT}"')
@@ -342,3 +343,12 @@ def plan_trajectory(level: Level, plan_text: str | None = None) -> list[Frame]:
     if isinstance(level.solution, PuzzleSolution):
         return puzzle_trajectory(level, moves)
     return stacking_trajectory(level, places)
+
+
+def write_trajectory(level: Level, plan_text: str | None, path: Path) -> Path:
+    """The plan's trajectory as canonical JSON (sorted keys, one frame a line), atomically."""
+    data = trajectory_json(level.id, plan_trajectory(level, plan_text))
+    head = json.dumps({k: v for k, v in data.items() if k != "frames"}, sort_keys=True)
+    lines = [json.dumps(f, sort_keys=True, separators=(",", ":")) for f in data["frames"]]
+    text = head[:-1] + ', "frames": [\n' + ",\n".join(lines) + "\n]}\n"
+    return atomic_write(path, text.encode("utf-8"))

@@ -61,7 +61,9 @@ class Verdict:
 
 
 class _Segments:
-    """Walks the lattice frames, checking each segment's motions and each lattice frame."""
+    """Cuts each piece's frames at the frames where it sits on the lattice, checks each of
+    its motions, sweeps each group's motion against the pieces at rest meanwhile, and tests
+    the pieces on the lattice for overlap whenever one of them changes."""
 
     def __init__(self, level: Level, ps: Poses, found: Findings, max_jump: float | None) -> None:
         self.level, self.ps, self.found, self.max_jump = level, ps, found, max_jump
@@ -69,33 +71,74 @@ class _Segments:
         self.voxels = {n: level.piece(n).shape.voxels for n in ps.names}
         self.overlapping: set[tuple[str, str]] = set()
         self.motions: list[list[Motion]] = []
+        # changes[f, j]: piece j's pose differs from frame f - 1 (prefix sums: at rest or not)
+        step = (np.abs(np.diff(ps.rot, axis=0)).max(axis=(2, 3)) > TOL) | (
+            np.abs(np.diff(ps.tr, axis=0)).max(axis=2) > TOL
+        )
+        step |= ~ps.ok[1:] | ~ps.ok[:-1]
+        self.changes = np.concatenate(
+            [np.zeros((1, len(ps.names)), np.int64), np.cumsum(step, axis=0)]
+        )
+
+    def at_rest(self, j: int, a: int, b: int) -> bool:
+        return bool(self.changes[b, j] == self.changes[a, j]) and bool(self.ps.ok[a, j])
 
     def run(self) -> None:
         ps = self.ps
         n_f, n_p = ps.ok.shape
-        lattice = [i for i in range(n_f) if bool((ps.lat[i] | ~ps.ok[i]).all())]
-        for f, why in ((0, "starts"), (n_f - 1, "ends")):
-            if not lattice or lattice[0 if f == 0 else -1] != f:
-                for j in range(n_p):
-                    if ps.ok[f, j] and not ps.lat[f, j]:
-                        self.found.add("off-lattice", f, ps.names[j], f"it {why} off the lattice")
-        if not lattice:
-            return
-        self.overlap(lattice[0])
-        for a, b in itertools.pairwise(lattice):
-            self.motions.append(self.segment(a, b))
-            self.overlap(b)
-        self.motions = _merged([s for s in self.motions if s])
+        moving: list[tuple[int, Motion]] = []
+        for j in range(n_p):
+            frames = [f for f in range(n_f) if ps.ok[f, j] and ps.lat[f, j]]
+            for f, why in ((0, "starts"), (n_f - 1, "ends")):
+                if ps.ok[f, j] and not ps.lat[f, j]:
+                    self.found.add("off-lattice", f, ps.names[j], f"it {why} off the lattice")
+            for a, b in itertools.pairwise(frames):
+                if self.at_rest(j, a, b) or not ps.ok[a : b + 1, j].all():
+                    continue
+                motion = self.classified(j, a, b)
+                if motion is not None:
+                    moving.append((j, motion))
+        groups = self.grouped(moving)
+        boxes = [self.sweep(js, m) for js, m in groups]
+        self.concurrent(groups, boxes)
+        self.overlaps()
+        order = sorted(groups, key=lambda g: (g[1].b, g[1].a, g[1].pieces))
+        self.motions = _merged([[m] for _, m in order])
 
-    def overlap(self, f: int) -> None:
-        """Pieces that share a cell at lattice frame ``f`` (each pair once while it lasts)."""
+    def classified(self, j: int, a: int, b: int) -> Motion | None:
         ps = self.ps
+        motion, why = classify(ps, a, b, j, self.turns)
+        size = jump(ps, a, b, j, self.voxels[ps.names[j]])
+        at = self.first_move(a, b, j)
+        if self.max_jump is not None and size > self.max_jump + TOL:
+            self.found.add(
+                "teleport",
+                at,
+                ps.names[j],
+                f"it moves {size:.3g} units in one frame (at most {self.max_jump:g})",
+            )
+        if why is not None:
+            self.not_allowed(a, b, j, at, why, size)
+        return motion
+
+    def overlaps(self) -> None:
+        """Pieces on the lattice that share a cell (each pair once while it lasts), tested at
+        every frame where a piece on the lattice changes."""
+        ps = self.ps
+        last: tuple[Any, ...] | None = None
+        for f in range(ps.ok.shape[0]):
+            on = ps.ok[f] & ps.lat[f]
+            key = (on.tobytes(), ps.ridx[f][on].tobytes(), ps.off[f][on].tobytes())
+            if key != last:
+                self.overlap(f, [j for j in range(len(ps.names)) if on[j]])
+            last = key
+
+    def overlap(self, f: int, js: list[int]) -> None:
         owner: dict[Cell, str] = {}
         now: dict[tuple[str, str], Cell] = {}
-        for j, n in enumerate(ps.names):
-            if not ps.ok[f, j]:
-                continue
-            for c in sorted(cells_at(self.level, ps, f, j)):
+        for j in js:
+            n = self.ps.names[j]
+            for c in sorted(cells_at(self.level, self.ps, f, j)):
                 other = owner.setdefault(c, n)
                 if other != n:
                     now.setdefault((other, n), c)
@@ -103,6 +146,44 @@ class _Segments:
             if (a, b) not in self.overlapping:
                 self.found.add("overlap", f, b, f"it overlaps {a} at cell {list(c)}", other=a)
         self.overlapping = set(now)
+
+    def concurrent(self, groups: list[tuple[list[int], Motion]], boxes: list[Any]) -> None:
+        """Two groups moving at the same time: decided only when their swept boxes are apart."""
+        for (_, g1), (_, g2), b1, b2 in (
+            (p[0], q[0], p[1], q[1])
+            for p, q in itertools.combinations(zip(groups, boxes, strict=True), 2)
+        ):
+            if g1.a >= g2.b or g2.a >= g1.b:
+                continue
+            if b1 is None or b2 is None or _boxes_meet(b1, b2):
+                self.found.undecided.append(
+                    {
+                        "frame": max(g1.a, g2.a),
+                        "pieces": sorted(g1.pieces + g2.pieces),
+                        "reason": "two groups move at once and their swept regions may meet",
+                    }
+                )
+
+    def swapped(self, a: int, b: int, j: int) -> str | None:
+        """The piece that ``j`` changes places with from ``a`` to ``b`` (poses or cells
+        exchanged, where the two differed), or None."""
+        ps = self.ps
+        if not (ps.lat[a, j] and ps.lat[b, j]):
+            return None
+        lv = self.level
+        for o in range(len(ps.names)):
+            if o == j or not (ps.ok[a, o] and ps.ok[b, o] and ps.lat[a, o] and ps.lat[b, o]):
+                continue
+            if _same(ps, b, j, a, o) and _same(ps, b, o, a, j) and not _same(ps, a, j, a, o):
+                return ps.names[o]
+            mine, theirs = cells_at(lv, ps, a, j), cells_at(lv, ps, a, o)
+            if (
+                mine != theirs
+                and cells_at(lv, ps, b, j) == theirs
+                and cells_at(lv, ps, b, o) == mine
+            ):
+                return ps.names[o]
+        return None
 
     def first_move(self, a: int, b: int, j: int) -> int:
         ps = self.ps
@@ -114,65 +195,19 @@ class _Segments:
                 return i
         return b
 
-    def segment(self, a: int, b: int) -> list[Motion]:
-        ps = self.ps
-        js = [j for j in range(len(ps.names)) if bool(ps.ok[a : b + 1, j].all())]
-        moving: list[tuple[int, Motion]] = []
-        still: list[int] = []
-        for j in js:
-            motion, why = classify(ps, a, b, j, self.turns)
-            size = jump(ps, a, b, j, self.voxels[ps.names[j]])
-            at = self.first_move(a, b, j)
-            if self.max_jump is not None and size > self.max_jump + TOL:
-                self.found.add(
-                    "teleport",
-                    at,
-                    ps.names[j],
-                    f"it moves {size:.3g} units in one frame (at most {self.max_jump:g})",
-                )
-            if why is not None:
-                self.not_allowed(a, b, j, at, why, size)
-            elif motion is None:
-                still.append(j)
-            else:
-                moving.append((j, motion))
-        groups = self.grouped(a, b, moving)
-        fixed = {c: ps.names[j] for j in still for c in cells_at(self.level, ps, a, j)}
-        boxes = [self.sweep(a, js_, m, fixed, still) for js_, m in groups]
-        for (g1, b1), (g2, b2) in itertools.combinations(
-            zip([m for _, m in groups], boxes, strict=True), 2
-        ):
-            if b1 is None or b2 is None or _boxes_meet(b1, b2):
-                self.found.undecided.append(
-                    {
-                        "frame": a,
-                        "pieces": sorted(g1.pieces + g2.pieces),
-                        "reason": "two groups move at once and their swept regions may meet",
-                    }
-                )
-        return [m for _, m in groups]
-
     def not_allowed(self, a: int, b: int, j: int, at: int, why: str, size: float) -> None:
         ps = self.ps
         name = ps.names[j]
-        if ps.ok[b, j] and ps.lat[b, j]:
-            for o in range(len(ps.names)):
-                if (
-                    o != j
-                    and ps.ok[a, o]
-                    and ps.ok[b, o]
-                    and _same(ps, b, j, a, o)
-                    and _same(ps, b, o, a, j)
-                ):
-                    self.found.add(
-                        "swap",
-                        at,
-                        name,
-                        f"it takes {ps.names[o]}'s place and {ps.names[o]} takes its "
-                        "(identities swapped)",
-                        other=ps.names[o],
-                    )
-                    return
+        other = self.swapped(a, b, j)
+        if other is not None:
+            self.found.add(
+                "swap",
+                at,
+                name,
+                f"it takes {other}'s place and {other} takes its (identities swapped)",
+                other=other,
+            )
+            return
         if "drifts" in why or "overshoots" in why:
             self.found.add("off-lattice", at, name, why)
         elif size > 1 + TOL:
@@ -182,33 +217,32 @@ class _Segments:
         else:
             self.found.add("motion", at, name, f"not an allowed motion: {why}")
 
-    def grouped(
-        self, a: int, b: int, moving: list[tuple[int, Motion]]
-    ) -> list[tuple[list[int], Motion]]:
-        """Pieces moving with the same motion, as one group each (relative poses equal at
-        every frame of the segment)."""
+    def grouped(self, moving: list[tuple[int, Motion]]) -> list[tuple[list[int], Motion]]:
+        """Pieces moving with the same motion over the same frames, as one group each."""
         ps = self.ps
         groups: list[tuple[list[int], Motion]] = []
         for j, m in moving:
-            for js_, g in groups:
-                k = js_[0]
-                if (g.kind, g.axis, g.k, g.quarter) == (
+            for js, g in groups:
+                same = (g.a, g.b, g.kind, g.axis, g.k, g.quarter) == (
+                    m.a,
+                    m.b,
                     m.kind,
                     m.axis,
                     m.k,
                     m.quarter,
-                ) and _same_motion(ps, a, b, j, k):
-                    js_.append(j)
+                )
+                if same and _same_motion(ps, m.a, m.b, j, js[0]):
+                    js.append(j)
                     break
             else:
                 groups.append(([j], m))
         return [
             (
-                js_,
+                js,
                 Motion(
-                    tuple(sorted(ps.names[j] for j in js_)),
-                    a,
-                    b,
+                    tuple(sorted(ps.names[j] for j in js)),
+                    m.a,
+                    m.b,
                     m.kind,
                     m.axis,
                     m.k,
@@ -216,15 +250,20 @@ class _Segments:
                     m.pivot,
                 ),
             )
-            for js_, m in groups
+            for js, m in groups
         ]
 
-    def sweep(
-        self, a: int, js: list[int], m: Motion, fixed: dict[Cell, str], still: list[int]
-    ) -> tuple[Cell, Cell] | None:
-        """Test the group's swept region against the pieces at rest; its bounding box (None:
-        not known)."""
+    def sweep(self, js: list[int], m: Motion) -> tuple[Cell, Cell] | None:
+        """Test the group's swept region against the pieces at rest meanwhile; its bounding
+        box (None: not known)."""
         ps = self.ps
+        a = m.a
+        still = [
+            o
+            for o in range(len(ps.names))
+            if o not in js and self.at_rest(o, a, m.b) and ps.lat[a, o]
+        ]
+        fixed = {c: ps.names[o] for o in still for c in cells_at(self.level, ps, a, o)}
         cells = [c for j in js for c in cells_at(self.level, ps, a, j)]
         size = max(jump(ps, a, m.b, j, self.voxels[ps.names[j]]) for j in js)
         at = min(self.first_move(a, m.b, j) for j in js)
