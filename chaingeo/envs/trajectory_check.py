@@ -17,13 +17,14 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any, Final
 
 import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core import limits
-from chaingeo.core.geometry import ROTATIONS, Cell, rotation_index
+from chaingeo.core.geometry import ROTATIONS, Cell, Shape, rotation_index
 from chaingeo.core.level import Level
 from chaingeo.core.turns import AXES, lateral, quarter_matrix, spinning_rods, swept_by
 from chaingeo.envs.trajectory import Pose, Trajectory, TrajectoryError
@@ -197,16 +198,27 @@ def _relative(ps: Poses, a: int, b: int, j: int) -> tuple[FloatArray, FloatArray
     return rr, tt
 
 
-def _classify_slide(rr: FloatArray, tt: FloatArray, axis: int, k: int) -> str | None:
-    if np.abs(rr - np.eye(3)).max() > TOL:
-        return "it turns while it slides"
+def _first(bad: npt.NDArray[np.bool_]) -> int | None:
+    """Index of the first True, or None."""
+    hits = np.flatnonzero(bad)
+    return int(hits[0]) if hits.size else None
+
+
+def _classify_slide(rr: FloatArray, tt: FloatArray, axis: int, k: int) -> tuple[str, int] | None:
+    """Why these relative poses are no slide by ``k`` along ``axis`` (and the first frame
+    that shows it), or None."""
     others = [i for i in range(3) if i != axis]
-    if np.abs(tt[:, others]).max() > TOL:
-        return "it leaves the line of its slide (not along one axis)"
     s = tt[:, axis]
-    if s.min() < min(0, k) - TOL or s.max() > max(0, k) + TOL:
-        return "it overshoots its lattice pose and comes back"
-    return None
+    checks = (
+        (np.abs(rr - np.eye(3)).max(axis=(1, 2)) > TOL, "it turns while it slides"),
+        (np.abs(tt[:, others]).max(axis=1) > TOL, "it leaves the line of its slide"),
+        (
+            (s < min(0, k) - TOL) | (s > max(0, k) + TOL),
+            "it overshoots its lattice pose and comes back",
+        ),
+    )
+    found = [(i, why) for bad, why in checks if (i := _first(bad)) is not None]
+    return None if not found else (min(found)[1], min(found)[0])
 
 
 def _pivot(q: FloatArray, u: FloatArray, axis: int) -> FloatArray | None:
@@ -225,57 +237,66 @@ def _pivot(q: FloatArray, u: FloatArray, axis: int) -> FloatArray | None:
 
 def _classify_turn(
     rr: FloatArray, tt: FloatArray, axis: int, quarter: int
-) -> tuple[str | None, FloatArray]:
+) -> tuple[tuple[str, int] | None, FloatArray]:
     q = rr[-1]
+    last = len(rr) - 1
     if abs(tt[-1][axis]) > TOL:
-        return "it slides along its axis while it turns", np.zeros(3)
+        return ("it slides along its axis while it turns", last), np.zeros(3)
     c = _pivot(q, tt[-1], axis)
     if c is None:
-        return "its turn's line runs through neither cell centres nor cell corners", np.zeros(3)
+        why = "its turn's line runs through neither cell centres nor cell corners"
+        return (why, last), np.zeros(3)
     uu, vv = lateral(axis)
-    for r, t in zip(rr, tt, strict=True):
+    for i, (r, t) in enumerate(zip(rr, tt, strict=True)):
         theta = math.atan2(r[vv, uu], r[uu, uu]) * quarter
         expect = np.eye(3)
         cs, sn = math.cos(theta * quarter), math.sin(theta * quarter)
         expect[uu, uu], expect[uu, vv], expect[vv, uu], expect[vv, vv] = cs, -sn, sn, cs
         if np.abs(r - expect).max() > TOL or not -TOL <= theta <= math.pi / 2 + TOL:
-            return "it does not turn about one axis by 0 to 90 degrees", c
+            return ("it does not turn about one axis by 0 to 90 degrees", i), c
         if np.abs(t - (c - r @ c)).max() > 1e-5:
-            return "its turn does not keep one line fixed", c
+            return ("its turn does not keep one line fixed", i), c
     return None, c
 
 
-def classify(ps: Poses, a: int, b: int, j: int, turns: bool) -> tuple[Motion | None, str | None]:
+def classify(
+    ps: Poses, a: int, b: int, j: int, turns: bool
+) -> tuple[Motion | None, tuple[str, int] | None]:
     """Piece ``j``'s motion from lattice frame ``a`` to ``b`` (both ends on the lattice):
-    (the motion, None), (None, why it is no allowed motion), or (None, None) at rest."""
+    (the motion, None), (None, (why it is no allowed motion, the frame that shows it)), or
+    (None, None) at rest."""
     rr, tt = _relative(ps, a, b, j)
-    moved = np.abs(rr - np.eye(3)).max() > TOL or np.abs(tt).max() > TOL
-    if not moved:
+    off = (np.abs(rr - np.eye(3)).max(axis=(1, 2)) > TOL) | (np.abs(tt).max(axis=1) > TOL)
+    first = _first(off)
+    if first is None:
         return None, None
+    at = a + first
     q = np.rint(rr[-1]).astype(np.int64)
     u = tt[-1]
     name = ps.names[j]
     if (q == np.eye(3, dtype=np.int64)).all():
         nz = [i for i in range(3) if abs(u[i]) > TOL]
         if not nz:
-            return None, "it drifts off the lattice at rest (and back)"
+            return None, ("it drifts off the lattice at rest (and back)", at)
         if len(nz) > 1:
-            return None, "it moves along more than one axis at once (no slide)"
+            return None, ("it moves along more than one axis at once (no slide)", at)
         axis = nz[0]
         k = round(float(u[axis]))
         why = _classify_slide(rr, tt, axis, k)
-        return (None, why) if why else (Motion((name,), a, b, "slide", axis, k=k), None)
+        if why is not None:
+            return None, (why[0], a + why[1])
+        return Motion((name,), a, b, "slide", axis, k=k), None
     for axis in range(3):
         for quarter in (1, -1):
             if (q == quarter_matrix(axis, quarter)).all():
                 if not turns:
-                    return None, "it turns, and this level allows no turns"
-                why, c = _classify_turn(rr, tt, axis, quarter)
-                if why:
-                    return None, why
+                    return None, ("it turns, and this level allows no turns", at)
+                bad, c = _classify_turn(rr, tt, axis, quarter)
+                if bad is not None:
+                    return None, (bad[0], a + bad[1])
                 piv = (float(c[0]), float(c[1]), float(c[2]))
                 return Motion((name,), a, b, "turn", axis, quarter=quarter, pivot=piv), None
-    return None, "its rotation is neither one quarter turn nor none (no allowed motion)"
+    return None, ("its rotation is neither one quarter turn nor none (no allowed motion)", at)
 
 
 def jump(ps: Poses, a: int, b: int, j: int, shape_cells: npt.NDArray[np.int64]) -> float:
@@ -297,10 +318,16 @@ def jump(ps: Poses, a: int, b: int, j: int, shape_cells: npt.NDArray[np.int64]) 
 
 
 def cells_at(level: Level, ps: Poses, f: int, j: int) -> frozenset[Cell]:
-    shape = level.piece(ps.names[j]).shape
-    r = ROTATIONS[int(ps.ridx[f, j])]
+    """The cells piece ``j`` fills at frame ``f`` (where it is on the lattice)."""
     o = ps.off[f, j]
-    return frozenset((int(x), int(y), int(z)) for x, y, z in (shape.voxels @ r.T + o).tolist())
+    offset = (int(o[0]), int(o[1]), int(o[2]))
+    return _cells(level.piece(ps.names[j]).shape, int(ps.ridx[f, j]), offset)
+
+
+@lru_cache(maxsize=1 << 14)
+def _cells(shape: Shape, ridx: int, offset: Cell) -> frozenset[Cell]:
+    moved = shape.voxels @ ROTATIONS[ridx].T + np.asarray(offset)
+    return frozenset((int(x), int(y), int(z)) for x, y, z in moved.tolist())
 
 
 def slide_hit(

@@ -118,7 +118,18 @@ class _Segments:
                 f"it moves {size:.3g} units in one frame (at most {self.max_jump:g})",
             )
         if why is not None:
-            self.not_allowed(a, b, j, at, why, size)
+            self.not_allowed(a, b, j, why[1], why[0], size)
+            return None
+        other = self.swapped(a, b, j)
+        if other is not None:
+            self.found.add(
+                "swap",
+                at,
+                ps.names[j],
+                f"it takes {other}'s place and {other} takes its (identities swapped)",
+                other=other,
+            )
+            return None
         return motion
 
     def overlaps(self) -> None:
