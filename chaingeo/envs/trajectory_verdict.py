@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Final
 
 import numpy as np
 
@@ -36,6 +36,10 @@ from chaingeo.envs.trajectory_check import (
     spinning_of,
     turn_swept,
 )
+
+
+#: Cubes tested for overlap at poses between lattice frames, per check (a few seconds).
+BETWEEN_BUDGET: Final = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -70,6 +74,7 @@ class _Segments:
         self.turns = level.family == "stacking" or bool(getattr(level.rules, "turns", False))
         self.voxels = {n: level.piece(n).shape.voxels for n in ps.names}
         self.overlapping: set[tuple[str, str]] = set()
+        self.budget = BETWEEN_BUDGET  # cubes tested off the lattice, in all
         self.motions: list[list[Motion]] = []
         # changes[f, j]: piece j's pose differs from frame f - 1 (prefix sums: at rest or not)
         step = (np.abs(np.diff(ps.rot, axis=0)).max(axis=(2, 3)) > TOL) | (
@@ -175,6 +180,34 @@ class _Segments:
                     }
                 )
 
+    def between(self, a: int, b: int, j: int) -> tuple[int, str, Cell] | None:
+        """The first frame strictly between ``a`` and ``b`` where piece ``j``, turned by a
+        lattice rotation but off the lattice, overlaps a piece at rest (exact for unit cubes
+        with parallel faces: open intervals per axis), with that piece and its cell."""
+        ps = self.ps
+        still = [o for o in range(len(ps.names)) if o != j and self.at_rest(o, a, b)]
+        owner = {
+            c: ps.names[o] for o in still if ps.lat[a, o] for c in cells_at(self.level, ps, a, o)
+        }
+        centres = self.voxels[ps.names[j]] + 0.5
+        corners = np.array(list(itertools.product((0, 1), repeat=3)))
+        for f in range(a + 1, b):
+            r = ps.rot[f, j]
+            if np.abs(r - np.rint(r)).max() > TOL:
+                continue
+            self.budget -= len(centres)
+            if self.budget < 0:
+                why = "too many poses between lattice frames to test for overlap"
+                self.found.undecided.append({"frame": f, "pieces": [ps.names[j]], "reason": why})
+                return None
+            lows = centres @ r.T + ps.tr[f, j] - 0.5  # each cube's lowest corner
+            for p in lows:
+                for c in np.floor(p).astype(np.int64) + corners:
+                    cell = (int(c[0]), int(c[1]), int(c[2]))
+                    if cell in owner and bool((np.abs(p - c) < 1 - TOL).all()):
+                        return f, owner[cell], cell
+        return None
+
     def swapped(self, a: int, b: int, j: int) -> str | None:
         """The piece that ``j`` changes places with from ``a`` to ``b`` (poses or cells
         exchanged, where the two differed), or None."""
@@ -219,7 +252,12 @@ class _Segments:
                 other=other,
             )
             return
-        if "drifts" in why or "overshoots" in why:
+        hit = self.between(a, b, j)
+        if hit is not None:
+            f, other, cell = hit
+            reason = f"between lattice poses it overlaps {other} (at cell {list(cell)})"
+            self.found.add("overlap", f, name, reason, other=other)
+        elif "drifts" in why or "overshoots" in why:
             self.found.add("off-lattice", at, name, why)
         elif size > 1 + TOL:
             self.found.add(
