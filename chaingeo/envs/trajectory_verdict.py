@@ -37,7 +37,6 @@ from chaingeo.envs.trajectory_check import (
     turn_swept,
 )
 
-
 #: Cubes tested for overlap at poses between lattice frames, per check (a few seconds).
 BETWEEN_BUDGET: Final = 2_000_000
 
