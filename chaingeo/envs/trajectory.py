@@ -323,7 +323,8 @@ def stacking_trajectory(
     sol = level.solution
     plan = [(n, sol.placements[n]) for n in sol.order] if order is None else list(order)
     shots, _, _ = _stacking_shots(level, plan)
-    base = {n: _placing(level.piece(n).shape, cells) for n, cells in plan}
+    base = {p.name: (np.eye(3), np.zeros(3)) for p in level.pieces}  # still waiting: as given
+    base.update({n: _placing(level.piece(n).shape, cells) for n, cells in plan})
     frames: list[Frame] = []
     for shot in shots:
         frame: Frame = {}

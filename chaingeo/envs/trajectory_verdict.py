@@ -415,8 +415,11 @@ def _forward(found: Findings, n_frames: int) -> None:
     """Frame numbers (and appear/disappear) of a backwards check, as the file runs: its start
     is the assembly's goal."""
     for v in found.violations:
-        v["frame"] = n_frames - 1 - v["frame"]
-        v["kind"] = _FORWARD.get(v["kind"], v["kind"])
+        back = v["frame"]
+        v["frame"] = n_frames - 1 - back
+        if v["kind"] in _FORWARD and back > 0:  # a run of absence, seen from its other end
+            v["kind"] = _FORWARD[v["kind"]]
+            v["frame"] += 1
         if v["kind"] == "start" and v["frame"] == n_frames - 1 and v["piece"] is None:
             v["kind"], v["reason"] = (
                 "goal",

@@ -254,10 +254,12 @@ def _stacking_shots(
     bx, by, bz = level.box
     eye = np.eye(3)
     # a grid beside the box: about sqrt(n) pieces a row along +x, rows one behind another
-    per_row = max(1, math.ceil(math.sqrt(len(order))))
+    placed = {n for n, _ in order}
+    rest = [(p.name, p.shape) for p in level.pieces if p.name not in placed]  # stay waiting
+    per_row = max(1, math.ceil(math.sqrt(len(order) + len(rest))))
     waiting: dict[str, FloatArray] = {}
     x, y, row_depth, width = bx + 1, 0, 0, bx
-    for i, (name, cells) in enumerate(order):
+    for i, (name, cells) in enumerate([*order, *rest]):
         if i and i % per_row == 0:
             x, y, row_depth = bx + 1, y + row_depth + 1, 0
         lo = cells.min_corner
@@ -265,7 +267,7 @@ def _stacking_shots(
         x += cells.extent[0] + 1
         row_depth = max(row_depth, cells.extent[1])
         width = max(width, x - 1)
-    tallest = max((s.extent[2] for _, s in order), default=0)
+    tallest = max((s.extent[2] for _, s in [*order, *rest]), default=0)
     clear = max(bz, tallest) + 1  # the height a carried piece's bottom rises to
     at: dict[str, FloatArray] = dict(waiting)
     segments: list[list[_Shot]] = []
@@ -397,7 +399,7 @@ def stacking_video(
     sol = level.solution
     plan = [(n, sol.placements[n]) for n in sol.order] if order is None else list(order)
     shots, captions, frame = _stacking_shots(level, plan)
-    shapes = dict(plan)
+    shapes = {**level.shapes, **dict(plan)}  # pieces never placed wait as given
     return PlanVideo(_draw(level, shapes, shots, captions, frame, size), tuple(captions), frame)
 
 
