@@ -301,7 +301,8 @@ class _Builder:
             '<button type="button" id="play" aria-pressed="false">▶ Play</button>'
             '<label class="muted">speed <select id="speed">'
             '<option value="0.5">0.5&times;</option><option value="1" selected>1&times;</option>'
-            '<option value="2">2&times;</option><option value="4">4&times;</option></select></label>'
+            '<option value="2">2&times;</option><option value="4">4&times;</option>'
+            "</select></label>"
             '<span class="muted">or the ← → keys, space to play</span></div>'
         )
         parts.extend(frames or ['<p class="note">No turn was played.</p>'])
