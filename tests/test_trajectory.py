@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, Phase, given, settings
+from hypothesis import HealthCheck, Phase, assume, given, settings
 from hypothesis import strategies as st
 
 from chaingeo.cli.main import main
@@ -33,6 +33,8 @@ from chaingeo.envs.trajectory import (
 )
 from chaingeo.envs.trajectory_verdict import Verdict, check_trajectory
 from chaingeo.envs.video import read_plan
+from generator.config import PuzzleConfig
+from generator.puzzle import make
 
 LEVELS = Path(__file__).resolve().parent.parent / "levels"
 TURNS = load_level(LEVELS / "puzzle" / "puzzle-easy-01-luban-3-piece.json")  # has a turn
@@ -40,6 +42,7 @@ BURR = load_level(LEVELS / "puzzle" / "puzzle-easy-04-burr6.json")  # slides onl
 SMALL = sorted(
     (p for p in (LEVELS / "puzzle").glob("puzzle-easy-*.json")), key=lambda p: p.name
 ) + sorted((LEVELS / "stacking").glob("stacking-2x2x*.json"))
+RANDOM = PuzzleConfig(shape="cube3", pieces=3, min_level=2, hole_rate=0.3, hill_steps=10)
 FAST = settings(
     max_examples=8,
     deadline=None,
@@ -71,6 +74,19 @@ def test_the_levels_own_plan_is_valid_and_replays(path: Path) -> None:
     if level.family == "puzzle":  # the plan replays by the state machine to the goal
         moves, _ = read_plan(level, "\n".join(verdict.plan))
         assert len(moves) == level.optimal_steps
+
+
+@settings(FAST, max_examples=4)
+@given(st.integers(0, 1 << 20), st.sampled_from(["disassemble", "assemble"]))
+def test_generated_levels_plans_are_valid(seed: int, goal: str) -> None:
+    """Random small levels of the generator: their optimal plans' trajectories are valid."""
+    config = dataclasses.replace(RANDOM, goal=goal)  # type: ignore[arg-type]
+    level = make(config, seed, 0)
+    assume(isinstance(level, Level))
+    assert isinstance(level, Level)
+    verdict = _check(level, _doc(level))
+    assert verdict.valid and verdict.goal, verdict.violations[:3]
+    assert verdict.plan is not None and len(verdict.plan) == level.optimal_steps
 
 
 @FAST
@@ -279,7 +295,8 @@ def test_a_mirrored_or_scaled_piece_and_a_wrong_goal() -> None:
     pose["rotation"] = [[1.5, 0, 0], [0, 1, 0], [0, 0, 1]]
     _has(_check(BURR, doc), "shape", 3, NAMES[0])
     short = copy.deepcopy(BASE)
-    cut = [i for i in range(1, N_FRAMES - 1) if all(i in _lattice_frames(n) for n in NAMES)]
+    on = [set(_lattice_frames(n)) for n in NAMES]
+    cut = [i for i in range(1, N_FRAMES - 1) if all(i in frames for frames in on)]
     short["frames"] = short["frames"][: cut[len(cut) // 2] + 1]
     verdict = _check(BURR, short)
     assert [v["kind"] for v in verdict.violations] == ["goal"] and verdict.goal is False
