@@ -34,7 +34,7 @@ TOL: Final = 1e-6
 #: Violations listed at most; past it the list ends with one "truncated" entry.
 MAX_VIOLATIONS: Final = 1000
 #: Widest turn swept exactly (cells from the axis); a wider one is undecided.
-MAX_TURN_RADIUS: Final = 64
+MAX_TURN_RADIUS: Final = 16
 FloatArray = npt.NDArray[np.float64]
 
 
