@@ -64,7 +64,15 @@ def _check(level: Level, doc: dict[str, Any] | str) -> Verdict:
     return check_trajectory(level, parse_trajectory(text))
 
 
-@pytest.mark.parametrize("path", SMALL[:6] + SMALL[-3:], ids=lambda p: p.stem)
+#: Stacking levels whose own order would drop a piece through a placed one: the video's
+#: order (chain.envs.video.carried_order) carries each piece in by a free way.
+REORDERED = [
+    LEVELS / "stacking" / f"{n}.json"
+    for n in ("stacking-2x2x2-mid-s102-000000", "stacking-2x3x3-easy-s107-000000")
+]
+
+
+@pytest.mark.parametrize("path", SMALL[:6] + SMALL[-2:] + REORDERED, ids=lambda p: p.stem)
 def test_the_levels_own_plan_is_valid_and_replays(path: Path) -> None:
     level = load_level(path)
     verdict = _check(level, _doc(level))

@@ -45,6 +45,7 @@ from chaingeo.envs.video import (
     _ease,
     _stacking_shots,
     _turn_matrix,
+    carried_order,
     read_plan,
 )
 
@@ -316,12 +317,12 @@ def _placing(shape: Shape, cells: Shape) -> tuple[FloatArray, FloatArray]:
 def stacking_trajectory(
     level: Level, order: Sequence[tuple[str, Shape]] | None = None
 ) -> list[Frame]:
-    """The frames of a stacking plan (None: the level's own solution), the video's motion:
+    """The frames of a stacking plan (None: the level's own solution, in the video's order),
+    the video's motion:
     each piece rises from its place beside the box, travels over it and is lowered in."""
     if not isinstance(level.solution, StackingSolution):
         raise VideoError(f"{level.id} is a {level.family} level, not a stacking level")
-    sol = level.solution
-    plan = [(n, sol.placements[n]) for n in sol.order] if order is None else list(order)
+    plan = carried_order(level) if order is None else list(order)
     shots, _, _ = _stacking_shots(level, plan)
     base = {p.name: (np.eye(3), np.zeros(3)) for p in level.pieces}  # still waiting: as given
     base.update({n: _placing(level.piece(n).shape, cells) for n, cells in plan})

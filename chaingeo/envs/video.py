@@ -224,11 +224,10 @@ def _puzzle_shots(
     return shots, captions, ((lo[0], lo[1], lo[2]), (hi[0], hi[1], hi[2]))
 
 
-def _approach(cells: Shape, filled: set[Cell], box: Cell | None) -> tuple[Cell, int]:
+def _free_way(cells: Shape, filled: set[Cell], box: Cell) -> tuple[Cell, int] | None:
     """The last leg into place: straight down (the first way whose path no placed cell
     blocks), else in from the -x, -y or +y side of the box at the piece's own height (the
-    waiting row lies on the +x side); (direction, length of the leg, 0 for down)."""
-    assert box is not None
+    waiting row lies on the +x side); (direction, length of the leg, 0 for down), or None."""
     own = cells.cell_set
     ways: tuple[Cell, ...] = ((0, 0, -1), (1, 0, 0), (0, 1, 0), (0, -1, 0))
     for d in ways:
@@ -241,7 +240,64 @@ def _approach(cells: Shape, filled: set[Cell], box: Cell | None) -> tuple[Cell, 
             for j in range(1, back + 1)
         ):
             return d, reach
-    return (0, 0, -1), 0  # blocked every way: shown falling through (a checker says so)
+    return None
+
+
+def _approach(cells: Shape, filled: set[Cell], box: Cell | None) -> tuple[Cell, int]:
+    """:func:`_free_way`, or straight down when every way is blocked (the piece is then
+    shown passing through placed ones, and a trajectory checker says so)."""
+    assert box is not None
+    return _free_way(cells, filled, box) or ((0, 0, -1), 0)
+
+
+#: Placing orders tried by :func:`carried_order` before it keeps the level's own.
+ORDER_SEARCH_NODES: Final = 20_000
+
+
+def carried_order(level: Level) -> list[tuple[str, Shape]]:
+    """The level's solution in a placing order that its state machine accepts and in which
+    every piece has a free way in (:func:`_free_way`), found by a depth-first search over
+    orders (the level's own order first); the level's own order when none is found in
+    :data:`ORDER_SEARCH_NODES` steps."""
+    from chaingeo.envs.actions import ActionError, PlaceAction
+    from chaingeo.envs.machines import new_state
+
+    assert isinstance(level.solution, StackingSolution) and level.box is not None
+    sol, box = level.solution, level.box
+    own = [(n, sol.placements[n]) for n in sol.order]
+    state = new_state(level)
+    budget = [ORDER_SEARCH_NODES]
+
+    dead: set[frozenset[str]] = set()  # placed sets known to lead nowhere (the rest depends
+    # only on which pieces are in: the cells are fixed)
+
+    def search(done: list[tuple[str, Shape]], filled: set[Cell]) -> bool:
+        if len(done) == len(own):
+            return True
+        key = frozenset(n for n, _ in done)
+        if key in dead:
+            return False
+        for name, cells in own:
+            if budget[0] <= 0:
+                return False
+            if any(name == n for n, _ in done) or _free_way(cells, filled, box) is None:
+                continue
+            budget[0] -= 1
+            try:
+                state.apply(PlaceAction(name, tuple(cells.cells)))
+            except ActionError:
+                continue
+            done.append((name, cells))
+            if search(done, filled | cells.cell_set):
+                return True
+            done.pop()
+            state.pop()
+        if budget[0] > 0:
+            dead.add(key)
+        return False
+
+    found: list[tuple[str, Shape]] = []
+    return found if search(found, set()) else own
 
 
 def _stacking_shots(
@@ -393,11 +449,11 @@ def stacking_video(
     level: Level, order: Sequence[tuple[str, Shape]] | None = None, size: int = VIDEO_SIZE
 ) -> PlanVideo:
     """The video of a stacking plan: (piece, the cells it fills) in placing order; None: the
-    level's own solution in its placing order."""
+    level's own solution in an order where each piece can be carried in
+    (:func:`carried_order`)."""
     if not isinstance(level.solution, StackingSolution):
         raise VideoError(f"{level.id} is a {level.family} level, not a stacking level")
-    sol = level.solution
-    plan = [(n, sol.placements[n]) for n in sol.order] if order is None else list(order)
+    plan = carried_order(level) if order is None else list(order)
     shots, captions, frame = _stacking_shots(level, plan)
     shapes = {**level.shapes, **dict(plan)}  # pieces never placed wait as given
     return PlanVideo(_draw(level, shapes, shots, captions, frame, size), tuple(captions), frame)
