@@ -350,16 +350,17 @@ def test_browser_steps_an_episode(chromium: str, site: Path, tmp_path: Path) -> 
     dom = _browse(chromium, tmp_path, page.as_uri() + f"?selftest={actions}#step=2", "--dump-dom")
     lines, attrs = _selftest(dom)
     assert attrs.get("data-done") == "yes"
-    assert lines == [
-        ("start", {"step": 2}),
-        ("key:ArrowRight", {"step": 3}),
-        ("key:ArrowRight", {"step": 4}),
-        ("key:ArrowLeft", {"step": 3}),
-        ("click:next", {"step": 4}),
-        ("click:prev", {"step": 3}),
-        ("click:last", {"step": 4}),
-        ("key:Home", {"step": 1}),
+    assert [(a, shown["step"]) for a, shown in lines] == [
+        ("start", 2),
+        ("key:ArrowRight", 3),
+        ("key:ArrowRight", 4),
+        ("key:ArrowLeft", 3),
+        ("click:next", 4),
+        ("click:prev", 3),
+        ("click:last", 4),
+        ("key:Home", 1),
     ]
+    assert not any(shown["playing"] for _, shown in lines)
     # One turn visible, the others hidden; its five pictures loaded from ../../images.
     shown = re.findall(r'<article class="frame" id="frame-(\d)"([^>]*)>', dom)
     assert [(i, "hidden" in a) for i, a in shown] == [
@@ -371,6 +372,30 @@ def test_browser_steps_an_episode(chromium: str, site: Path, tmp_path: Path) -> 
     assert attrs["data-images"] == "5/5"
     assert 'id="position">Turn 1 (1 of 4)<' in dom
     assert "<img src=x" not in dom and "alert(1)&gt;" in dom
+
+
+def test_browser_plays_an_episode(chromium: str, site: Path, tmp_path: Path) -> None:
+    """Play steps on by itself (1.5 s a step at 1x), pause holds, speed changes the pace, it
+    stops at the last step and plays again from the first; a step by hand pauses it."""
+    page = _episode(site, "vlm-interactive", _levels()[0].id)
+    script = [
+        ("click:play", 1, True),
+        ("wait:1600", 2, True),  # one step in 1.5 s
+        ("click:play", 2, False),  # paused
+        ("wait:1600", 2, False),  # and it stays
+        ("select:speed=4", 2, False),
+        ("click:play", 2, True),
+        ("wait:400", 3, True),  # 4x: a step in 375 ms
+        ("wait:400", 4, False),  # the last step: it stops by itself
+        ("key:Space", 1, True),  # from the start again
+        ("click:next", 2, False),  # a step by hand takes over
+    ]
+    actions = ",".join(a for a, _, _ in script)
+    dom = _browse(chromium, tmp_path, page.as_uri() + f"?selftest={actions}#step=1", "--dump-dom")
+    lines, attrs = _selftest(dom)
+    assert attrs.get("data-done") == "yes"
+    assert [(a, s["step"], s["playing"]) for a, s in lines] == [("start", 1, False), *script]
+    assert re.search(r'<button type="button" id="play" aria-pressed="false">▶ Play<', dom)
 
 
 def test_browser_screenshot_is_not_blank(chromium: str, site: Path, tmp_path: Path) -> None:

@@ -255,3 +255,15 @@ MAX_VIDEO_BYTES: Final = 512 * 1024 * 1024
 MAX_VIDEO_FRAME_PIXELS: Final = 3840 * 2160
 MAX_VIDEO_FRAMES: Final = 18_000
 MAX_VIDEO_TOTAL_PIXELS: Final = 4_000_000_000
+
+# ---------------------------------------------------------------------------------------------
+# chain check-trajectory: pose trajectory files (issue #22)
+# ---------------------------------------------------------------------------------------------
+
+#: Bytes of one trajectory file (checked before reading), its frames, its poses in all (frames
+#: times pieces) and the magnitude of a translation or cell coordinate in it. A plan's own
+#: trajectory of the shipped suite stays under 2,000 frames and 4 MB.
+MAX_TRAJECTORY_BYTES: Final = 64 * 1024 * 1024
+MAX_TRAJECTORY_FRAMES: Final = 50_000
+MAX_TRAJECTORY_POSES: Final = 1_000_000
+MAX_TRAJECTORY_COORD: Final = 1e6

@@ -15,6 +15,7 @@ Pillow; MP4 needs the optional extra ``video`` (imageio with its own ffmpeg).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -223,20 +224,98 @@ def _puzzle_shots(
     return shots, captions, ((lo[0], lo[1], lo[2]), (hi[0], hi[1], hi[2]))
 
 
+def _free_way(cells: Shape, filled: set[Cell], box: Cell) -> tuple[Cell, int] | None:
+    """The last leg into place: straight down (the first way whose path no placed cell
+    blocks), else in from the -x, -y or +y side of the box at the piece's own height (the
+    waiting row lies on the +x side); (direction, length of the leg, 0 for down), or None."""
+    own = cells.cell_set
+    ways: tuple[Cell, ...] = ((0, 0, -1), (1, 0, 0), (0, 1, 0), (0, -1, 0))
+    for d in ways:
+        axis = next(i for i in range(3) if d[i])
+        reach = box[axis] + 1 if d[2] == 0 else 0
+        back = reach if reach else box[2] + 1
+        if all(
+            tuple(c[i] - d[i] * j for i in range(3)) not in filled
+            for c in own
+            for j in range(1, back + 1)
+        ):
+            return d, reach
+    return None
+
+
+def _approach(cells: Shape, filled: set[Cell], box: Cell | None) -> tuple[Cell, int]:
+    """:func:`_free_way`, or straight down when every way is blocked (the piece is then
+    shown passing through placed ones, and a trajectory checker says so)."""
+    assert box is not None
+    return _free_way(cells, filled, box) or ((0, 0, -1), 0)
+
+
+#: Placing orders tried by :func:`carried_order` before it keeps the level's own.
+ORDER_SEARCH_NODES: Final = 20_000
+
+
+def carried_order(level: Level) -> list[tuple[str, Shape]]:
+    """The level's solution in a placing order that its state machine accepts and in which
+    every piece has a free way in (:func:`_free_way`), found by a depth-first search over
+    orders (the level's own order first); the level's own order when none is found in
+    :data:`ORDER_SEARCH_NODES` steps."""
+    from chaingeo.envs.actions import ActionError, PlaceAction
+    from chaingeo.envs.machines import new_state
+
+    assert isinstance(level.solution, StackingSolution) and level.box is not None
+    sol, box = level.solution, level.box
+    own = [(n, sol.placements[n]) for n in sol.order]
+    state = new_state(level)
+    budget = [ORDER_SEARCH_NODES]
+
+    dead: set[frozenset[str]] = set()  # placed sets known to lead nowhere (the rest depends
+    # only on which pieces are in: the cells are fixed)
+
+    def search(done: list[tuple[str, Shape]], filled: set[Cell]) -> bool:
+        if len(done) == len(own):
+            return True
+        key = frozenset(n for n, _ in done)
+        if key in dead:
+            return False
+        for name, cells in own:
+            if budget[0] <= 0:
+                return False
+            if any(name == n for n, _ in done) or _free_way(cells, filled, box) is None:
+                continue
+            budget[0] -= 1
+            try:
+                state.apply(PlaceAction(name, tuple(cells.cells)))
+            except ActionError:
+                continue
+            done.append((name, cells))
+            if search(done, filled | cells.cell_set):
+                return True
+            done.pop()
+            state.pop()
+        if budget[0] > 0:
+            dead.add(key)
+        return False
+
+    found: list[tuple[str, Shape]] = []
+    return found if search(found, set()) else own
+
+
 def _stacking_shots(
     level: Level, order: Sequence[tuple[str, Shape]]
 ) -> tuple[list[_Shot], list[str], tuple[Cell, Cell]]:
     """The pieces wait on the floor in a row beside the box (+x), already turned as they will
-    lie, in placing order; each in turn rises above everything, travels over the box and is
-    lowered into place (nothing appears from nowhere or passes through a piece)."""
+    lie, in placing order; each in turn rises above everything, travels over the box (along x,
+    then y) and is lowered into place (nothing appears from nowhere or passes through a piece)."""
     assert level.box is not None
     bx, by, bz = level.box
     eye = np.eye(3)
     # a grid beside the box: about sqrt(n) pieces a row along +x, rows one behind another
-    per_row = max(1, math.ceil(math.sqrt(len(order))))
+    placed = {n for n, _ in order}
+    rest = [(p.name, p.shape) for p in level.pieces if p.name not in placed]  # stay waiting
+    per_row = max(1, math.ceil(math.sqrt(len(order) + len(rest))))
     waiting: dict[str, FloatArray] = {}
     x, y, row_depth, width = bx + 1, 0, 0, bx
-    for i, (name, cells) in enumerate(order):
+    for i, (name, cells) in enumerate([*order, *rest]):
         if i and i % per_row == 0:
             x, y, row_depth = bx + 1, y + row_depth + 1, 0
         lo = cells.min_corner
@@ -244,7 +323,7 @@ def _stacking_shots(
         x += cells.extent[0] + 1
         row_depth = max(row_depth, cells.extent[1])
         width = max(width, x - 1)
-    tallest = max((s.extent[2] for _, s in order), default=0)
+    tallest = max((s.extent[2] for _, s in [*order, *rest]), default=0)
     clear = max(bz, tallest) + 1  # the height a carried piece's bottom rises to
     at: dict[str, FloatArray] = dict(waiting)
     segments: list[list[_Shot]] = []
@@ -252,27 +331,41 @@ def _stacking_shots(
     def shot() -> _Shot:
         return tuple((n, eye, at[n]) for n in sorted(at))
 
+    filled: set[Cell] = set()
+    low, high = np.zeros(3, dtype=np.int64), np.zeros(3, dtype=np.int64)  # sides entered from
     for name, cells in order:
         start = waiting[name]
-        above = np.array([start[0], start[1], clear - cells.min_corner[2]], dtype=np.float64)
-        over = np.array([0.0, 0.0, above[2]])
+        lift = np.array([start[0], start[1], clear - cells.min_corner[2]], dtype=np.float64)
+        d, back = _approach(cells, filled, level.box)
+        entry = np.array([-back * d[0], -back * d[1], 0.0])  # where the last leg starts
+        low = np.minimum(low, entry.astype(np.int64) + cells.min_corner)
+        high = np.maximum(high, entry.astype(np.int64) + cells.max_corner + 1)
+        path = [
+            start,
+            lift,
+            np.array([entry[0], lift[1], lift[2]]),  # along x, then y: axis-aligned slides
+            np.array([entry[0], entry[1], lift[2]]),
+            entry,
+            np.zeros(3),
+        ]
         seg = [shot()]
-        for a, b, frames in ((start, above, LIFT_FRAMES), (above, over, DROP_FRAMES)):
+        for a, b in itertools.pairwise(path):
+            if np.array_equal(a, b):
+                continue
+            frames = LIFT_FRAMES if a is start else DROP_FRAMES
             for i in range(1, frames + 1):
                 at[name] = a + (b - a) * _ease(i, frames)
                 seg.append(shot())
-        for i in range(1, DROP_FRAMES + 1):
-            at[name] = over * (1.0 - _ease(i, DROP_FRAMES))
-            seg.append(shot())
         at[name] = np.zeros(3)
         seg[-1] = shot()
         segments.append(seg)
+        filled |= cells.cell_set
     texts = [f"place {name}" for name, _ in order]
     full = len(order) == len(level.pieces)
     first = tuple((n, eye, waiting[n]) for n in sorted(waiting))
     shots, captions = _captioned(level, segments, texts, (first, shot()), full)
-    depth = max(by, y + row_depth)
-    return shots, captions, ((0, 0, 0), (width, depth, clear + tallest))
+    depth = max(by, y + row_depth, int(high[1]))
+    return shots, captions, ((int(low[0]), int(low[1]), 0), (width, depth, clear + tallest))
 
 
 def _draw(
@@ -356,13 +449,13 @@ def stacking_video(
     level: Level, order: Sequence[tuple[str, Shape]] | None = None, size: int = VIDEO_SIZE
 ) -> PlanVideo:
     """The video of a stacking plan: (piece, the cells it fills) in placing order; None: the
-    level's own solution in its placing order."""
+    level's own solution in an order where each piece can be carried in
+    (:func:`carried_order`)."""
     if not isinstance(level.solution, StackingSolution):
         raise VideoError(f"{level.id} is a {level.family} level, not a stacking level")
-    sol = level.solution
-    plan = [(n, sol.placements[n]) for n in sol.order] if order is None else list(order)
+    plan = carried_order(level) if order is None else list(order)
     shots, captions, frame = _stacking_shots(level, plan)
-    shapes = dict(plan)
+    shapes = {**level.shapes, **dict(plan)}  # pieces never placed wait as given
     return PlanVideo(_draw(level, shapes, shots, captions, frame, size), tuple(captions), frame)
 
 

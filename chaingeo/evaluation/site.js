@@ -1,4 +1,5 @@
-// The run viewer's behaviour: sortable tables and the episode stepper. Pages are complete
+// The run viewer's behaviour: sortable tables and the episode stepper (with a play button
+// that steps on by itself, pause and speed). Pages are complete
 // without it (every turn is shown, tables in their written order); this script only
 // rearranges and hides what the server already escaped. It never writes HTML: text goes in
 // through textContent, so nothing from a log can become markup here either.
@@ -86,14 +87,49 @@
     setHash("#step=" + (current + 1));
   }
 
+  // ---- play: one step every STEP_MS / speed, pausing at the last step ----------------------
+  var STEP_MS = 1500;
+  var timer = null;
+
+  function speed() {
+    var select = document.getElementById("speed");
+    var value = select ? parseFloat(select.value) : 1;
+    return value > 0 ? value : 1;
+  }
+
+  function setPlaying(on) {
+    if (timer !== null) clearInterval(timer);
+    timer = null;
+    if (on) {
+      if (current === frames.length - 1) show(0);  // played to the end: start again
+      timer = setInterval(tick, STEP_MS / speed());
+    }
+    var button = document.getElementById("play");
+    button.setAttribute("aria-pressed", on ? "true" : "false");
+    button.textContent = on ? "\u275A\u275A Pause" : "\u25B6 Play";
+    viewer.setAttribute("data-playing", on ? "yes" : "no");
+  }
+
+  function tick() {
+    show(current + 1);
+    if (current === frames.length - 1) setPlaying(false);
+  }
+
+  function step(index) {
+    // a person taking a step by hand takes over from the player
+    if (timer !== null) setPlaying(false);
+    show(index);
+  }
+
   function onKey(event) {
     if (!frames.length || event.altKey || event.ctrlKey || event.metaKey) return;
     var tag = event.target && event.target.tagName;
-    if (tag === "INPUT" || tag === "TEXTAREA" || tag === "SELECT") return;
-    if (event.key === "ArrowRight") show(current + 1);
-    else if (event.key === "ArrowLeft") show(current - 1);
-    else if (event.key === "Home") show(0);
-    else if (event.key === "End") show(frames.length - 1);
+    if (tag === "INPUT" || tag === "TEXTAREA" || tag === "SELECT" || tag === "BUTTON") return;
+    if (event.key === "ArrowRight") step(current + 1);
+    else if (event.key === "ArrowLeft") step(current - 1);
+    else if (event.key === "Home") step(0);
+    else if (event.key === "End") step(frames.length - 1);
+    else if (event.key === " ") setPlaying(timer === null);
     else return;
     event.preventDefault();
   }
@@ -113,11 +149,17 @@
   });
   if (frames.length) {
     viewer.classList.add("stepping");
-    document.getElementById("first").addEventListener("click", function () { show(0); });
-    document.getElementById("prev").addEventListener("click", function () { show(current - 1); });
-    document.getElementById("next").addEventListener("click", function () { show(current + 1); });
+    document.getElementById("first").addEventListener("click", function () { step(0); });
+    document.getElementById("prev").addEventListener("click", function () { step(current - 1); });
+    document.getElementById("next").addEventListener("click", function () { step(current + 1); });
     document.getElementById("last").addEventListener("click", function () {
-      show(frames.length - 1);
+      step(frames.length - 1);
+    });
+    document.getElementById("play").addEventListener("click", function () {
+      setPlaying(timer === null);
+    });
+    document.getElementById("speed").addEventListener("change", function () {
+      if (timer !== null) setPlaying(true);  // the new pace from now on
     });
     document.addEventListener("keydown", onKey);
   }
@@ -131,9 +173,13 @@
   log.id = "selftest";
   document.body.appendChild(log);
   function state() {
-    // JSON, one line: {"step": N} on an episode, {"TABLE": [first cells...]} elsewhere.
+    // JSON, one line: {"step": N, "playing": B} on an episode, {"TABLE": [first cells...]}
+    // elsewhere.
     var out = {};
-    if (frames.length) out.step = parseInt(viewer.getAttribute("data-current"), 10);
+    if (frames.length) {
+      out.step = parseInt(viewer.getAttribute("data-current"), 10);
+      out.playing = timer !== null;
+    }
     Array.prototype.forEach.call(document.querySelectorAll("table.sortable"), function (t) {
       out[t.id] = Array.prototype.map.call(t.tBodies[0].rows, function (r) {
         return r.cells[0].textContent;
@@ -142,9 +188,34 @@
     return JSON.stringify(out);
   }
   log.textContent = "start " + state() + "\n";
-  test.split(",").forEach(function (action) {
-    var i = action.indexOf(":");
-    var kind = action.slice(0, i), arg = action.slice(i + 1);
+  var actions = test.split(",");
+  var finished = { actions: false, load: false };
+  function done(what) {
+    finished[what] = true;
+    if (finished.actions && finished.load) log.setAttribute("data-done", "yes");
+  }
+  function run(i) {
+    // one action after another; "wait:MS" resumes on the page's clock
+    for (; i < actions.length; i++) {
+      var action = actions[i];
+      var at = action.indexOf(":");
+      var kind = action.slice(0, at), arg = action.slice(at + 1);
+      if (kind === "wait") {
+        setTimeout(function () {
+          log.textContent += action + " " + state() + "\n";
+          run(i + 1);
+        }, parseInt(arg, 10) || 0);
+        return;
+      }
+      if (!perform(kind, arg)) {
+        log.textContent += "missing " + action + "\n";
+        continue;
+      }
+      log.textContent += action + " " + state() + "\n";
+    }
+    done("actions");
+  }
+  function perform(kind, arg) {
     var target = null;
     if (kind === "sort") {
       var dot = arg.lastIndexOf(".");
@@ -153,17 +224,24 @@
       target = th && th.querySelector("button");
     } else if (kind === "click") {
       target = document.getElementById(arg);
+    } else if (kind === "select") {
+      var eq = arg.indexOf("=");
+      var select = document.getElementById(arg.slice(0, eq));
+      if (!select) return false;
+      select.value = arg.slice(eq + 1);
+      select.dispatchEvent(new Event("change", { bubbles: true }));
+      return true;
     }
     if (kind === "key") {
-      document.body.dispatchEvent(new KeyboardEvent("keydown", { key: arg, bubbles: true }));
-    } else if (target) {
-      target.dispatchEvent(new MouseEvent("click", { bubbles: true, cancelable: true }));
-    } else {
-      log.textContent += "missing " + action + "\n";
-      return;
+      document.body.dispatchEvent(
+        new KeyboardEvent("keydown", { key: arg === "Space" ? " " : arg, bubbles: true }));
+      return true;
     }
-    log.textContent += action + " " + state() + "\n";
-  });
+    if (!target) return false;
+    target.dispatchEvent(new MouseEvent("click", { bubbles: true, cancelable: true }));
+    return true;
+  }
+  run(0);
   window.addEventListener("load", function () {
     // Only the images on screen: hidden turns load theirs lazily, when shown.
     var images = Array.prototype.filter.call(document.querySelectorAll("img"), function (img) {
@@ -171,6 +249,6 @@
     });
     var loaded = images.filter(function (img) { return img.complete && img.naturalWidth > 0; });
     log.setAttribute("data-images", loaded.length + "/" + images.length);
-    log.setAttribute("data-done", "yes");
+    done("load");
   });
 })();

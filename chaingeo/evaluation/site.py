@@ -22,7 +22,8 @@ Why it looks the way it does:
   slip in escaping still could not run code or phone home. Image names are used only when they
   are SHA-256 file names whose content matches, so a log cannot point outside the run.
 - **Complete without JavaScript.** Every turn is in the page; the script hides all but one and
-  steps through them (buttons, arrow keys, ``#step=N``) and sorts tables (header buttons,
+  steps through them (buttons, arrow keys, ``#step=N``, a play button with pause and speed)
+  and sorts tables (header buttons,
   ``#sort=TABLE.COLUMN&dir=asc``).
 - **Deterministic.** The same runs give the same bytes: no clocks, sorted iteration, stable
   file names. The site is built beside ``DIR`` and moved into place, and an existing ``DIR`` is
@@ -297,7 +298,12 @@ class _Builder:
             '<button type="button" id="prev">◀ Previous</button><span id="position"></span>'
             '<button type="button" id="next">Next ▶</button>'
             '<button type="button" id="last">Last</button>'
-            '<span class="muted">or the ← → keys</span></div>'
+            '<button type="button" id="play" aria-pressed="false">▶ Play</button>'
+            '<label class="muted">speed <select id="speed">'
+            '<option value="0.5">0.5&times;</option><option value="1" selected>1&times;</option>'
+            '<option value="2">2&times;</option><option value="4">4&times;</option>'
+            "</select></label>"
+            '<span class="muted">or the ← → keys, space to play</span></div>'
         )
         parts.extend(frames or ['<p class="note">No turn was played.</p>'])
         parts.append("</section>")

@@ -19,13 +19,21 @@ def register(sub: Any) -> None:
         "as an agent would type them",
     )
     p.add_argument("--out", type=Path, required=True, help="FILE.mp4 or FILE.gif")
-    p.add_argument("--size", type=int, default=384, help="frame size in pixels (default 384)")
+    p.add_argument("--size", type=int, default=384, help="frame size in pixels")
+    p.add_argument(
+        "--trajectory-out",
+        type=Path,
+        default=None,
+        help="also write the plan's pose trajectory (chain-trajectory/1 JSON; chain "
+        "check-trajectory reads it)",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
     from chaingeo.cli.level_arg import find_level
+    from chaingeo.envs.trajectory import write_trajectory
     from chaingeo.envs.video import VideoError, plan_video, write_video
 
     if args.out.suffix.lower() not in (".mp4", ".gif"):
@@ -42,6 +50,8 @@ def run(args: argparse.Namespace) -> int:
                 raise CommandError(f"--plan: no file {args.plan!r} (or say 'optimal')")
             text = path.read_text(encoding="utf-8")
         video = plan_video(level, text, args.size)
+        if args.trajectory_out is not None:
+            write_trajectory(level, text, args.trajectory_out)
         args.out.parent.mkdir(parents=True, exist_ok=True)
         tmp = args.out.with_name(f".{args.out.stem}.tmp{args.out.suffix}")
         write_video(video, tmp)
