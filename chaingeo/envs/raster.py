@@ -27,6 +27,8 @@ RGB = tuple[int, int, int]
 #: A colour as ``"#rrggbb"`` or an ``(r, g, b)`` triple.
 ColorLike = str | tuple[int, int, int]
 FloatArray = npt.NDArray[np.float64]
+#: (x0, y0, x1, y1) in pixels, the end exclusive.
+Box = tuple[int, int, int, int]
 #: Deflate level for PNG (zlib-ng): fast, and fixed so the same picture gives the same bytes.
 PNG_COMPRESS_LEVEL: Final = 2
 EDGE: Final[RGB] = (0, 0, 0)
@@ -168,6 +170,19 @@ def _text_mask(text: str, px: int, anchor: str) -> tuple[Image.Image, int, int]:
     return mask, left, top
 
 
+def _text_at(
+    xy: Sequence[float] | FloatArray, text: str, px: int, anchor: str
+) -> tuple[Image.Image, Box]:
+    mask, dx, dy = _text_mask(text, px, anchor)
+    x, y = round(float(xy[0])) + dx, round(float(xy[1])) + dy
+    return mask, (x, y, x + mask.size[0], y + mask.size[1])
+
+
+def text_box(xy: Sequence[float] | FloatArray, text: str, px: int, anchor: str = "mm") -> Box:
+    """The pixels :func:`put_text` may change (end exclusive)."""
+    return _text_at(xy, text, px, anchor)[1]
+
+
 def put_text(
     image: Image.Image,
     xy: Sequence[float] | FloatArray,
@@ -176,9 +191,16 @@ def put_text(
     fill: RGB,
     anchor: str = "mm",
 ) -> None:
-    """Draw ``text`` at ``xy`` (``anchor`` as in Pillow: "mm" centre, "la" top left)."""
-    mask, dx, dy = _text_mask(text, px, anchor)
-    image.paste(fill, (round(float(xy[0])) + dx, round(float(xy[1])) + dy), mask)
+    """Draw ``text`` at ``xy`` (``anchor`` as in Pillow: "mm" centre, "la" top left).
+
+    Calls the core paste ``Image.paste(fill, box, mask)`` ends in, without its checks."""
+    mask, box = _text_at(xy, text, px, anchor)
+    if image.readonly:
+        image.paste(fill, box, mask)
+        return
+    image.load()
+    mask.load()
+    image.im.paste(fill, box, mask.im)
 
 
 @dataclass(frozen=True)
@@ -254,6 +276,29 @@ def draw_faces(draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: 
         ring = [(p[0], p[1]) for p in pts]
         draw.polygon(ring, fill=(fill[0], fill[1], fill[2]))
         draw.line([*ring, ring[0]], fill=EDGE, width=width, joint="curve")
+
+
+def draw_faces_fast(
+    draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: int
+) -> FloatArray:
+    """:func:`draw_faces` calling the core drawing methods ``ImageDraw.polygon`` and ``line``
+    end in, without their per-call checks (same pixels); returns the faces' screen corners."""
+    pix: FloatArray = proj.screen(faces.corners)
+    if width > 4:  # wide lines get round joints, drawn by ImageDraw.line itself
+        draw_faces(draw, faces, proj, width)
+        return pix
+    core = draw.draw
+    edge = core.draw_ink(EDGE)
+    inks: dict[tuple[int, int, int], int] = {}
+    for pts, fill in zip(pix.tolist(), faces.fills.tolist(), strict=True):
+        ring = [(p[0], p[1]) for p in pts]
+        key = (fill[0], fill[1], fill[2])
+        ink = inks.get(key)
+        if ink is None:
+            ink = inks[key] = core.draw_ink(key)
+        core.draw_polygon(ring, ink, 1)
+        core.draw_lines([*ring, ring[0]], edge, width)
+    return pix
 
 
 def fit_centre(

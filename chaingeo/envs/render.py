@@ -26,6 +26,14 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from chaingeo.core.geometry import Shape
+from chaingeo.envs.labels import (
+    AXIS_NAMES,
+    TEXT,
+    depth_label_steps,
+    run_steps,
+    tick_steps,
+    title_steps,
+)
 from chaingeo.envs.legend import draw_legend, legend_layout
 from chaingeo.envs.raster import (
     EDGE,
@@ -36,7 +44,6 @@ from chaingeo.envs.raster import (
     FloatArray,
     Posed,
     Projector,
-    arrow,
     draw_faces,
     fit,
     fit_centre,
@@ -50,7 +57,6 @@ from chaingeo.envs.raster import (
     posed_faces,
     put_text,
     scaled,
-    text_color,
     visible_faces,
 )
 
@@ -70,9 +76,8 @@ _FLOOR: Final[RGB] = (232, 232, 228)
 _WALL: Final[RGB] = (244, 244, 241)
 _GRID: Final[RGB] = (185, 185, 180)
 _FRAME: Final[RGB] = (90, 90, 90)
-_TEXT: Final[RGB] = (20, 20, 20)
-_AXIS_COLORS: Final[tuple[RGB, RGB, RGB]] = ((190, 30, 30), (20, 130, 40), (30, 60, 200))
-_AXIS_NAMES: Final = "xyz"
+_TEXT: Final[RGB] = TEXT
+_AXIS_NAMES: Final = AXIS_NAMES
 
 #: Azimuth and elevation of the oblique view (camera at +x, -y, +z, like matplotlib's default
 #: but slightly off the true isometric so that no two cube corners project onto one point).
@@ -263,74 +268,11 @@ def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArra
 def _draw_ticks(
     image: Image.Image, scene: _Scene, cam: Camera, proj: Projector, lay: _Layout
 ) -> None:
-    """1-based cell indices along one frame edge per displayed axis, then the axis name and an
-    arrow pointing the way the index grows."""
-    draw = ImageDraw.Draw(image)
-    centre = proj(np.add(scene.lo, scene.hi) / 2.0)
-    for axis, spec in cam.tick_edges:
-        base = np.array(
-            [
-                0.0 if s == "*" else float(scene.lo[i] if s == "lo" else scene.hi[i])
-                for i, s in enumerate(spec)
-            ]
-        )
-        start, end = base.copy(), base.copy()
-        start[axis], end[axis] = scene.lo[axis], scene.hi[axis]
-        a, b = proj(start), proj(end)
-        d = b - a
-        length = float(np.hypot(*d))
-        if length < 1e-6:
-            continue
-        d /= length
-        normal = np.array([-d[1], d[0]])
-        mid = (a + b) / 2
-        if float(np.dot(normal, mid - centre)) < 0:
-            normal = -normal
-        count = scene.hi[axis] - scene.lo[axis]
-        cell_px = length / count
-        px = int(min(lay.tick_px, max(8, cell_px * 0.8)))
-        every = max(1, math.ceil(px * 1.4 / cell_px))
-        offset = normal * (px * 0.95 + 3)
-        for i, c in enumerate(range(scene.lo[axis], scene.hi[axis])):
-            if i % every and c != scene.hi[axis] - 1:
-                continue
-            p = base.copy()
-            p[axis] = c + 0.5
-            put_text(image, proj(p) + offset, str(c + 1), px, _TEXT)
-        # The arrow continues the row of numbers; the axis name sits just outside it.
-        color = _AXIS_COLORS[axis]
-        tail = b + offset + d * (px * 0.5)
-        head = tail + d * (lay.tick_px * 1.2)
-        arrow(draw, tail, head, color, max(2, lay.tick_px // 8))
-        name_at = (tail + head) / 2 + normal * (lay.tick_px * 0.9)
-        put_text(image, name_at, _AXIS_NAMES[axis], lay.tick_px + 3, color)
-
-
-def _draw_depth_labels(image: Image.Image, faces: Faces, cam: Camera, proj: Projector) -> None:
-    """On each visible face of an axis view, the 1-based coordinate along the line of sight."""
-    depth = cam.depth_axis
-    assert depth is not None
-    nearest: dict[tuple[int, int], int] = {}
-    others = [i for i in range(3) if i != depth]
-    for i, cell in enumerate(faces.cells.tolist()):
-        nearest[(cell[others[0]], cell[others[1]])] = i  # far to near: the last one is in front
-    cell_px = proj.scale
-    px = int(min(22, max(9, cell_px * 0.24)))
-    if cell_px < 1.6 * px:
-        return  # too small to print legibly
-    prefix = f"{_AXIS_NAMES[depth]}=" if cell_px >= 3.2 * px else ""  # small cells: number only
-    for i in sorted(nearest.values()):
-        centre = proj.screen(faces.corners[i].mean(axis=0))
-        fill = faces.fills[i]
-        text = f"{prefix}{int(faces.cells[i][depth]) + 1}"
-        put_text(image, centre, text, px, text_color(fill))
+    run_steps(image, tick_steps(scene.lo, scene.hi, cam, proj, lay.tick_px))
 
 
 def _title(image: Image.Image, lines: Sequence[str], lay: _Layout) -> None:
-    y = max(4, lay.size // 100)
-    for text in lines:
-        put_text(image, (max(4, lay.size // 64), y), text, lay.title_px, _TEXT, anchor="la")
-        y += int(lay.title_px * 1.25)
+    run_steps(image, title_steps(lines, lay.size, lay.title_px))
 
 
 def _view_titles(cam: Camera, scene: _Scene) -> list[str]:
@@ -387,7 +329,7 @@ def _render_view(
     _title(image, titles if title is None else [title, *titles[1:]], lay)
     _draw_ticks(image, scene, cam, proj, lay)
     if cam.depth_axis is not None and len(faces.cells):
-        _draw_depth_labels(image, faces, cam, proj)
+        run_steps(image, depth_label_steps(faces, cam, proj))
     draw_legend(image, scene.legend)
     return image
 
