@@ -58,9 +58,9 @@ def _views(state: BaseState, size: int) -> dict[str, Frame]:
 
 
 def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
-    import chaingeo.envs.render as render
+    import chaingeo.envs.fastview as fastview
 
-    return {v: _array(img) for v, img in render.render_images(pieces, box, VIEWS, size).items()}
+    return {v: _array(img) for v, img in fastview.render_images(pieces, box, VIEWS, size).items()}
 
 
 def _extra(state: BaseState, size: int) -> Frame:
@@ -85,7 +85,7 @@ def decode_png(data: bytes) -> Frame:
 def png_frames(state: BaseState, size: int) -> dict[str, Frame]:
     """The same arrays the long way: encode every picture to PNG and decode it back (what the
     environments did before :func:`render_frames`; the benchmark's reference)."""
-    return {v: decode_png(png) for v, png in render_state(state, size).items()}
+    return {v: decode_png(png) for v, png in render_state(state, size, reference=True).items()}
 
 
 class FrameCache:

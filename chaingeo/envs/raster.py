@@ -154,6 +154,12 @@ def font(px: int) -> ImageFont.FreeTypeFont | ImageFont.ImageFont:
     return ImageFont.load_default(size=max(6, px))
 
 
+@lru_cache(maxsize=4096)
+def text_length(text: str, px: int) -> float:
+    """Advance width of ``text`` in :func:`font` ``(px)`` (labels recur; measuring is costly)."""
+    return float(font(px).getlength(text))
+
+
 def text_color(fill: Iterable[int]) -> RGB:
     r, g, b = fill
     return (0, 0, 0) if 0.299 * r + 0.587 * g + 0.114 * b > 140 else (255, 255, 255)

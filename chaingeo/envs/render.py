@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from typing import TYPE_CHECKING, Final
 
 import numpy as np
@@ -45,9 +46,9 @@ from chaingeo.envs.raster import (
     Posed,
     Projector,
     draw_faces,
+    draw_faces_fast,
     fit,
     fit_centre,
-    font,
     frame_corners,
     line,
     oblique_camera,
@@ -57,6 +58,7 @@ from chaingeo.envs.raster import (
     posed_faces,
     put_text,
     scaled,
+    text_length,
     visible_faces,
 )
 
@@ -362,7 +364,15 @@ def _sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: Floa
     return best
 
 
-def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
+@lru_cache(maxsize=512)
+def _sheet_faces(cells: tuple[tuple[int, int, int], ...], rgb: RGB, cam: int) -> Faces:
+    """One piece's faces on the sheet (they depend only on its shape, colour and camera)."""
+    voxels = np.array(cells, dtype=np.int64).reshape(-1, 3)
+    colors = np.tile(np.array(rgb, dtype=np.float64), (len(cells), 1))
+    return visible_faces(voxels, colors, SHEET_CAMERAS[cam])
+
+
+def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) -> Image.Image:
     """Every piece in its own cell, drawn twice (see :data:`SHEET_CAMERAS`) at one common
     scale, labelled with a colour swatch, its name and its number of cubes."""
     lay = _Layout.of(size)
@@ -401,8 +411,12 @@ def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
             proj = Projector(
                 np.array(cam.right), np.array(cam.up), scale, fit_centre(corners, cam, box, scale)
             )
-            faces = visible_faces(shapes[n].voxels, colors, cam)
-            draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
+            if fast:
+                faces = _sheet_faces(shapes[n].cells, rgb, j)
+                draw_faces_fast(draw, faces, scaled(proj, k), lay.edge_px(k))
+            else:
+                faces = visible_faces(shapes[n].voxels, colors, cam)
+                draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
         cubes = len(shapes[n])
         label = f"{n} ({cubes} cube{'s' if cubes != 1 else ''})"
         slots.append((label, rgb, x0 + cell_w / 2, y0 + cell_h - label_h / 2))
@@ -410,7 +424,7 @@ def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
     small = ImageDraw.Draw(image)
     _title(image, [title, _SHEET_NOTE], lay)
     for text, rgb, x, y in slots:
-        width = float(font(label_px).getlength(text))
+        width = text_length(text, label_px)
         left = x - (width + label_px * 1.4) / 2
         small.rectangle(
             [left, y - label_px / 2, left + label_px, y + label_px / 2], fill=rgb, outline=EDGE
@@ -497,12 +511,18 @@ def render_tray_image(
 ) -> Image.Image:
     """The piece sheet: each piece (only its shape matters, not where it is) from two opposite
     corners, labelled; titled the tray (stacking) or :data:`PIECES_TITLE` (puzzles)."""
+    return render_tray_image_with(pieces, size, title, fast=False)
+
+
+def render_tray_image_with(pieces: PieceMap, size: int, title: str, fast: bool) -> Image.Image:
+    """:func:`render_tray_image`; ``fast`` keeps each piece's faces and skips Pillow's per-call
+    checks (the same pixels; :mod:`chaingeo.envs.fastview`)."""
     _check_size(size)
     for shape, color in pieces.values():
         parse_color(color)
         if len(shape) == 0:
             raise ValueError("a piece needs at least one cell")
-    return _render_tray(pieces, size, title)
+    return _render_tray(pieces, size, title, fast)
 
 
 def render_tray(pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE) -> bytes:
