@@ -61,6 +61,9 @@ from chaingeo.envs.render import (
     _view_titles,
     render_tray_image_with,
 )
+from chaingeo.envs.render import (
+    _render_view as render_view,
+)
 
 #: Layouts kept per process (each about 1 MB at 256 px: the iso background is drawn at 2x).
 CAPACITY: Final = 48
@@ -79,20 +82,30 @@ class _Static:
 
 
 _STORE: OrderedDict[Hashable, _Static] = OrderedDict()
+_SEEN: OrderedDict[Hashable, None] = OrderedDict()
 
 
 def clear() -> None:
     """Forget every kept layout."""
     _STORE.clear()
+    _SEEN.clear()
 
 
-def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static:
+def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static | None:
+    """The layout's static parts, drawn on first use in a box, else on the second (a puzzle's
+    frame follows its pieces, so many of its layouts are seen once: keeping those would cost
+    more than it saves)."""
     key = (cam.name, size, scene.lo, scene.hi, scene.has_box, title)
     key += (legend_layout(scene.legend, size)[1],)
     found = _STORE.get(key)
     if found is not None:
         _STORE.move_to_end(key)
         return found
+    if key not in _SEEN and not scene.has_box:
+        _SEEN[key] = None
+        while len(_SEEN) > 16 * CAPACITY:
+            _SEEN.popitem(last=False)
+        return None
     made = _draw_static(scene, cam, size, title)
     _STORE[key] = made
     while len(_STORE) > CAPACITY:
@@ -167,6 +180,8 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Image.Imag
 
 def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Image.Image:
     st = _static(scene, cam, size, title)
+    if st is None:
+        return render_view(scene, cam, size, title=title, fast=True)
     faces = visible_faces(scene.cells, scene.colors, cam)
     image = _with_faces(st, faces, cam, size) if len(faces.fills) else st.plain.copy()
     draw_legend(image, scene.legend)

@@ -138,6 +138,10 @@ class FrameCache:
         return {n: f.copy() for n, f in zip(names, (*views, extra), strict=True)}
 
     def clear(self) -> None:
-        """Forget every picture (levels were replaced under the same ids)."""
+        """Forget every picture (levels were replaced under the same ids), and the layouts
+        :mod:`chaingeo.envs.fastview` keeps in this process."""
+        import chaingeo.envs.fastview as fastview
+
         self._store.clear()
         self._pictures = 0
+        fastview.clear()
