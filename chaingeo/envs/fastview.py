@@ -19,8 +19,12 @@ from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
 from typing import Final
 
-from PIL import Image, ImageDraw
+import numpy as np
+import numpy.typing as npt
+from PIL import Image
 
+from chaingeo.core.jit import mode as jit_mode
+from chaingeo.envs import rasterjit
 from chaingeo.envs.labels import (
     Step,
     depth_label_steps,
@@ -31,13 +35,12 @@ from chaingeo.envs.labels import (
 )
 from chaingeo.envs.legend import draw_legend, legend_layout
 from chaingeo.envs.raster import (
+    EDGE,
     Box,
     Camera,
     Faces,
     FloatArray,
     Projector,
-    draw_faces_fast,
-    line,
     scaled,
     visible_faces,
 )
@@ -49,16 +52,17 @@ from chaingeo.envs.render import (
     DEFAULT_SIZE,
     TRAY_TITLE,
     VIEWS,
+    Flat,
     PieceMap,
     _check_size,
     _check_views,
-    _draw_walls,
     _frame_edges,
     _Layout,
     _Scene,
     _scene,
     _view_projector,
     _view_titles,
+    _wall_shapes,
     render_tray_image_with,
 )
 from chaingeo.envs.render import (
@@ -67,16 +71,25 @@ from chaingeo.envs.render import (
 
 #: Layouts kept per process (each about 1 MB at 256 px: the iso background is drawn at 2x).
 CAPACITY: Final = 48
+_EDGE: Final = np.array(EDGE, dtype=np.uint8)
+Pixels = npt.NDArray[np.uint8]
+
+
+@dataclass(frozen=True)
+class _Back:
+    """A view's frame drawn without pieces: at drawing scale ``k``, before the front edges."""
+
+    proj: Projector
+    k: int
+    big: Pixels
+    front: list[Flat]
 
 
 @dataclass(frozen=True)
 class _Static:
     """What a view shows without pieces, for one frame, camera, size and legend height."""
 
-    proj: Projector
-    k: int  # drawing scale (supersampling)
-    big: Image.Image  # background at drawing scale, before the pieces
-    front: tuple[tuple[FloatArray, FloatArray], ...]  # front frame edges, drawing pixels
+    back: _Back
     plain: Image.Image  # the finished picture without pieces, depth labels or legend
     steps: tuple[Step, ...]  # titles and ticks, in drawing order
 
@@ -89,6 +102,57 @@ def clear() -> None:
     """Forget every kept layout."""
     _STORE.clear()
     _SEEN.clear()
+
+
+def _draw(img: Pixels, shapes: Sequence[Flat]) -> None:
+    """Flat shapes drawn by the kernel, as :func:`chaingeo.envs.render.draw_flat` would."""
+    if not shapes:
+        return
+    counts = [len(pts) for _, pts, _, _ in shapes]
+    starts = np.zeros(len(shapes) + 1, dtype=np.int64)
+    starts[1:] = np.cumsum(counts)
+    rasterjit.draw_shapes(
+        img,
+        np.array([kind for kind, _, _, _ in shapes], dtype=np.int64),
+        starts,
+        np.concatenate([pts for _, pts, _, _ in shapes]).astype(np.float64),
+        np.array([rgb for _, _, rgb, _ in shapes], dtype=np.uint8),
+        np.array([w for _, _, _, w in shapes], dtype=np.int64),
+    )
+
+
+def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
+    """The steps of ``render._render_view`` before the pieces, drawn by the kernels."""
+    lay = _Layout.of(size)
+    k = _SUPERSAMPLE if cam.depth_axis is None else 1
+    proj = _view_projector(scene, cam, lay)
+    big_proj = scaled(proj, k)
+    big = np.empty((size * k, size * k, 3), dtype=np.uint8)
+    big[:] = _BACKGROUND
+    shapes = _wall_shapes(scene, cam, big_proj, k)
+    for p, q in _frame_edges(scene, cam, back=True):
+        shapes.append((1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k))
+    _draw(big, shapes)
+    edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
+    front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
+    return _Back(proj, k, big, front)
+
+
+def _finish(back: _Back, big: Pixels) -> Image.Image:
+    _draw(big, back.front)
+    return Image.fromarray(rasterjit.reduce2(big) if back.k > 1 else big)
+
+
+def _label_steps(
+    scene: _Scene, cam: Camera, size: int, proj: Projector, title: str | None
+) -> tuple[Step, ...]:
+    lay = _Layout.of(size)
+    titles = _view_titles(cam, scene)
+    lines = titles if title is None else [title, *titles[1:]]
+    return (
+        *title_steps(lines, size, lay.title_px),
+        *tick_steps(scene.lo, scene.hi, cam, proj, lay.tick_px),
+    )
 
 
 def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static | None:
@@ -106,43 +170,15 @@ def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static
         while len(_SEEN) > 16 * CAPACITY:
             _SEEN.popitem(last=False)
         return None
-    made = _draw_static(scene, cam, size, title)
+    back = _back(scene, cam, size)
+    plain = _finish(back, back.big.copy())
+    steps = _label_steps(scene, cam, size, back.proj, title)
+    run_steps(plain, steps)
+    made = _Static(back, plain, steps)
     _STORE[key] = made
     while len(_STORE) > CAPACITY:
         _STORE.popitem(last=False)
     return made
-
-
-def _draw_static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static:
-    """The steps of ``render._render_view`` that do not depend on the pieces."""
-    lay = _Layout.of(size)
-    k = _SUPERSAMPLE if cam.depth_axis is None else 1
-    proj = _view_projector(scene, cam, lay)
-    big_proj = scaled(proj, k)
-    big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
-    draw = ImageDraw.Draw(big)
-    _draw_walls(draw, scene, cam, big_proj, k)
-    for p, q in _frame_edges(scene, cam, back=True):
-        line(draw, big_proj(p), big_proj(q), _FRAME, k)
-    edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
-    front = tuple((big_proj(p), big_proj(q)) for p, q in edges)
-    plain = big.copy()
-    _front_edges(plain, front, k)
-    plain = plain.reduce(k) if k > 1 else plain
-    titles = _view_titles(cam, scene)
-    lines = titles if title is None else [title, *titles[1:]]
-    steps = (
-        *title_steps(lines, size, lay.title_px),
-        *tick_steps(scene.lo, scene.hi, cam, proj, lay.tick_px),
-    )
-    run_steps(plain, steps)
-    return _Static(proj, k, big, front, plain, steps)
-
-
-def _front_edges(big: Image.Image, front: Sequence[tuple[FloatArray, FloatArray]], k: int) -> None:
-    draw = ImageDraw.Draw(big)
-    for a, b in front:
-        line(draw, a, b, _FRAME, k)
 
 
 def _union(a: Box, b: Box) -> Box:
@@ -158,14 +194,20 @@ def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
     return max(0, x0), max(0, y0), min(size, x1), min(size, y1)
 
 
+def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Image.Image, FloatArray]:
+    """The picture with the faces drawn (before labels), and their drawing pixels."""
+    big = back.big.copy()
+    pix = scaled(back.proj, back.k).screen(faces.corners)
+    width = _Layout.of(size).edge_px(back.k)
+    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
+    return _finish(back, big), pix
+
+
 def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Image.Image:
-    big = st.big.copy()
-    width = _Layout.of(size).edge_px(st.k)
-    pix = draw_faces_fast(ImageDraw.Draw(big), faces, scaled(st.proj, st.k), width)
-    _front_edges(big, st.front, st.k)
-    image = big.reduce(st.k) if st.k > 1 else big
-    labels = depth_label_steps(faces, cam, st.proj) if cam.depth_axis is not None else []
-    box = _touched(pix, width + 2, st.k, size)
+    image, pix = _pieces(st.back, faces, size)
+    proj, k = st.back.proj, st.back.k
+    labels = depth_label_steps(faces, cam, proj) if cam.depth_axis is not None else []
+    box = _touched(pix, _Layout.of(size).edge_px(k) + 2, k, size)
     for step in labels:
         box = _union(box, step.box)
     box = max(0, box[0]), max(0, box[1]), min(size, box[2]), min(size, box[3])
@@ -178,12 +220,28 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Image.Imag
     return out
 
 
+def _one_pass(
+    scene: _Scene, cam: Camera, size: int, title: str | None, faces: Faces
+) -> Image.Image:
+    back = _back(scene, cam, size)
+    image = _pieces(back, faces, size)[0] if len(faces.fills) else _finish(back, back.big)
+    run_steps(image, _label_steps(scene, cam, size, back.proj, title))
+    if cam.depth_axis is not None and len(faces.cells):
+        run_steps(image, depth_label_steps(faces, cam, back.proj))
+    return image
+
+
 def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Image.Image:
+    if _Layout.of(size).edge_px(_SUPERSAMPLE) > 4 or jit_mode() != "numba":
+        return render_view(scene, cam, size, title=title, fast=True)  # round joints: Pillow
+    faces = visible_faces(scene.cells, scene.colors, cam)
     st = _static(scene, cam, size, title)
     if st is None:
-        return render_view(scene, cam, size, title=title, fast=True)
-    faces = visible_faces(scene.cells, scene.colors, cam)
-    image = _with_faces(st, faces, cam, size) if len(faces.fills) else st.plain.copy()
+        image = _one_pass(scene, cam, size, title, faces)
+    elif len(faces.fills):
+        image = _with_faces(st, faces, cam, size)
+    else:
+        image = st.plain.copy()
     draw_legend(image, scene.legend)
     return image
 

@@ -35,30 +35,30 @@ def _f32(v: float) -> float:
 def _round_up(f: float) -> int:
     """Pillow's ROUND_UP on a float32 (``floor(f + 0.5F)``, symmetric about zero)."""
     if f >= 0.0:
-        return int(math.floor(_f32(f + 0.5)))
-    return -int(math.floor(abs(f) + 0.5))  # fabs() is a double: double arithmetic
+        return math.floor(_f32(f + 0.5))
+    return -math.floor(abs(f) + 0.5)  # fabs() is a double: double arithmetic
 
 
 @njit(cache=True)
 def _round_down(f: float) -> int:
     if f >= 0.0:
-        return int(math.ceil(_f32(f - 0.5)))
-    return -int(math.ceil(abs(f) - 0.5))
+        return math.ceil(_f32(f - 0.5))
+    return -math.ceil(abs(f) - 0.5)
 
 
 @njit(cache=True)
 def _round_up_d(f: float) -> int:
     """ROUND_UP on a double (``0.5F`` promoted: double arithmetic)."""
     if f >= 0.0:
-        return int(math.floor(f + 0.5))
-    return -int(math.floor(abs(f) + 0.5))
+        return math.floor(f + 0.5)
+    return -math.floor(abs(f) + 0.5)
 
 
 @njit(cache=True)
 def _round_down_d(f: float) -> int:
     if f >= 0.0:
-        return int(math.ceil(f - 0.5))
-    return -int(math.ceil(abs(f) - 0.5))
+        return math.ceil(f - 0.5)
+    return -math.ceil(abs(f) - 0.5)
 
 
 @njit(cache=True)

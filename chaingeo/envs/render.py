@@ -54,7 +54,6 @@ from chaingeo.envs.raster import (
     oblique_camera,
     parse_color,
     png_bytes,
-    polygon,
     posed_faces,
     put_text,
     scaled,
@@ -223,17 +222,19 @@ def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
     return np.array(pts)
 
 
-def _draw_walls(
-    draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector, width: int
-) -> None:
+#: A flat shape: (0 polygon fill or 1 polyline, its points in pixels, colour, line width).
+Flat = tuple[int, FloatArray, RGB, int]
+
+
+def _wall_shapes(scene: _Scene, cam: Camera, proj: Projector, width: int) -> list[Flat]:
     """Back walls and floor with a line per cell boundary, so empty cells can be counted."""
-    grid = draw.draw.draw_ink(_GRID)
+    out: list[Flat] = []
     for axis in (2, 0, 1):
         for side in ("lo", "hi"):
             if not _plane_is_back(axis, side, cam):
                 continue
             fill = _FLOOR if axis == 2 and side == "lo" else _WALL
-            polygon(draw, proj(_wall_corners(scene, axis, side)), fill=fill)
+            out.append((0, proj(_wall_corners(scene, axis, side)), fill, 0))
             b, c = [i for i in range(3) if i != axis]
             ends: list[list[float]] = []
             for along, across in ((b, c), (c, b)):
@@ -243,9 +244,26 @@ def _draw_walls(
                         p[axis] = scene.lo[axis] if side == "lo" else scene.hi[axis]
                         p[along], p[across] = t, at
                         ends.append(p)
-            pix = proj(np.array(ends)).tolist()
-            for i in range(0, len(pix), 2):  # ImageDraw.line's core call, without its checks
-                draw.draw.draw_lines([tuple(pix[i]), tuple(pix[i + 1])], grid, width)
+            pix = proj(np.array(ends))
+            out.extend((1, pix[i : i + 2], _GRID, width) for i in range(0, len(pix), 2))
+    return out
+
+
+def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
+    """Flat shapes with Pillow (``polygon``'s and ``line``'s core calls, without their checks)."""
+    for kind, pts, rgb, width in shapes:
+        ink = draw.draw.draw_ink(rgb)
+        ring = [(x, y) for x, y in pts.tolist()]
+        if kind == 0:
+            draw.draw.draw_polygon(ring, ink, 1)
+        else:
+            draw.draw.draw_lines(ring, ink, width)
+
+
+def _draw_walls(
+    draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector, width: int
+) -> None:
+    draw_flat(draw, _wall_shapes(scene, cam, proj, width))
 
 
 def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArray, FloatArray]]:
