@@ -223,9 +223,15 @@ def _polygon_generic(
                 j += 1
             elif (y == edges[e, 1] or y == edges[e, 3]) and dxs[e] != 0.0:
                 xx[j - 1] = _corner(edges, dxs, table, ii, y, xx[j - 1])
-        row = np.sort(xx[:j])
+        for i in range(1, j):  # qsort's order (equal crossings are interchangeable)
+            v = xx[i]
+            k = i
+            while k > 0 and xx[k - 1] > v:
+                xx[k] = xx[k - 1]
+                k -= 1
+            xx[k] = v
         for i in range(1, j, 2):
-            _hline(img, _round_up(row[i - 1]), y, _round_down(row[i]), c)
+            _hline(img, _round_up(xx[i - 1]), y, _round_down(xx[i]), c)
 
 
 @njit(cache=True)
@@ -330,14 +336,15 @@ def reduce2(img: U8) -> U8:
     """``Image.reduce(2)`` of an even-sized picture: each 2x2 block's mean, rounded half up."""
     h, w = img.shape[0] // 2, img.shape[1] // 2
     out = np.empty((h, w, 3), np.uint8)
+    flat = img.reshape(img.shape[0], img.shape[1] * 3)
+    dst = out.reshape(h, w * 3)
+    acc = np.empty(w * 6, np.uint16)
     for y in range(h):
+        top, bottom = flat[2 * y], flat[2 * y + 1]
+        for i in range(w * 6):
+            acc[i] = np.uint16(top[i]) + np.uint16(bottom[i])
         for x in range(w):
             for ch in range(3):
-                s = (
-                    np.int64(img[2 * y, 2 * x, ch])
-                    + img[2 * y, 2 * x + 1, ch]
-                    + img[2 * y + 1, 2 * x, ch]
-                    + img[2 * y + 1, 2 * x + 1, ch]
-                )
-                out[y, x, ch] = (s + 2) >> 2
+                s = acc[6 * x + ch] + acc[6 * x + 3 + ch] + 2
+                dst[y, 3 * x + ch] = s >> 2
     return out
