@@ -168,8 +168,8 @@ def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static
     """The layout's static parts, drawn on first use in a box, else on the second (a puzzle's
     frame follows its pieces, so many of its layouts are seen once: keeping those would cost
     more than it saves)."""
-    key = (cam.name, size, scene.lo, scene.hi, scene.has_box, title)
-    key += (legend_layout(scene.legend, size)[1],)
+    legend_h = legend_layout(scene.legend, size)[1]
+    key = (cam.name, size, scene.lo, scene.hi, scene.has_box, title, legend_h)
     found = _STORE.get(key)
     if found is not None:
         _STORE.move_to_end(key)

@@ -26,6 +26,25 @@ POLYGON = 0
 POLYLINE = 1
 
 
+#: Work arrays of the fill, made once per kernel call: edges (xmin, ymin, xmax, ymax, x0, y0),
+#: their float32 slopes, the indices of the slanted ones, a row's crossings.
+Scratch = tuple[
+    npt.NDArray[np.int64], npt.NDArray[np.float64], npt.NDArray[np.int64], npt.NDArray[np.float64]
+]
+
+
+@njit(cache=True)
+def scratch(points: int) -> Scratch:
+    """Work arrays for shapes of up to ``points`` points."""
+    n = points + 1
+    return (
+        np.zeros((n, 6), np.int64),
+        np.zeros(n, np.float64),
+        np.zeros(n, np.int64),
+        np.zeros(2 * n + 1, np.float64),
+    )
+
+
 @njit(cache=True)
 def _f32(v: float) -> float:
     return float(np.float32(v))
@@ -192,12 +211,10 @@ def _corner(
 
 
 @njit(cache=True)
-def _polygon_generic(
-    img: U8, edges: npt.NDArray[np.int64], dxs: npt.NDArray[np.float64], n: int, c: U8
-) -> None:
-    """Pillow's scanline fill of ``n`` edges (``polygon_generic``, no alpha)."""
+def _polygon_generic(img: U8, sc: Scratch, n: int, c: U8) -> None:
+    """Pillow's scanline fill of the first ``n`` edges (``polygon_generic``, no alpha)."""
+    edges, dxs, table, xx = sc
     ymin, ymax = img.shape[0] - 1, 0
-    table = np.empty(n, np.int64)
     count = 0
     for i in range(n):
         ymin = min(ymin, edges[i, 1])
@@ -209,7 +226,6 @@ def _polygon_generic(
         count += 1
     ymin = max(ymin, 0)
     ymax = min(ymax, img.shape[0])
-    xx = np.empty(2 * count + 1, np.float64)
     for y in range(ymin, ymax + 1):
         j = 0
         for ii in range(count):
@@ -235,36 +251,36 @@ def _polygon_generic(
 
 
 @njit(cache=True)
-def _fill_polygon(img: U8, xy: npt.NDArray[np.float64], c: U8) -> None:
+def _fill_polygon(img: U8, xy: npt.NDArray[np.float64], c: U8, sc: Scratch) -> None:
     """``ImageDraw.polygon(xy, fill=c)``: ``ImagingDrawPolygon`` with its merged horizontals."""
     m = xy.shape[0]
-    ix = np.empty(m, np.int64)
-    iy = np.empty(m, np.int64)
-    for i in range(m):
-        ix[i], iy[i] = int(xy[i, 0]), int(xy[i, 1])  # C's (int) cast truncates
-    edges = np.zeros((m + 1, 6), np.int64)
-    dxs = np.zeros(m + 1, np.float64)
+    edges, dxs = sc[0], sc[1]
     n = 0
+    px, py = int(xy[0, 0]), int(xy[0, 1])  # C's (int) cast truncates
+    x0, y0 = px, py
     for i in range(m - 1):
-        x0, y0, x1, y1 = ix[i], iy[i], ix[i + 1], iy[i + 1]
-        if y0 == y1 and i != 0 and y0 == iy[i - 1]:
-            if x1 > x0 and x0 > ix[i - 1]:
+        x1, y1 = int(xy[i + 1, 0]), int(xy[i + 1, 1])
+        merged = False
+        if y0 == y1 and i != 0 and y0 == py:
+            if x1 > x0 and x0 > px:
                 edges[n - 1, 2] = x1
-                continue
-            if x1 < x0 and x0 < ix[i - 1]:
+                merged = True
+            elif x1 < x0 and x0 < px:
                 edges[n - 1, 0] = x1
-                continue
-        _add_edge(edges, dxs, n, x0, y0, x1, y1)
+                merged = True
+        if not merged:
+            _add_edge(edges, dxs, n, x0, y0, x1, y1)
+            n += 1
+        px, py, x0, y0 = x0, y0, x1, y1
+    fx, fy = int(xy[0, 0]), int(xy[0, 1])
+    if x0 != fx or y0 != fy:
+        _add_edge(edges, dxs, n, x0, y0, fx, fy)
         n += 1
-    last = m - 1
-    if ix[last] != ix[0] or iy[last] != iy[0]:
-        _add_edge(edges, dxs, n, ix[last], iy[last], ix[0], iy[0])
-        n += 1
-    _polygon_generic(img, edges, dxs, n, c)
+    _polygon_generic(img, sc, n, c)
 
 
 @njit(cache=True)
-def _wide_line(img: U8, x0: int, y0: int, x1: int, y1: int, width: int, c: U8) -> None:
+def _wide_line(img: U8, x0: int, y0: int, x1: int, y1: int, width: int, c: U8, sc: Scratch) -> None:
     """Pillow's ``ImagingDrawWideLine``: the segment's quad, filled."""
     dx, dy = x1 - x0, y1 - y0
     if dx == 0 and dy == 0:
@@ -278,16 +294,14 @@ def _wide_line(img: U8, x0: int, y0: int, x1: int, y1: int, width: int, c: U8) -
     dymin, dymax = _round_down_d(ratio_min * dx), _round_down_d(ratio_max * dx)
     vx = (x0 - dxmin, x1 - dxmin, x1 + dxmax, x0 + dxmax)
     vy = (y0 + dymax, y1 + dymax, y1 - dymin, y0 - dymin)
-    edges = np.zeros((4, 6), np.int64)
-    dxs = np.zeros(4, np.float64)
     for i in range(4):
         k = (i + 1) % 4
-        _add_edge(edges, dxs, i, vx[i], vy[i], vx[k], vy[k])
-    _polygon_generic(img, edges, dxs, 4, c)
+        _add_edge(sc[0], sc[1], i, vx[i], vy[i], vx[k], vy[k])
+    _polygon_generic(img, sc, 4, c)
 
 
 @njit(cache=True)
-def _polyline(img: U8, xy: npt.NDArray[np.float64], width: int, c: U8) -> None:
+def _polyline(img: U8, xy: npt.NDArray[np.float64], width: int, c: U8, sc: Scratch) -> None:
     """``ImageDraw.line(xy, fill=c, width=width)`` without round joints (``draw_lines``)."""
     m = xy.shape[0]
     for i in range(m - 1):
@@ -296,7 +310,7 @@ def _polyline(img: U8, xy: npt.NDArray[np.float64], width: int, c: U8) -> None:
         if width <= 1:
             _line(img, x0, y0, x1, y1, c)
         else:
-            _wide_line(img, x0, y0, x1, y1, width, c)
+            _wide_line(img, x0, y0, x1, y1, width, c, sc)
     if width <= 1 and m > 1:
         _point(img, int(xy[m - 1, 0]), int(xy[m - 1, 1]), c)
 
@@ -311,12 +325,16 @@ def draw_shapes(
     widths: npt.NDArray[np.int64],
 ) -> None:
     """Every shape in order, as Pillow would draw them one call at a time."""
+    most = 4
+    for i in range(kinds.shape[0]):
+        most = max(most, starts[i + 1] - starts[i])
+    sc = scratch(most)
     for i in range(kinds.shape[0]):
         xy = pts[starts[i] : starts[i + 1]]
         if kinds[i] == POLYGON:
-            _fill_polygon(img, xy, colors[i])
+            _fill_polygon(img, xy, colors[i], sc)
         else:
-            _polyline(img, xy, widths[i], colors[i])
+            _polyline(img, xy, widths[i], colors[i], sc)
 
 
 @njit(cache=True)
@@ -324,11 +342,12 @@ def draw_faces(img: U8, corners: npt.NDArray[np.float64], fills: U8, edge: U8, w
     """Each face (``corners`` (n, 4, 2) in pixels) filled, then its closed outline: the calls
     :func:`chaingeo.envs.raster.draw_faces` makes."""
     ring = np.empty((5, 2), np.float64)
+    sc = scratch(5)
     for i in range(corners.shape[0]):
-        _fill_polygon(img, corners[i], fills[i])
+        _fill_polygon(img, corners[i], fills[i], sc)
         ring[:4] = corners[i]
         ring[4] = corners[i, 0]
-        _polyline(img, ring, width, edge)
+        _polyline(img, ring, width, edge, sc)
 
 
 @njit(cache=True)
