@@ -17,7 +17,6 @@ import math
 from collections import OrderedDict
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Final
 
 import numpy as np
@@ -122,22 +121,13 @@ def _draw(img: Pixels, shapes: Sequence[Flat]) -> None:
     )
 
 
-@lru_cache(maxsize=8)
-def _blank(side: int) -> Pixels:
-    """A background-coloured picture to copy (filling one from a colour is 20x slower)."""
-    out = np.empty((side, side, 3), dtype=np.uint8)
-    out[:] = _BACKGROUND
-    out.flags.writeable = False
-    return out
-
-
 def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
     """The steps of ``render._render_view`` before the pieces, drawn by the kernels."""
     lay = _Layout.of(size)
     k = _SUPERSAMPLE if cam.depth_axis is None else 1
     proj = _view_projector(scene, cam, lay)
     big_proj = scaled(proj, k)
-    big = _blank(size * k).copy()
+    big = rasterjit.blank(size * k, _BACKGROUND).copy()
     shapes = _wall_shapes(scene, cam, big_proj, k)
     for p, q in _frame_edges(scene, cam, back=True):
         shapes.append((1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k))

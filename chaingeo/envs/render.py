@@ -27,6 +27,8 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from chaingeo.core.geometry import Shape
+from chaingeo.core.jit import mode as jit_mode
+from chaingeo.envs import rasterjit
 from chaingeo.envs.labels import (
     AXIS_NAMES,
     TEXT,
@@ -393,6 +395,26 @@ def _sheet_faces(cells: tuple[tuple[int, int, int], ...], rgb: RGB, cam: int) ->
     return visible_faces(voxels, colors, SHEET_CAMERAS[cam])
 
 
+def _sheet_pieces(
+    drawn: Sequence[tuple[Faces, Projector]], size: int, width: int, fast: bool
+) -> Image.Image:
+    """The sheet's pieces drawn at twice the size and reduced: by Pillow, or (``fast``) all at
+    once by :mod:`chaingeo.envs.rasterjit` (the same pixels; Pillow when lines get round
+    joints)."""
+    k = _SUPERSAMPLE
+    if fast and width <= 4 and jit_mode() == "numba":
+        big = rasterjit.blank(size * k, _BACKGROUND).copy()
+        corners = np.concatenate([p.screen(f.corners) for f, p in drawn])
+        fills = np.concatenate([f.fills for f, _ in drawn])
+        rasterjit.draw_faces(big, corners, fills, np.array(EDGE, dtype=np.uint8), width)
+        return Image.fromarray(rasterjit.reduce2(big))
+    image = Image.new("RGB", (size * k, size * k), _BACKGROUND)
+    draw = ImageDraw.Draw(image)
+    for faces, proj in drawn:
+        (draw_faces_fast if fast else draw_faces)(draw, faces, proj, width)
+    return image.reduce(k)
+
+
 def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) -> Image.Image:
     """Every piece in its own cell, drawn twice (see :data:`SHEET_CAMERAS`) at one common
     scale, labelled with a colour swatch, its name and its number of cubes."""
@@ -405,7 +427,6 @@ def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) ->
         _title(image, [title], lay)
         put_text(image, (size / 2, size / 2), "(no pieces)", lay.tick_px, _TEXT)
         return image
-    big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
     label_px = max(9, min(lay.tick_px, size // 40))
     label_h = label_px * 1.7
     shapes = {n: pieces[n][0].normalized() for n in names}
@@ -419,7 +440,7 @@ def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) ->
     rows = math.ceil(len(names) / cols)
     cell_w, cell_h = size / cols, (size - title_h) / rows
     scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
-    draw = ImageDraw.Draw(big)
+    drawn: list[tuple[Faces, Projector]] = []
     slots: list[tuple[str, RGB, float, float]] = []
     for i, n in enumerate(names):
         col, row = i % cols, i // cols
@@ -434,14 +455,13 @@ def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) ->
             )
             if fast:
                 faces = _sheet_faces(shapes[n].cells, rgb, j)
-                draw_faces_fast(draw, faces, scaled(proj, k), lay.edge_px(k))
             else:
                 faces = visible_faces(shapes[n].voxels, colors, cam)
-                draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
+            drawn.append((faces, scaled(proj, k)))
         cubes = len(shapes[n])
         label = f"{n} ({cubes} cube{'s' if cubes != 1 else ''})"
         slots.append((label, rgb, x0 + cell_w / 2, y0 + cell_h - label_h / 2))
-    image = big.reduce(k)
+    image = _sheet_pieces(drawn, size, lay.edge_px(k), fast)
     small = ImageDraw.Draw(image)
     _title(image, [title, _SHEET_NOTE], lay)
     for text, rgb, x, y in slots:
