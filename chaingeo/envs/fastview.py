@@ -29,7 +29,7 @@ from chaingeo.envs.labels import (
     Step,
     depth_label_steps,
     overlaps,
-    run_steps,
+    paint_steps,
     tick_steps,
     title_steps,
 )
@@ -39,6 +39,7 @@ from chaingeo.envs.raster import (
     Box,
     Camera,
     Faces,
+    Flat,
     FloatArray,
     Projector,
     scaled,
@@ -52,7 +53,6 @@ from chaingeo.envs.render import (
     DEFAULT_SIZE,
     TRAY_TITLE,
     VIEWS,
-    Flat,
     PieceMap,
     _check_size,
     _check_views,
@@ -90,7 +90,7 @@ class _Static:
     """What a view shows without pieces, for one frame, camera, size and legend height."""
 
     back: _Back
-    plain: Image.Image  # the finished picture without pieces, depth labels or legend
+    plain: Pixels  # the finished picture without pieces, depth labels or legend
     steps: tuple[Step, ...]  # titles and ticks, in drawing order
 
 
@@ -104,23 +104,6 @@ def clear() -> None:
     _SEEN.clear()
 
 
-def _draw(img: Pixels, shapes: Sequence[Flat]) -> None:
-    """Flat shapes drawn by the kernel, as :func:`chaingeo.envs.render.draw_flat` would."""
-    if not shapes:
-        return
-    counts = [len(pts) for _, pts, _, _ in shapes]
-    starts = np.zeros(len(shapes) + 1, dtype=np.int64)
-    starts[1:] = np.cumsum(counts)
-    rasterjit.draw_shapes(
-        img,
-        np.array([kind for kind, _, _, _ in shapes], dtype=np.int64),
-        starts,
-        np.concatenate([pts for _, pts, _, _ in shapes]).astype(np.float64),
-        np.array([rgb for _, _, rgb, _ in shapes], dtype=np.uint8),
-        np.array([w for _, _, _, w in shapes], dtype=np.int64),
-    )
-
-
 def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
     """The steps of ``render._render_view`` before the pieces, drawn by the kernels."""
     lay = _Layout.of(size)
@@ -131,15 +114,15 @@ def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
     shapes = _wall_shapes(scene, cam, big_proj, k)
     for p, q in _frame_edges(scene, cam, back=True):
         shapes.append((1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k))
-    _draw(big, shapes)
+    rasterjit.draw_flat(big, shapes)
     edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
     front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
     return _Back(proj, k, big, front)
 
 
-def _finish(back: _Back, big: Pixels) -> Image.Image:
-    _draw(big, back.front)
-    return Image.fromarray(rasterjit.reduce2(big) if back.k > 1 else big)
+def _finish(back: _Back, big: Pixels) -> Pixels:
+    rasterjit.draw_flat(big, back.front)
+    return rasterjit.reduce2(big) if back.k > 1 else big
 
 
 def _label_steps(
@@ -172,7 +155,8 @@ def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static
     back = _back(scene, cam, size)
     plain = _finish(back, back.big.copy())
     steps = _label_steps(scene, cam, size, back.proj, title)
-    run_steps(plain, steps)
+    paint_steps(plain, steps)
+    plain.flags.writeable = False
     made = _Static(back, plain, steps)
     _STORE[key] = made
     while len(_STORE) > CAPACITY:
@@ -193,7 +177,7 @@ def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
     return max(0, x0), max(0, y0), min(size, x1), min(size, y1)
 
 
-def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Image.Image, FloatArray]:
+def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, FloatArray]:
     """The picture with the faces drawn (before labels), and their drawing pixels."""
     big = back.big.copy()
     pix = scaled(back.proj, back.k).screen(faces.corners)
@@ -202,31 +186,29 @@ def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Image.Image, FloatArr
     return _finish(back, big), pix
 
 
-def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Image.Image:
+def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     image, pix = _pieces(st.back, faces, size)
     proj, k = st.back.proj, st.back.k
     labels = depth_label_steps(faces, cam, proj) if cam.depth_axis is not None else []
     box = _touched(pix, _Layout.of(size).edge_px(k) + 2, k, size)
     for step in labels:
         box = _union(box, step.box)
-    box = max(0, box[0]), max(0, box[1]), min(size, box[2]), min(size, box[3])
-    if box[0] >= box[2] or box[1] >= box[3]:
-        return st.plain.copy()
-    run_steps(image, [s for s in st.steps if overlaps(s.box, box)])
-    run_steps(image, labels)
+    x0, y0, x1, y1 = max(0, box[0]), max(0, box[1]), min(size, box[2]), min(size, box[3])
     out = st.plain.copy()
-    out.paste(image.crop(box), box[:2])
+    if x0 >= x1 or y0 >= y1:
+        return out
+    paint_steps(image, [s for s in st.steps if overlaps(s.box, (x0, y0, x1, y1))])
+    paint_steps(image, labels)
+    out[y0:y1, x0:x1] = image[y0:y1, x0:x1]
     return out
 
 
-def _one_pass(
-    scene: _Scene, cam: Camera, size: int, title: str | None, faces: Faces
-) -> Image.Image:
+def _one_pass(scene: _Scene, cam: Camera, size: int, title: str | None, faces: Faces) -> Pixels:
     back = _back(scene, cam, size)
     image = _pieces(back, faces, size)[0] if len(faces.fills) else _finish(back, back.big)
-    run_steps(image, _label_steps(scene, cam, size, back.proj, title))
+    paint_steps(image, _label_steps(scene, cam, size, back.proj, title))
     if cam.depth_axis is not None and len(faces.cells):
-        run_steps(image, depth_label_steps(faces, cam, back.proj))
+        paint_steps(image, depth_label_steps(faces, cam, back.proj))
     return image
 
 
@@ -236,11 +218,12 @@ def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Im
     faces = visible_faces(scene.cells, scene.colors, cam)
     st = _static(scene, cam, size, title)
     if st is None:
-        image = _one_pass(scene, cam, size, title, faces)
+        pixels = _one_pass(scene, cam, size, title, faces)
     elif len(faces.fills):
-        image = _with_faces(st, faces, cam, size)
+        pixels = _with_faces(st, faces, cam, size)
     else:
-        image = st.plain.copy()
+        pixels = st.plain
+    image = Image.fromarray(pixels)
     draw_legend(image, scene.legend)
     return image
 

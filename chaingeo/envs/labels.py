@@ -14,8 +14,10 @@ from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
+import numpy.typing as npt
 from PIL import Image, ImageDraw
 
+from chaingeo.envs import rasterjit
 from chaingeo.envs.raster import (
     RGB,
     Box,
@@ -23,12 +25,15 @@ from chaingeo.envs.raster import (
     Faces,
     FloatArray,
     Projector,
-    arrow,
+    arrow_shapes,
+    draw_flat,
     put_text,
     text_box,
     text_color,
+    text_mask_array,
 )
 
+Pixels = npt.NDArray[np.uint8]
 TEXT: Final[RGB] = (20, 20, 20)
 AXIS_COLORS: Final[tuple[RGB, RGB, RGB]] = ((190, 30, 30), (20, 130, 40), (30, 60, 200))
 AXIS_NAMES: Final = "xyz"
@@ -40,6 +45,7 @@ class Step:
 
     box: Box
     run: Callable[[Image.Image], None]
+    paint: Callable[[Pixels], None]  # the same on an (h, w, 3) array, by the kernels
 
 
 def overlaps(a: Box, b: Box) -> bool:
@@ -51,13 +57,22 @@ def run_steps(image: Image.Image, steps: Sequence[Step]) -> None:
         step.run(image)
 
 
+def paint_steps(pixels: Pixels, steps: Sequence[Step]) -> None:
+    for step in steps:
+        step.paint(pixels)
+
+
 def text_step(
     xy: Sequence[float] | FloatArray, text: str, px: int, fill: RGB, anchor: str = "mm"
 ) -> Step:
     at = (float(xy[0]), float(xy[1]))
+    box = text_box(at, text, px, anchor)
+    mask = text_mask_array(text, px, anchor)
+    ink = np.array(fill, dtype=np.uint8)
     return Step(
-        text_box(at, text, px, anchor),
+        box,
         lambda im: put_text(im, at, text, px, fill, anchor),
+        lambda arr: rasterjit.paste_mask(arr, mask, box[0], box[1], ink),
     )
 
 
@@ -65,7 +80,12 @@ def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
     reach = max(4.0, 3.2 * width) + width + 2
     lo, hi = np.minimum(a, b) - reach, np.maximum(a, b) + reach
     box = (math.floor(lo[0]), math.floor(lo[1]), math.ceil(hi[0]) + 1, math.ceil(hi[1]) + 1)
-    return Step(box, lambda im: arrow(ImageDraw.Draw(im), a, b, fill, width))
+    shapes = arrow_shapes(a, b, fill, width)
+    return Step(
+        box,
+        lambda im: draw_flat(ImageDraw.Draw(im), shapes),
+        lambda arr: rasterjit.draw_flat(arr, shapes),
+    )
 
 
 def tick_steps(

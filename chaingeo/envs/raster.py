@@ -166,6 +166,14 @@ def text_color(fill: Iterable[int]) -> RGB:
 
 
 @lru_cache(maxsize=4096)
+def text_mask_array(text: str, px: int, anchor: str) -> npt.NDArray[np.uint8]:
+    """:func:`_text_mask`'s glyphs as a read-only array (for the kernels)."""
+    out = np.array(_text_mask(text, px, anchor)[0], dtype=np.uint8)
+    out.flags.writeable = False
+    return out
+
+
+@lru_cache(maxsize=4096)
 def _text_mask(text: str, px: int, anchor: str) -> tuple[Image.Image, int, int]:
     """The glyphs of ``text`` as an 8-bit mask and its offset from the anchor point (cached:
     the same few labels recur in every picture, and rasterising them is the costly part)."""
@@ -260,18 +268,39 @@ def line(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, wid
     draw.line([(float(a[0]), float(a[1])), (float(b[0]), float(b[1]))], fill=fill, width=width)
 
 
-def arrow(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:
+#: A flat shape: (0 polygon fill or 1 polyline, its points in pixels, colour, line width).
+Flat = tuple[int, FloatArray, RGB, int]
+
+
+def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
+    """Flat shapes with Pillow (``polygon``'s and ``line``'s core calls, without their checks)."""
+    for kind, pts, rgb, width in shapes:
+        ink = draw.draw.draw_ink(rgb)
+        ring = [(x, y) for x, y in pts.tolist()]
+        if kind == 0:
+            draw.draw.draw_polygon(ring, ink, 1)
+        else:
+            draw.draw.draw_lines(ring, ink, width)
+
+
+def arrow_shapes(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> list[Flat]:
     """A line from ``a`` to ``b`` with a filled head at ``b`` (the font has no arrow glyphs)."""
     d = b - a
     n = float(np.hypot(*d))
     if n < 1e-6:
-        return
+        return []
     d = d / n
     head = max(4.0, 3.2 * width)
     base = b - d * head
     perp = np.array([-d[1], d[0]]) * head * 0.55
-    line(draw, a, base, fill, width)
-    polygon(draw, np.array([b, base + perp, base - perp]), fill=fill)
+    return [
+        (1, np.array([a, base]), fill, width),
+        (0, np.array([b, base + perp, base - perp]), fill, 0),
+    ]
+
+
+def arrow(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:
+    draw_flat(draw, arrow_shapes(a, b, fill, width))
 
 
 def draw_faces(draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: int) -> None:

@@ -15,12 +15,14 @@ points in ``pts`` (float64 ``(m, 2)``), ``colors[i]`` its RGB and ``widths[i]`` 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from functools import lru_cache
 
 import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.jit import njit
+from chaingeo.envs.raster import Flat
 
 U8 = npt.NDArray[np.uint8]
 POLYGON = 0
@@ -378,3 +380,34 @@ def reduce2(img: U8) -> U8:
                 s = acc[6 * x + ch] + acc[6 * x + 3 + ch] + 2
                 dst[y, 3 * x + ch] = s >> 2
     return out
+
+
+@njit(cache=True)
+def paste_mask(img: U8, mask: U8, x0: int, y0: int, c: U8) -> None:
+    """``Image.paste(c, (x0, y0), mask)`` of an 8-bit mask (Pillow's ``fill_mask_L``: each
+    channel blended as ``(out * (255 - m) + c * m) / 255``, rounded its way), clipped."""
+    h, w = mask.shape[0], mask.shape[1]
+    for my in range(max(0, -y0), min(h, img.shape[0] - y0)):
+        y = y0 + my
+        for mx in range(max(0, -x0), min(w, img.shape[1] - x0)):
+            m = np.int64(mask[my, mx])
+            x = x0 + mx
+            for ch in range(3):
+                t = np.int64(img[y, x, ch]) * (255 - m) + np.int64(c[ch]) * m + 128
+                img[y, x, ch] = ((t >> 8) + t) >> 8
+
+
+def draw_flat(img: U8, shapes: Sequence[Flat]) -> None:
+    """Flat shapes drawn in one kernel call, as :func:`chaingeo.envs.raster.draw_flat` would."""
+    if not shapes:
+        return
+    starts = np.zeros(len(shapes) + 1, dtype=np.int64)
+    starts[1:] = np.cumsum([len(pts) for _, pts, _, _ in shapes])
+    draw_shapes(
+        img,
+        np.array([kind for kind, _, _, _ in shapes], dtype=np.int64),
+        starts,
+        np.concatenate([pts for _, pts, _, _ in shapes]).astype(np.float64),
+        np.array([rgb for _, _, rgb, _ in shapes], dtype=np.uint8),
+        np.array([w for _, _, _, w in shapes], dtype=np.int64),
+    )

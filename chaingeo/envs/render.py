@@ -44,11 +44,13 @@ from chaingeo.envs.raster import (
     Camera,
     ColorLike,
     Faces,
+    Flat,
     FloatArray,
     Posed,
     Projector,
     draw_faces,
     draw_faces_fast,
+    draw_flat,
     fit,
     fit_centre,
     frame_corners,
@@ -224,10 +226,6 @@ def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
     return np.array(pts)
 
 
-#: A flat shape: (0 polygon fill or 1 polyline, its points in pixels, colour, line width).
-Flat = tuple[int, FloatArray, RGB, int]
-
-
 def _wall_shapes(scene: _Scene, cam: Camera, proj: Projector, width: int) -> list[Flat]:
     """Back walls and floor with a line per cell boundary, so empty cells can be counted."""
     out: list[Flat] = []
@@ -249,17 +247,6 @@ def _wall_shapes(scene: _Scene, cam: Camera, proj: Projector, width: int) -> lis
             pix = proj(np.array(ends))
             out.extend((1, pix[i : i + 2], _GRID, width) for i in range(0, len(pix), 2))
     return out
-
-
-def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
-    """Flat shapes with Pillow (``polygon``'s and ``line``'s core calls, without their checks)."""
-    for kind, pts, rgb, width in shapes:
-        ink = draw.draw.draw_ink(rgb)
-        ring = [(x, y) for x, y in pts.tolist()]
-        if kind == 0:
-            draw.draw.draw_polygon(ring, ink, 1)
-        else:
-            draw.draw.draw_lines(ring, ink, width)
 
 
 def _draw_walls(
