@@ -88,8 +88,8 @@ def _pixels(state: BaseState, size: int, reference: bool) -> list[bytes]:
 
 def _assert_same(state: BaseState, size: int) -> None:
     expected = _pixels(state, size, reference=True)
-    assert _pixels(state, size, reference=False) == expected  # first sight: one pass
-    assert _pixels(state, size, reference=False) == expected  # then the kept layout
+    assert _pixels(state, size, reference=False) == expected
+    assert _pixels(state, size, reference=False) == expected  # a box's layout, kept
 
 
 def test_every_shipped_level_starts_with_the_reference_pictures() -> None:

@@ -1,14 +1,17 @@
-"""The renderer's pictures, pixel for pixel, drawing again only what the pieces change.
+"""The renderer's pictures, byte for byte, drawn on arrays by kernels and partly kept.
 
 A view is the frame's background (walls, floor grid, back frame edges), the pieces' faces, the
-front frame edges, then titles, axis ticks, depth labels and the legend. All but the faces, the
-depth labels and the legend depend only on the frame, the camera and the legend's height, which
-a run of steps seldom changes; :func:`render_images` keeps them per layout (the background at
-drawing scale, and the finished picture without pieces) and per step draws the faces on a copy
-of the background, then takes from that only the rectangle the faces (and their labels) cover,
-redrawing the labels that overlap it. Every drawing call is the one
-:mod:`chaingeo.envs.render` makes, in the same order, on the same pixels, so the pictures are
-the same bytes (tested over the shipped levels); ``render`` stays the reference.
+front frame edges, then titles, axis ticks, depth labels and the legend. Here every shape and
+every label is drawn by :mod:`chaingeo.envs.rasterjit` (Pillow's own algorithms as numba
+kernels) on a numpy array; only the legend still goes through Pillow. In a box (stacking) the
+frame stays put, so all but the faces, depth labels and legend are kept per layout (the
+background at drawing scale, and the picture without pieces): a step draws the faces on a copy
+of the background and takes only the rectangle they (and their labels) cover, redrawing the
+labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass.
+Every drawing call is the one :mod:`chaingeo.envs.render` makes, in the same order, so the
+pictures are the same bytes (tested over the shipped levels); ``render`` stays the reference
+(and draws where the kernels do not apply: lines wide enough for round joints, or
+``CHAINGEO_JIT=python``).
 """
 
 from __future__ import annotations
@@ -95,13 +98,11 @@ class _Static:
 
 
 _STORE: OrderedDict[Hashable, _Static] = OrderedDict()
-_SEEN: OrderedDict[Hashable, None] = OrderedDict()
 
 
 def clear() -> None:
     """Forget every kept layout."""
     _STORE.clear()
-    _SEEN.clear()
 
 
 def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
@@ -138,20 +139,17 @@ def _label_steps(
 
 
 def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static | None:
-    """The layout's static parts, drawn on first use in a box, else on the second (a puzzle's
-    frame follows its pieces, so many of its layouts are seen once: keeping those would cost
-    more than it saves)."""
+    """The layout's static parts when the frame is a box (it stays put); None for a frame that
+    follows the pieces (a puzzle's: its layouts seldom recur, so keeping them costs more than
+    it saves)."""
+    if not scene.has_box:
+        return None
     legend_h = legend_layout(scene.legend, size)[1]
-    key = (cam.name, size, scene.lo, scene.hi, scene.has_box, title, legend_h)
+    key = (cam.name, size, scene.lo, scene.hi, title, legend_h)
     found = _STORE.get(key)
     if found is not None:
         _STORE.move_to_end(key)
         return found
-    if key not in _SEEN and not scene.has_box:
-        _SEEN[key] = None
-        while len(_SEEN) > 16 * CAPACITY:
-            _SEEN.popitem(last=False)
-        return None
     back = _back(scene, cam, size)
     plain = _finish(back, back.big.copy())
     steps = _label_steps(scene, cam, size, back.proj, title)
