@@ -9,17 +9,19 @@ each), at the environments' default 256 px, under two seeded policies:
 * ``plan``: each level's stored optimal plan, then ``finish`` (every step legal and every
   picture new: this times drawing).
 
-Rows with images are timed twice on the very same trajectory: ours (pictures drawn straight to
-arrays, cached by what they show) and the reference, today's path (every picture encoded to PNG
-and decoded back, nothing cached) in the same run; ``ratio`` = ours / reference steps per
-second. ``vs today`` divides by the single-environment reference of the same family and policy.
+Rows with images are timed twice on the very same trajectory: ours (pictures drawn to arrays by
+:mod:`chaingeo.envs.fastview`'s kernels, cached by what they show) and the reference, the old
+path (:mod:`chaingeo.envs.render` through Pillow, every picture encoded to PNG and decoded back,
+nothing cached) in the same run; ``ratio`` = ours / reference steps per second. ``vs today``
+divides by the single-environment reference of the same family and policy.
 Each environment first plays its trajectory once untimed (level tables built, numba compiled),
 then forgets its pictures and plays it again timed; steps/s counts sub-environment steps, wall
 clock (the async workers are other processes). ``--quick``: 30 steps a row instead of 200.
 
 First, the pictures alone: one observation's pictures along the plans of the first levels of
-each family, drawn to arrays (:func:`render_frames`, no cache) against the PNG round trip
-(:func:`png_frames`), best of ``--repeat`` CPU times: what dropping PNG saves by itself.
+each family, drawn to arrays (:func:`render_frames`, no cache), by the old renderer without PNG
+(:func:`reference_frames`) and with the PNG round trip (:func:`png_frames`), best of
+``--repeat`` CPU times: what the kernels and dropping PNG save by themselves.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from gymnasium.vector import AsyncVectorEnv, SyncVectorEnv
 
 from chaingeo.core.level import Level
 from chaingeo.envs.demos import plan_texts
-from chaingeo.envs.frames import Frame, png_frames, render_frames
+from chaingeo.envs.frames import Frame, png_frames, reference_frames, render_frames
 from chaingeo.envs.gym import ChainEnv, PuzzleEnv, StackingEnv
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.state import BaseState
@@ -153,13 +155,14 @@ def _plan_states(level: Level) -> list[BaseState]:
     return out
 
 
-def pictures(family: str, levels: int, repeat: int) -> tuple[int, float, float]:
-    """(observations, ms per observation drawn to arrays, ms through PNG), best CPU times."""
+def pictures(family: str, levels: int, repeat: int) -> tuple[int, list[float]]:
+    """(observations, ms per observation: ours, the old drawing, the old drawing and PNG),
+    best CPU times."""
     env = FAMILIES[family][1](images=False)
     states = [s for lv in list(env.levels.values())[:levels] for s in _plan_states(lv)]
     best = []
-    for draw in (render_frames, png_frames):
-        draw(states[0], SIZE)  # warm-up: fonts
+    for draw in (render_frames, reference_frames, png_frames):
+        draw(states[0], SIZE)  # warm-up: fonts, kernels
         times = []
         for _ in range(repeat):
             start = time.process_time()
@@ -167,7 +170,7 @@ def pictures(family: str, levels: int, repeat: int) -> tuple[int, float, float]:
                 draw(state, SIZE)
             times.append(time.process_time() - start)
         best.append(min(times) / len(states) * 1e3)
-    return len(states), best[0], best[1]
+    return len(states), best
 
 
 def _line(row: Row, today: float | None) -> str:
@@ -205,10 +208,10 @@ def run(args: argparse.Namespace) -> int:
     repeat = max(1, int(getattr(args, "repeat", 3)))
     print(f"pictures of one observation, {SIZE} px, CPU ms (best of {repeat})")
     for family in FAMILIES:
-        n, arrays, png = pictures(family, 1 if quick else 3, repeat)
+        n, (arrays, old, png) = pictures(family, 1 if quick else 3, repeat)
         print(
-            f"  {family:9s} {n:3d} states: arrays {arrays:6.1f}  PNG round trip {png:6.1f}  "
-            f"ratio {png / arrays:.2f}x",
+            f"  {family:9s} {n:3d} states: arrays {arrays:6.1f}  old drawing {old:6.1f}  "
+            f"+ PNG round trip {png:6.1f}  ratio {png / arrays:.2f}x",
             flush=True,
         )
     print(

@@ -2,16 +2,16 @@
 
 The Gymnasium environments hand out pixels, not files: encoding every picture to PNG and
 decoding it back cost about a third of the time spent on an observation's pictures.
-:func:`render_frames` takes the renderer's images (:func:`chaingeo.envs.render.render_images`
-and ``render_tray_image``, the very images :func:`chaingeo.envs.observation.render_state`
-encodes) as arrays; PNG is lossless, so they are pixel-equal to decoding today's PNG (tested).
+:func:`render_frames` takes the images :func:`chaingeo.envs.observation.render_state` encodes
+(drawn by :mod:`chaingeo.envs.fastview`, byte-equal to :mod:`chaingeo.envs.render`) as arrays;
+PNG is lossless, so they are pixel-equal to decoding the PNG (tested).
 PNG stays where bytes are wanted (the harness' logs and agents call ``render_state``);
 :func:`png_frames` keeps the round trip callable as the reference of ``chain bench env``.
 
 A picture depends only on what it shows, so :class:`FrameCache` keeps recent ones: the four views
 by the cells drawn, the tray by the pieces still in it, a puzzle's target by the level alone. A
 refused action, an undo or a position seen before then costs a copy, not a render. This module
-only calls the renderer's public entry points; it does not change how pictures look.
+does not change how pictures look.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from chaingeo.envs.observation import (
     extra_picture_of,
     render_state,
     scene,
+    state_images,
 )
 from chaingeo.envs.stacking import StackingState
 from chaingeo.envs.state import BaseState
@@ -58,9 +59,9 @@ def _views(state: BaseState, size: int) -> dict[str, Frame]:
 
 
 def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
-    import chaingeo.envs.render as render
+    import chaingeo.envs.fastview as fastview
 
-    return {v: _array(img) for v, img in render.render_images(pieces, box, VIEWS, size).items()}
+    return {v: _array(img) for v, img in fastview.render_images(pieces, box, VIEWS, size).items()}
 
 
 def _extra(state: BaseState, size: int) -> Frame:
@@ -82,10 +83,16 @@ def decode_png(data: bytes) -> Frame:
         return np.asarray(img.convert("RGB"), dtype=np.uint8).copy()
 
 
+def reference_frames(state: BaseState, size: int) -> dict[str, Frame]:
+    """:func:`render_frames` drawn by :mod:`chaingeo.envs.render` itself (the reference of
+    :mod:`chaingeo.envs.fastview`: the same pixels, slower), no PNG."""
+    return {v: _array(img) for v, img in state_images(state, size, reference=True).items()}
+
+
 def png_frames(state: BaseState, size: int) -> dict[str, Frame]:
     """The same arrays the long way: encode every picture to PNG and decode it back (what the
     environments did before :func:`render_frames`; the benchmark's reference)."""
-    return {v: decode_png(png) for v, png in render_state(state, size).items()}
+    return {v: decode_png(png) for v, png in render_state(state, size, reference=True).items()}
 
 
 class FrameCache:
@@ -138,6 +145,10 @@ class FrameCache:
         return {n: f.copy() for n, f in zip(names, (*views, extra), strict=True)}
 
     def clear(self) -> None:
-        """Forget every picture (levels were replaced under the same ids)."""
+        """Forget every picture (levels were replaced under the same ids), and the layouts
+        :mod:`chaingeo.envs.fastview` keeps in this process."""
+        import chaingeo.envs.fastview as fastview
+
         self._store.clear()
         self._pictures = 0
+        fastview.clear()

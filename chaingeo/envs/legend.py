@@ -5,11 +5,12 @@ without the observation's colour table."""
 from __future__ import annotations
 
 from collections.abc import Sequence
+from functools import lru_cache
 from typing import Final
 
 from PIL import Image, ImageDraw
 
-from chaingeo.envs.raster import EDGE, RGB, font, put_text
+from chaingeo.envs.raster import EDGE, RGB, put_text, text_length
 
 #: (name, colour) per entry, in the order drawn.
 Entries = Sequence[tuple[str, RGB]]
@@ -21,17 +22,24 @@ _MAX_SHARE: Final = 0.2
 
 def _rows(entries: Entries, px: int, width: int) -> list[list[tuple[str, RGB, float]]]:
     """Entries flowed into rows no wider than ``width``: (name, colour, x of the swatch)."""
+    return [list(r) for r in _flow(tuple(entries), px, width)]
+
+
+@lru_cache(maxsize=1024)
+def _flow(
+    entries: tuple[tuple[str, RGB], ...], px: int, width: int
+) -> tuple[tuple[tuple[str, RGB, float], ...], ...]:
     margin, gap = px * 0.6, px * 1.1
     rows: list[list[tuple[str, RGB, float]]] = [[]]
     x = margin
     for name, rgb in entries:
-        w = px * 1.4 + float(font(px).getlength(name))
+        w = px * 1.4 + text_length(name, px)
         if rows[-1] and x + w > width - margin:
             rows.append([])
             x = margin
         rows[-1].append((name, rgb, x))
         x += w + gap
-    return rows
+    return tuple(tuple(r) for r in rows)
 
 
 def legend_layout(entries: Entries, size: int) -> tuple[int, float]:

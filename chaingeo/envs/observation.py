@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from types import ModuleType
 from typing import TYPE_CHECKING, Final
 
 from chaingeo.core.geometry import Cell, Shape
@@ -238,22 +239,37 @@ def scene(state: BaseState) -> tuple[PieceMap, tuple[int, int, int] | None, Piec
     return pieces, None, {}
 
 
-def render_state(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> dict[str, bytes]:
+def render_state(
+    state: BaseState, size: int = DEFAULT_IMAGE_SIZE, reference: bool = False
+) -> dict[str, bytes]:
     """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (puzzles)."""
     from chaingeo.envs.raster import png_bytes
 
-    return {name: png_bytes(img) for name, img in state_images(state, size).items()}
+    images = state_images(state, size, reference)
+    return {name: png_bytes(img) for name, img in images.items()}
 
 
-def state_images(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> dict[str, Image.Image]:
+def state_images(
+    state: BaseState, size: int = DEFAULT_IMAGE_SIZE, reference: bool = False
+) -> dict[str, Image.Image]:
     """The pictures of an observation as images (:func:`render_state` encodes them; the
-    Gymnasium environments take their pixels): the four views, then the extra picture."""
-    import chaingeo.envs.render as render
-
+    Gymnasium environments take their pixels): the four views, then the extra picture.
+    ``reference`` draws them with :mod:`chaingeo.envs.render` itself, the slower reference
+    of :mod:`chaingeo.envs.fastview` (the same pixels)."""
     pieces, box, _ = scene(state)
-    images = dict(render.render_images(pieces, box, VIEWS, size))
-    images[extra_picture(state)] = extra_image(state, size)
+    images = dict(_drawer(reference).render_images(pieces, box, VIEWS, size))
+    images[extra_picture(state)] = extra_image(state, size, reference)
     return images
+
+
+def _drawer(reference: bool) -> ModuleType:
+    if reference:
+        import chaingeo.envs.render as render
+
+        return render
+    import chaingeo.envs.fastview as fastview
+
+    return fastview
 
 
 def extra_picture(state: BaseState) -> str:
@@ -265,14 +281,19 @@ def extra_picture_of(family: str) -> str:
     return "tray" if family == "stacking" else "target"
 
 
-def extra_image(state: BaseState, size: int = DEFAULT_IMAGE_SIZE) -> Image.Image:
+def extra_image(
+    state: BaseState, size: int = DEFAULT_IMAGE_SIZE, reference: bool = False
+) -> Image.Image:
     """The tray (stacking: the pieces not yet placed) or the target (puzzles: the goal)."""
-    import chaingeo.envs.render as render
-
+    draw = _drawer(reference)
     if state.level.family == "stacking":
-        return render.render_tray_image(scene(state)[2], size)
+        image: Image.Image = draw.render_tray_image(scene(state)[2], size)
+        return image
     title = TARGET_TITLES[state.level.goal]
-    return render.render_images(target_scene(state), None, ("iso",), size, title)["iso"]
+    images: dict[str, Image.Image] = draw.render_images(
+        target_scene(state), None, ("iso",), size, title
+    )
+    return images["iso"]
 
 
 #: The first title line of a puzzle's ``target`` picture (not the current view's title).

@@ -27,6 +27,8 @@ RGB = tuple[int, int, int]
 #: A colour as ``"#rrggbb"`` or an ``(r, g, b)`` triple.
 ColorLike = str | tuple[int, int, int]
 FloatArray = npt.NDArray[np.float64]
+#: (x0, y0, x1, y1) in pixels, the end exclusive.
+Box = tuple[int, int, int, int]
 #: Deflate level for PNG (zlib-ng): fast, and fixed so the same picture gives the same bytes.
 PNG_COMPRESS_LEVEL: Final = 2
 EDGE: Final[RGB] = (0, 0, 0)
@@ -152,9 +154,23 @@ def font(px: int) -> ImageFont.FreeTypeFont | ImageFont.ImageFont:
     return ImageFont.load_default(size=max(6, px))
 
 
+@lru_cache(maxsize=4096)
+def text_length(text: str, px: int) -> float:
+    """Advance width of ``text`` in :func:`font` ``(px)`` (labels recur; measuring is costly)."""
+    return float(font(px).getlength(text))
+
+
 def text_color(fill: Iterable[int]) -> RGB:
     r, g, b = fill
     return (0, 0, 0) if 0.299 * r + 0.587 * g + 0.114 * b > 140 else (255, 255, 255)
+
+
+@lru_cache(maxsize=4096)
+def text_mask_array(text: str, px: int, anchor: str) -> npt.NDArray[np.uint8]:
+    """:func:`_text_mask`'s glyphs as a read-only array (for the kernels)."""
+    out = np.array(_text_mask(text, px, anchor)[0], dtype=np.uint8)
+    out.flags.writeable = False
+    return out
 
 
 @lru_cache(maxsize=4096)
@@ -168,6 +184,19 @@ def _text_mask(text: str, px: int, anchor: str) -> tuple[Image.Image, int, int]:
     return mask, left, top
 
 
+def _text_at(
+    xy: Sequence[float] | FloatArray, text: str, px: int, anchor: str
+) -> tuple[Image.Image, Box]:
+    mask, dx, dy = _text_mask(text, px, anchor)
+    x, y = round(float(xy[0])) + dx, round(float(xy[1])) + dy
+    return mask, (x, y, x + mask.size[0], y + mask.size[1])
+
+
+def text_box(xy: Sequence[float] | FloatArray, text: str, px: int, anchor: str = "mm") -> Box:
+    """The pixels :func:`put_text` may change (end exclusive)."""
+    return _text_at(xy, text, px, anchor)[1]
+
+
 def put_text(
     image: Image.Image,
     xy: Sequence[float] | FloatArray,
@@ -176,9 +205,16 @@ def put_text(
     fill: RGB,
     anchor: str = "mm",
 ) -> None:
-    """Draw ``text`` at ``xy`` (``anchor`` as in Pillow: "mm" centre, "la" top left)."""
-    mask, dx, dy = _text_mask(text, px, anchor)
-    image.paste(fill, (round(float(xy[0])) + dx, round(float(xy[1])) + dy), mask)
+    """Draw ``text`` at ``xy`` (``anchor`` as in Pillow: "mm" centre, "la" top left).
+
+    Calls the core paste ``Image.paste(fill, box, mask)`` ends in, without its checks."""
+    mask, box = _text_at(xy, text, px, anchor)
+    if image.readonly:
+        image.paste(fill, box, mask)
+        return
+    image.load()
+    mask.load()
+    image.im.paste(fill, box, mask.im)
 
 
 @dataclass(frozen=True)
@@ -232,18 +268,39 @@ def line(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, wid
     draw.line([(float(a[0]), float(a[1])), (float(b[0]), float(b[1]))], fill=fill, width=width)
 
 
-def arrow(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:
+#: A flat shape: (0 polygon fill or 1 polyline, its points in pixels, colour, line width).
+Flat = tuple[int, FloatArray, RGB, int]
+
+
+def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
+    """Flat shapes with Pillow (``polygon``'s and ``line``'s core calls, without their checks)."""
+    for kind, pts, rgb, width in shapes:
+        ink = draw.draw.draw_ink(rgb)
+        ring = [(x, y) for x, y in pts.tolist()]
+        if kind == 0:
+            draw.draw.draw_polygon(ring, ink, 1)
+        else:
+            draw.draw.draw_lines(ring, ink, width)
+
+
+def arrow_shapes(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> list[Flat]:
     """A line from ``a`` to ``b`` with a filled head at ``b`` (the font has no arrow glyphs)."""
     d = b - a
     n = float(np.hypot(*d))
     if n < 1e-6:
-        return
+        return []
     d = d / n
     head = max(4.0, 3.2 * width)
     base = b - d * head
     perp = np.array([-d[1], d[0]]) * head * 0.55
-    line(draw, a, base, fill, width)
-    polygon(draw, np.array([b, base + perp, base - perp]), fill=fill)
+    return [
+        (1, np.array([a, base]), fill, width),
+        (0, np.array([b, base + perp, base - perp]), fill, 0),
+    ]
+
+
+def arrow(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:
+    draw_flat(draw, arrow_shapes(a, b, fill, width))
 
 
 def draw_faces(draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: int) -> None:
@@ -254,6 +311,29 @@ def draw_faces(draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: 
         ring = [(p[0], p[1]) for p in pts]
         draw.polygon(ring, fill=(fill[0], fill[1], fill[2]))
         draw.line([*ring, ring[0]], fill=EDGE, width=width, joint="curve")
+
+
+def draw_faces_fast(
+    draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: int
+) -> FloatArray:
+    """:func:`draw_faces` calling the core drawing methods ``ImageDraw.polygon`` and ``line``
+    end in, without their per-call checks (same pixels); returns the faces' screen corners."""
+    pix: FloatArray = proj.screen(faces.corners)
+    if width > 4:  # wide lines get round joints, drawn by ImageDraw.line itself
+        draw_faces(draw, faces, proj, width)
+        return pix
+    core = draw.draw
+    edge = core.draw_ink(EDGE)
+    inks: dict[tuple[int, int, int], int] = {}
+    for pts, fill in zip(pix.tolist(), faces.fills.tolist(), strict=True):
+        ring = [(p[0], p[1]) for p in pts]
+        key = (fill[0], fill[1], fill[2])
+        ink = inks.get(key)
+        if ink is None:
+            ink = inks[key] = core.draw_ink(key)
+        core.draw_polygon(ring, ink, 1)
+        core.draw_lines([*ring, ring[0]], edge, width)
+    return pix
 
 
 def fit_centre(

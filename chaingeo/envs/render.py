@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from functools import lru_cache
 from typing import TYPE_CHECKING, Final
 
 import numpy as np
@@ -26,6 +27,16 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from chaingeo.core.geometry import Shape
+from chaingeo.core.jit import mode as jit_mode
+from chaingeo.envs import rasterjit
+from chaingeo.envs.labels import (
+    AXIS_NAMES,
+    TEXT,
+    depth_label_steps,
+    run_steps,
+    tick_steps,
+    title_steps,
+)
 from chaingeo.envs.legend import draw_legend, legend_layout
 from chaingeo.envs.raster import (
     EDGE,
@@ -33,24 +44,24 @@ from chaingeo.envs.raster import (
     Camera,
     ColorLike,
     Faces,
+    Flat,
     FloatArray,
     Posed,
     Projector,
-    arrow,
     draw_faces,
+    draw_faces_fast,
+    draw_flat,
     fit,
     fit_centre,
-    font,
     frame_corners,
     line,
     oblique_camera,
     parse_color,
     png_bytes,
-    polygon,
     posed_faces,
     put_text,
     scaled,
-    text_color,
+    text_length,
     visible_faces,
 )
 
@@ -70,9 +81,8 @@ _FLOOR: Final[RGB] = (232, 232, 228)
 _WALL: Final[RGB] = (244, 244, 241)
 _GRID: Final[RGB] = (185, 185, 180)
 _FRAME: Final[RGB] = (90, 90, 90)
-_TEXT: Final[RGB] = (20, 20, 20)
-_AXIS_COLORS: Final[tuple[RGB, RGB, RGB]] = ((190, 30, 30), (20, 130, 40), (30, 60, 200))
-_AXIS_NAMES: Final = "xyz"
+_TEXT: Final[RGB] = TEXT
+_AXIS_NAMES: Final = AXIS_NAMES
 
 #: Azimuth and elevation of the oblique view (camera at +x, -y, +z, like matplotlib's default
 #: but slightly off the true isometric so that no two cube corners project onto one point).
@@ -216,16 +226,15 @@ def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
     return np.array(pts)
 
 
-def _draw_walls(
-    draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector, width: int
-) -> None:
+def _wall_shapes(scene: _Scene, cam: Camera, proj: Projector, width: int) -> list[Flat]:
     """Back walls and floor with a line per cell boundary, so empty cells can be counted."""
+    out: list[Flat] = []
     for axis in (2, 0, 1):
         for side in ("lo", "hi"):
             if not _plane_is_back(axis, side, cam):
                 continue
             fill = _FLOOR if axis == 2 and side == "lo" else _WALL
-            polygon(draw, proj(_wall_corners(scene, axis, side)), fill=fill)
+            out.append((0, proj(_wall_corners(scene, axis, side)), fill, 0))
             b, c = [i for i in range(3) if i != axis]
             ends: list[list[float]] = []
             for along, across in ((b, c), (c, b)):
@@ -235,9 +244,15 @@ def _draw_walls(
                         p[axis] = scene.lo[axis] if side == "lo" else scene.hi[axis]
                         p[along], p[across] = t, at
                         ends.append(p)
-            pix = proj(np.array(ends)).tolist()
-            for i in range(0, len(pix), 2):
-                draw.line([tuple(pix[i]), tuple(pix[i + 1])], fill=_GRID, width=width)
+            pix = proj(np.array(ends))
+            out.extend((1, pix[i : i + 2], _GRID, width) for i in range(0, len(pix), 2))
+    return out
+
+
+def _draw_walls(
+    draw: ImageDraw.ImageDraw, scene: _Scene, cam: Camera, proj: Projector, width: int
+) -> None:
+    draw_flat(draw, _wall_shapes(scene, cam, proj, width))
 
 
 def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArray, FloatArray]]:
@@ -263,74 +278,11 @@ def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArra
 def _draw_ticks(
     image: Image.Image, scene: _Scene, cam: Camera, proj: Projector, lay: _Layout
 ) -> None:
-    """1-based cell indices along one frame edge per displayed axis, then the axis name and an
-    arrow pointing the way the index grows."""
-    draw = ImageDraw.Draw(image)
-    centre = proj(np.add(scene.lo, scene.hi) / 2.0)
-    for axis, spec in cam.tick_edges:
-        base = np.array(
-            [
-                0.0 if s == "*" else float(scene.lo[i] if s == "lo" else scene.hi[i])
-                for i, s in enumerate(spec)
-            ]
-        )
-        start, end = base.copy(), base.copy()
-        start[axis], end[axis] = scene.lo[axis], scene.hi[axis]
-        a, b = proj(start), proj(end)
-        d = b - a
-        length = float(np.hypot(*d))
-        if length < 1e-6:
-            continue
-        d /= length
-        normal = np.array([-d[1], d[0]])
-        mid = (a + b) / 2
-        if float(np.dot(normal, mid - centre)) < 0:
-            normal = -normal
-        count = scene.hi[axis] - scene.lo[axis]
-        cell_px = length / count
-        px = int(min(lay.tick_px, max(8, cell_px * 0.8)))
-        every = max(1, math.ceil(px * 1.4 / cell_px))
-        offset = normal * (px * 0.95 + 3)
-        for i, c in enumerate(range(scene.lo[axis], scene.hi[axis])):
-            if i % every and c != scene.hi[axis] - 1:
-                continue
-            p = base.copy()
-            p[axis] = c + 0.5
-            put_text(image, proj(p) + offset, str(c + 1), px, _TEXT)
-        # The arrow continues the row of numbers; the axis name sits just outside it.
-        color = _AXIS_COLORS[axis]
-        tail = b + offset + d * (px * 0.5)
-        head = tail + d * (lay.tick_px * 1.2)
-        arrow(draw, tail, head, color, max(2, lay.tick_px // 8))
-        name_at = (tail + head) / 2 + normal * (lay.tick_px * 0.9)
-        put_text(image, name_at, _AXIS_NAMES[axis], lay.tick_px + 3, color)
-
-
-def _draw_depth_labels(image: Image.Image, faces: Faces, cam: Camera, proj: Projector) -> None:
-    """On each visible face of an axis view, the 1-based coordinate along the line of sight."""
-    depth = cam.depth_axis
-    assert depth is not None
-    nearest: dict[tuple[int, int], int] = {}
-    others = [i for i in range(3) if i != depth]
-    for i, cell in enumerate(faces.cells.tolist()):
-        nearest[(cell[others[0]], cell[others[1]])] = i  # far to near: the last one is in front
-    cell_px = proj.scale
-    px = int(min(22, max(9, cell_px * 0.24)))
-    if cell_px < 1.6 * px:
-        return  # too small to print legibly
-    prefix = f"{_AXIS_NAMES[depth]}=" if cell_px >= 3.2 * px else ""  # small cells: number only
-    for i in sorted(nearest.values()):
-        centre = proj.screen(faces.corners[i].mean(axis=0))
-        fill = faces.fills[i]
-        text = f"{prefix}{int(faces.cells[i][depth]) + 1}"
-        put_text(image, centre, text, px, text_color(fill))
+    run_steps(image, tick_steps(scene.lo, scene.hi, cam, proj, lay.tick_px))
 
 
 def _title(image: Image.Image, lines: Sequence[str], lay: _Layout) -> None:
-    y = max(4, lay.size // 100)
-    for text in lines:
-        put_text(image, (max(4, lay.size // 64), y), text, lay.title_px, _TEXT, anchor="la")
-        y += int(lay.title_px * 1.25)
+    run_steps(image, title_steps(lines, lay.size, lay.title_px))
 
 
 def _view_titles(cam: Camera, scene: _Scene) -> list[str]:
@@ -360,9 +312,11 @@ def _render_view(
     faces: Faces | None = None,
     title: str | None = None,
     outline: _Scene | None = None,
+    fast: bool = False,
 ) -> Image.Image:
     """One view; ``faces`` (else the scene's cells) are drawn, ``title`` replaces the camera's
-    first title line, ``outline`` is a box drawn as a wire frame inside the frame."""
+    first title line, ``outline`` is a box drawn as a wire frame inside the frame; ``fast``
+    draws the faces with :func:`draw_faces_fast` (the same pixels)."""
     lay = _Layout.of(size)
     # Axis views have only axis-parallel edges: no aliasing, so no supersampling needed.
     k = _SUPERSAMPLE if cam.depth_axis is None else 1
@@ -377,7 +331,7 @@ def _render_view(
         line(draw, big_proj(p), big_proj(q), _FRAME, 2 * k)
     if faces is None:
         faces = visible_faces(scene.cells, scene.colors, cam)
-    draw_faces(draw, faces, big_proj, lay.edge_px(k))
+    (draw_faces_fast if fast else draw_faces)(draw, faces, big_proj, lay.edge_px(k))
     for p, q in _frame_edges(scene, cam, back=False) if scene.has_box else ():
         line(draw, big_proj(p), big_proj(q), _FRAME, k)
     for p, q in _frame_edges(outline, cam, back=False) if outline else ():
@@ -387,7 +341,7 @@ def _render_view(
     _title(image, titles if title is None else [title, *titles[1:]], lay)
     _draw_ticks(image, scene, cam, proj, lay)
     if cam.depth_axis is not None and len(faces.cells):
-        _draw_depth_labels(image, faces, cam, proj)
+        run_steps(image, depth_label_steps(faces, cam, proj))
     draw_legend(image, scene.legend)
     return image
 
@@ -420,7 +374,35 @@ def _sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: Floa
     return best
 
 
-def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
+@lru_cache(maxsize=512)
+def _sheet_faces(cells: tuple[tuple[int, int, int], ...], rgb: RGB, cam: int) -> Faces:
+    """One piece's faces on the sheet (they depend only on its shape, colour and camera)."""
+    voxels = np.array(cells, dtype=np.int64).reshape(-1, 3)
+    colors = np.tile(np.array(rgb, dtype=np.float64), (len(cells), 1))
+    return visible_faces(voxels, colors, SHEET_CAMERAS[cam])
+
+
+def _sheet_pieces(
+    drawn: Sequence[tuple[Faces, Projector]], size: int, width: int, fast: bool
+) -> Image.Image:
+    """The sheet's pieces drawn at twice the size and reduced: by Pillow, or (``fast``) all at
+    once by :mod:`chaingeo.envs.rasterjit` (the same pixels; Pillow when lines get round
+    joints)."""
+    k = _SUPERSAMPLE
+    if fast and width <= 4 and jit_mode() == "numba":
+        big = rasterjit.blank(size * k, _BACKGROUND).copy()
+        corners = np.concatenate([p.screen(f.corners) for f, p in drawn])
+        fills = np.concatenate([f.fills for f, _ in drawn])
+        rasterjit.draw_faces(big, corners, fills, np.array(EDGE, dtype=np.uint8), width)
+        return Image.fromarray(rasterjit.reduce2(big))
+    image = Image.new("RGB", (size * k, size * k), _BACKGROUND)
+    draw = ImageDraw.Draw(image)
+    for faces, proj in drawn:
+        (draw_faces_fast if fast else draw_faces)(draw, faces, proj, width)
+    return image.reduce(k)
+
+
+def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) -> Image.Image:
     """Every piece in its own cell, drawn twice (see :data:`SHEET_CAMERAS`) at one common
     scale, labelled with a colour swatch, its name and its number of cubes."""
     lay = _Layout.of(size)
@@ -432,7 +414,6 @@ def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
         _title(image, [title], lay)
         put_text(image, (size / 2, size / 2), "(no pieces)", lay.tick_px, _TEXT)
         return image
-    big = Image.new("RGB", (size * k, size * k), _BACKGROUND)
     label_px = max(9, min(lay.tick_px, size // 40))
     label_h = label_px * 1.7
     shapes = {n: pieces[n][0].normalized() for n in names}
@@ -446,7 +427,7 @@ def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
     rows = math.ceil(len(names) / cols)
     cell_w, cell_h = size / cols, (size - title_h) / rows
     scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
-    draw = ImageDraw.Draw(big)
+    drawn: list[tuple[Faces, Projector]] = []
     slots: list[tuple[str, RGB, float, float]] = []
     for i, n in enumerate(names):
         col, row = i % cols, i // cols
@@ -459,16 +440,19 @@ def _render_tray(pieces: PieceMap, size: int, title: str) -> Image.Image:
             proj = Projector(
                 np.array(cam.right), np.array(cam.up), scale, fit_centre(corners, cam, box, scale)
             )
-            faces = visible_faces(shapes[n].voxels, colors, cam)
-            draw_faces(draw, faces, scaled(proj, k), lay.edge_px(k))
+            if fast:
+                faces = _sheet_faces(shapes[n].cells, rgb, j)
+            else:
+                faces = visible_faces(shapes[n].voxels, colors, cam)
+            drawn.append((faces, scaled(proj, k)))
         cubes = len(shapes[n])
         label = f"{n} ({cubes} cube{'s' if cubes != 1 else ''})"
         slots.append((label, rgb, x0 + cell_w / 2, y0 + cell_h - label_h / 2))
-    image = big.reduce(k)
+    image = _sheet_pieces(drawn, size, lay.edge_px(k), fast)
     small = ImageDraw.Draw(image)
     _title(image, [title, _SHEET_NOTE], lay)
     for text, rgb, x, y in slots:
-        width = float(font(label_px).getlength(text))
+        width = text_length(text, label_px)
         left = x - (width + label_px * 1.4) / 2
         small.rectangle(
             [left, y - label_px / 2, left + label_px, y + label_px / 2], fill=rgb, outline=EDGE
@@ -555,12 +539,18 @@ def render_tray_image(
 ) -> Image.Image:
     """The piece sheet: each piece (only its shape matters, not where it is) from two opposite
     corners, labelled; titled the tray (stacking) or :data:`PIECES_TITLE` (puzzles)."""
+    return render_tray_image_with(pieces, size, title, fast=False)
+
+
+def render_tray_image_with(pieces: PieceMap, size: int, title: str, fast: bool) -> Image.Image:
+    """:func:`render_tray_image`; ``fast`` keeps each piece's faces and skips Pillow's per-call
+    checks (the same pixels; :mod:`chaingeo.envs.fastview`)."""
     _check_size(size)
     for shape, color in pieces.values():
         parse_color(color)
         if len(shape) == 0:
             raise ValueError("a piece needs at least one cell")
-    return _render_tray(pieces, size, title)
+    return _render_tray(pieces, size, title, fast)
 
 
 def render_tray(pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE) -> bytes:
