@@ -19,6 +19,8 @@ from chaingeo.core.level_reader import LevelError
 from chaingeo.core.limits import LimitError
 from solvers.search import CoverLimitError
 
+PACKAGES = ("chaingeo", "generator", "solvers")
+
 
 def _defined_exceptions() -> dict[str, type[Exception]]:
     """Every Exception subclass a module of the three packages defines, by qualified name."""
@@ -26,7 +28,13 @@ def _defined_exceptions() -> dict[str, type[Exception]]:
     for package in (chaingeo, generator, solvers):
         names = [m.name for m in pkgutil.walk_packages(package.__path__, package.__name__ + ".")]
         for name in [package.__name__, *names]:
-            for obj in vars(importlib.import_module(name)).values():
+            try:
+                module = importlib.import_module(name)
+            except ModuleNotFoundError as e:  # an optional extra not installed, not our bug
+                if (e.name or "").split(".")[0] in PACKAGES:
+                    raise
+                continue
+            for obj in vars(module).values():
                 if inspect.isclass(obj) and issubclass(obj, Exception) and obj.__module__ == name:
                     out[f"{name}.{obj.__qualname__}"] = obj
     return out
