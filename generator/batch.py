@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.files import atomic_write
 from chaingeo.core.level import Level, level_bytes
 from generator.dedup import Reservation, SignatureStore
@@ -41,7 +42,7 @@ DUPLICATE = "duplicate-signature"
 HELD_OUT = "held-out-signature"
 
 
-class GenerationError(RuntimeError):
+class GenerationError(ChainGeoError, RuntimeError):
     """The run cannot go on (e.g. the output folder holds a different level with the same id)."""
 
 

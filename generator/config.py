@@ -14,6 +14,7 @@ import re
 from dataclasses import dataclass
 from typing import Any, Final, Literal
 
+from chaingeo.core.registry import Registry
 from chaingeo.core.rules import SUPPORT_RULES, SupportRule
 
 Mode = Literal["easy", "mid", "hard"]
@@ -168,26 +169,20 @@ def stacking_config(box: tuple[int, int, int], mode: str, **overrides: Any) -> S
     return StackingConfig(**fields)
 
 
-_REGISTRY: dict[str, StackingConfig] = {}
+#: The named stacking configs (``2x2x2-easy``, ...); a taken name is refused.
+CONFIGS: Registry[StackingConfig] = Registry("stacking config", missing="no {kind} named {name!r}")
 
 
 def register_config(name: str, config: StackingConfig) -> None:
-    if name in _REGISTRY:
-        raise ValueError(f"a stacking config named {name!r} is already registered")
-    _REGISTRY[name] = config
+    CONFIGS.register(name, config)
 
 
 def get_config(name: str) -> StackingConfig:
-    try:
-        return _REGISTRY[name]
-    except KeyError:
-        raise ValueError(
-            f"no stacking config named {name!r}; known: {', '.join(sorted(_REGISTRY))}"
-        ) from None
+    return CONFIGS.get(name)
 
 
 def config_names() -> list[str]:
-    return sorted(_REGISTRY)
+    return sorted(CONFIGS)
 
 
 for _box in BOX_LIMITS:

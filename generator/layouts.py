@@ -16,6 +16,7 @@ from functools import cache, partial
 
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.piecesets.burrs import SLOTS, slot_cells
+from chaingeo.core.registry import Registry
 
 
 @dataclass(frozen=True)
@@ -136,24 +137,22 @@ def plate3() -> Layout:
     )
 
 
-LAYOUTS: dict[str, Callable[[], Layout]] = {
-    "burr3": burr3,
-    "plate3": plate3,
-    "burr6": burr6,
-    "burr12": partial(burr_tower, 2),
-    "burr18": partial(burr_tower, 3),
-    "burr24": partial(burr_tower, 4),
-    "burr36": partial(burr_tower, 6),
-}
+#: Layout builders by puzzle shape name; cubeN, mazeN and burr6x8[u] have families of their
+#: own (:data:`generator.puzzle.SHAPES`).
+LAYOUTS: Registry[Callable[[], Layout]] = Registry(
+    "puzzle shape", missing="unknown {kind} {name!r} (cubeN, mazeN, burr6x8, burr6x8u or a layout)"
+)
+LAYOUTS.register("burr3", burr3)
+LAYOUTS.register("plate3", plate3)
+LAYOUTS.register("burr6", burr6)
+LAYOUTS.register("burr12", partial(burr_tower, 2))
+LAYOUTS.register("burr18", partial(burr_tower, 3))
+LAYOUTS.register("burr24", partial(burr_tower, 4))
+LAYOUTS.register("burr36", partial(burr_tower, 6))
 
 
 def get_layout(name: str) -> Layout:
-    try:
-        return LAYOUTS[name]()
-    except KeyError:
-        raise ValueError(
-            f"unknown puzzle shape {name!r}; known: {sorted(LAYOUTS)} and cubeN (e.g. cube3)"
-        ) from None
+    return LAYOUTS.get(name)()
 
 
 def cube_cells(n: int) -> list[Cell]:

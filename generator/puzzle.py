@@ -11,7 +11,8 @@ level file is built and verified. Everything random comes from ``SeedSequence([s
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -28,6 +29,7 @@ from chaingeo.core.level import (
     default_step_budget,
     revalidate,
 )
+from chaingeo.core.registry import Registry
 from chaingeo.core.rules import PuzzleRules
 from generator.candidate import Candidate, evaluate
 from generator.config import STANDARD_SHAPES, PuzzleConfig
@@ -174,36 +176,98 @@ def puzzle_level(
     return revalidate(level)
 
 
+@dataclass(frozen=True)
+class Built:
+    """What a shape family's search found: the best candidate (None: nothing came apart), the
+    blocks of a tower, and the family's own statistics for the level file."""
+
+    best: Candidate | None
+    blocks: list[list[int]] | None = None
+    stats: dict[str, object] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class ShapeFamily:
+    """The ``shape`` names a family builds (the first registered family that matches is used),
+    how it searches, and how a search that found nothing is reported."""
+
+    matches: Callable[[PuzzleConfig], bool]
+    build: Callable[[PuzzleConfig, np.random.Generator], Built]
+    failure: Callable[[PuzzleConfig], str]
+
+
+def _standard(config: PuzzleConfig, rng: np.random.Generator) -> Built:
+    outcome = standard_burr_search(config, rng)
+    return Built(None) if outcome is None else Built(outcome.candidate, None, outcome.stats())
+
+
+def _cube(config: PuzzleConfig, rng: np.random.Generator) -> Built:
+    try:
+        n = int(config.shape[4:])
+    except ValueError:
+        raise ValueError(f"cube shapes are cube3..cube5, got {config.shape!r}") from None
+    return Built(cube_search(config, n, rng))
+
+
+def _tower(config: PuzzleConfig, rng: np.random.Generator) -> Built:
+    units = TOWERS[config.shape]
+    blocks = [list(range(6 * u, 6 * u + 6)) for u in range(units)]
+    return Built(tower_candidate(config, units, rng, _layout_search), blocks)
+
+
+def _apart(config: PuzzleConfig) -> str:
+    return "no design that comes apart"
+
+
+def _standard_failure(config: PuzzleConfig) -> str:
+    if config.unique or config.shape.endswith("u"):
+        return "no design that comes apart and assembles uniquely"
+    return _apart(config)
+
+
+#: Puzzle shape families by name, tried in this order; ``layout`` takes every other name.
+SHAPES: Registry[ShapeFamily] = Registry("puzzle shape family")
+SHAPES.register(
+    "standard", ShapeFamily(lambda c: c.shape in STANDARD_SHAPES, _standard, _standard_failure)
+)
+SHAPES.register(
+    "cube",
+    ShapeFamily(
+        lambda c: c.shape.startswith("cube"),
+        _cube,
+        lambda c: f"no cube design comes apart at level {interlocking_target(c.min_level)} or more",
+    ),
+)
+SHAPES.register(
+    "maze",
+    ShapeFamily(
+        lambda c: c.shape.startswith("maze"),
+        lambda c, rng: Built(maze_candidate(c, parse_maze_shape(c.shape), rng)),
+        _apart,
+    ),
+)
+SHAPES.register(
+    "tower", ShapeFamily(lambda c: c.max_group == 1 and c.shape in TOWERS, _tower, _apart)
+)
+SHAPES.register(
+    "layout", ShapeFamily(lambda c: True, lambda c, rng: Built(_layout_search(c, rng)), _apart)
+)
+
+
+def shape_family(config: PuzzleConfig) -> ShapeFamily:
+    """The first registered family that builds ``config.shape``."""
+    return next(family for _, family in SHAPES.items() if family.matches(config))
+
+
 def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
-    blocks: list[list[int]] | None = None
-    extra: dict[str, object] = {"shape": config.shape}
-    if config.shape in STANDARD_SHAPES:
-        outcome = standard_burr_search(config, rng)
-        best = None if outcome is None else outcome.candidate
-        extra.update({} if outcome is None else outcome.stats())
-    elif config.shape.startswith("cube"):
-        try:
-            n = int(config.shape[4:])
-        except ValueError:
-            raise ValueError(f"cube shapes are cube3..cube5, got {config.shape!r}") from None
-        best = cube_search(config, n, rng)
-    elif config.shape.startswith("maze"):
-        best = maze_candidate(config, parse_maze_shape(config.shape), rng)
-    elif config.max_group == 1 and config.shape in TOWERS:
-        units = TOWERS[config.shape]
-        best = tower_candidate(config, units, rng, _layout_search)
-        blocks = [list(range(6 * u, 6 * u + 6)) for u in range(units)]
-    else:
-        best = _layout_search(config, rng)
+    family = shape_family(config)
+    built = family.build(config, rng)
+    best, blocks = built.best, built.blocks
+    extra: dict[str, object] = {"shape": config.shape, **built.stats}
     if best is None:
-        if config.shape.startswith("cube"):
-            target = interlocking_target(config.min_level)
-            return Rejection(f"no cube design comes apart at level {target} or more", seed, index)
-        if config.shape in STANDARD_SHAPES and (config.unique or config.shape.endswith("u")):
-            return Rejection("no design that comes apart and assembles uniquely", seed, index)
-        return Rejection("no design that comes apart", seed, index)
+        return Rejection(family.failure(config), seed, index)
     if best.score[0] < config.min_level:
         return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)
     limits = SearchLimits(

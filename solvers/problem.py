@@ -20,6 +20,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import Shape, box_cells
 from solvers.placements import (
     Int32Array,
@@ -32,7 +33,7 @@ from solvers.placements import (
 )
 
 
-class CoverError(ValueError):
+class CoverError(ChainGeoError, ValueError):
     """Bad input to the exact-cover engine (the message says which argument and why)."""
 
 

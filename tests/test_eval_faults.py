@@ -60,9 +60,8 @@ class _Raising(Agent):
 
 @pytest.fixture
 def raising_agent() -> Iterator[None]:
-    AGENTS["raising"] = lambda spec: _Raising(dict(spec.options))
-    yield
-    del AGENTS["raising"]
+    with AGENTS.registered("raising", lambda spec: _Raising(dict(spec.options))):
+        yield
 
 
 @pytest.mark.parametrize("kind", ["overflow", "recursion"])

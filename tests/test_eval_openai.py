@@ -237,15 +237,12 @@ class _TwoWays(Agent):
         return Reply(text, text)
 
 
-def test_a_model_judge_picks_among_verified_candidates(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.setitem(AGENTS, "two-ways", lambda spec: _TwoWays())
+def test_a_model_judge_picks_among_verified_candidates(tmp_path: Path) -> None:
     level = stacking_level(
         "t3", "easy", (3, 1, 1), [Shape([(0, 0, 0)]), Shape([(1, 0, 0)]), Shape([(2, 0, 0)])]
     )
     script = Script([reply("the last one <choice>2</choice>", 500, 10), reply("no idea", 400, 5)])
-    with fake_openai(script) as url:
+    with AGENTS.registered("two-ways", lambda spec: _TwoWays()), fake_openai(script) as url:
         proto = ProtocolConfig(
             candidates=3,
             judge="model",

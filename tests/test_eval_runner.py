@@ -10,6 +10,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -175,10 +176,13 @@ class _Picky(Agent):
         return Reply(text, text)
 
 
-def test_verifier_selection_commits_a_checked_candidate(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    monkeypatch.setitem(AGENTS, "picky", lambda spec: _Picky())
+@pytest.fixture
+def picky() -> Iterator[None]:
+    with AGENTS.registered("picky", lambda spec: _Picky()):
+        yield
+
+
+def test_verifier_selection_commits_a_checked_candidate(tmp_path: Path, picky: None) -> None:
     (level,) = _levels(1, pieces=3)
     for judge in ("first", "vote", "progress"):
         proto = ProtocolConfig(candidates=3, judge=judge, env=FAKE.env)

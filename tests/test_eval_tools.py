@@ -280,13 +280,12 @@ class _Several(Agent):
         return Reply(f"turn {turn.index}", actions[0], Usage(calls=1), actions=actions)
 
 
-def test_several_actions_a_turn_stop_at_the_first_rejected(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_several_actions_a_turn_stop_at_the_first_rejected(tmp_path: Path) -> None:
     agent = _Several()
-    monkeypatch.setitem(AGENTS, "several", lambda spec: agent)
     proto = ProtocolConfig(candidates=2, env="tests.eval_support.fake_env")
-    evaluate([_stacking()], AgentSpec("several"), tmp_path / "r", proto, RunConfig(progress=False))
+    with AGENTS.registered("several", lambda spec: agent):
+        run = AgentSpec("several")
+        evaluate([_stacking()], run, tmp_path / "r", proto, RunConfig(progress=False))
     rec = json.loads((tmp_path / "r" / "episodes.jsonl").read_text())
     assert rec["success"] and rec["steps_used"] == 3 and not rec["finished"]
     assert [(s["turn"], s["sent"], s["legal"]) for s in rec["steps"]] == [

@@ -21,6 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Final
 
+from chaingeo.core.errors import ChainGeoError
+
 #: The folder beside the checkout that holds BurrTools' sources (``CHAIN_BURRTOOLS_SRC``).
 SOURCES_ENV: Final = "CHAIN_BURRTOOLS_SRC"
 BINARY_ENV: Final = "CHAIN_BURRTXT"
@@ -29,7 +31,7 @@ _FINAL = re.compile(r"(\d+) assemblies and (\d+) solutions found with (\d+) iter
 _LEVEL = re.compile(r"^level: ([0-9.]+)\s*$", re.MULTILINE)
 
 
-class BurrTxtError(RuntimeError):
+class BurrTxtError(ChainGeoError, RuntimeError):
     """burrTxt could not be built, or did not finish with its final line."""
 
 

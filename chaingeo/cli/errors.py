@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from chaingeo.core.errors import ChainGeoError
 
-class CommandError(Exception):
+
+class CommandError(ChainGeoError):
     """A user-facing failure: printed as one line, exit status 2."""

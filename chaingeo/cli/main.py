@@ -18,8 +18,7 @@ from typing import Any
 
 import chaingeo.cli.commands
 from chaingeo import __version__
-from chaingeo.cli.errors import CommandError
-from chaingeo.core.level_reader import LevelError
+from chaingeo.core.errors import ChainGeoError
 
 # At exit, the interpreter's last collections walk every object numba and numpy created (about
 # 0.15 s of a 1 s ``chain analyze``); the process ends anyway, so freeze them instead.
@@ -78,7 +77,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     try:
         return int(args.func(args) or 0)
-    except (CommandError, LevelError, FileNotFoundError, ValueError) as e:
+    except (ChainGeoError, FileNotFoundError, ValueError) as e:
         print(f"chain {args.command}: error: {e}", file=sys.stderr)
         return 2
 

@@ -8,8 +8,10 @@ import stat
 import uuid
 from pathlib import Path
 
+from chaingeo.core.errors import ChainGeoError
 
-class UnreadableFile(Exception):
+
+class UnreadableFile(ChainGeoError):
     """An input file that cannot be read as given; ``reason`` says why (the caller names the
     file in its own error type)."""
 

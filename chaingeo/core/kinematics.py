@@ -24,6 +24,7 @@ from typing import Any, Final
 
 import numpy as np
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import ROTATIONS, Cell, Shape, rotation_index
 from chaingeo.core.turns import (
     AXES,
@@ -53,7 +54,7 @@ OPPOSITE: Final[dict[str, str]] = {
 }
 
 
-class MoveError(ValueError):
+class MoveError(ChainGeoError, ValueError):
     """A move that the kinematics forbids; ``reason`` says why in words a user can act on."""
 
     def __init__(self, move: Move | TurnMove, reason: str) -> None:
@@ -315,7 +316,7 @@ class Assembly:
         return Assembly(self.shapes, offsets, self.parts, rotations, self.rods)
 
 
-class SearchLimitError(RuntimeError):
+class SearchLimitError(ChainGeoError, RuntimeError):
     """A search or enumeration stopped at its cap; the message says which cap and how to lift it.
 
     ``reason`` says what was reached; ``cap`` names the cap when it is a field of the caller's

@@ -8,10 +8,11 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import Shape
 
 
-class LevelError(ValueError):
+class LevelError(ChainGeoError, ValueError):
     """A level that cannot be loaded or is not valid: which file, which field, and why."""
 
     def __init__(self, source: str, field: str, reason: str) -> None:

@@ -17,6 +17,8 @@ from typing import Any, Final
 
 import numpy as np
 
+from chaingeo.core.errors import ChainGeoError
+
 #: Largest coordinate magnitude in a level file (voxels, box sizes): a lattice level never
 #: needs more, and every later span (kinematics, insertions) is bounded by a few times this.
 MAX_COORD: Final = 1024
@@ -109,7 +111,7 @@ def json_depth(text: str) -> int:
     return int(np.cumsum(step).max(initial=0))
 
 
-class LimitError(ValueError):
+class LimitError(ChainGeoError, ValueError):
     """Input past one of these limits; ``reason`` says which, ``field`` where when known (the
     path of a JSON value, e.g. ``stats.score``)."""
 

@@ -18,6 +18,7 @@ from collections.abc import Hashable, Iterable, Sequence
 from typing import Final, Protocol
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.kinematics import Move
 from chaingeo.core.level import Level
 from chaingeo.core.rules import Rejection, StackingRules
@@ -75,13 +76,13 @@ _OPEN: Final = "([{"
 _CLOSE: Final = ")]}"
 
 
-class _Unparseable(Exception):
+class _Unparseable(ChainGeoError):
     def __init__(self, hint: str) -> None:
         super().__init__(hint)
         self.hint = hint
 
 
-class _Meaningless(Exception):
+class _Meaningless(ChainGeoError):
     """Well-formed text that no rule could accept (a cell listed twice, distance 0)."""
 
     def __init__(self, reason: str) -> None:

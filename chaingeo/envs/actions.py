@@ -38,6 +38,7 @@ from functools import total_ordering
 from itertools import pairwise
 from typing import Any, ClassVar, Final
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.kinematics import Move
 from chaingeo.core.rules import ChainCode
 from chaingeo.core.turns import ANGLES, TurnMove, half_text, turn_from_json
@@ -325,7 +326,7 @@ class TurnRequest:
 # ---------------------------------------------------------------------------------------------
 
 
-class ActionFormatError(ValueError):
+class ActionFormatError(ChainGeoError, ValueError):
     """A JSON object that is not an action; the message says which field and why."""
 
 
@@ -445,7 +446,7 @@ def shown_text(text: str) -> str:
     return s if len(s) <= SHOWN_CHARS else s[:SHOWN_CHARS] + f"... ({len(s)} characters)"
 
 
-class ActionError(Exception):
+class ActionError(ChainGeoError):
     """Agent input that was not carried out. Nothing changed; ``feedback`` is for the agent.
     ``code`` is CHAIN's error name for the refusal (stacking levels), else None."""
 

@@ -31,6 +31,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any, Final, Protocol
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level
 from chaingeo.core.rules import Rejection, StackingRules
 from chaingeo.envs.actions import (
@@ -91,7 +92,7 @@ class PlacementCellsError(IllegalActionError):
         self.cells = tuple(cells)
 
 
-class _Bad(Exception):
+class _Bad(ChainGeoError):
     """Not a CHAIN tool call; ``hint`` says what is wrong."""
 
     def __init__(self, hint: str) -> None:
@@ -99,7 +100,7 @@ class _Bad(Exception):
         self.hint = hint
 
 
-class _TooBig(Exception):
+class _TooBig(ChainGeoError):
     pass
 
 
@@ -141,7 +142,7 @@ def _constant(name: str) -> Any:
     raise _Bad(f"{name} is not a number")
 
 
-class AgentJsonError(ValueError):
+class AgentJsonError(ChainGeoError, ValueError):
     """Agent JSON that is malformed or past a limit of :mod:`chaingeo.core.limits` (length,
     nesting, digits); ``too_big``: an integer longer than an agent number may be."""
 

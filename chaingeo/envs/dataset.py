@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any, Final
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level, level_bytes
 from chaingeo.core.limits import LimitError
 from chaingeo.envs.demos import demonstration, plan_texts
@@ -79,7 +80,7 @@ FEATURES: Final[dict[str, dict[str, Any]]] = {
 }
 
 
-class DatasetError(ValueError):
+class DatasetError(ChainGeoError, ValueError):
     """The export cannot be made (bad levels, options past a limit, pyarrow missing)."""
 
 

@@ -16,11 +16,12 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
 from chaingeo.envs.actions import PlaceAction, action_of_move
 
 
-class DemonstrationError(RuntimeError):
+class DemonstrationError(ChainGeoError, RuntimeError):
     """A stored plan that does not solve its level when replayed (a broken level file)."""
 
 

@@ -14,6 +14,7 @@ import re
 from typing import Final
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.envs.actions import TurnRequest, centre_from_agent
 
 VERBS: Final = frozenset({"rotate", "turn"})
@@ -30,7 +31,7 @@ _AXES: Final = ("x", "y", "z")
 _FILLER: Final = frozenset({"by", "degrees", "degree", "deg", "around", "axis", "the", "of"})
 
 
-class TurnTextError(ValueError):
+class TurnTextError(ChainGeoError, ValueError):
     """Text that is no turn (``meaningless`` False: a hint; True: well-formed but impossible,
     such as a centre at a quarter)."""
 

@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import (
     DIRECTIONS,
@@ -55,7 +56,7 @@ FPS: Final = 10  # 100 ms a frame: GIF counts time in hundredths of a second
 VIDEO_SIZE: Final = 384  # a multiple of 16, as H.264 wants
 
 
-class VideoError(ValueError):
+class VideoError(ChainGeoError, ValueError):
     """A plan that cannot be shown (illegal for the level, or the wrong family), or a format
     that cannot be written here; the message says which and why."""
 

@@ -7,24 +7,22 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
+from chaingeo.core.registry import Registry
 from chaingeo.evaluation.model_judge import ModelJudge
 from chaingeo.evaluation.selection import FirstLegal, Judge, Progress, Vote
 
-JUDGES: dict[str, Callable[[Mapping[str, Any]], Judge]] = {
-    "first": lambda options: FirstLegal(),
-    "vote": lambda options: Vote(),
-    "progress": lambda options: Progress(),
-    "model": ModelJudge,
-}
+#: Judge factories by name (taking the judge options); a taken name is refused.
+JUDGES: Registry[Callable[[Mapping[str, Any]], Judge]] = Registry("judge")
+JUDGES.register("first", lambda options: FirstLegal())
+JUDGES.register("vote", lambda options: Vote())
+JUDGES.register("progress", lambda options: Progress())
+JUDGES.register("model", ModelJudge)
 
 
 def register_judge(name: str, factory: Callable[[Mapping[str, Any]], Judge]) -> None:
-    JUDGES[name] = factory
+    """Add a judge; a name already taken raises :class:`DuplicateNameError`."""
+    JUDGES.register(name, factory)
 
 
 def make_judge(name: str, options: Mapping[str, Any] | None = None) -> Judge:
-    try:
-        factory = JUDGES[name]
-    except KeyError:
-        raise ValueError(f"unknown judge {name!r}; known: {sorted(JUDGES)}") from None
-    return factory(options or {})
+    return JUDGES.get(name)(options or {})

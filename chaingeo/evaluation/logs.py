@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any, Final
 
 from chaingeo.core import canonical_json
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.files import atomic_write
 from chaingeo.evaluation.sanitize import clean, dumps_line
 
@@ -51,7 +52,7 @@ PACKAGES: Final = (
 )
 
 
-class RunError(ValueError):
+class RunError(ChainGeoError, ValueError):
     """A run directory that cannot be used as asked (exists, differs, unreadable)."""
 
 

@@ -21,13 +21,14 @@ from pathlib import Path
 from typing import Any, Final
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 
 #: The largest count a cost multiplies (int64, what any real counter holds): with prices at
 #: most :data:`~chaingeo.core.limits.MAX_PRICE_USD` every cost is a finite float.
 _MAX_PRICED: Final = 2**63 - 1
 
 
-class UsageError(ValueError):
+class UsageError(ChainGeoError, ValueError):
     """A usage block that is not whole, non-negative, bounded token counts; names the field."""
 
 
@@ -154,7 +155,7 @@ class Price:
         ) / 1_000_000
 
 
-class PriceError(ValueError):
+class PriceError(ChainGeoError, ValueError):
     """A price file that cannot be read: which file and why."""
 
 

@@ -164,9 +164,8 @@ def _cut_short(spec: str, out: dict[str, Any]) -> int:
 
 def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
     """The figures of one file (``CommandError`` for any failure, with the reason)."""
-    from chaingeo.core.formats.bt_model import BurrToolsError
+    from chaingeo.core.errors import ChainGeoError
     from chaingeo.core.kinematics import SearchLimitError
-    from chaingeo.core.level import LevelError
     from solvers.analysis import level_figures, xmpuzzle_figures
     from solvers.deadline import Deadline
     from solvers.partsearch import SearchLimits
@@ -200,7 +199,7 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
                 )
     except SearchLimitError as e:
         raise CommandError(limit_message(e)) from None
-    except (LevelError, BurrToolsError, FileNotFoundError) as e:
+    except (ChainGeoError, FileNotFoundError) as e:
         raise CommandError(str(e)) from None
     except (IndexError, RuntimeError, ValueError) as e:
         raise CommandError(str(e)) from None

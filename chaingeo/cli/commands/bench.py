@@ -6,16 +6,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import importlib.util
-import pkgutil
 from typing import Any
 
 import chaingeo.benchmarks
 from chaingeo.cli.errors import CommandError
 
 #: Benchmark names: the modules of :mod:`chaingeo.benchmarks`, discovered.
-BENCHMARKS: tuple[str, ...] = tuple(
-    sorted(m.name for m in pkgutil.iter_modules(chaingeo.benchmarks.__path__))
-)
+BENCHMARKS: tuple[str, ...] = chaingeo.benchmarks.BENCHMARKS.names()
 
 
 def register(sub: Any) -> None:
@@ -27,7 +24,7 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    module = importlib.import_module(f"chaingeo.benchmarks.{args.name}")
+    module = importlib.import_module(chaingeo.benchmarks.BENCHMARKS.get(args.name))
     missing = [m for m in getattr(module, "REQUIRES", ()) if importlib.util.find_spec(m) is None]
     if missing:  # before any work: one line saying what to install, not a traceback
         extra = getattr(module, "EXTRA", "bench")

@@ -19,6 +19,8 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from chaingeo.core.errors import ChainGeoError
+
 if TYPE_CHECKING:  # the level reader is imported when a command runs, not to list commands
     from chaingeo.core.level import Level
 
@@ -32,7 +34,7 @@ def register(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
-class NotRechecked(Exception):
+class NotRechecked(ChainGeoError):
     """The optimal search cannot settle this level's optimum; ``reason`` says why."""
 
     def __init__(self, reason: str) -> None:
@@ -40,7 +42,7 @@ class NotRechecked(Exception):
         self.reason = reason
 
 
-class BadBlocks(ValueError):
+class BadBlocks(ChainGeoError, ValueError):
     """``stats.blocks`` (the towers a proven bound uses) is malformed: the file is wrong."""
 
 

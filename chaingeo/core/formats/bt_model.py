@@ -26,6 +26,7 @@ from typing import Final
 
 import numpy as np
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import QUARTER_TURNS, Shape
 
 Cell = tuple[int, int, int]
@@ -61,7 +62,7 @@ TRANSFORMS_BT: Final[tuple[np.ndarray, ...]] = ROTATIONS_BT + tuple(
 )
 
 
-class BurrToolsError(ValueError):
+class BurrToolsError(ChainGeoError, ValueError):
     """A file that is not a readable cube-grid BurrTools puzzle: where, and why."""
 
     def __init__(self, source: str, where: str, reason: str) -> None:

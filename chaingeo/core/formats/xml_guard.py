@@ -13,8 +13,10 @@ from __future__ import annotations
 from typing import Any
 from xml.parsers import expat
 
+from chaingeo.core.errors import ChainGeoError
 
-class _Stop(Exception):
+
+class _Stop(ChainGeoError):
     """Raised from an expat handler to end the scan; ``reason`` None means the XML is clean."""
 
     def __init__(self, reason: str | None) -> None:

@@ -21,6 +21,7 @@ from collections.abc import Hashable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level
 from chaingeo.evaluation.usage import Usage
 
@@ -124,7 +125,7 @@ class Reply:
     calls: tuple[ToolCall, ...] = ()  # native tool calls, one per action, in order
 
 
-class AgentError(RuntimeError):
+class AgentError(ChainGeoError, RuntimeError):
     """The agent could not produce a reply at all (server down after every retry, program
     died): the episode is recorded with status ``error`` and can be retried with ``--resume``."""
 

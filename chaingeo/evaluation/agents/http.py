@@ -34,6 +34,7 @@ from typing import Any, Final
 import numpy as np
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.evaluation.agents.base import AgentError, AuthenticationError
 from chaingeo.evaluation.agents.protocol import ProtocolError, check_answer, parse_answer
 from chaingeo.evaluation.sanitize import clean_text
@@ -106,7 +107,7 @@ class ServerSettings:
         )
 
 
-class TransientError(Exception):
+class TransientError(ChainGeoError):
     """A failure worth retrying; ``retry_after`` is the server's hint in seconds."""
 
     def __init__(self, reason: str, retry_after: float | None = None) -> None:

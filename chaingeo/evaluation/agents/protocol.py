@@ -17,6 +17,7 @@ import json
 from typing import Any, Final
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.evaluation.agents.base import AgentError
 from chaingeo.evaluation.usage import Usage, UsageError
 
@@ -29,7 +30,7 @@ class ProtocolError(AgentError):
     """The server's answer broke the chat-completions protocol (shape, types, bounds)."""
 
 
-class _TooLong(ValueError):
+class _TooLong(ChainGeoError, ValueError):
     pass
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from chaingeo.core.registry import Registry
 from chaingeo.evaluation.agents.base import Agent, AgentSpec
 from chaingeo.evaluation.agents.baselines import GreedyAgent, OracleAgent, RandomAgent
 from chaingeo.evaluation.agents.command import CommandAgent
@@ -41,26 +42,23 @@ def _openai(spec: AgentSpec) -> Agent:
     return OpenAIAgent(spec.options, spec.secrets)
 
 
-AGENTS: dict[str, Callable[[AgentSpec], Agent]] = {
-    "command": _command,
-    "greedy": _greedy,
-    "openai": _openai,
-    "oracle": _oracle,
-    "random": _random,
-    "replay": _replay,
-}
+#: Agent factories by name; a second one under a taken name is refused.
+AGENTS: Registry[Callable[[AgentSpec], Agent]] = Registry("agent")
+AGENTS.register("command", _command)
+AGENTS.register("greedy", _greedy)
+AGENTS.register("openai", _openai)
+AGENTS.register("oracle", _oracle)
+AGENTS.register("random", _random)
+AGENTS.register("replay", _replay)
 
 #: The agents ``chain eval`` runs when given none: no network, no files needed.
 BASELINES: tuple[str, ...] = ("oracle", "greedy", "random")
 
 
 def register_agent(name: str, factory: Callable[[AgentSpec], Agent]) -> None:
-    AGENTS[name] = factory
+    """Add an agent; a name already taken raises :class:`DuplicateNameError`."""
+    AGENTS.register(name, factory)
 
 
 def make_agent(spec: AgentSpec) -> Agent:
-    try:
-        factory = AGENTS[spec.name]
-    except KeyError:
-        raise ValueError(f"unknown agent {spec.name!r}; known: {sorted(AGENTS)}") from None
-    return factory(spec)
+    return AGENTS.get(spec.name)(spec)

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any, Final
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level
 from chaingeo.envs.chain_dialect import AgentJsonError, loads_agent_json
 
@@ -173,7 +174,7 @@ def tool_specs(level: Level, *, state: bool = True) -> list[dict[str, Any]]:
 # ---------------------------------------------------------------------------------------------
 
 
-class _Malformed(Exception):
+class _Malformed(ChainGeoError):
     pass
 
 
