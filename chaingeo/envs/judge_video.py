@@ -20,6 +20,7 @@ import numpy as np
 from PIL import Image
 
 from chaingeo.core import limits
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.envs.judge_segment import (
     U8,
     BoolArray,
@@ -37,7 +38,7 @@ EVIDENCE_ZOOM: Final = 2
 _TINTS: Final = ((255, 0, 255), (0, 255, 255), (255, 255, 0), (0, 255, 0))
 
 
-class VideoJudgeError(ValueError):
+class VideoJudgeError(ChainGeoError, ValueError):
     """A video that cannot be judged: missing, too large, or not a readable video."""
 
 

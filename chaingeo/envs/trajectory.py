@@ -31,6 +31,7 @@ from typing import Any, Final
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.files import atomic_write
 from chaingeo.core.geometry import ROTATIONS, Cell, Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, disassembly_of_assembly_plan
@@ -53,7 +54,7 @@ FORMAT: Final = "chain-trajectory/1"
 FloatArray = npt.NDArray[np.float64]
 
 
-class TrajectoryError(ValueError):
+class TrajectoryError(ChainGeoError, ValueError):
     """A trajectory file that cannot be read as ``chain-trajectory/1``; the message says where."""
 
 
