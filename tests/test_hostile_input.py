@@ -28,7 +28,7 @@ from chaingeo.core.suite import shipped_levels
 from chaingeo.envs.actions import MoveAction
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.puzzle import PuzzleState
-from chaingeo.envs.state import BaseState
+from chaingeo.envs.state import BaseState, StepResult
 
 SECONDS = 1.0  # per agent turn
 LOAD_SECONDS = 3.0  # per malformed level file
@@ -56,9 +56,20 @@ _TOKENS = (
 )
 
 
-def _turn(state: BaseState, text: str) -> None:
-    _, seconds = check_turn(state.clone(), text)
+def _timed_turn(state: BaseState, text: str) -> StepResult:
+    """One turn on a clone of ``state`` within :data:`SECONDS`; a slow first try is timed
+    again on a fresh clone, so a kernel compiled on first use (a fresh checkout has no numba
+    cache) or a busy machine does not fail the test, while a slow path (slow every time) still
+    does."""
+    result, seconds = check_turn(state.clone(), text)
+    if seconds >= SECONDS:
+        result, seconds = check_turn(state.clone(), text)
     assert seconds < SECONDS, f"{seconds:.2f} s for {text[:80]!r}"
+    return result
+
+
+def _turn(state: BaseState, text: str) -> None:
+    _timed_turn(state, text)
 
 
 _fuzz = settings(max_examples=400, suppress_health_check=[HealthCheck.too_slow])
@@ -110,9 +121,8 @@ ISSUE_TEXTS = (
 @pytest.mark.parametrize("kind", KINDS)
 @pytest.mark.parametrize("text", ISSUE_TEXTS, ids=range(len(ISSUE_TEXTS)))
 def test_reported_texts_are_typed_and_fast(kind: str, text: str) -> None:
-    state = _states()[kind].clone()
-    result, seconds = check_turn(state, text)
-    assert not result.legal and seconds < SECONDS
+    result = _timed_turn(_states()[kind], text)
+    assert not result.legal
     assert len(result.feedback) < 2_000  # long text is not echoed back whole
 
 
@@ -121,8 +131,7 @@ def test_far_offset_is_illegal_not_slow() -> None:
     assert isinstance(state, PuzzleState)
     a, b = sorted(state.assembly.parts, key=sorted)[:2]
     text = f"move {'+'.join(sorted(a))} +x inf into {'+'.join(sorted(b))} offset (99999,0,0)"
-    result, seconds = check_turn(state.clone(), text)
-    assert result.error == "illegal" and seconds < SECONDS
+    assert _timed_turn(state, text).error == "illegal"
 
 
 # ---------------------------------------------------------------------------------------------
