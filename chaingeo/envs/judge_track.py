@@ -305,6 +305,9 @@ class Tracker:
         name = self.names[p.cls]
         if p.touches_border() or self._heading_out(p, b - 1):
             return Event("left", b, name, None, "went out through the border")
+        if self._shrinking(p, b - 1) and self._against_others(p, b - 1):
+            detail = f"the {name} piece shrank out of sight beside another piece"
+            return Event("hidden", b, name, None, detail, (p.mask,))
         if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
             return Event(
                 "lost", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
@@ -324,6 +327,18 @@ class Tracker:
             return Event("merge", b, name, other, detail, (p.mask, cover.mask))
         detail = f"the {name} piece went out of sight behind the {other} piece"
         return Event("hidden", b, name, other, detail, (p.mask, cover.mask))
+
+    def _shrinking(self, p: Obj, t: int) -> bool:
+        """Whether ``p`` (seen at frame ``t``) is under half the area its colour showed near it
+        within WINDOW frames before: it was going behind something, not deleted in view."""
+        near = dilate(p.mask, 2 * self.reach)
+        seen = [
+            o.area
+            for u in range(max(0, t - WINDOW), t)
+            for o in self._of(u, p.cls)
+            if (o.mask & near).any()
+        ]
+        return bool(seen) and p.area < 0.5 * max(seen)
 
     def _heading_out(self, p: Obj, t: int, step: int = -1) -> bool:
         """Whether ``p`` (seen at frame ``t``) moves fast enough to be out of the picture two
