@@ -57,7 +57,9 @@ def main(names: list[str]) -> int:
         secs = time.perf_counter() - t0
         why = "; ".join(f"{v['kind']}@{v['frame']} {v['detail']}" for v in report["violations"])
         failed += not report["valid"]
-        print(f"{name:40s} {'ok  ' if report['valid'] else 'FAIL'} {secs:5.1f}s {why}", flush=True)
+        fit = "unfit" if any("not decidable" in u for u in report["undecided"]) else "fit  "
+        verdict = "ok  " if report["valid"] else "FAIL"
+        print(f"{name:40s} {verdict} {fit} {secs:5.1f}s {why}", flush=True)
     print(f"{len(names or puzzle_levels()) - failed} pass, {failed} fail")
     return 1 if failed else 0
 
