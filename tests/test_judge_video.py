@@ -78,11 +78,8 @@ def test_our_videos_of_legal_plans_pass(name: str, with_level: bool) -> None:
 #: Levels whose videos the judge once misread (occlusion read as a split, a colour revealed
 #: behind a moving piece read as a swap, a shaded grey read as another grey).
 #: With whether our camera is fitted on them (mid-02 starts with its pieces too small to fit).
-ONCE_MISREAD = (
-    ("puzzle-hard-10-cube4", True),
-    ("puzzle-mid-02-interlocking-cube", False),
-    ("puzzle-easy-05-burr6", True),
-)
+#: (easy-05, a colour revealed behind a moving piece once read as a swap, is in the slow sweep.)
+ONCE_MISREAD = (("puzzle-hard-10-cube4", True), ("puzzle-mid-02-interlocking-cube", False))
 
 
 def _sweep_verdict(name: str) -> dict[str, object]:
