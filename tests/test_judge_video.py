@@ -56,8 +56,10 @@ def _mask(frame: U8, colors: Colors, piece: int) -> BoolArray:
     return class_masks(frame, palette_model(colors))[piece]
 
 
-def _kinds(frames: list[U8], colors: Colors | None) -> list[tuple[str, int, str]]:
-    return [(e.kind, e.frame, e.piece) for e in judge_frames(frames, colors).violations]
+def _kinds(
+    frames: list[U8], colors: Colors | None, level: Level | None = None
+) -> list[tuple[str, int, str]]:
+    return [(e.kind, e.frame, e.piece) for e in judge_frames(frames, colors, level).violations]
 
 
 @pytest.mark.parametrize(
@@ -71,6 +73,35 @@ def _kinds(frames: list[U8], colors: Colors | None) -> list[tuple[str, int, str]
 def test_our_videos_of_legal_plans_pass(name: str, with_level: bool) -> None:
     colors = _colors(_level(name)) if with_level else None
     assert _kinds(list(_frames(name)), colors) == []
+
+
+#: Levels whose videos the judge once misread (occlusion read as a split, a colour revealed
+#: behind a moving piece read as a swap, a shaded grey read as another grey).
+#: With whether our camera is fitted on them (mid-02 starts with its pieces too small to fit).
+#: (easy-05, a colour revealed behind a moving piece once read as a swap, is in the slow sweep.)
+ONCE_MISREAD = (("puzzle-hard-10-cube4", True), ("puzzle-mid-02-interlocking-cube", False))
+
+
+def _sweep_verdict(name: str) -> dict[str, object]:
+    from tests.judge_sweep import judged
+
+    report = judged(name)
+    assert report["valid"] is True, report["violations"]
+    return report
+
+
+@pytest.mark.parametrize(("name", "fitted"), ONCE_MISREAD)
+def test_our_gif_of_a_once_misread_level_passes_with_the_level(name: str, fitted: bool) -> None:
+    report = _sweep_verdict(name)
+    undecided = report["undecided"]
+    assert isinstance(undecided, list)
+    assert fitted == (not any("not decidable" in u for u in undecided)), undecided
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(p.stem for p in shipped_levels("puzzle").glob("*.json")))
+def test_our_gif_of_every_shipped_puzzle_passes_with_the_level(name: str) -> None:
+    _sweep_verdict(name)
 
 
 def _in_view(frame: U8, colors: Colors, k: int) -> bool:
@@ -108,19 +139,19 @@ BLANK = np.array([255, 255, 255], dtype=np.uint8)
 
 
 @st.composite
-def corrupted(draw: st.DrawFn, kind: str) -> tuple[list[U8], Colors, int, set[str]]:
-    """Frames corrupted from a drawn frame on, the colours, that frame and the pieces the
-    violation may name (a swap of two colours names either)."""
+def corrupted(draw: st.DrawFn, kind: str) -> tuple[list[U8], Colors, int, set[str], str]:
+    """Frames corrupted from a drawn frame on, the colours, that frame, the pieces the
+    violation may name (a swap of two colours names either) and the level."""
     name = draw(st.sampled_from(LEVELS))
     frames, colors = list(_frames(name)), _colors(_level(name))
     options = _targets(name, kind)
     if not options:
-        return frames, colors, -1, set()
+        return frames, colors, -1, set(), name
     t, k = draw(st.sampled_from(options))
     for i in range(t, len(frames)):
         frames[i] = _corrupt(kind, frames[i], colors, k)
     swapped = {colors[(k + 1) % len(colors)][0]} if kind == "recolor" else set()
-    return frames, colors, t, {colors[k][0], *swapped}
+    return frames, colors, t, {colors[k][0], *swapped}, name
 
 
 def _corrupt(kind: str, frame: U8, colors: Colors, k: int) -> U8:
@@ -148,13 +179,18 @@ def _paint(out: U8, frame: U8, m: BoolArray, color: tuple[int, int, int]) -> Non
     out[m] = np.clip(rgb[None, :] * shade, 0, 255).astype(np.uint8)
 
 
+@pytest.mark.parametrize("with_level", [False, True])
 @pytest.mark.parametrize("kind", ["lost", "split", "recolor"])
 @settings(max_examples=3, deadline=None, derandomize=True)
 @given(data=st.data())
-def test_corruptions_are_caught_with_kind_and_frame(kind: str, data: st.DataObject) -> None:
-    frames, colors, t, pieces = data.draw(corrupted(kind))
+def test_corruptions_are_caught_with_kind_and_frame(
+    kind: str, with_level: bool, data: st.DataObject
+) -> None:
+    """With the level too: its model of occlusion and shading explains our renders, not
+    corruptions of them."""
+    frames, colors, t, pieces, name = data.draw(corrupted(kind))
     assume(t >= 0)
-    found = _kinds(frames, colors)
+    found = _kinds(frames, colors, _level(name) if with_level else None)
     assert any(k == kind and abs(f - t) <= 2 and p in pieces for k, f, p in found), (
         kind,
         t,
@@ -170,7 +206,8 @@ def _paste(frame: U8, src: U8, m: BoolArray, dy: int, dx: int) -> U8:
     return out
 
 
-def test_added_piece_is_caught() -> None:
+@pytest.mark.parametrize("with_level", [False, True])
+def test_added_piece_is_caught(with_level: bool) -> None:
     """A copy of a piece appears in empty background mid-video."""
     name = "puzzle-easy-09-cube3"
     frames, colors = list(_frames(name)), _colors(_level(name))
@@ -180,7 +217,7 @@ def test_added_piece_is_caught() -> None:
     dy, dx = 8 - int(ys.min()) + 40, 8 - int(xs.min())  # the top-left corner is empty
     for i in range(t, len(frames)):
         frames[i] = _paste(frames[i], frames[t], m, dy, dx)
-    found = _kinds(frames, colors)
+    found = _kinds(frames, colors, _level(name) if with_level else None)
     assert any(k == "added" and abs(f - t) <= 2 and p == colors[1][0] for k, f, p in found), found
 
 

@@ -42,10 +42,16 @@ MAX_SCALE_MISMATCH: Final = 0.06
 SLACK: Final = 0.06
 LOST_IOU: Final = 0.5
 SURE_IOU: Final = 0.85
+#: A piece's drawn silhouette agrees with the seen one at least this well for a change of its
+#: parts to be read as occlusion.
+EXPLAIN_IOU: Final = 0.7
 #: Frames on either side of a move during which another piece must stay put to be an obstacle.
 STILL_FRAMES: Final = 4
 #: Candidate offsets near the last pose (cells, along one axis).
 NEAR: Final = tuple(float(d) for d in np.arange(-2.0, 2.01, 0.25) if abs(d) > 1e-9)
+
+
+Bools = npt.NDArray[np.bool_]
 
 
 @dataclass(frozen=True)
@@ -250,14 +256,55 @@ class _Tracker:
         return {tuple(c) for c in (self.scene.pieces[j].cells + off).tolist()}
 
 
+class Fit:
+    """Where the tracker put every piece in every frame, with the fitted camera: the level
+    drawn at those poses tells occlusion (a piece seen in parts round another) from a break."""
+
+    def __init__(self, scene: _Scene, poses: dict[int, FloatArray], gone: dict[int, Bools]):
+        self.scene, self.poses, self.gone = scene, poses, gone
+
+    def _best(self, g: int, i: int, seen: BoolArray) -> tuple[float, FloatArray, BoolArray]:
+        """Piece ``i``'s best agreement with ``seen`` at frame ``g``: at its tracked pose or
+        up to a cell from it along one axis (the tracker refits only on a clear loss)."""
+        best: tuple[float, FloatArray, BoolArray] = (-1.0, self.poses[g][i], seen)
+        steps = [(0, 0.0)] + [(a, d) for a in range(3) for d in NEAR if abs(d) <= 1.0]
+        for a, d in steps:
+            t = self.poses[g].copy()
+            t[self.gone[g]] = 1e4  # pieces no longer followed: far off the picture
+            t[i, a] += d
+            drawn = self.scene.draw(t) == i + 1
+            score = _iou(drawn, seen)
+            if score > best[0] + 1e-9:
+                best = (score, t[i], drawn)
+        return best
+
+    def explains(self, masks: list[list[BoolArray]], f: int, i: int, area: int) -> bool:
+        """Whether piece ``i`` is seen in frames ``f - 1`` and ``f`` as the level drawn near
+        its tracked poses shows it (no jump; no part missing in open view; no extra part):
+        what changed there is occlusion, not a break, a copy or a loss."""
+        if any(g not in self.poses or self.gone[g][i] for g in (f - 1, f)):
+            return False
+        fits = [self._best(g, i, masks[g][i]) for g in (f - 1, f)]
+        if float(np.abs(fits[1][1] - fits[0][1]).max()) > 1.0:
+            return False
+        for g, (score, _, drawn) in zip((f - 1, f), fits, strict=True):
+            seen = masks[g][i]
+            anything = dilate(np.logical_or.reduce(masks[g]), 2)
+            if score < EXPLAIN_IOU:
+                return False
+            if (drawn & ~anything).sum() > area / 2 or (seen & ~dilate(drawn, 2)).sum() > area / 2:
+                return False
+        return True
+
+
 def pass_through(
     level: Level, masks: list[list[BoolArray]], names: tuple[str, ...]
-) -> tuple[list[Event], list[str]]:
+) -> tuple[list[Event], list[str], Fit | None]:
     """Pass-through violations of a video drawn by our camera, and why not when undecidable.
     The camera is fitted on the first frame, or on the last one played backwards (a video
     of an assembly ends assembled): a collision is one either way."""
     if level.family != "puzzle":
-        return [], ["pass_through: checked only for puzzles"]
+        return [], ["pass_through: checked only for puzzles"], None
     cam = CAMERAS["iso"]
     pieces = _pieces(level, cam)
     agree = 0.0
@@ -271,7 +318,7 @@ def pass_through(
         if score >= MIN_FIT_IOU:
             return _follow(scene, names, masks, order, base)
     why = f"neither end frame is our camera's view of the level assembled (agreement {agree:.2f})"
-    return [], [f"pass_through: not decidable: {why}"]
+    return [], [f"pass_through: not decidable: {why}"], None
 
 
 def _follow(
@@ -280,7 +327,7 @@ def _follow(
     masks: list[list[BoolArray]],
     order: list[int],
     base: list[float],
-) -> tuple[list[Event], list[str]]:
+) -> tuple[list[Event], list[str], Fit]:
     track = _Tracker(scene, names, base)
     why: list[str] = []
     poses = [track.t.copy()]
@@ -314,7 +361,8 @@ def _follow(
                     events.append(
                         Event("pass_through", shown, names[i], names[j], detail, masks_, before=0)
                     )
-    return events, why
+    fit = Fit(scene, dict(zip(order, poses, strict=True)), dict(zip(order, gone, strict=True)))
+    return events, why, fit
 
 
 def _still(poses: list[FloatArray], gone: list[npt.NDArray[np.bool_]], n: int, i: int) -> list[int]:

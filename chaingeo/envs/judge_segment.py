@@ -25,6 +25,7 @@ from PIL import Image
 
 from chaingeo.core.colors import PALETTE, ciede2000, srgb_to_lab
 from chaingeo.core.jit import njit
+from chaingeo.envs.raster import SHADE
 
 U8 = npt.NDArray[np.uint8]
 I32 = npt.NDArray[np.int32]
@@ -39,6 +40,14 @@ DELTA_E: Final = 11.0
 #: Brightness factors a level colour is tried at (the renderer shades faces 0.62-1.0; video
 #: models light them more freely).
 SHADES: Final = tuple(float(s) for s in np.linspace(0.45, 1.15, 15))
+#: Brightness factors of our own renderer's faces (its SHADE, 0.62-1.0, a little widened for
+#: GIF quantisation and anti-aliasing): used with a level, so a shaded white is not a grey.
+RENDER_SHADES: Final = tuple(
+    float(s) for s in np.linspace(float(SHADE.min()) - 0.05, float(SHADE.max()) + 0.03, 11)
+)
+#: Two level colours closer than this (CIEDE2000) under some pair of RENDER_SHADES cannot be
+#: told apart reliably: identity changes between them are undecided, not violations.
+CONFUSABLE: Final = 6.0
 #: Least CIELAB chroma of a piece pixel without a level (grey backgrounds are below 8).
 MIN_CHROMA: Final = 14.0
 #: Hue clusters: a peak holds at least this share of the chromatic pixels of the first frame,
@@ -72,23 +81,43 @@ def _table_index(rgb: U8) -> npt.NDArray[np.int64]:
     return out
 
 
-def palette_model(colors: list[tuple[str, tuple[int, int, int]]]) -> ColorModel:
-    """Classes for a level's piece colours (name, RGB), tried at every shade of SHADES."""
-    return _palette_model(tuple(colors))
+Colors = list[tuple[str, tuple[int, int, int]]]
+
+
+def palette_model(colors: Colors, shades: tuple[float, ...] = SHADES) -> ColorModel:
+    """Classes for a level's piece colours (name, RGB), tried at every brightness of
+    ``shades`` (the nearest shaded colour wins)."""
+    return _palette_model(tuple(colors), shades)
+
+
+def _shaded_lab(rgb: tuple[int, int, int], shades: tuple[float, ...]) -> FloatArray:
+    lit = np.array(rgb, dtype=np.float64)[None, :] * np.array(shades)[:, None]
+    return srgb_to_lab(np.clip(lit, 0, 255))
+
+
+def confusable(colors: Colors, shades: tuple[float, ...] = RENDER_SHADES) -> set[int]:
+    """Indices of the colours that come within CONFUSABLE of another colour under some pair
+    of ``shades`` (a shaded white is a grey): their identity cannot be read reliably."""
+    labs = [_shaded_lab(rgb, shades) for _, rgb in colors]
+    out: set[int] = set()
+    for i in range(len(labs)):
+        for j in range(i + 1, len(labs)):
+            if ciede2000(labs[i][:, None, :], labs[j][None, :, :]).min() < CONFUSABLE:
+                out |= {i, j}
+    return out
 
 
 @lru_cache(maxsize=8)
-def _palette_model(colors: tuple[tuple[str, tuple[int, int, int]], ...]) -> ColorModel:
+def _palette_model(
+    colors: tuple[tuple[str, tuple[int, int, int]], ...], shades: tuple[float, ...]
+) -> ColorModel:
     if not colors or len(colors) > 255:
         raise ValueError(f"1 to 255 piece colours, got {len(colors)}")
     lab_table = srgb_to_lab(_table_rgb())
     best = np.full(len(lab_table), np.inf)
     label = np.zeros(len(lab_table), dtype=np.uint8)
     for i, (_, rgb) in enumerate(colors):
-        shades = np.clip(
-            np.array(rgb, dtype=np.float64)[None, :] * np.array(SHADES)[:, None], 0, 255
-        )
-        d = ciede2000(lab_table[:, None, :], srgb_to_lab(shades)[None, :, :]).min(axis=1)
+        d = ciede2000(lab_table[:, None, :], _shaded_lab(rgb, shades)[None, :, :]).min(axis=1)
         closer = d < best
         best[closer] = d[closer]
         label[closer] = i + 1

@@ -29,6 +29,10 @@ PERSIST: Final = 3
 #: Share of the gap between two same-coloured parts that other pieces must cover for the parts
 #: to count as one occluded piece.
 OCCLUDED_GAP: Final = 0.6
+#: Furthest move (share of the frame's longer side) of a piece between two frames.
+FAST_SHARE: Final = 0.25
+#: Pixels from the picture's edge within which a part touches the border.
+BORDER: Final = 3
 #: Growth (share of the frame's longer side) of a mask when matching across one frame.
 MOTION_SHARE: Final = 0.03
 
@@ -46,8 +50,9 @@ class Obj:
         return int(self.mask.sum())
 
     def touches_border(self) -> bool:
-        m = self.mask
-        return bool(m[0].any() or m[-1].any() or m[:, 0].any() or m[:, -1].any())
+        """Within BORDER pixels of the picture's edge (cleaning may eat the outer column)."""
+        m, b = self.mask, BORDER
+        return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
 
 
 @dataclass(frozen=True)
@@ -227,10 +232,16 @@ class Tracker:
                 detail = f"one {name} piece became {len(hit)} separate parts (background between)"
                 return [Event("split", b, name, None, detail, masks)]
         out: list[Event] = []
+        unmatched = [p for p in before if not self._touching(p, now)]
         for c in now:
             if self._touching(c, before):
                 continue
-            if c.touches_border():
+            fast = [p for p in unmatched if self._fast_move(p, c)]
+            if fast:
+                unmatched.remove(fast[0])
+                out.append(Event("moved", b, name, None, "moved further than one frame's reach"))
+                continue
+            if c.touches_border() or self._from_border(k, b) or self._heading_out(c, b, 1):
                 out.append(Event("entered", b, name, None, "came in through the border"))
                 continue
             gone = [
@@ -251,6 +262,18 @@ class Tracker:
                 detail = f"a {name} piece appeared in open view, away from the border"
                 out.append(Event("added", b, name, None, detail, (c.mask,), before=0))
         return out
+
+    def _fast_move(self, p: Obj, c: Obj) -> bool:
+        """Whether ``c`` may be ``p`` moved fast: alike in area, within FAST_SHARE of the
+        frame (a piece matched nowhere before and one matched nowhere now)."""
+        d = _centroid(c.mask) - _centroid(p.mask)
+        far = float(np.hypot(*d)) <= FAST_SHARE * max(p.mask.shape)
+        return far and _alike(p, c)
+
+    def _from_border(self, k: int, b: int) -> bool:
+        """Whether a piece of class ``k`` touched the border a frame or two before ``b``: one
+        carried in at speed (our videos bring pieces in fast) is past the reach of one frame."""
+        return any(o.touches_border() for t in (b - 1, b - 2) if t >= 0 for o in self._of(t, k))
 
     def _under_others(self, whole: BoolArray, parts: list[Obj], t: int) -> bool:
         """Whether what ``whole`` has beyond ``parts`` lies, at frame ``t``, mostly on other
@@ -282,6 +305,9 @@ class Tracker:
         name = self.names[p.cls]
         if p.touches_border() or self._heading_out(p, b - 1):
             return Event("left", b, name, None, "went out through the border")
+        if self._shrinking(p, b - 1) and self._against_others(p, b - 1):
+            detail = f"the {name} piece shrank out of sight beside another piece"
+            return Event("hidden", b, name, None, detail, (p.mask,))
         if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
             return Event(
                 "lost", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
@@ -302,17 +328,30 @@ class Tracker:
         detail = f"the {name} piece went out of sight behind the {other} piece"
         return Event("hidden", b, name, other, detail, (p.mask, cover.mask))
 
-    def _heading_out(self, p: Obj, t: int) -> bool:
+    def _shrinking(self, p: Obj, t: int) -> bool:
+        """Whether ``p`` (seen at frame ``t``) is under half the area its colour showed near it
+        within WINDOW frames before: it was going behind something, not deleted in view."""
+        near = dilate(p.mask, 2 * self.reach)
+        seen = [
+            o.area
+            for u in range(max(0, t - WINDOW), t)
+            for o in self._of(u, p.cls)
+            if (o.mask & near).any()
+        ]
+        return bool(seen) and p.area < 0.5 * max(seen)
+
+    def _heading_out(self, p: Obj, t: int, step: int = -1) -> bool:
         """Whether ``p`` (seen at frame ``t``) moves fast enough to be out of the picture two
-        frames later (our videos carry removed pieces out at speed)."""
-        if t < 1:
+        frames later (our videos carry removed pieces out at speed); with ``step`` 1, two
+        frames earlier (carried in at speed)."""
+        if not 0 <= t + step < len(self.frames):
             return False
-        earlier = self._of(t - 1, p.cls)
-        if not earlier:
+        other = self._of(t + step, p.cls)
+        if not other:
             return False
         here = _centroid(p.mask)
         d = here - min(
-            (_centroid(o.mask) for o in earlier), key=lambda c: float(((here - c) ** 2).sum())
+            (_centroid(o.mask) for o in other), key=lambda c: float(((here - c) ** 2).sum())
         )
         ys, xs = np.nonzero(p.mask)
         h, w = p.mask.shape
@@ -348,12 +387,19 @@ class Tracker:
             partner = [x for x in self._of(b, o.cls) if _overlaps(x, was)]
             if len(partner) != 1 or (partner[0].mask & o.mask).sum() >= 0.2 * partner[0].area:
                 continue
+            if not (_alike(c, o) and _alike(partner[0], was)):
+                continue  # a swap of colours keeps both silhouettes; a reveal changes them
             later = [self._of(b + d, k) for d in range(1, PERSIST)]
             if all(len(x) == 1 and (x[0].mask & was.mask).sum() < 0.2 * x[0].area for x in later):
                 other = self.names[o.cls]
                 detail = f"the {other} piece now shows as {self.names[k]} (and the reverse)"
                 return Event("recolor", b, other, self.names[k], detail, (o.mask, c.mask))
         return None
+
+
+def _alike(a: Obj, b: Obj) -> bool:
+    """Areas within a factor of two (one silhouette seen twice, not a piece and a sliver)."""
+    return min(a.area, b.area) >= 0.5 * max(a.area, b.area)
 
 
 def _overlaps(a: Obj, b: Obj) -> bool:

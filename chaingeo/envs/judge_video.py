@@ -12,7 +12,7 @@ in ``undecided``, never as a verdict.
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Final
 
@@ -22,19 +22,35 @@ from PIL import Image
 from chaingeo.core import limits
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.envs.judge_segment import (
+    RENDER_SHADES,
+    SHADES,
     U8,
     BoolArray,
     ColorModel,
+    Colors,
     class_masks,
     clustered_model,
+    confusable,
+    dilate,
     min_area,
     palette_model,
     shrink,
 )
-from chaingeo.envs.judge_track import VIOLATIONS, Event, Obj, Tracker, frame_objects
+from chaingeo.envs.judge_track import (
+    VIOLATIONS,
+    Event,
+    Obj,
+    Tracker,
+    frame_objects,
+)
 
 #: The evidence picture: the two frames around an event, each at this many times working size.
 EVIDENCE_ZOOM: Final = 2
+#: Reach (share of the frame's longer side) within which fragments of a piece's colour in the
+#: other frame make its loss or appearance a misreading.
+NEAR_SHARE: Final = 0.1
+#: Mean change (RGB levels) below which a region's picture is the same in two frames.
+UNCHANGED: Final = 12.0
 _TINTS: Final = ((255, 0, 255), (0, 255, 255), (255, 255, 0), (0, 255, 0))
 
 
@@ -172,40 +188,97 @@ class Verdict:
 
 def judge_frames(
     frames: tuple[U8, ...] | list[U8],
-    colors: list[tuple[str, tuple[int, int, int]]] | None = None,
+    colors: Colors | None = None,
     level: Any = None,
 ) -> Verdict:
     """The verdict on working-size frames; ``colors`` (name, RGB) of the pieces if known (else
-    clustered from the first frame); ``level`` enables the kinematic check of our renders."""
+    clustered from the first frame); ``level`` enables the kinematic check of our renders, and
+    the reading of occlusion and shading by our renderer's model."""
     try:
-        model = palette_model(colors) if colors else clustered_model(frames[0])
+        if not colors:
+            model = clustered_model(frames[0])
+        else:
+            model = palette_model(colors, RENDER_SHADES if level is not None else SHADES)
     except ValueError as e:
         raise VideoJudgeError(str(e)) from None
     area = min_area(frames[0].shape)
     masks = [class_masks(f, model) for f in frames]
     objects = [frame_objects(m, area) for m in masks]
     events = Tracker(objects, model.names).events()
+    shape = frames[0].shape[:2]
+    kept = [[_union(objs, k, shape) for k in range(len(model.names))] for objs, _ in objects]
     undecided: list[str] = []
-    if level is not None:
-        from chaingeo.envs.judge_pose import pass_through
-
-        kept = [
-            [_union(objs, k, m[0].shape) for k in range(len(model.names))]
-            for (objs, _), m in zip(objects, masks, strict=True)
-        ]
-        found, why = pass_through(level, kept, model.names)
-        events = sorted([*events, *found], key=lambda e: (e.frame, e.kind, e.piece))
-        undecided.extend(why)
+    if level is not None and colors:
+        events, undecided = _with_level(level, colors, model.names, events, kept, area)
     else:
         undecided.append(
             "pass_through: motion through another piece is not decidable without the level's "
             "geometry and a known camera (give --level for a video drawn by chain video)"
         )
+    misread = [e for e in events if _misread(frames, masks, kept, e, model.names)]
+    undecided += [f"frame {e.frame}: {e.detail} (but it was misread)" for e in misread]
+    events = [e for e in events if e not in misread]
     hidden = [e for e in events if e.kind == "hidden"]
     undecided += [f"frame {e.frame}: {e.detail} (occluded, or lost)" for e in hidden]
     violations = tuple(e for e in events if e.kind in VIOLATIONS)
     notes = tuple(e for e in events if e.kind not in VIOLATIONS)
     return Verdict(violations, notes, tuple(undecided), model, len(frames))
+
+
+def _with_level(
+    level: Any,
+    colors: Colors,
+    names: tuple[str, ...],
+    events: list[Event],
+    kept: list[list[BoolArray]],
+    area: int,
+) -> tuple[list[Event], list[str]]:
+    """Events read with the level: pass-throughs added; a change the level drawn at the
+    tracked poses shows (occlusion) becomes a note; a change naming a piece whose colour is
+    too close to another's is undecided."""
+    from chaingeo.envs.judge_pose import pass_through
+
+    found, undecided, fit = pass_through(level, kept, names)
+    alike = {names[i] for i in confusable(colors)}
+    index = {n: i for i, n in enumerate(names)}
+    out: list[Event] = list(found)
+    for e in events:
+        who = [e.piece] + ([e.other] if e.other is not None else [])
+        if e.kind not in VIOLATIONS:
+            out.append(e)
+        elif fit is not None and all(fit.explains(kept, e.frame, index[n], area) for n in who):
+            out.append(replace(e, kind="occluded", detail=f"{e.detail}: as the level is drawn"))
+        elif any(n in alike for n in who):
+            undecided.append(
+                f"frame {e.frame}: {e.detail} (the {'/'.join(who)} colour is too close to "
+                "another piece's to tell)"
+            )
+        else:
+            out.append(e)
+    return sorted(out, key=lambda e: (e.frame, e.kind, e.piece)), undecided
+
+
+def _misread(
+    frames: tuple[U8, ...] | list[U8],
+    masks: list[list[BoolArray]],
+    kept: list[list[BoolArray]],
+    e: Event,
+    names: tuple[str, ...],
+) -> bool:
+    """Whether a piece said to vanish (appear) is still there (already there) in the other
+    frame: drawn alike in both, or its colour seen nearby in fragments each below the least area
+    (small cells in a small picture): a misreading, not an event."""
+    if e.kind not in ("lost", "added") or not e.masks or e.frame < 1 or not e.masks[0].any():
+        return False
+    m = e.masks[0]
+    a, b = frames[e.frame - 1][m].astype(np.int64), frames[e.frame][m].astype(np.int64)
+    if float(np.abs(a - b).mean()) < UNCHANGED:
+        return True
+    other = e.frame if e.kind == "lost" else e.frame - 1
+    k = names.index(e.piece)
+    near = dilate(m, max(2, round(NEAR_SHARE * max(m.shape))))
+    fragments = masks[other][k] & ~kept[other][k]
+    return float((fragments & near).sum()) >= 0.5 * float(m.sum())
 
 
 def _union(objs: list[Obj], k: int, shape: tuple[int, ...]) -> BoolArray:
