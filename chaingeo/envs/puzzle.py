@@ -79,6 +79,7 @@ from chaingeo.envs.puzzle_actions import (
 )
 from chaingeo.envs.puzzle_tables import PositionKey as PositionKey
 from chaingeo.envs.puzzle_tables import PuzzleTables as PuzzleTables
+from chaingeo.envs.puzzle_tables import join_shifts, part_key
 from chaingeo.envs.puzzle_tables import normal_key as normal_key
 from chaingeo.envs.puzzle_turns import describe_turn, resolve_turn, turn_problem
 from chaingeo.envs.state import BaseState
@@ -355,7 +356,7 @@ class PuzzleState(BaseState):
                 text=text,
                 state_key=self.key(),
             )
-        on_path = [(self.tables.path.get(normal_key(self._inserted(c))), c) for c in cands]
+        on_path = self._path_steps(cands)
         best = max((p for p, _ in on_path if p is not None), default=None)
         if best is not None:
             return self._insertion_action(next(c for p, c in on_path if p == best))
@@ -364,6 +365,29 @@ class PuzzleState(BaseState):
             return self._insertion_action(homely[0])
         shown = homely or cands
         raise AmbiguousActionError(text, [self._insertion_action(c) for c in shown], self.key())
+
+    def _path_steps(self, cands: list[Insertion]) -> list[tuple[int | None, Insertion]]:
+        """How far along the plan each insertion lands (None: off it), the same as
+        ``path.get(normal_key(self._inserted(c)))``: the joined part of an insertion on the plan
+        is a part of a position on it, and that part fixes the shift, so only the shifts the
+        plan's parts ask for are keyed (most candidates are off the plan)."""
+        asm, t = self._asm, self.tables
+        by_pair: dict[tuple[frozenset[str], frozenset[str]], dict[Cell, list[Insertion]]] = {}
+        for c in cands:
+            shift = self._shift_of(c.part, c.into, c.offset)
+            by_pair.setdefault((c.part, c.into), {}).setdefault(shift, []).append(c)
+        steps: dict[int, int | None] = {}
+        for (part, into), by_shift in by_pair.items():
+            names = tuple(sorted(part | into))
+            if any(asm.rotation_of(n) for n in names):
+                for c in (c for cs in by_shift.values() for c in cs):
+                    steps[id(c)] = t.path.get(normal_key(self._inserted(c)))
+                continue
+            rest = [part_key(asm, p) for p in asm.parts if p != part and p != into]
+            for shift, joined in join_shifts(asm, part, into, t.path_parts.get(names, ())):
+                for c in by_shift.get(shift, ()):
+                    steps[id(c)] = t.path.get(tuple(sorted([*rest, joined])))
+        return [(steps.get(id(c)), c) for c in cands]
 
     def _inserted(self, ins: Insertion) -> Assembly:
         asm = self._asm
