@@ -1,13 +1,16 @@
-"""The plan lookup of ambiguous insertions keyed part by part equals keying whole positions."""
+"""Faster exact step paths without images: the plan lookup of ambiguous insertions keyed part
+by part equals keying whole positions; the observation text's ASCII filter equals per character."""
 
 from __future__ import annotations
 
 import random
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from chaingeo.envs.demos import plan_texts
-from chaingeo.envs.gym import PuzzleEnv
+from chaingeo.envs.gym import CHARSET, PuzzleEnv, _ascii
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.puzzle import Insertion, PuzzleState
 from chaingeo.envs.puzzle_tables import normal_key
@@ -40,3 +43,10 @@ def test_path_steps_equal_whole_keys(seed: int, monkeypatch: pytest.MonkeyPatch)
             state.step_text(text)
         assert state.is_success()
     assert seen["cands"] > 0 and seen["hits"] > 0
+
+
+@given(st.text(alphabet=st.characters(max_codepoint=0x2FF)))
+def test_ascii_replaces_what_charset_lacks(text: str) -> None:
+    want = "".join(c if c in CHARSET else "?" for c in text)
+    assert _ascii(text) == want
+    assert set(CHARSET) == {chr(i) for i in range(128) if _ascii(chr(i)) == chr(i)}
