@@ -7,7 +7,8 @@ kernels) on a numpy array; only the legend still goes through Pillow. In a box (
 frame stays put, so all but the faces, depth labels and legend are kept per layout (the
 background at drawing scale, and the picture without pieces): a step draws the faces on a copy
 of the background and takes only the rectangle they (and their labels) cover, redrawing the
-labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass.
+labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass
+(on a recent background, with recent label steps: a frame recurs within an episode).
 Every drawing call is the one :mod:`chaingeo.envs.render` makes, in the same order, so the
 pictures are the same bytes (tested over the shipped levels); ``render`` stays the reference
 (and draws where the kernels do not apply: lines wide enough for round joints, or
@@ -98,11 +99,21 @@ class _Static:
 
 
 _STORE: OrderedDict[Hashable, _Static] = OrderedDict()
+#: A frame that follows the pieces (a puzzle's): its background and label steps, kept only
+#: while recent (a frame recurs within an episode, seldom later; no finished picture is kept).
+_FOLLOW: OrderedDict[Hashable, tuple[_Back, tuple[Step, ...]]] = OrderedDict()
+FOLLOW_CAPACITY: Final = 16
 
 
 def clear() -> None:
     """Forget every kept layout."""
     _STORE.clear()
+    _FOLLOW.clear()
+
+
+def _layout_key(scene: _Scene, cam: Camera, size: int, title: str | None) -> Hashable:
+    legend_h = legend_layout(scene.legend, size)[1]
+    return (cam.name, size, scene.lo, scene.hi, title, legend_h, scene.has_box)
 
 
 def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
@@ -144,8 +155,7 @@ def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static
     it saves)."""
     if not scene.has_box:
         return None
-    legend_h = legend_layout(scene.legend, size)[1]
-    key = (cam.name, size, scene.lo, scene.hi, title, legend_h)
+    key = _layout_key(scene, cam, size, title)
     found = _STORE.get(key)
     if found is not None:
         _STORE.move_to_end(key)
@@ -201,10 +211,28 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     return out
 
 
-def _one_pass(scene: _Scene, cam: Camera, size: int, title: str | None, faces: Faces) -> Pixels:
+def _recent(
+    scene: _Scene, cam: Camera, size: int, title: str | None
+) -> tuple[_Back, tuple[Step, ...]]:
+    """The background and label steps of a frame that follows the pieces (kept while recent)."""
+    key = _layout_key(scene, cam, size, title)
+    found = _FOLLOW.get(key)
+    if found is not None:
+        _FOLLOW.move_to_end(key)
+        return found
     back = _back(scene, cam, size)
-    image = _pieces(back, faces, size)[0] if len(faces.fills) else _finish(back, back.big)
-    paint_steps(image, _label_steps(scene, cam, size, back.proj, title))
+    back.big.flags.writeable = False
+    made = back, tuple(_label_steps(scene, cam, size, back.proj, title))
+    _FOLLOW[key] = made
+    while len(_FOLLOW) > FOLLOW_CAPACITY:
+        _FOLLOW.popitem(last=False)
+    return made
+
+
+def _one_pass(scene: _Scene, cam: Camera, size: int, title: str | None, faces: Faces) -> Pixels:
+    back, steps = _recent(scene, cam, size, title)
+    image = _pieces(back, faces, size)[0] if len(faces.fills) else _finish(back, back.big.copy())
+    paint_steps(image, steps)
     if cam.depth_axis is not None and len(faces.cells):
         paint_steps(image, depth_label_steps(faces, cam, back.proj))
     return image

@@ -79,8 +79,9 @@ from chaingeo.envs.puzzle_actions import (
 )
 from chaingeo.envs.puzzle_tables import PositionKey as PositionKey
 from chaingeo.envs.puzzle_tables import PuzzleTables as PuzzleTables
+from chaingeo.envs.puzzle_tables import join_shifts, part_key
 from chaingeo.envs.puzzle_tables import normal_key as normal_key
-from chaingeo.envs.puzzle_turns import describe_turn, resolve_turn, turn_problem
+from chaingeo.envs.puzzle_turns import PartKey, describe_turn, resolve_turn, turn_problem
 from chaingeo.envs.state import BaseState
 
 _ByGroup = dict[tuple[tuple[str, ...], str], MoveRange]
@@ -98,6 +99,10 @@ def _axis(direction: str) -> tuple[int, int]:
     d = DIRECTIONS[direction]
     axis = next(i for i in range(3) if d[i])
     return axis, d[axis]
+
+
+#: the other parts' keys, and the offsets at which a part joins another on the plan (its key)
+_Joins = tuple[list[PartKey], dict[Cell, PartKey]]
 
 
 @dataclass(frozen=True)
@@ -355,7 +360,7 @@ class PuzzleState(BaseState):
                 text=text,
                 state_key=self.key(),
             )
-        on_path = [(self.tables.path.get(normal_key(self._inserted(c))), c) for c in cands]
+        on_path = self._path_steps(cands)
         best = max((p for p, _ in on_path if p is not None), default=None)
         if best is not None:
             return self._insertion_action(next(c for p, c in on_path if p == best))
@@ -364,6 +369,38 @@ class PuzzleState(BaseState):
             return self._insertion_action(homely[0])
         shown = homely or cands
         raise AmbiguousActionError(text, [self._insertion_action(c) for c in shown], self.key())
+
+    def _path_steps(self, cands: list[Insertion]) -> list[tuple[int | None, Insertion]]:
+        """How far along the plan each insertion lands (None: off it), the same as
+        ``path.get(normal_key(self._inserted(c)))``: the joined part of an insertion on the plan
+        is a part of a position on it, and that part fixes the shift, so only the shifts the
+        plan's parts ask for are keyed (most candidates are off the plan)."""
+        t = self.tables
+        keyed: dict[tuple[frozenset[str], frozenset[str]], _Joins | None] = {}
+        out: list[tuple[int | None, Insertion]] = []
+        for c in cands:
+            pair = (c.part, c.into)
+            if pair not in keyed:
+                keyed[pair] = self._joins(*pair)
+            joins = keyed[pair]
+            if joins is None:  # turned pieces: key the whole position
+                out.append((t.path.get(normal_key(self._inserted(c))), c))
+                continue
+            joined = joins[1].get(c.offset)
+            key = None if joined is None else tuple(sorted([*joins[0], joined]))
+            out.append((None if key is None else t.path.get(key), c))
+        return out
+
+    def _joins(self, part: frozenset[str], into: frozenset[str]) -> _Joins | None:
+        """The keys of the other parts, and the offsets at which ``part`` joins ``into`` as a
+        part of the plan (with that part's key); None where a piece is turned."""
+        asm = self._asm
+        if any(asm.rotation_of(n) for n in part | into):
+            return None
+        names = tuple(sorted(part | into))
+        rest = [part_key(asm, p) for p in asm.parts if p != part and p != into]
+        found = join_shifts(asm, part, into, self.tables.path_parts.get(names, ()))
+        return rest, {self._offset_of(part, into, shift): key for shift, key in found}
 
     def _inserted(self, ins: Insertion) -> Assembly:
         asm = self._asm

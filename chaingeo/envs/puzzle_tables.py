@@ -3,7 +3,9 @@
 
 from __future__ import annotations
 
-from chaingeo.core.geometry import Shape
+from collections.abc import Sequence
+
+from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import Assembly, disassembly_of_assembly_plan
 from chaingeo.core.level import Level, PuzzleSolution
 from chaingeo.core.rules import PuzzleRules
@@ -14,23 +16,64 @@ from solvers.turnmoves import TurnTable
 PositionKey = tuple[PartKey, ...]
 
 
+def part_key(asm: Assembly, part: frozenset[str]) -> PartKey:
+    """One part as (name, offset relative to the part's first piece); where turns left pieces
+    turned, see :func:`chaingeo.envs.puzzle_turns.turned_part_key`."""
+    names = sorted(part)
+    if any(asm.rotation_of(n) for n in names):
+        return turned_part_key(asm, names)
+    bx, by, bz = asm.offsets[names[0]]
+    return tuple(
+        (n, (asm.offsets[n][0] - bx, asm.offsets[n][1] - by, asm.offsets[n][2] - bz)) for n in names
+    )
+
+
 def normal_key(asm: Assembly) -> PositionKey:
-    """Each part as (name, offset relative to the part's first piece), parts sorted. Where
-    turns left pieces turned, see :func:`chaingeo.envs.puzzle_turns.turned_part_key`."""
-    parts: list[PartKey] = []
-    for part in asm.parts:
-        names = sorted(part)
-        if any(asm.rotation_of(n) for n in names):
-            parts.append(turned_part_key(asm, names))
-            continue
-        bx, by, bz = asm.offsets[names[0]]
-        parts.append(
-            tuple(
-                (n, (asm.offsets[n][0] - bx, asm.offsets[n][1] - by, asm.offsets[n][2] - bz))
-                for n in names
-            )
-        )
-    return tuple(sorted(parts))
+    """Each part's :func:`part_key`, parts sorted."""
+    return tuple(sorted(part_key(asm, part) for part in asm.parts))
+
+
+def join_shifts(
+    asm: Assembly, part: frozenset[str], into: frozenset[str], keys: Sequence[PartKey]
+) -> list[tuple[Cell, PartKey]]:
+    """The shifts of ``part`` for which :func:`joined_part_key` is one of ``keys`` (part keys
+    of ``part | into``), with that key: a piece on the far side of the first name fixes it."""
+    names = sorted(part | into)
+    far = next(n for n in names if (n in part) != (names[0] in part))
+    sign = 1 if far in part else -1
+    zero = joined_part_key(asm, part, into, (0, 0, 0))
+    if zero is None:
+        return []
+    at = dict((e[0], e[1]) for e in zero)[far]
+    out: list[tuple[Cell, PartKey]] = []
+    for key in keys:
+        rel = dict((e[0], e[1]) for e in key)[far]
+        shift = (sign * (rel[0] - at[0]), sign * (rel[1] - at[1]), sign * (rel[2] - at[2]))
+        if joined_part_key(asm, part, into, shift) == key:
+            out.append((shift, key))
+    return out
+
+
+def joined_part_key(
+    asm: Assembly, part: frozenset[str], into: frozenset[str], shift: Cell
+) -> PartKey | None:
+    """:func:`part_key` of ``part | into`` once ``part`` is translated by ``shift``, without
+    building that assembly; None where a piece is turned (then build it)."""
+    names = sorted(part | into)
+    if any(asm.rotation_of(n) for n in names):
+        return None
+    offs = asm.offsets
+
+    def at(n: str) -> Cell:
+        x, y, z = offs[n]
+        return (x + shift[0], y + shift[1], z + shift[2]) if n in part else (x, y, z)
+
+    bx, by, bz = at(names[0])
+    out = []
+    for n in names:
+        x, y, z = at(n)
+        out.append((n, (x - bx, y - by, z - bz)))
+    return tuple(out)
 
 
 class PuzzleTables:
@@ -65,3 +108,7 @@ class PuzzleTables:
             for i, s in enumerate(states):
                 self.path.setdefault(normal_key(s), n - i)
             self.start_rotations = dict(states[-1].rotations)
+        #: every part of every position on the plan, by its pieces' names
+        self.path_parts: dict[tuple[str, ...], list[PartKey]] = {}
+        for p in sorted({p for k in self.path for p in k}):
+            self.path_parts.setdefault(tuple(e[0] for e in p), []).append(p)
