@@ -113,6 +113,30 @@ def test_our_gif_of_a_once_misread_stacking_level_passes_with_the_level(name: st
     assert any(n["kind"] == "hidden" for n in notes), notes  # occlusion said, not a verdict
 
 
+@pytest.mark.parametrize("name", ONCE_MISREAD_STACKING[:1])  # one level: the time budget
+def test_a_piece_blanked_out_of_our_stacking_gif_is_still_lost(name: str) -> None:
+    """The box's wire frame and the pieces round a sunk piece excuse a vanishing only where its
+    colour still shows: a piece deleted outright (in the box or waiting) is lost."""
+    from tests.judge_sweep import level, rendered
+
+    lv = level(name)
+    frames, colors = list(read_clip(rendered(name)).frames), _colors(lv)
+    n = len(frames)
+    targets = [
+        (t, k)
+        for t in range(n // 5, n - 8, 5)
+        for k in range(len(colors))
+        if all(_in_view(frames[u], colors, k) for u in range(t, t + 7))
+    ]
+    assert len(targets) >= 2
+    for t, k in (targets[0], targets[-1]):  # a piece waiting early, one placed late
+        cut = frames[:t] + [_corrupt("lost", f, colors, k) for f in frames[t:]]
+        found = _kinds(cut, colors, lv)
+        assert any(
+            kind == "lost" and abs(f - t) <= 2 and p == colors[k][0] for kind, f, p in found
+        ), (t, colors[k][0], found)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "name",
