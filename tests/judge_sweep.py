@@ -1,5 +1,6 @@
-"""Our own optimal-plan video of every shipped puzzle level, judged with its level: the
-measurement behind the false-alarm tests (``python -m tests.judge_sweep [NAME...]``).
+"""Our own optimal-plan video of every shipped puzzle level (and of every 4th shipped stacking
+level), judged with its level: the measurement behind the false-alarm tests
+(``python -m tests.judge_sweep [NAME...]``).
 
 Renders are cached as GIFs in a temporary folder (``JUDGE_SWEEP_DIR``, default
 ``/tmp/judge-sweep``), never in the repository: a video is rendered once per machine.
@@ -16,7 +17,7 @@ from typing import Any
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import shipped_levels
 from chaingeo.envs.judge_video import judge_video
-from chaingeo.envs.video import puzzle_video, write_gif
+from chaingeo.envs.video import plan_video, write_gif
 
 SIZE = 256
 
@@ -31,8 +32,14 @@ def puzzle_levels() -> list[str]:
     return sorted(p.stem for p in shipped_levels("puzzle").glob("*.json"))
 
 
+def stacking_levels() -> list[str]:
+    """Every 4th shipped stacking level: a spread of sizes at a quarter of the render time."""
+    return sorted(p.stem for p in shipped_levels("stacking").glob("*.json"))[::4]
+
+
 def level(name: str) -> Level:
-    return load_level(shipped_levels("puzzle") / f"{name}.json")
+    family = "stacking" if name.startswith("stack") else "puzzle"
+    return load_level(shipped_levels(family) / f"{name}.json")
 
 
 def rendered(name: str) -> Path:
@@ -40,7 +47,7 @@ def rendered(name: str) -> Path:
     path = cache_dir() / f"{name}-{SIZE}.gif"
     if not path.exists():
         tmp = path.with_suffix(".part.gif")
-        write_gif(puzzle_video(level(name), size=SIZE), tmp)
+        write_gif(plan_video(level(name), size=SIZE), tmp)
         tmp.replace(path)
     return path
 
@@ -51,7 +58,8 @@ def judged(name: str) -> dict[str, Any]:
 
 def main(names: list[str]) -> int:
     failed = 0
-    for name in names or puzzle_levels():
+    names = names or puzzle_levels() + stacking_levels()
+    for name in names:
         t0 = time.perf_counter()
         report = judged(name)
         secs = time.perf_counter() - t0
@@ -60,7 +68,7 @@ def main(names: list[str]) -> int:
         fit = "unfit" if any("not decidable" in u for u in report["undecided"]) else "fit  "
         verdict = "ok  " if report["valid"] else "FAIL"
         print(f"{name:40s} {verdict} {fit} {secs:5.1f}s {why}", flush=True)
-    print(f"{len(names or puzzle_levels()) - failed} pass, {failed} fail")
+    print(f"{len(names) - failed} pass, {failed} fail")
     return 1 if failed else 0
 
 

@@ -133,10 +133,13 @@ def solid_of(masks: list[BoolArray]) -> BoolArray:
     return close(solid)
 
 
-def frame_objects(masks: list[BoolArray], min_area: int) -> tuple[list[Obj], BoolArray]:
+def frame_objects(
+    masks: list[BoolArray], min_area: int, occluders: BoolArray | None = None
+) -> tuple[list[Obj], BoolArray]:
     """Objects of one frame (each class's components grouped across occluders), and the
-    frame's piece pixels (:func:`solid_of`)."""
-    solid = solid_of(masks)
+    frame's piece pixels (:func:`solid_of`) with ``occluders`` (a box's wire frame drawn over
+    the pieces), which hide pieces as pieces do."""
+    solid = solid_of(masks if occluders is None else [*masks, occluders])
     out: list[Obj] = []
     for k, mask in enumerate(masks):
         comps = components(mask, min_area)

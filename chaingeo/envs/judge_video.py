@@ -51,6 +51,17 @@ EVIDENCE_ZOOM: Final = 2
 NEAR_SHARE: Final = 0.1
 #: Mean change (RGB levels) below which a region's picture is the same in two frames.
 UNCHANGED: Final = 12.0
+#: A piece that vanishes is sunk among others when this share of the ring round its last
+#: silhouette lies on other pieces, and this share of its area still shows in its colour
+#: within SUNK_REACH pixels.
+SUNK_WALLED: Final = 0.5
+SUNK_LEFT: Final = 0.15
+SUNK_REACH: Final = 6
+#: The box's wire frame in our renders: grey level, its spread (anti-aliasing), and the largest
+#: channel spread of a neutral grey.
+WIRE_GREY: Final = 90.0
+WIRE_SPREAD: Final = 35.0
+WIRE_CHROMA: Final = 12
 _TINTS: Final = ((255, 0, 255), (0, 255, 255), (255, 255, 0), (0, 255, 0))
 
 
@@ -203,7 +214,11 @@ def judge_frames(
         raise VideoJudgeError(str(e)) from None
     area = min_area(frames[0].shape)
     masks = [class_masks(f, model) for f in frames]
-    objects = [frame_objects(m, area) for m in masks]
+    wire = level is not None and getattr(level, "box", None) is not None
+    objects = [
+        frame_objects(m, area, _wire(f, m) if wire else None)
+        for f, m in zip(frames, masks, strict=True)
+    ]
     events = Tracker(objects, model.names).events()
     shape = frames[0].shape[:2]
     kept = [[_union(objs, k, shape) for k in range(len(model.names))] for objs, _ in objects]
@@ -215,6 +230,8 @@ def judge_frames(
             "pass_through: motion through another piece is not decidable without the level's "
             "geometry and a known camera (give --level for a video drawn by chain video)"
         )
+    solids = [solid for _, solid in objects]
+    events = [_sunk(e, masks, solids, model.names) for e in events]
     misread = [e for e in events if _misread(frames, masks, kept, e, model.names)]
     undecided += [f"frame {e.frame}: {e.detail} (but it was misread)" for e in misread]
     events = [e for e in events if e not in misread]
@@ -223,6 +240,17 @@ def judge_frames(
     violations = tuple(e for e in events if e.kind in VIOLATIONS)
     notes = tuple(e for e in events if e.kind not in VIOLATIONS)
     return Verdict(violations, notes, tuple(undecided), model, len(frames))
+
+
+def _wire(frame: U8, masks: list[BoolArray]) -> BoolArray:
+    """Pixels of the box's wire frame our renderer draws over a stacking scene: a dark
+    neutral grey (render._FRAME, anti-aliased) that is no piece's colour."""
+    rgb = frame.astype(np.int64)
+    grey = (rgb.max(axis=2) - rgb.min(axis=2) <= WIRE_CHROMA) & (
+        np.abs(rgb.mean(axis=2) - WIRE_GREY) <= WIRE_SPREAD
+    )
+    out: BoolArray = grey & ~np.logical_or.reduce(masks)
+    return out
 
 
 def _with_level(
@@ -279,6 +307,24 @@ def _misread(
     near = dilate(m, max(2, round(NEAR_SHARE * max(m.shape))))
     fragments = masks[other][k] & ~kept[other][k]
     return float((fragments & near).sum()) >= 0.5 * float(m.sum())
+
+
+def _sunk(
+    e: Event, masks: list[list[BoolArray]], solids: list[BoolArray], names: tuple[str, ...]
+) -> Event:
+    """A piece said lost whose last silhouette was mostly surrounded by other pieces (or the
+    box's wire frame) and whose colour still shows in fragments where it was: it went out of
+    sight among them (a piece lowered into a box behind pieces placed before), not lost."""
+    if e.kind != "lost" or not e.masks or e.frame < 1:
+        return e
+    m, k = e.masks[0], names.index(e.piece)
+    ring = dilate(m, 2) & ~m
+    walled = float((ring & solids[e.frame - 1]).sum()) >= SUNK_WALLED * float(ring.sum())
+    left = float((masks[e.frame][k] & dilate(m, SUNK_REACH)).sum())
+    if not walled or left < SUNK_LEFT * float(m.sum()):
+        return e
+    detail = f"the {e.piece} piece went out of sight among other pieces (fragments still seen)"
+    return replace(e, kind="hidden", detail=detail)
 
 
 def _union(objs: list[Obj], k: int, shape: tuple[int, ...]) -> BoolArray:
