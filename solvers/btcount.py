@@ -36,7 +36,7 @@ from solvers.btassemble import (
 )
 from solvers.constrained import Packing
 from solvers.deadline import Deadline
-from solvers.disassemble import Analysis, Separations
+from solvers.disassemble import KERNEL_NODES, Analysis, Separations
 from solvers.partsearch import SearchLimits
 
 I64 = npt.NDArray[np.int64]
@@ -111,11 +111,10 @@ class RowVerdicts:
         self.keys = np.full(packing.n_rows, _UNKNOWN, dtype=np.int64)
         self.shared = {t: self.image.shared[slot] for t, slot in self.type_slot.items()}
         lim = limits or SearchLimits()
+        total = -1 if lim.max_total_states is None else lim.max_total_states
         self.params = np.array(
-            [lim.max_states, lim.group_limit, 20000, -1 if lim.max_total_states is None
-             else lim.max_total_states],
-            dtype=np.int64,
-        )  # fmt: skip
+            [lim.max_states, lim.group_limit, KERNEL_NODES, total], dtype=np.int64
+        )
         self.level: str | None = None
 
     def _key(self, rows: I64) -> I64:
@@ -123,7 +122,7 @@ class RowVerdicts:
         keys = self.keys[rows]
         for r in np.unique(rows[keys == _UNKNOWN]).tolist():
             name = self.type_slot[int(self.row_type[r])]
-            t, x, y, z = self.image._key(name, self.packing.placed(r).voxels)
+            t, x, y, z = self.image.placement_key(name, self.packing.placed(r).voxels)
             self.keys[r] = (((t << 16 | x + _BIAS) << 16 | y + _BIAS) << 16) | z + _BIAS
         return self.keys[rows]
 

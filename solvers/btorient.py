@@ -163,12 +163,14 @@ class BTImage:
         image: dict[str, Shape] = {}
         for part in parts:
             moved = [placed[n].voxels @ np.asarray(m).T + shift for n in part]
-            ranked = sorted(moved, key=lambda v: self._key(part[0], v))
+            ranked = sorted(moved, key=lambda v: self.placement_key(part[0], v))
             for n, v in zip(part, ranked, strict=True):
                 image[n] = Shape(v)
         return image, np.asarray(m, dtype=np.int64)
 
-    def _key(self, name: str, vox: np.ndarray) -> Key:
+    def placement_key(self, name: str, vox: np.ndarray) -> Key:
+        """BurrTools' placement of a piece: its first rotation giving the voxels, and where the
+        shape's origin lands."""
         t, low = self.find[name][_normal(vox)]
         p = vox.min(axis=0) - low
         return (t, int(p[0]), int(p[1]), int(p[2]))

@@ -58,7 +58,7 @@ __all__ = [
 _UNSOLVABLE = 1 << 30
 #: Nodes the level kernel may expand before the Python search (with its deadline) takes over:
 #: the Python search's own chunk between two clock readings.
-_KERNEL_NODES = 20000
+KERNEL_NODES = 20000
 #: Tree nodes and memo entries the level kernel starts with (4 moves per node).
 _TREE_ROWS = 64
 
@@ -264,7 +264,7 @@ class _Solver:
 
     def level_tree(self) -> Separation | None:
         """:meth:`part_tree` of the whole assembled puzzle (translations only, no piece
-        groups) in one kernel call, decoded into a tree; past :data:`_KERNEL_NODES` expanded
+        groups) in one kernel call, decoded into a tree; past :data:`KERNEL_NODES` expanded
         nodes the Python search takes over, reading the clock between chunks."""
         n = len(self.table.names)
         if n > mv.MAX_PIECES:
@@ -276,7 +276,7 @@ class _Solver:
             [
                 lim.max_states,
                 lim.group_limit,
-                _KERNEL_NODES,
+                KERNEL_NODES,
                 -1 if lim.max_total_states is None else lim.max_total_states,
             ],
             dtype=np.int64,
@@ -338,7 +338,7 @@ class _Solver:
     def any_tree(self) -> Separation | None:
         """:meth:`greedy` of the whole assembled puzzle (translations only, no piece groups)
         in one kernel call (:func:`solvers.levelsearch.greedy`), decoded into a tree. Past
-        :data:`_KERNEL_NODES` expanded nodes it hands over to :meth:`greedy`, which checks
+        :data:`KERNEL_NODES` expanded nodes it hands over to :meth:`greedy`, which checks
         the deadline between chunks (the kernel cannot read the clock)."""
         n = len(self.table.names)
         lim = self.limits
@@ -348,7 +348,7 @@ class _Solver:
                 lim.group_limit,
                 lim.max_states,
                 -1 if lim.max_total_states is None else lim.max_total_states,
-                _KERNEL_NODES,
+                KERNEL_NODES,
             ],
             dtype=np.int64,
         )

@@ -151,7 +151,7 @@ def test_level_kernel_matches_python_search(
         return
     limits = SearchLimits(max_total_states=total)
     mp = pytest.MonkeyPatch()
-    mp.setattr(disassemble, "_KERNEL_NODES", budget)
+    mp.setattr(disassemble, "KERNEL_NODES", budget)
     mp.setattr(disassemble, "_TREE_ROWS", 1)
     try:
         fast = _level_or_error(_Solver(shapes, max_group, limits, separations=separations), True)
