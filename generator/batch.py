@@ -2,7 +2,7 @@
 
 Underneath is one pure function per family, ``make(config, seed, index) -> Level | Rejection``;
 a worker runs it (and draws the pictures) and sends back bytes. The runner, the only writer,
-takes the results strictly in index order, reserves each signature (:mod:`generator.dedup`)
+takes the results strictly in index order, reserves each signature (:mod:`chaingeo.generator.dedup`)
 and writes the accepted ones, until ``count`` levels are accepted or ``max_items`` indices
 were tried. So which levels come out, and their bytes, do not depend on the backend or the
 number of workers. Output folder::
@@ -29,9 +29,9 @@ from typing import Any
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.files import atomic_write
 from chaingeo.core.level import Level, level_bytes
-from generator.dedup import Reservation, SignatureStore
-from generator.result import ATTEMPTS_KEY, Rejection
-from generator.signature import level_signature
+from chaingeo.generator.dedup import Reservation, SignatureStore
+from chaingeo.generator.result import ATTEMPTS_KEY, Rejection
+from chaingeo.generator.signature import level_signature
 
 MakeFn = Callable[[Any, int, int], "Level | Rejection"]
 PictureFn = Callable[[Level], dict[str, bytes]]
@@ -51,7 +51,7 @@ class GenerationJob:
     """What to generate: ``count`` levels of ``family`` from items ``first_index`` onwards.
 
     ``make`` and ``pictures`` must be module-level functions (they travel to workers by name).
-    ``held_out``: split signatures (:mod:`generator.signature`) never accepted, each such level
+    ``held_out``: split signatures (:mod:`chaingeo.generator.signature`) never accepted, each such level
     counted as :data:`HELD_OUT` (a train split holds out the shipped suite).
     """
 

@@ -8,7 +8,7 @@ them by name (``tests/data/burrtools/<name>.xmpuzzle`` holds each one as written
   colour rules leave a handful.
 * ``linked_rings``: two linked rings in one piece group on a base, the top layer variable and
   an optional lid: the rings never come apart, and need not.
-* ``ring_maze``: a maze burr (:mod:`generator.maze`) whose pin carries a ring it can never
+* ``ring_maze``: a maze burr (:mod:`chaingeo.generator.maze`) whose pin carries a ring it can never
   lose (pin and ring in one group); the ring sits at either of two heights (variable cells).
 * ``deep_maze``: a maze burr on a staircase path, level above 50.
 * ``soma_problems``: three problems in one file: the Soma cube; the Soma pieces with ranges
@@ -38,7 +38,7 @@ from chaingeo.core.formats.burrtools import (
 from chaingeo.core.geometry import Cell, Shape, box_cells
 from chaingeo.core.piecesets import PENTOMINOES, SOMA
 from chaingeo.core.piecesets.burrs import SOLID_BURR_CODES, burr_piece, solid_knot
-from generator.maze import maze_pieces, maze_search
+from chaingeo.generator.maze import maze_pieces, maze_search
 
 _STEPS = ((1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1))
 
@@ -213,6 +213,6 @@ def write_examples(folder: str | os.PathLike[str]) -> list[Path]:
     ]
 
 
-if __name__ == "__main__":  # python -m generator.bt_examples tests/data/burrtools
+if __name__ == "__main__":  # python -m chaingeo.generator.bt_examples tests/data/burrtools
     for path in write_examples(sys.argv[1] if len(sys.argv) > 1 else "."):
         print(path)

@@ -1,8 +1,8 @@
 """One puzzle design under improvement, and the solver's verdict on it.
 
-Shared by the layout search (:mod:`generator.puzzle`) and the cube search
-(:mod:`generator.cubes`): a candidate is a list of pieces (assembled position) with the
-BurrTools-style analysis of :func:`solvers.disassemble.analyze`, scored by (level, total moves).
+Shared by the layout search (:mod:`chaingeo.generator.puzzle`) and the cube search
+(:mod:`chaingeo.generator.cubes`): a candidate is a list of pieces (assembled position) with the
+BurrTools-style analysis of :func:`chaingeo.solvers.disassemble.analyze`, scored by (level, total moves).
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ from collections.abc import Sequence
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
-from generator.config import PuzzleConfig
-from solvers.disassemble import Analysis, analyze
-from solvers.partsearch import SearchLimits
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.solvers.disassemble import Analysis, analyze
+from chaingeo.solvers.partsearch import SearchLimits
 
 Score = tuple[int, int]
 

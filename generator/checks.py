@@ -14,11 +14,11 @@ recorded search effort.
 from __future__ import annotations
 
 from chaingeo.core.level import Level, StackingSolution
-from generator import packing
-from generator.assembly import assembly_order, has_isolated_piece
-from generator.config import StackingConfig
-from generator.partition import PieceRules, is_planar
-from generator.stacking import piece_problem
+from chaingeo.generator import packing
+from chaingeo.generator.assembly import assembly_order, has_isolated_piece
+from chaingeo.generator.config import StackingConfig
+from chaingeo.generator.partition import PieceRules, is_planar
+from chaingeo.generator.stacking import piece_problem
 
 
 def _two_equal_sides(extent: tuple[int, int, int]) -> bool:

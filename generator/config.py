@@ -194,16 +194,16 @@ for _box in BOX_LIMITS:
 class PuzzleConfig:
     """What to make. ``shape``: a layout name (burr3, plate3, burr6, burr12, burr18, burr24,
     burr36), ``burr6x8`` / ``burr6x8u`` (Cutler's standard six-piece burr, 2x2x8 holey sticks;
-    ``u``: unique assembly, :mod:`generator.standard_burr`), ``cubeN`` with ``pieces``, or
+    ``u``: unique assembly, :mod:`chaingeo.generator.standard_burr`), ``cubeN`` with ``pieces``, or
     ``mazeN`` (a maze burr on an N x N grid, the best of ``hill_steps`` walks); ``min_level``:
     moves until the first part comes free. Towers (burr12..burr36) with ``max_group=1`` are
-    built unit by unit (:mod:`generator.deep`)."""
+    built unit by unit (:mod:`chaingeo.generator.deep`)."""
 
     shape: str = "burr6"
     min_level: int = 1
     pieces: int = 0  # cube partitions only
     hole_rate: float = 0.1  # chance a shared cell starts empty (0: solid burrs); cubes:
-    # the share of inner cells left empty (at least one, see generator.cubes)
+    # the share of inner cells left empty (at least one, see chaingeo.generator.cubes)
     hill_steps: int = 300  # improvement steps (cubes: steering one level deeper at a time)
     goal: Literal["disassemble", "assemble"] = "disassemble"
     max_group: int | None = None
@@ -227,7 +227,7 @@ class PuzzleConfig:
         return dataclasses.asdict(self)
 
 
-#: ``--shape`` names of Cutler's standard six-piece burrs (:mod:`generator.standard_burr`):
+#: ``--shape`` names of Cutler's standard six-piece burrs (:mod:`chaingeo.generator.standard_burr`):
 #: ``burr6x8`` (six 2x2x8 sticks); ``burr6x8u`` also demands that the pieces assemble in
 #: exactly one way (the CLI passes configuration by shape name).
 STANDARD_SHAPES: Final = ("burr6x8", "burr6x8u")

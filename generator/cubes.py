@@ -33,10 +33,10 @@ import numpy.typing as npt
 from chaingeo.core.geometry import NEIGHBOURS, Shape
 from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Assembly, SearchLimitError
-from generator.candidate import Candidate, evaluate, piece_names, probe_limits
-from generator.config import PuzzleConfig
-from solvers.disassemble import fast_legal_moves
-from solvers.partsearch import Deadline, PartSearch, PieceTable, Removal
+from chaingeo.generator.candidate import Candidate, evaluate, piece_names, probe_limits
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.solvers.disassemble import fast_legal_moves
+from chaingeo.solvers.partsearch import Deadline, PartSearch, PieceTable, Removal
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import Final
 
-from generator.config import PuzzleConfig, StackingConfig, stacking_config
+from chaingeo.generator.config import PuzzleConfig, StackingConfig, stacking_config
 
 #: Stacking steps: (box, mode), easy to hard.
 STACKING_STEPS: Final[tuple[tuple[tuple[int, int, int], str], ...]] = (

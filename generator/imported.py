@@ -1,7 +1,7 @@
 """Levels made from CHAIN's published models: the importer's lattice pieces plus what needs
 the solvers (a puzzle's level and optimal plan, a stacking model's packing).
 
-One place for ``chain import`` and for the puzzle suite (:mod:`generator.puzzle_suite`), so an
+One place for ``chain import`` and for the puzzle suite (:mod:`chaingeo.generator.puzzle_suite`), so an
 imported level in the suite is byte for byte what ``chain import`` writes for the same model
 and options.
 """
@@ -17,11 +17,11 @@ from chaingeo.core.formats.models import (
     model_stacking_level,
 )
 from chaingeo.core.level import Difficulty, Level
-from generator.puzzle import difficulty_of
-from solvers.analysis import analyze_puzzle
-from solvers.cover import first_solution
-from solvers.disassemble import Analysis
-from solvers.partsearch import SearchLimits
+from chaingeo.generator.puzzle import difficulty_of
+from chaingeo.solvers.analysis import analyze_puzzle
+from chaingeo.solvers.cover import first_solution
+from chaingeo.solvers.disassemble import Analysis
+from chaingeo.solvers.partsearch import SearchLimits
 
 #: The caps of ``chain import`` (its ``--max-states`` / ``--max-total-states`` / ``--seconds``).
 IMPORT_LIMITS = SearchLimits(max_states=500_000, seconds=120.0, max_total_states=3_000_000)
@@ -61,7 +61,7 @@ def imported_puzzle_level(
     level_id: str | None = None,
 ) -> tuple[Level, Analysis]:
     """The verified puzzle level of an imported model: level and o_i from
-    :func:`solvers.analysis.analyze_puzzle`, difficulty from the suite's rule. Raises
+    :func:`chaingeo.solvers.analysis.analyze_puzzle`, difficulty from the suite's rule. Raises
     :class:`ModelImportError` when the model does not come apart (by translations, or also by
     turns when ``turns``) and :class:`~chaingeo.core.kinematics.SearchLimitError` at the caps."""
     a = analyze_puzzle(

@@ -138,7 +138,7 @@ def plate3() -> Layout:
 
 
 #: Layout builders by puzzle shape name; cubeN, mazeN and burr6x8[u] have families of their
-#: own (:data:`generator.puzzle.SHAPES`).
+#: own (:data:`chaingeo.generator.puzzle.SHAPES`).
 LAYOUTS: Registry[Callable[[], Layout]] = Registry(
     "puzzle shape", missing="unknown {kind} {name!r} (cubeN, mazeN, burr6x8, burr6x8u or a layout)"
 )

@@ -1,4 +1,4 @@
-"""The generator's thin layer over the exact-cover engine (:mod:`solvers.cover`).
+"""The generator's thin layer over the exact-cover engine (:mod:`chaingeo.solvers.cover`).
 
 Two questions are asked of it: how hard is a packing to find (nodes of a plain dancing-links
 search with MRV column choice to the first packing, the CHAIN generator's difficulty proxy;
@@ -18,7 +18,7 @@ from typing import Any, Final
 import numpy as np
 
 from chaingeo.core.geometry import Shape
-from solvers.cover import (
+from chaingeo.solvers.cover import (
     CoverLimitError,
     CoverSearch,
     count_solutions,

@@ -1,10 +1,10 @@
 """Interlocking-puzzle generator: one pure function ``make(config, seed, index)``.
 
-A candidate is a random design of a layout (:mod:`generator.layouts`: who owns each shared
+A candidate is a random design of a layout (:mod:`chaingeo.generator.layouts`: who owns each shared
 cell of a burr, a plate burr or a chain of burr units), improved by hill climbing on single
 voxels (give one shared cell to another slot), keeping a change when the puzzle still comes
 apart and its (level, total moves) does not drop; or an interlocking partition of an n x n x n
-cube (:mod:`generator.cubes`). The result is
+cube (:mod:`chaingeo.generator.cubes`). The result is
 accepted when it reaches ``min_level``; its optimal plan (o_i) is then computed exactly and the
 level file is built and verified. Everything random comes from ``SeedSequence([seed, index])``.
 """
@@ -31,18 +31,18 @@ from chaingeo.core.level import (
 )
 from chaingeo.core.registry import Registry
 from chaingeo.core.rules import PuzzleRules
-from generator.candidate import Candidate, evaluate
-from generator.config import STANDARD_SHAPES, PuzzleConfig
-from generator.cubes import cube_search, interlocking_target
-from generator.deep import TOWERS, maze_candidate, tower_candidate
-from generator.layouts import get_layout
-from generator.maze import parse_maze_shape
-from generator.result import Rejection
-from generator.standard_burr import standard_burr_search
-from solvers.analysis import BLOCKS_KEY, analyze_puzzle
-from solvers.partsearch import SearchLimits
+from chaingeo.generator.candidate import Candidate, evaluate
+from chaingeo.generator.config import STANDARD_SHAPES, PuzzleConfig
+from chaingeo.generator.cubes import cube_search, interlocking_target
+from chaingeo.generator.deep import TOWERS, maze_candidate, tower_candidate
+from chaingeo.generator.layouts import get_layout
+from chaingeo.generator.maze import parse_maze_shape
+from chaingeo.generator.result import Rejection
+from chaingeo.generator.standard_burr import standard_burr_search
+from chaingeo.solvers.analysis import BLOCKS_KEY, analyze_puzzle
+from chaingeo.solvers.partsearch import SearchLimits
 
-GENERATOR = "generator.puzzle"
+GENERATOR = "chaingeo.generator.puzzle"
 VERSION = "1"
 
 
@@ -131,8 +131,8 @@ def puzzle_level(
     (the assembly optimum equals the disassembly optimum: the two state graphs are mirror
     images). Raises :class:`SearchLimitError` when o_i cannot be computed within ``limits``.
     ``blocks`` (indices into ``shapes``, a stack of units along z; single-piece moves only)
-    proves o_i with the block bound of :mod:`solvers.blockbound` instead of searching; the
-    level carries them (``stats["blocks"]``) so that :func:`solvers.analysis.analyze_level`
+    proves o_i with the block bound of :mod:`chaingeo.solvers.blockbound` instead of searching; the
+    level carries them (``stats["blocks"]``) so that :func:`chaingeo.solvers.analysis.analyze_level`
     analyses it the same way.
     """
     base = np.min(np.concatenate([s.voxels for s in shapes]), axis=0)

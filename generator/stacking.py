@@ -22,7 +22,7 @@ in a random order (colours carry no hint) and handed to the agent in a random ro
 ``rejected_attempts`` (reason -> count for the failed attempts before), ``repair_moves``,
 ``exact_cover`` (``nodes_first``: dancing-links nodes to a first packing; ``solutions`` and
 ``distinct`` packings when counted within ``count_budget`` nodes, else None; see
-:mod:`generator.packing`) and ``linear_assembly`` (``[piece, direction it slides in]`` in
+:mod:`chaingeo.generator.packing`) and ``linear_assembly`` (``[piece, direction it slides in]`` in
 insertion order, or None).
 """
 
@@ -39,10 +39,10 @@ from chaingeo.core.colors import assign_colors
 from chaingeo.core.geometry import ROTATIONS, Shape
 from chaingeo.core.level import Level, stacking_level
 from chaingeo.core.rules import StackingRules
-from generator import packing
-from generator.assembly import assembly_order, has_isolated_piece
-from generator.config import StackingConfig, box_text
-from generator.partition import (
+from chaingeo.generator import packing
+from chaingeo.generator.assembly import assembly_order, has_isolated_piece
+from chaingeo.generator.config import StackingConfig, box_text
+from chaingeo.generator.partition import (
     PieceRules,
     box_grid,
     grow,
@@ -52,9 +52,9 @@ from generator.partition import (
     random_sizes,
     repair,
 )
-from generator.result import ATTEMPTS_KEY, Rejection
+from chaingeo.generator.result import ATTEMPTS_KEY, Rejection
 
-GENERATOR: Final = "generator.stacking"
+GENERATOR: Final = "chaingeo.generator.stacking"
 #: Bump when a change to the algorithm changes what a (config, seed, index) produces.
 VERSION: Final = "1"
 

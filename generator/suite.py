@@ -15,9 +15,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Final
 
-from generator.batch import GenerationJob, PictureFn, Summary, run
-from generator.config import StackingConfig, get_config
-from generator.stacking import GENERATOR, make
+from chaingeo.generator.batch import GenerationJob, PictureFn, Summary, run
+from chaingeo.generator.config import StackingConfig, get_config
+from chaingeo.generator.stacking import GENERATOR, make
 
 DEFAULT_OUT: Final = Path("levels") / "stacking"
 

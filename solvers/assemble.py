@@ -2,11 +2,11 @@
 decides which of them can actually be taken apart ('assemblies' and 'solutions' as BurrTools
 counts them).
 
-Assemblies come from the exact-cover engine (:mod:`solvers.cover`) with every rotation of every
+Assemblies come from the exact-cover engine (:mod:`chaingeo.solvers.cover`) with every rotation of every
 piece, one per class of the target's rotations (symmetric duplicates removed; mirror images are
 kept apart, BurrTools' default). A *solution* is an assembly the disassembler can take apart
 completely under the reference kinematics. :func:`count_solutions` runs the enumeration and
-every disassembly under one :class:`solvers.deadline.Deadline` (``limits.seconds``).
+every disassembly under one :class:`chaingeo.solvers.deadline.Deadline` (``limits.seconds``).
 """
 
 from __future__ import annotations
@@ -16,11 +16,11 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 from chaingeo.core.geometry import Shape
-from solvers.cover import iter_solutions
-from solvers.deadline import Deadline
-from solvers.disassemble import Analysis, analyze
-from solvers.partsearch import SearchLimits
-from solvers.problem import PieceSpec
+from chaingeo.solvers.cover import iter_solutions
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.disassemble import Analysis, analyze
+from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.problem import PieceSpec
 
 
 @dataclass(frozen=True)

@@ -41,9 +41,9 @@ from collections.abc import Mapping, Sequence
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, Move, MoveError, SearchLimitError
-from solvers.deadline import Deadline
-from solvers.disassemble import Analysis, analyze, translations
-from solvers.partsearch import SearchLimits
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.disassemble import Analysis, analyze, translations
+from chaingeo.solvers.partsearch import SearchLimits
 
 
 def block_lower_bound(
@@ -169,7 +169,7 @@ def analyze_by_blocks(
     search: bool = True,
     deadline: Deadline | None = None,
 ) -> Analysis:
-    """:func:`solvers.disassemble.analyze` with single-piece moves and the block bound: a plan
+    """:func:`chaingeo.solvers.disassemble.analyze` with single-piece moves and the block bound: a plan
     whose length meets the bound is optimal. Tried in turn: the BurrTools-style plan, (when
     ``stacked``: the blocks form a stack along z, see :func:`end_first_plan`) the stack taken
     apart from its ends, and (when ``search``) the exact search, which stops once it meets

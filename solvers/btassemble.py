@@ -1,4 +1,4 @@
-"""BurrTools' assembler on a compiled packing (:mod:`solvers.constrained`): assemblies, mirror
+"""BurrTools' assembler on a compiled packing (:mod:`chaingeo.solvers.constrained`): assemblies, mirror
 images, holes, and the solutions the disassembler takes apart.
 
 *Assemblies* are counted as BurrTools counts them: one per class of the result's symmetries
@@ -11,13 +11,13 @@ variable cells empty.
 
 The search is cut by symmetry first: an anchor (a piece used exactly once, else a fixed cell
 and the rotations keeping it in place) keeps one placement per orbit, so every class is met at
-least once; canonical keys (:func:`solvers.constrained.canonical_keys`) then keep each class
+least once; canonical keys (:func:`chaingeo.solvers.constrained.canonical_keys`) then keep each class
 once, the first met in the engine's fixed order. *Solutions* are the classes the disassembler
-takes apart (:func:`solvers.disassemble.analyze`; with piece groups
-:func:`solvers.groups.analyze_grouped`), under the same moves as everything else here.
+takes apart (:func:`chaingeo.solvers.disassemble.analyze`; with piece groups
+:func:`chaingeo.solvers.groups.analyze_grouped`), under the same moves as everything else here.
 
 *Time*: :func:`count_bt` runs the enumeration and every disassembly under one
-:class:`solvers.deadline.Deadline` (the caller's, else one of ``limits.seconds``); past it a
+:class:`chaingeo.solvers.deadline.Deadline` (the caller's, else one of ``limits.seconds``); past it a
 :class:`SearchLimitError` naming ``seconds`` is raised, wherever the time went.
 """
 
@@ -31,8 +31,8 @@ import numpy as np
 
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
-from solvers.btorient import BTImage
-from solvers.constrained import (
+from chaingeo.solvers.btorient import BTImage
+from chaingeo.solvers.constrained import (
     ColoredPiece,
     ColorRules,
     Packing,
@@ -40,14 +40,14 @@ from solvers.constrained import (
     PartSpec,
     canonical_keys,
 )
-from solvers.deadline import Deadline
-from solvers.disassemble import Analysis, Separations, analyze
-from solvers.groups import PieceGroups, analyze_grouped
-from solvers.partsearch import SearchLimits
-from solvers.placements import Int32Array
-from solvers.problem import CoverError
-from solvers.rowreduce import live_rows
-from solvers.search import CoverSearch
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.disassemble import Analysis, Separations, analyze
+from chaingeo.solvers.groups import PieceGroups, analyze_grouped
+from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.placements import Int32Array
+from chaingeo.solvers.problem import CoverError
+from chaingeo.solvers.rowreduce import live_rows
+from chaingeo.solvers.search import CoverSearch
 
 Mirrors = Literal["keep", "drop"]
 
@@ -95,7 +95,7 @@ class Anchor:
 def choose_anchor(packing: Packing) -> Anchor | None:
     """One placement per rotation orbit of a piece used exactly once, else of the rows through
     a fixed cell (under the rotations fixing it); None without symmetry. Among pieces, as the
-    engine does (:func:`solvers.cover.anchor_plan`): the fewest orientations first (the most
+    engine does (:func:`chaingeo.solvers.cover.anchor_plan`): the fewest orientations first (the most
     symmetric piece, Knuth's choice for pentominoes), then the fewest representatives per
     placement, then the fewest representatives."""
     maps = packing.row_maps(False)
@@ -218,7 +218,7 @@ def named_assembly(packing: Packing, rows: Int32Array) -> dict[str, Shape]:
 
 class BTFrame:
     """Turns an assembly into the symmetric image BurrTools' assembler reports
-    (:class:`solvers.btorient.BTImage`), whose disassembly BurrTools prints."""
+    (:class:`chaingeo.solvers.btorient.BTImage`), whose disassembly BurrTools prints."""
 
     def __init__(self, packing: Packing) -> None:
         spec = packing.spec
@@ -266,7 +266,7 @@ def disassemble(
     """The disassembler's verdict on one assembly (level and moves), groups honoured
     (``groups``: :func:`piece_groups` of the packing, when the caller has it already;
     ``deadline``: the analysis' shared one, else one of ``limits.seconds``;
-    ``separations``: see :func:`solvers.disassemble.analyze`). Pieces are searched in the
+    ``separations``: see :func:`chaingeo.solvers.disassemble.analyze`). Pieces are searched in the
     assembly's order (:func:`named_assembly`: BurrTools')."""
     groups = piece_groups(packing) if groups is None else groups
     order = list(assembly)

@@ -28,9 +28,9 @@ import numpy.typing as npt
 
 from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Move, SearchLimitError
-from solvers import movement as mv
-from solvers.deadline import Deadline
-from solvers.levelsearch import (
+from chaingeo.solvers import movement as mv
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.levelsearch import (
     EXPANDED,
     GROUP_CAP,
     INFO,
@@ -41,7 +41,7 @@ from solvers.levelsearch import (
     TOTAL_CAP,
     _record,
 )
-from solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits, part_size
+from chaingeo.solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits, part_size
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]
@@ -137,7 +137,7 @@ def part_search(
     added stay, as BurrTools would have added them in the same order). ``move`` rows: mask,
     direction, distance of the move that found each state. The part's pieces are the table
     rows ``members`` (``vox`` ... ``hi``: the whole puzzle's :class:`PieceTable` arrays), their
-    pair gaps kept in ``memo_rel``/``memo_gap`` (:func:`solvers.movement.memo_pair_gaps`).
+    pair gaps kept in ``memo_rel``/``memo_gap`` (:func:`chaingeo.solvers.movement.memo_pair_gaps`).
     Returns a status code."""
     k = members.shape[0]
     half = k // 2
@@ -239,7 +239,7 @@ def part_search(
 #: nodes to expand in the call, max_total_states (-1: none).
 MAX_STATES, GROUP_LIMIT, BUDGET, MAX_TOTAL = 0, 1, 2, 3
 #: ``ctx`` of :func:`first_tree` has the slots and status codes of
-#: :func:`solvers.levelsearch.greedy` (its tree is decoded the same way); no memo.
+#: :func:`chaingeo.solvers.levelsearch.greedy` (its tree is decoded the same way); no memo.
 
 
 @njit(cache=True)

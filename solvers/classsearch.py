@@ -1,12 +1,12 @@
 """o_i with multi-piece moves: iterative deepening under the class bound.
 
 Towers of burr units played with moves that may carry any group of pieces have state spaces far
-beyond breadth-first search, and A* with pair databases (:mod:`solvers.astar`) proves only 36
-on the suite's 36-piece towers. The class bound of :mod:`solvers.classbound` is much closer; as
+beyond breadth-first search, and A* with pair databases (:mod:`chaingeo.solvers.astar`) proves only 36
+on the suite's 36-piece towers. The class bound of :mod:`chaingeo.solvers.classbound` is much closer; as
 the heuristic of a depth-first iterative deepening search it closes them (figures: README,
 "Class search", and ``chain bench astar``).
 
-**Problem** as in :mod:`solvers.astar`: a state is a partition of the pieces into parts with
+**Problem** as in :mod:`chaingeo.solvers.astar`: a state is a partition of the pieces into parts with
 offsets; a move carries a proper group of one part one or more steps along an axis, or away for
 good (a *removal*, which splits the part); parts never interact again, so the distance of a
 state is the sum of its parts' distances ``d(P)``.
@@ -24,7 +24,7 @@ every child, whatever ``h`` says of them.)
 
 **Search.** ``within(P, r)`` finds a plan of at most ``r`` moves for part ``P`` or proves there
 is none. It prunes when ``h(P) > r`` or a memoised lower bound on ``d(P)`` exceeds ``r``; else
-it tries every legal move of ``P`` (:func:`solvers.movement.node_moves`: one of each group / rest
+it tries every legal move of ``P`` (:func:`chaingeo.solvers.movement.node_moves`: one of each group / rest
 pair, every finite distance, and the removal), smallest ``f = 1 + bound(child)`` first,
 removals first among equals. A finite move needs ``within(P', r - 1)``. A removal into ``P1``
 and ``P2`` needs ``d(P1) + d(P2) <= r - 1``: ``d(P1)`` is found exactly (deepening from its
@@ -44,11 +44,11 @@ import numpy as np
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Move, SearchLimitError
-from solvers import movement as mv
-from solvers.classbound import MAX_BUDGET, ClassVectors, moved
-from solvers.deadline import Deadline, deadline_of
-from solvers.disassemble import Analysis, analyze
-from solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits
+from chaingeo.solvers import movement as mv
+from chaingeo.solvers.classbound import MAX_BUDGET, ClassVectors, moved
+from chaingeo.solvers.deadline import Deadline, deadline_of
+from chaingeo.solvers.disassemble import Analysis, analyze
+from chaingeo.solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits
 
 Offsets = np.ndarray
 Key = tuple[tuple[int, ...], bytes]
@@ -266,7 +266,7 @@ def class_search_optimal(
 ) -> ClassSearchResult:
     """o_i of ``shapes`` (assembled as given) and an optimal plan, by the search of the module
     docstring with the class bound over ``blocks`` (a partition of the piece names; for a
-    tower of burr units, :func:`solvers.classbound.band_blocks`). ``deadline``: shared with
+    tower of burr units, :func:`chaingeo.solvers.classbound.band_blocks`). ``deadline``: shared with
     the caller's other searches (default: one of ``limits.seconds``).
 
     Raises ``ValueError`` when the blocks are not a partition, and :class:`SearchLimitError`
@@ -316,7 +316,7 @@ def analyze_by_classes(
     limits: SearchLimits | None = None,
     deadline: Deadline | None = None,
 ) -> Analysis:
-    """:func:`solvers.disassemble.analyze` of a puzzle made of ``blocks`` with moves of several
+    """:func:`chaingeo.solvers.disassemble.analyze` of a puzzle made of ``blocks`` with moves of several
     pieces: level and moves from the BurrTools-style search, o_i and its plan from
     :func:`class_search_optimal` (``states`` counts both). Its caps come from ``limits``:
     ``max_total_states`` (default 1,000,000) expanded states, ``max_states`` class-vector

@@ -1,6 +1,6 @@
 """Packing problems with BurrTools' constraints, compiled to exact-cover rows.
 
-On top of the plain engine's problem (:mod:`solvers.problem`): voxels carry colours and a
+On top of the plain engine's problem (:mod:`chaingeo.solvers.problem`): voxels carry colours and a
 placement is a row only when every coloured piece voxel may sit on the result voxel under it
 (:class:`ColorRules`, BurrTools' ``<bitmap>``); result cells may be *variable* (covered at most
 once, the secondary columns of the engine; when a piece fits wholly on variable cells, where
@@ -10,7 +10,7 @@ one type whose copies are interchangeable. A piece is a coloured voxel set, so a
 shape is symmetric but whose colouring is not has more orientations than its shape; rows are
 ``(type, coloured placement)`` and two rows may cover the same cells.
 
-Rows are filtered here, before the kernels (:mod:`solvers.bitboard`, :mod:`solvers.dlx`), and
+Rows are filtered here, before the kernels (:mod:`chaingeo.solvers.bitboard`, :mod:`chaingeo.solvers.dlx`), and
 the engine searches them as they are. Symmetry is this module's business: the group is the
 result's own (cells, variable marks and colours kept) and acts on rows by :meth:`row_maps`;
 a reflection sends a row to its mirror piece's row when that piece is in the problem (else
@@ -28,8 +28,8 @@ import numpy as np
 
 from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
 from chaingeo.core.jit import njit
-from solvers.placements import Int32Array, IntArray, Placements, target_index
-from solvers.problem import CoverError, CoverProblem, PieceType
+from chaingeo.solvers.placements import Int32Array, IntArray, Placements, target_index
+from chaingeo.solvers.problem import CoverError, CoverProblem, PieceType
 
 Cell = tuple[int, int, int]
 #: Colour codes pack ``cell * COLOR_BASE + colour`` (BurrTools has at most 63 colours).

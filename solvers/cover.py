@@ -31,14 +31,14 @@ lists one solution per class from the reduced search (the default keeps the plai
 *Engines*: ``"bitboard"`` (the default, as ``"auto"``) or ``"dlx"`` (dancing links, MRV). The
 bit-board branches on the first empty cell (``"bitboard-first"``, at most 64 cells) or on the
 most constrained cell (``"bitboard-mrv"``, any size); ``"bitboard"`` picks between them by the
-rule of :func:`solvers.search.first_cell_wins` (first cell for one-layer targets and targets of
+rule of :func:`chaingeo.solvers.search.first_cell_wins` (first cell for one-layer targets and targets of
 at most 32 cells). Every function
 also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``target``).
 ``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
 the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a
 ``SearchLimitError``) is raised carrying the solutions found so far and the stats; iterators
 first yield what they found. Every function also takes a ``deadline``
-(:class:`solvers.deadline.Deadline`): past it the search stops with the deadline's
+(:class:`chaingeo.solvers.deadline.Deadline`): past it the search stops with the deadline's
 ``SearchLimitError`` (it names ``seconds``), iterators again first yielding what they found.
 """
 
@@ -50,9 +50,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
-from solvers.deadline import Deadline
-from solvers.placements import Int32Array
-from solvers.problem import (
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.placements import Int32Array
+from chaingeo.solvers.problem import (
     CoverError,
     CoverProblem,
     PiecesLike,
@@ -60,7 +60,7 @@ from solvers.problem import (
     TargetLike,
     cover_problem,
 )
-from solvers.search import CoverLimitError, CoverSearch, CoverStats, Engine
+from chaingeo.solvers.search import CoverLimitError, CoverSearch, CoverStats, Engine
 
 __all__ = [
     "AnchorPlan",

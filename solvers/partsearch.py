@@ -2,7 +2,7 @@
 
 A *part* is a set of pieces still to be taken apart; its states are the pieces' offsets relative
 to its first piece. :class:`PartSearch` grows the search one depth layer at a time (numba does
-the expansion, :mod:`solvers.movement`), remembers each state's parent and the move that made
+the expansion, :mod:`chaingeo.solvers.movement`), remembers each state's parent and the move that made
 it, and collects every removal (a move that splits the part) seen on the way.
 """
 
@@ -15,8 +15,8 @@ import numpy as np
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
-from solvers import movement as mv
-from solvers.deadline import Deadline as Deadline  # re-exported: its historical home
+from chaingeo.solvers import movement as mv
+from chaingeo.solvers.deadline import Deadline as Deadline  # re-exported: its historical home
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 

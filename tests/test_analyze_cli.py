@@ -143,9 +143,9 @@ def test_chain_version(capsys: pytest.CaptureFixture[str]) -> None:
 def test_counting_cut_short_keeps_the_known_assembly_s_figures() -> None:
     from chaingeo.core.formats.bt_level import level_puzzle
     from chaingeo.core.level import load_level
-    from solvers.analysis import level_figures, problem_figures
-    from solvers.deadline import Deadline
-    from solvers.partsearch import SearchLimits
+    from chaingeo.solvers.analysis import level_figures, problem_figures
+    from chaingeo.solvers.deadline import Deadline
+    from chaingeo.solvers.partsearch import SearchLimits
 
     level = load_level(shipped_levels("puzzle") / "puzzle-mid-04-burr12.json")
     limits = SearchLimits(seconds=30.0)

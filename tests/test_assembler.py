@@ -9,8 +9,8 @@ import pytest
 
 from chaingeo.cli.main import main
 from chaingeo.core.geometry import Shape
-from solvers.assemble import count_solutions, iter_assemblies
-from solvers.problem import PieceSpec
+from chaingeo.solvers.assemble import count_solutions, iter_assemblies
+from chaingeo.solvers.problem import PieceSpec
 from tests.shared_files import BT, needs_files
 
 

@@ -17,8 +17,8 @@ from chaingeo.core.kinematics import (
     reference_optimal_disassembly,
     replay_disassembly,
 )
-from solvers.astar import AStarLimits, Heuristic, astar_optimal
-from solvers.disassemble import analyze
+from chaingeo.solvers.astar import AStarLimits, Heuristic, astar_optimal
+from chaingeo.solvers.disassemble import analyze
 from tests.puzzle_strategies import random_partition, small_scenes
 from tests.shared_files import BT, needs_files
 from tests.test_disassemble import SCENE, random_walk

@@ -12,11 +12,11 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import disassembly_of_assembly_plan, replay_disassembly
 from chaingeo.core.level import Level, PuzzleSolution
 from chaingeo.envs.machines import new_state
-from generator.config import PuzzleConfig
-from generator.puzzle import make
-from generator.result import Rejection
-from solvers.blockbound import analyze_by_blocks, block_lower_bound
-from solvers.disassemble import analyze
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.puzzle import make
+from chaingeo.generator.result import Rejection
+from chaingeo.solvers.blockbound import analyze_by_blocks, block_lower_bound
+from chaingeo.solvers.disassemble import analyze
 
 
 @cache

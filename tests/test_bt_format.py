@@ -26,7 +26,7 @@ from chaingeo.core.formats.burrtools import (
     xmpuzzle_xml,
 )
 from chaingeo.core.geometry import Shape
-from generator.bt_examples import EXAMPLES
+from chaingeo.generator.bt_examples import EXAMPLES
 from tests.shared_files import BT, needs_files
 
 DATA = Path(__file__).parent / "data" / "burrtools"
@@ -40,7 +40,7 @@ def _xml(body: str, colors: str = "") -> bytes:
 @pytest.mark.parametrize("name", sorted(EXAMPLES))
 def test_example_files_are_the_builders_output(name: str) -> None:
     """tests/data/burrtools holds each example exactly as the builder writes it (regenerate
-    with ``python -m generator.bt_examples tests/data/burrtools``)."""
+    with ``python -m chaingeo.generator.bt_examples tests/data/burrtools``)."""
     data = xmpuzzle_bytes(EXAMPLES[name]())
     assert (DATA / f"{name}.xmpuzzle").read_bytes() == data
     assert xmpuzzle_bytes(parse_xmpuzzle(data)) == data
@@ -301,8 +301,8 @@ def test_any_readable_problem_is_analysed_or_refused_with_a_value_error(puzzle: 
     """Whatever a readable file's problems say (empty pieces, variable voxels in a piece, no
     parts, colours), the analysis answers or raises a ValueError saying why."""
     from chaingeo.core.kinematics import SearchLimitError
-    from solvers.analysis import problem_figures
-    from solvers.partsearch import SearchLimits
+    from chaingeo.solvers.analysis import problem_figures
+    from chaingeo.solvers.partsearch import SearchLimits
 
     back = parse_xmpuzzle(xmpuzzle_bytes(puzzle))
     for i in range(len(back.problems)):

@@ -1,6 +1,6 @@
 """BurrTools' problem semantics in the assembler and disassembler, checked against the naive
 oracle of :mod:`tests.bt_reference` (no shared code), on random problems and on the example
-files (:mod:`generator.bt_examples`)."""
+files (:mod:`chaingeo.generator.bt_examples`)."""
 
 from __future__ import annotations
 
@@ -14,20 +14,20 @@ from chaingeo.cli.main import main
 from chaingeo.core.formats.burrtools import BTPuzzle, parse_xmpuzzle, xmpuzzle_bytes
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
-from generator.bt_examples import EXAMPLES, staircase
-from generator.maze import runs, with_exit
-from solvers.btassemble import (
+from chaingeo.generator.bt_examples import EXAMPLES, staircase
+from chaingeo.generator.maze import runs, with_exit
+from chaingeo.solvers.btassemble import (
     Mirrors,
     bt_packing_spec,
     disassemble,
     iter_classes,
     named_assembly,
 )
-from solvers.btcount import StuckCheck, count_bt
-from solvers.constrained import compile_packing
-from solvers.disassemble import Separation, Separations, _Solver, analyze
-from solvers.groups import PieceGroups, assignable
-from solvers.partsearch import SearchLimits
+from chaingeo.solvers.btcount import StuckCheck, count_bt
+from chaingeo.solvers.constrained import compile_packing
+from chaingeo.solvers.disassemble import Separation, Separations, _Solver, analyze
+from chaingeo.solvers.groups import PieceGroups, assignable
+from chaingeo.solvers.partsearch import SearchLimits
 from tests import bt_reference as ref
 from tests.bt_instances import random_puzzle, reference_parts
 from tests.test_disassemble import _level_or_error

@@ -1,4 +1,4 @@
-"""BurrTools' verdicts on rows (solvers.btcount.RowVerdicts) against the general path: the
+"""BurrTools' verdicts on rows (chaingeo.solvers.btcount.RowVerdicts) against the general path: the
 same image, the same counts, the same level strings in the same order, on puzzles we did not
 hand-make (seeded random boxes cut into pieces, congruent and mirror pieces, holes) and on the
 feature examples and shipped levels."""
@@ -13,10 +13,16 @@ import pytest
 from chaingeo.core.formats.bt_level import level_puzzle
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.level import load_level
-from generator.bt_examples import EXAMPLES
-from solvers.btassemble import BTFrame, Mirrors, bt_packing_spec, iter_classes, named_assembly
-from solvers.btcount import RowVerdicts, count_bt
-from solvers.constrained import compile_packing
+from chaingeo.generator.bt_examples import EXAMPLES
+from chaingeo.solvers.btassemble import (
+    BTFrame,
+    Mirrors,
+    bt_packing_spec,
+    iter_classes,
+    named_assembly,
+)
+from chaingeo.solvers.btcount import RowVerdicts, count_bt
+from chaingeo.solvers.constrained import compile_packing
 from tests.burrtxt import random_puzzle
 
 LEVELS = Path(__file__).resolve().parents[1] / "levels" / "puzzle"

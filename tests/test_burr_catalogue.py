@@ -12,8 +12,8 @@ from chaingeo.core.piecesets.burrs import (
     solid_burr_pieces,
     solid_knot,
 )
-from solvers.assemble import count_solutions, solid_burr_codes
-from solvers.problem import PieceSpec
+from chaingeo.solvers.assemble import count_solutions, solid_burr_codes
+from chaingeo.solvers.problem import PieceSpec
 from tests.shared_files import BT, needs_files
 
 

@@ -25,10 +25,10 @@ from chaingeo.core.formats.burrtools import read_xmpuzzle
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.rules import PuzzleRules
-from solvers.btassemble import bt_packing_spec
-from solvers.btcount import count_bt
-from solvers.constrained import compile_packing
-from solvers.partsearch import SearchLimits
+from chaingeo.solvers.btassemble import bt_packing_spec
+from chaingeo.solvers.btcount import count_bt
+from chaingeo.solvers.constrained import compile_packing
+from chaingeo.solvers.partsearch import SearchLimits
 from tests import burrtxt as bt
 from tests.shared_files import BT
 
@@ -150,7 +150,7 @@ def test_a_level_string_is_the_one_burrtxt_prints_for_its_assembly() -> None:
 
 
 def _own_level(level: Level) -> str | None:
-    from solvers.disassemble import analyze
+    from chaingeo.solvers.disassemble import analyze
 
     return analyze(level.shapes, optimal=False).level
 
@@ -168,8 +168,8 @@ GENERATED_SLOW: list[tuple[str, dict[str, int]]] = [
 
 
 def _generated_case(binary: Path, shape: str, extra: dict[str, int], index: int, tmp: Path) -> None:
-    from generator.config import PuzzleConfig
-    from generator.puzzle import make
+    from chaingeo.generator.config import PuzzleConfig
+    from chaingeo.generator.puzzle import make
 
     item = make(PuzzleConfig(shape=shape, **extra), 1, index)  # type: ignore[arg-type]
     if not isinstance(item, Level):

@@ -14,10 +14,10 @@ from hypothesis import strategies as st
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import Level, load_level
-from generator.config import PuzzleConfig
-from generator.puzzle import make
-from solvers.blockbound import end_first_plan
-from solvers.classbound import (
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.puzzle import make
+from chaingeo.solvers.blockbound import end_first_plan
+from chaingeo.solvers.classbound import (
     MAX_BUDGET,
     ClassVector,
     Packing,
@@ -27,7 +27,7 @@ from solvers.classbound import (
     join,
     total,
 )
-from solvers.disassemble import analyze, translations
+from chaingeo.solvers.disassemble import analyze, translations
 from tests.puzzle_strategies import random_blocks, small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"

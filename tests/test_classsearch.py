@@ -15,10 +15,10 @@ from chaingeo.cli.main import main
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import load_level
-from solvers.analysis import analyze_level
-from solvers.classbound import band_blocks, class_lower_bound
-from solvers.classsearch import ClassSearchLimits, class_search_optimal
-from solvers.disassemble import analyze, translations
+from chaingeo.solvers.analysis import analyze_level
+from chaingeo.solvers.classbound import band_blocks, class_lower_bound
+from chaingeo.solvers.classsearch import ClassSearchLimits, class_search_optimal
+from chaingeo.solvers.disassemble import analyze, translations
 from tests.puzzle_strategies import random_blocks, small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
@@ -97,7 +97,7 @@ def test_chain_analyze_proves_a_multi_piece_tower(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A tower level that carries its blocks and allows moves of any size: ``chain analyze``
-    (one analysis everywhere, :mod:`solvers.analysis`) proves o_i with the class search."""
+    (one analysis everywhere, :mod:`chaingeo.solvers.analysis`) proves o_i with the class search."""
     raw = json.loads((SUITE / "puzzle-hard-09-burr36.json").read_text())
     raw["rules"]["max_group"] = None
     path = tmp_path / "tower.json"

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from chaingeo.core.geometry import Shape, box_cells, box_symmetries
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.piecesets import BEDLAM, PENTOMINOES, SOMA
-from solvers.cover import (
+from chaingeo.solvers.cover import (
     CoverError,
     CoverLimitError,
     PieceSpec,
@@ -23,8 +23,8 @@ from solvers.cover import (
     iter_solutions,
     random_solutions,
 )
-from solvers.placements import placements, target_symmetries
-from solvers.search import Engine
+from chaingeo.solvers.placements import placements, target_symmetries
+from chaingeo.solvers.search import Engine
 from tests import cover_reference as ref
 from tests.strategies import polycubes
 

@@ -28,11 +28,11 @@ from chaingeo.core.formats.burrtools import (
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.piecesets import SOMA
-from solvers import assemble
-from solvers.btassemble import bt_packing_spec, iter_classes
-from solvers.btcount import count_bt
-from solvers.constrained import compile_packing
-from solvers.cover import (
+from chaingeo.solvers import assemble
+from chaingeo.solvers.btassemble import bt_packing_spec, iter_classes
+from chaingeo.solvers.btcount import count_bt
+from chaingeo.solvers.constrained import compile_packing
+from chaingeo.solvers.cover import (
     CoverLimitError,
     CoverSearch,
     PieceSpec,
@@ -41,10 +41,10 @@ from solvers.cover import (
     first_solution,
     iter_solutions,
 )
-from solvers.deadline import Deadline
-from solvers.disassemble import analyze
-from solvers.partsearch import SearchLimits
-from solvers.problem import CoverProblem
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.disassemble import analyze
+from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.problem import CoverProblem
 from tests.test_cover import instances
 from tests.test_cover_kernels import wide_instances
 

@@ -12,9 +12,15 @@ from hypothesis import strategies as st
 
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.piecesets import PENTOMINOES, SOMA
-from solvers.cover import CoverLimitError, CoverSearch, PieceSpec, count_solutions, cover_problem
-from solvers.problem import CoverProblem
-from solvers.search import choose_kernel
+from chaingeo.solvers.cover import (
+    CoverLimitError,
+    CoverSearch,
+    PieceSpec,
+    count_solutions,
+    cover_problem,
+)
+from chaingeo.solvers.problem import CoverProblem
+from chaingeo.solvers.search import choose_kernel
 from tests.strategies import polycubes
 from tests.test_cover import instances
 

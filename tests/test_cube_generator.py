@@ -18,8 +18,8 @@ from chaingeo.core.kinematics import (
     reference_optimal_disassembly,
 )
 from chaingeo.core.level import Level, level_bytes
-from generator.config import PuzzleConfig
-from generator.cubes import (
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.cubes import (
     VOID,
     nearest_to_leaving,
     random_partition,
@@ -27,9 +27,9 @@ from generator.cubes import (
     void_count,
     void_sites,
 )
-from generator.puzzle import make
-from generator.result import Rejection
-from solvers.partsearch import PieceTable
+from chaingeo.generator.puzzle import make
+from chaingeo.generator.result import Rejection
+from chaingeo.solvers.partsearch import PieceTable
 
 EASY = PuzzleConfig(shape="cube3", pieces=3, min_level=2, hole_rate=0.3, hill_steps=10)
 

@@ -190,7 +190,7 @@ def test_the_step_bound_is_checked_before_any_picture_is_drawn(
 def test_the_whole_shipped_suite_exports_and_loads(tmp_path: Path) -> None:
     datasets = pytest.importorskip("datasets")
     from chaingeo.core.level import load_levels
-    from generator.signature import level_signature
+    from chaingeo.generator.signature import level_signature
 
     suite = load_levels(shipped_levels())
     assert main(["export-dataset", "--out", str(tmp_path), "--image-size", "128"]) == 0

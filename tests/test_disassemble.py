@@ -19,9 +19,9 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
     state_key,
 )
-from solvers import disassemble
-from solvers.disassemble import Separation, Separations, _Solver, analyze, fast_legal_moves
-from solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
+from chaingeo.solvers import disassemble
+from chaingeo.solvers.disassemble import Separation, Separations, _Solver, analyze, fast_legal_moves
+from chaingeo.solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
 from tests.puzzle_strategies import small_scenes
 
 SCENE = {
@@ -143,8 +143,8 @@ def test_level_kernel_matches_python_search(
     total: int | None,
     separations: Separations,
 ) -> None:
-    """The one-call level kernels (BurrTools' first separation, :mod:`solvers.btsearch`, and
-    any separation, :mod:`solvers.levelsearch`) find the same tree, with the same state count
+    """The one-call level kernels (BurrTools' first separation, :mod:`chaingeo.solvers.btsearch`, and
+    any separation, :mod:`chaingeo.solvers.levelsearch`) find the same tree, with the same state count
     (or the same cap error), as the Python searches they stand for, also when they outgrow
     their buffers or their node budget."""
     if len(shapes) < 2:
@@ -191,7 +191,7 @@ def test_limits_raise_clear_errors() -> None:
 def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, steps: int) -> None:
     """Cutler's pairwise matrix from the numba kernel equals the reference blocking_matrix."""
     from chaingeo.core.kinematics import DIRECTIONS, blocking_matrix
-    from solvers import movement
+    from chaingeo.solvers import movement
 
     state = random_walk(shapes, seed, steps)
     table = PieceTable(state.shapes)

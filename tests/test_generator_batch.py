@@ -10,10 +10,10 @@ import pytest
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, load_levels, stacking_level
 from chaingeo.envs.pictures import level_pictures
-from generator.batch import SUMMARY_FILE, GenerationError, GenerationJob, run
-from generator.config import get_config
-from generator.result import Rejection
-from generator.stacking import make
+from chaingeo.generator.batch import SUMMARY_FILE, GenerationError, GenerationJob, run
+from chaingeo.generator.config import get_config
+from chaingeo.generator.result import Rejection
+from chaingeo.generator.stacking import make
 
 PLATES = [
     Shape([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)]),

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from generator.dedup import Reservation, SignatureStore
+from chaingeo.generator.dedup import Reservation, SignatureStore
 
 SIGS = [f"{i:040x}" for i in range(1, 31)]
 

@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.kinematics import DIRECTIONS, Assembly
-from generator.assembly import assembly_order, has_isolated_piece, removal_sequence
-from generator.partition import (
+from chaingeo.generator.assembly import assembly_order, has_isolated_piece, removal_sequence
+from chaingeo.generator.partition import (
     PieceRules,
     box_grid,
     grow,

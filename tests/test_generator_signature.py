@@ -14,15 +14,15 @@ from chaingeo.cli.main import main
 from chaingeo.core.geometry import IntArray, Shape
 from chaingeo.core.level import load_levels
 from chaingeo.core.suite import shipped_levels
-from generator.batch import HELD_OUT, GenerationJob, run
-from generator.config import stacking_config
-from generator.signature import (
+from chaingeo.generator.batch import HELD_OUT, GenerationJob, run
+from chaingeo.generator.config import stacking_config
+from chaingeo.generator.signature import (
     level_signature,
     puzzle_signature,
     shipped_signatures,
     stacking_signature,
 )
-from generator.stacking import make
+from chaingeo.generator.stacking import make
 from tests.strategies import offsets, polycubes, rotations
 
 pieces = st.lists(polycubes(1, 6), min_size=1, max_size=5)
@@ -112,7 +112,7 @@ def test_generate_split_train_refuses_the_shipped_levels_and_says_so(
 def test_curriculum_steps_run_easy_to_hard_and_bad_steps_are_one_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from generator.curriculum import CURRICULA, STACKING_STEPS, puzzle_step, stacking_step
+    from chaingeo.generator.curriculum import CURRICULA, STACKING_STEPS, puzzle_step, stacking_step
 
     modes = [stacking_step(k).mode for k in range(CURRICULA["stacking"])]
     assert modes == sorted(modes, key=("easy", "mid", "hard").index)

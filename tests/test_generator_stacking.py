@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from chaingeo.core.level import Level, level_bytes, revalidate
-from generator.checks import level_problems
-from generator.config import (
+from chaingeo.generator.checks import level_problems
+from chaingeo.generator.config import (
     StackingConfig,
     config_names,
     get_config,
@@ -17,8 +17,8 @@ from generator.config import (
     register_config,
     stacking_config,
 )
-from generator.result import ATTEMPTS_KEY, Rejection
-from generator.stacking import easy_cuboids, make, random_multiset, stage_problem
+from chaingeo.generator.result import ATTEMPTS_KEY, Rejection
+from chaingeo.generator.stacking import easy_cuboids, make, random_multiset, stage_problem
 
 
 def _level(config: StackingConfig, seed: int, index: int) -> Level:

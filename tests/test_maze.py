@@ -14,9 +14,9 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
 )
 from chaingeo.core.level import Level, level_bytes
-from generator.config import PuzzleConfig
-from generator.maze import maze_pieces, parse_maze_shape, random_walk, runs, with_exit
-from generator.puzzle import make
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.maze import maze_pieces, parse_maze_shape, random_walk, runs, with_exit
+from chaingeo.generator.puzzle import make
 
 DEEP = PuzzleConfig(shape="maze5", min_level=10, hill_steps=300)
 
@@ -59,7 +59,7 @@ def test_assemble_goal_plays_the_reversed_plan() -> None:
 @settings(max_examples=25, deadline=None)
 @given(n=st.integers(4, 7), seed=st.integers(0, 2**32 - 1))
 def test_runs_of_a_walk_are_the_solver_level(n: int, seed: int) -> None:
-    from solvers.disassemble import analyze
+    from chaingeo.solvers.disassemble import analyze
 
     path = random_walk(n, np.random.default_rng(seed))
     if not path:

@@ -21,9 +21,9 @@ from chaingeo.core.formats.models import (
 )
 from chaingeo.core.kinematics import replay_disassembly
 from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
-from solvers.cover import first_solution
-from solvers.disassemble import Analysis, analyze
-from solvers.partsearch import SearchLimits
+from chaingeo.solvers.cover import first_solution
+from chaingeo.solvers.disassemble import Analysis, analyze
+from chaingeo.solvers.partsearch import SearchLimits
 from tests.shared_files import MODELS, needs_models
 
 #: What each model must give: kind and cells per part (in part order), or the refusal.

@@ -14,13 +14,20 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_every_package_of_the_tree_goes_into_the_wheel() -> None:
     config = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]
     listed = set(config["setuptools"]["packages"])
+    dirs = config["setuptools"]["package-dir"]
+    assert dirs == {
+        "chaingeo.levels": "levels",
+        "chaingeo.solvers": "solvers",
+        "chaingeo.generator": "generator",
+    }
     found = {
-        ".".join(init.parent.relative_to(ROOT).parts)
-        for top in ("chaingeo", "solvers", "generator")
-        for init in (ROOT / top).rglob("__init__.py")
+        ".".join((package, *init.parent.relative_to(ROOT / folder).parts))
+        for package, folder in (("chaingeo", "chaingeo"), *((p, d) for p, d in dirs.items()))
+        if package != "chaingeo.levels"
+        for init in (ROOT / folder).rglob("__init__.py")
     }
     assert found | {"chaingeo.levels"} == listed
-    assert config["setuptools"]["package-dir"]["chaingeo.levels"] == "levels"
+    assert {name.split(".")[0] for name in listed} == {"chaingeo"}
 
 
 def test_the_shipped_suite_is_found_as_package_data() -> None:

@@ -6,7 +6,7 @@ import io
 import time
 
 from chaingeo.cli.progress import ProgressLines
-from solvers.deadline import Deadline
+from chaingeo.solvers.deadline import Deadline
 
 
 def test_quiet_first_then_stage_and_counts() -> None:

@@ -13,10 +13,10 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
 )
 from chaingeo.core.level import Level, level_bytes, load_level
-from generator.config import PuzzleConfig
-from generator.layouts import get_layout
-from generator.puzzle import difficulty_of, make
-from generator.result import Rejection
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.layouts import get_layout
+from chaingeo.generator.puzzle import difficulty_of, make
+from chaingeo.generator.result import Rejection
 
 SMALL = PuzzleConfig(shape="cube3", pieces=3, hill_steps=20, hole_rate=0.3)
 

@@ -13,11 +13,11 @@ from chaingeo.core.formats.models import import_model
 from chaingeo.core.kinematics import disassembly_of_assembly_plan, replay_disassembly
 from chaingeo.core.level import Level, PuzzleSolution, level_bytes, load_levels
 from chaingeo.core.rules import PuzzleRules
-from generator.imported import imported_puzzle_level
-from generator.puzzle import difficulty_of
-from generator.puzzle_suite import MODEL_LIMITS
-from solvers.analysis import analyze_level
-from solvers.partsearch import SearchLimits
+from chaingeo.generator.imported import imported_puzzle_level
+from chaingeo.generator.puzzle import difficulty_of
+from chaingeo.generator.puzzle_suite import MODEL_LIMITS
+from chaingeo.solvers.analysis import analyze_level
+from chaingeo.solvers.partsearch import SearchLimits
 from tests.env_levels import design_of
 from tests.shared_files import MODELS, needs_models
 
@@ -115,7 +115,7 @@ def test_optimal_steps_are_optimal(level: Level) -> None:
 @pytest.mark.slow
 @needs_models
 def test_suite_rebuilds_byte_for_byte(tmp_path: Path) -> None:
-    from generator.puzzle_suite import build_puzzle_suite
+    from chaingeo.generator.puzzle_suite import build_puzzle_suite
 
     assert MODELS is not None
     build_puzzle_suite(tmp_path, MODELS, jobs=2)

@@ -15,9 +15,9 @@ from chaingeo.core.registry import DuplicateNameError, Registry, UnknownNameErro
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.agents.registry import AGENTS, make_agent, register_agent
 from chaingeo.evaluation.judges import JUDGES, make_judge, register_judge
-from generator.config import CONFIGS, PuzzleConfig, get_config, register_config
-from generator.layouts import LAYOUTS
-from generator.puzzle import SHAPES, shape_family
+from chaingeo.generator.config import CONFIGS, PuzzleConfig, get_config, register_config
+from chaingeo.generator.layouts import LAYOUTS
+from chaingeo.generator.puzzle import SHAPES, shape_family
 
 NAMES = st.text(st.characters(codec="ascii", categories=["L", "N", "P"]), min_size=1, max_size=6)
 

@@ -1,4 +1,4 @@
-"""Rows no cover can hold (solvers.rowreduce): removing them changes no solution, on puzzles we
+"""Rows no cover can hold (chaingeo.solvers.rowreduce): removing them changes no solution, on puzzles we
 did not make (seeded random boxes cut into pieces, with holes and congruent pieces), and on a
 36-piece burr they are BurrTools' own figure (burrTxt -r: "removed 3688 rows")."""
 
@@ -12,12 +12,12 @@ import pytest
 
 from chaingeo.core.formats.bt_level import level_puzzle
 from chaingeo.core.level import load_level
-from generator.bt_examples import EXAMPLES
-from solvers.btassemble import bt_packing_spec, iter_classes
-from solvers.constrained import compile_packing
-from solvers.problem import CoverProblem
-from solvers.rowreduce import live_rows
-from solvers.search import CoverSearch
+from chaingeo.generator.bt_examples import EXAMPLES
+from chaingeo.solvers.btassemble import bt_packing_spec, iter_classes
+from chaingeo.solvers.constrained import compile_packing
+from chaingeo.solvers.problem import CoverProblem
+from chaingeo.solvers.rowreduce import live_rows
+from chaingeo.solvers.search import CoverSearch
 from tests.burrtxt import random_puzzle
 
 LEVELS = Path(__file__).resolve().parents[1] / "levels" / "puzzle"

@@ -9,9 +9,9 @@ from pathlib import Path
 import pytest
 
 from chaingeo.core.level import Level, level_bytes, load_level
-from generator.checks import level_problems
-from generator.stacking import make
-from generator.suite import SUITE, suite_entry
+from chaingeo.generator.checks import level_problems
+from chaingeo.generator.stacking import make
+from chaingeo.generator.suite import SUITE, suite_entry
 
 ROOT = Path(__file__).resolve().parents[1]
 SUITE_DIR = ROOT / "levels" / "stacking"

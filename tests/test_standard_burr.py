@@ -12,15 +12,15 @@ from hypothesis import strategies as st
 
 from chaingeo.core.kinematics import reference_first_level, replay_disassembly
 from chaingeo.core.level import Level, level_bytes
-from generator.config import STANDARD_DEFAULTS, PuzzleConfig
-from generator.puzzle import make
-from generator.standard_burr import (
+from chaingeo.generator.config import STANDARD_DEFAULTS, PuzzleConfig
+from chaingeo.generator.puzzle import make
+from chaingeo.generator.standard_burr import (
     assembly_counts,
     broken_pieces,
     design_pieces,
     standard_layout,
 )
-from solvers.partsearch import SearchLimits
+from chaingeo.solvers.partsearch import SearchLimits
 
 #: A short search (one restart of 200 changes): low levels, quick to re-check by pure Python.
 SMALL = PuzzleConfig(shape="burr6x8", hill_steps=200, restarts=1)

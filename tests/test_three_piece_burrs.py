@@ -24,11 +24,11 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
 )
 from chaingeo.core.level import Level, level_bytes, load_level
-from generator.config import PuzzleConfig
-from generator.layouts import Layout, get_layout, three_crossing
-from generator.puzzle import difficulty_of, make
-from solvers.disassemble import analyze
-from solvers.partsearch import SearchLimits
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.layouts import Layout, get_layout, three_crossing
+from chaingeo.generator.puzzle import difficulty_of, make
+from chaingeo.solvers.disassemble import analyze
+from chaingeo.solvers.partsearch import SearchLimits
 
 #: (config, seed, index) of one quick item per layout that the generator accepts (found by the
 #: histograms in the README: burr3 item 8 of seed 1 is a level-4 burr, plate3 item 27 level 3).

@@ -33,8 +33,8 @@ from chaingeo.envs.trajectory import (
 )
 from chaingeo.envs.trajectory_verdict import Verdict, check_trajectory
 from chaingeo.envs.video import read_plan
-from generator.config import PuzzleConfig
-from generator.puzzle import make
+from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.puzzle import make
 
 LEVELS = Path(__file__).resolve().parent.parent / "levels"
 TURNS = load_level(LEVELS / "puzzle" / "puzzle-easy-01-luban-3-piece.json")  # has a turn

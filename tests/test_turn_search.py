@@ -18,10 +18,10 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
     state_key,
 )
-from solvers.disassemble import analyze, fast_legal_moves
-from solvers.partsearch import Deadline, SearchLimits
-from solvers.turnmoves import TurnTable
-from solvers.turnsearch import TurnPartSearch, fast_legal_turns
+from chaingeo.solvers.disassemble import analyze, fast_legal_moves
+from chaingeo.solvers.partsearch import Deadline, SearchLimits
+from chaingeo.solvers.turnmoves import TurnTable
+from chaingeo.solvers.turnsearch import TurnPartSearch, fast_legal_turns
 from tests.puzzle_strategies import small_scenes
 
 

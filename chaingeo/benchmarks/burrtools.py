@@ -1,20 +1,20 @@
 """``chain bench burrtools``: BurrTools problems, our whole analysis against the previous engine.
 
-Instances: every example of :mod:`generator.bt_examples` (one per problem feature: colour
+Instances: every example of :mod:`chaingeo.generator.bt_examples` (one per problem feature: colour
 rules, piece groups with variable cells, ranges and several problems, mirror images, a level-51
 maze, the solid burr catalogue), plus BurrTools' own example files when present
 (``../shared/burrtools`` or ``CHAIN_BURRTOOLS_DIR``). For each problem, ``ours`` is what
-``chain analyze --no-optimal`` does (:func:`solvers.analysis.problem_figures`: BurrTools'
+``chain analyze --no-optimal`` does (:func:`chaingeo.solvers.analysis.problem_figures`: BurrTools'
 assemblies and solutions, then level and moves of the first solution; o_i is left out, being
 no BurrTools figure and the same code in both engines) and ``previous`` the engine before
 BurrTools' semantics, timed in the same run:
 
 * on a problem with colour rules, ``previous`` counts without them and filters after: every
-  packing of the uncoloured problem (:func:`solvers.cover.iter_solutions`), each coloured
+  packing of the uncoloured problem (:func:`chaingeo.solvers.cover.iter_solutions`), each coloured
   orientation of each piece checked voxel by voxel, classes of the survivors under the
   coloured result's symmetries, then the disassembler on those classes only (the same figures
   as ours, reached the slow way);
-* elsewhere ``previous`` is the old ``chain analyze`` (:func:`solvers.assemble.count_solutions`
+* elsewhere ``previous`` is the old ``chain analyze`` (:func:`chaingeo.solvers.assemble.count_solutions`
   on the uncoloured, ungrouped problem): its figures differ where groups, hole caps or pieces
   lying wholly on variable cells matter (the ring maze: 0 assemblies, the ring is never
   placed; the linked rings: no solution, the rings never come apart).
@@ -59,7 +59,7 @@ Instance = tuple[str, BTPuzzle, int, str]  # name, puzzle, problem, mirrors
 
 
 def _instances(quick: bool) -> list[Instance]:
-    from generator.bt_examples import EXAMPLES
+    from chaingeo.generator.bt_examples import EXAMPLES
 
     out: list[Instance] = []
     for name, build in EXAMPLES.items():
@@ -87,9 +87,9 @@ def _instances(quick: bool) -> list[Instance]:
 def previous_plain(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> dict[str, Any]:
     """The old ``chain analyze`` on a ``.xmpuzzle`` problem: colours, groups and hole caps
     unknown to it."""
-    from solvers.analysis import disassembly_figures
-    from solvers.assemble import count_solutions
-    from solvers.problem import PieceSpec
+    from chaingeo.solvers.analysis import disassembly_figures
+    from chaingeo.solvers.assemble import count_solutions
+    from chaingeo.solvers.problem import PieceSpec
 
     prob = puzzle.problem(index)
     result = puzzle.shapes[prob.result]
@@ -145,11 +145,11 @@ def previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) ->
     """Colour rules the slow way: every uncoloured packing, filtered voxel by voxel."""
     import itertools
 
-    from solvers.analysis import disassembly_figures
-    from solvers.cover import iter_solutions
-    from solvers.disassemble import analyze
-    from solvers.placements import target_symmetries
-    from solvers.problem import PieceSpec
+    from chaingeo.solvers.analysis import disassembly_figures
+    from chaingeo.solvers.cover import iter_solutions
+    from chaingeo.solvers.disassemble import analyze
+    from chaingeo.solvers.placements import target_symmetries
+    from chaingeo.solvers.problem import PieceSpec
 
     prob = puzzle.problem(index)
     res = puzzle.shapes[prob.result]
@@ -216,8 +216,8 @@ def _image(m: np.ndarray, t: np.ndarray, c: tuple[int, int, int]) -> tuple[int, 
 
 def _from_scratch() -> None:
     """Forget the placements and problems the engines cache, so every run builds its own."""
-    from solvers.placements import _placements, target_index
-    from solvers.problem import _cover_problem
+    from chaingeo.solvers.placements import _placements, target_index
+    from chaingeo.solvers.problem import _cover_problem
 
     for cached in (_placements, target_index, _cover_problem):
         cached.cache_clear()
@@ -241,12 +241,12 @@ def _timed(fn: Callable[[], dict[str, Any]], repeat: int) -> tuple[float, dict[s
 
 def _warm_up() -> None:
     """Compile every kernel both engines use (bit-board, dancing links, movement)."""
-    from generator.bt_examples import linked_rings
-    from solvers.analysis import problem_figures
-    from solvers.btassemble import bt_packing_spec
-    from solvers.constrained import compile_packing
-    from solvers.partsearch import SearchLimits
-    from solvers.search import CoverSearch
+    from chaingeo.generator.bt_examples import linked_rings
+    from chaingeo.solvers.analysis import problem_figures
+    from chaingeo.solvers.btassemble import bt_packing_spec
+    from chaingeo.solvers.constrained import compile_packing
+    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.search import CoverSearch
 
     puzzle = linked_rings()
     problem_figures(puzzle, 0, SearchLimits(), True, True)
@@ -255,9 +255,9 @@ def _warm_up() -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from solvers.analysis import problem_figures
-    from solvers.btassemble import Mirrors
-    from solvers.partsearch import SearchLimits
+    from chaingeo.solvers.analysis import problem_figures
+    from chaingeo.solvers.btassemble import Mirrors
+    from chaingeo.solvers.partsearch import SearchLimits
 
     seconds = float(os.environ.get("CHAIN_BENCH_BT_SECONDS", "5" if args.quick else "120"))
     limits = SearchLimits(seconds=seconds)

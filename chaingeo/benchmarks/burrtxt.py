@@ -132,7 +132,7 @@ def instances(folder: Path, quick: bool) -> list[Instance]:
     from chaingeo.core.level import load_levels
     from chaingeo.core.rules import PuzzleRules
     from chaingeo.core.suite import shipped_levels
-    from generator.bt_examples import EXAMPLES
+    from chaingeo.generator.bt_examples import EXAMPLES
 
     out: list[Instance] = []
     shared = Path(__file__).resolve().parents[3] / "shared" / "burrtools"

@@ -70,7 +70,7 @@ def _best(fn: Callable[[], int], repeat: int) -> tuple[float, int]:
 
 
 def _clear_caches() -> None:
-    from solvers import placements, problem
+    from chaingeo.solvers import placements, problem
 
     problem._cover_problem.cache_clear()
     placements._placements.cache_clear()
@@ -81,9 +81,9 @@ def _warm_up() -> None:
     """Compile (or load) every kernel on a tiny instance, outside the timed region."""
     from xcover import covers
 
-    from solvers.cover import count_solutions
-    from solvers.problem import cover_problem
-    from solvers.search import CoverSearch
+    from chaingeo.solvers.cover import count_solutions
+    from chaingeo.solvers.problem import cover_problem
+    from chaingeo.solvers.search import CoverSearch
 
     domino = Shape([(0, 0, 0), (1, 0, 0)])
     for engine in ("bitboard-first", "bitboard-mrv", "dlx"):
@@ -97,9 +97,9 @@ def _warm_up() -> None:
 def run(args: argparse.Namespace) -> int:
     from xcover import covers
 
-    from solvers.cover import count_solutions
-    from solvers.problem import cover_problem
-    from solvers.search import CoverSearch, CoverStats
+    from chaingeo.solvers.cover import count_solutions
+    from chaingeo.solvers.problem import cover_problem
+    from chaingeo.solvers.search import CoverSearch, CoverStats
 
     instances = list(INSTANCES)
     if os.environ.get("CHAIN_BENCH_COVER_BEDLAM") == "1":

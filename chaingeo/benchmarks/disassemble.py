@@ -57,8 +57,8 @@ def _ours(
     shapes: Mapping[str, Shape], max_group: int | None, level: Level | None = None
 ) -> tuple[float, int, dict[str, object]]:
     """Our full analysis; a suite level is analysed as it was made (towers with single-piece
-    moves by the block bound, :func:`solvers.analysis.analyze_level`)."""
-    from solvers.analysis import analyze_level, analyze_puzzle
+    moves by the block bound, :func:`chaingeo.solvers.analysis.analyze_level`)."""
+    from chaingeo.solvers.analysis import analyze_level, analyze_puzzle
 
     t0 = time.perf_counter()
     if level is not None:
@@ -76,15 +76,15 @@ def _ours(
 
 Instance = tuple[str, dict[str, Shape], int | None, dict[str, object], Level | None]
 
-#: Generated deep puzzles: maze burrs (:mod:`generator.maze`) of level >= 10 from seed 10.
+#: Generated deep puzzles: maze burrs (:mod:`chaingeo.generator.maze`) of level >= 10 from seed 10.
 DEEP_CONFIG = {"shape": "maze8", "min_level": 10, "hill_steps": 300}
 
 
 def _instances(quick: bool) -> list[Instance]:
     from chaingeo.core.level import load_levels
     from chaingeo.core.rules import PuzzleRules
-    from generator.config import PuzzleConfig
-    from generator.puzzle import make
+    from chaingeo.generator.config import PuzzleConfig
+    from chaingeo.generator.puzzle import make
 
     out: list[Instance] = []
     suite = shipped_levels("puzzle")

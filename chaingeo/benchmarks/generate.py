@@ -28,7 +28,7 @@ SEED = 2026
 
 def _reference_seconds(repeat: int) -> float:
     from chaingeo.core.piecesets import SOMA
-    from solvers.cover import count_solutions
+    from chaingeo.solvers.cover import count_solutions
 
     best = float("inf")
     for _ in range(max(1, repeat)):
@@ -41,16 +41,16 @@ def _reference_seconds(repeat: int) -> float:
 
 
 def _warm_up() -> None:
-    from generator.config import stacking_config
-    from generator.stacking import make
+    from chaingeo.generator.config import stacking_config
+    from chaingeo.generator.stacking import make
 
     for mode in MODES:
         make(stacking_config((2, 3, 3), mode), SEED, 10_000)
 
 
 def run(args: argparse.Namespace) -> int:
-    from generator.config import box_text, stacking_config
-    from generator.stacking import make
+    from chaingeo.generator.config import box_text, stacking_config
+    from chaingeo.generator.stacking import make
 
     items = int(os.environ.get("CHAIN_BENCH_GENERATE_ITEMS", 2 if args.quick else 6))
     _warm_up()
@@ -98,8 +98,8 @@ def run(args: argparse.Namespace) -> int:
 
 def _standard_burrs(items: int) -> dict[str, Any]:
     """Items 0..items-1 of :data:`SEED` with ``--shape burr6x8``: level histogram, s / item."""
-    from generator.config import PuzzleConfig
-    from generator.puzzle import make
+    from chaingeo.generator.config import PuzzleConfig
+    from chaingeo.generator.puzzle import make
 
     make(PuzzleConfig(shape="burr6x8", hill_steps=50), SEED, 10_000)  # compile the kernels
     cfg = PuzzleConfig(shape="burr6x8", min_level=1)

@@ -1,6 +1,6 @@
 """Progress of a long command on standard error: silent for the first few seconds, then a line
 every few seconds saying how long it has run and what it is doing, so a long analysis is never
-a silent one. The work writes a :class:`solvers.deadline.Progress`; a daemon thread reads it."""
+a silent one. The work writes a :class:`chaingeo.solvers.deadline.Progress`; a daemon thread reads it."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from types import TracebackType
 from typing import TYPE_CHECKING, Final, TextIO
 
 if TYPE_CHECKING:
-    from solvers.deadline import Progress
+    from chaingeo.solvers.deadline import Progress
 
 #: Seconds of quiet before the first line, and between two lines.
 FIRST_AFTER: Final = 3.0

@@ -316,7 +316,7 @@ def export_dataset(
     shard_bytes: int = limits.MAX_DATASET_SHARD_BYTES,
 ) -> ExportSummary:
     """Write both configurations of ``levels`` into ``out`` (see the module docstring);
-    ``signatures``: level id -> split signature (``generator.signature``), "" where absent.
+    ``signatures``: level id -> split signature (``chaingeo.generator.signature``), "" where absent.
     The card is written separately (:mod:`chaingeo.envs.dataset_card`)."""
     ordered = sorted(levels, key=lambda lv: lv.id)
     check_export(ordered, split, image_size)

@@ -21,7 +21,7 @@ When a cap (``--seconds``, ``--max-states``) stops the counting of assemblies, n
 is thrown away: the line keeps the counts so far with ``"counts_complete": false`` (they are
 lower bounds) and ``limit`` naming the cap and its flag, and still gives level, moves and o_i of
 the known assembly (the first solution found, a ``.xmpuzzle``'s stored assembly, or a level's
-own), which get a further :data:`solvers.analysis.GRACE_SECONDS` at most.
+own), which get a further :data:`chaingeo.solvers.analysis.GRACE_SECONDS` at most.
 
 Exit status: 0 when every figure is complete; 1 when counting was cut short by a cap; 2 when
 some file failed (its line carries ``error``; the message is also on standard error).
@@ -166,9 +166,9 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
     """The figures of one file (``CommandError`` for any failure, with the reason)."""
     from chaingeo.core.errors import ChainGeoError
     from chaingeo.core.kinematics import SearchLimitError
-    from solvers.analysis import level_figures, xmpuzzle_figures
-    from solvers.deadline import Deadline
-    from solvers.partsearch import SearchLimits
+    from chaingeo.solvers.analysis import level_figures, xmpuzzle_figures
+    from chaingeo.solvers.deadline import Deadline
+    from chaingeo.solvers.partsearch import SearchLimits
 
     limits = SearchLimits(
         max_states=args.max_states, seconds=args.seconds, optimal_seconds=args.optimal_seconds
@@ -279,7 +279,7 @@ def _run_interpreted(args: argparse.Namespace) -> int:
         raise _TooLong
 
     _set_mode("python")
-    import solvers.analysis  # noqa: F401 - imports are start-up, not the work the budget bounds
+    import chaingeo.solvers.analysis  # noqa: F401 - imports are start-up, not the work the budget bounds
 
     previous = signal.signal(signal.SIGPROF, expire)
     signal.setitimer(signal.ITIMER_PROF, INTERPRETED_SECONDS)

@@ -8,7 +8,7 @@ rules BurrTools cannot express (turns, a cap on group size) are named on standar
 
 ``--from chain`` (or ``--to chain-level``) reads CHAIN's level file as CHAIN writes it: packed
 (the cells fill the box) or in tray form (each piece where it lies beside the box). A tray
-file is packed here with the exact-cover engine (``solvers.cover.first_solution``, the pieces
+file is packed here with the exact-cover engine (``chaingeo.solvers.cover.first_solution``, the pieces
 as free shapes, rotations only as in CHAIN); the level keeps CHAIN's piece ids and is verified
 like any level file before it is written. ``--rules chain`` gives it CHAIN's rules profile.
 """
@@ -140,7 +140,7 @@ def import_chain_file(
 def pack(spec: ChainStacking, source: str) -> list[Shape]:
     """A packing of the file's pieces into its box (piece ``i`` first at index ``i``)."""
     from chaingeo.core.level import LevelError
-    from solvers.cover import CoverError, CoverLimitError, first_solution
+    from chaingeo.solvers.cover import CoverError, CoverLimitError, first_solution
 
     volume = spec.box[0] * spec.box[1] * spec.box[2]
     cubes = sum(len(s) for s in spec.pieces)

@@ -87,7 +87,7 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.geometry import Shape
-    from solvers.cover import CoverLimitError, count_solutions
+    from chaingeo.solvers.cover import CoverLimitError, count_solutions
 
     pieces, level_box = load_pieces(args.pieces)
     if args.box is not None:

@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.envs.dataset import DatasetError, export_dataset
     from chaingeo.envs.dataset_card import dataset_card
     from chaingeo.envs.demos import DemonstrationError
-    from generator.signature import level_signature
+    from chaingeo.generator.signature import level_signature
 
     levels = levels_of(args)
     signatures = {lv.id: level_signature(lv) for lv in levels}

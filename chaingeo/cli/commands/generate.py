@@ -55,8 +55,8 @@ def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
 
 
 def add_curriculum_option(p: argparse.ArgumentParser, family: str) -> None:
-    """``--curriculum K``: step K of the family's easy-to-hard list (generator.curriculum)."""
-    from generator.curriculum import CURRICULA
+    """``--curriculum K``: step K of the family's easy-to-hard list (chaingeo.generator.curriculum)."""
+    from chaingeo.generator.curriculum import CURRICULA
 
     p.add_argument(
         "--curriculum",
@@ -70,8 +70,8 @@ def add_curriculum_option(p: argparse.ArgumentParser, family: str) -> None:
 def run_job(args: argparse.Namespace, family: str, make: Any, config: Any) -> int:
     """Run one generation job from parsed options; print the summary as one JSON line."""
     from chaingeo.envs.pictures import level_pictures
-    from generator.batch import HELD_OUT, GenerationError, GenerationJob, run
-    from generator.signature import shipped_signatures
+    from chaingeo.generator.batch import HELD_OUT, GenerationError, GenerationJob, run
+    from chaingeo.generator.signature import shipped_signatures
 
     held_out = shipped_signatures() if args.split == "train" else frozenset()
     try:
@@ -118,7 +118,7 @@ def _register_stacking(fam: Any) -> None:
 
 
 def stacking_config_from_args(args: argparse.Namespace) -> Any:
-    from generator.config import get_config, parse_box, stacking_config
+    from chaingeo.generator.config import get_config, parse_box, stacking_config
 
     overrides: dict[str, Any] = {}
     for opt, fld in (
@@ -133,7 +133,7 @@ def stacking_config_from_args(args: argparse.Namespace) -> Any:
     if args.no_linear_assembly:
         overrides["linear_assembly"] = False
     if args.curriculum is not None:
-        from generator.curriculum import stacking_step
+        from chaingeo.generator.curriculum import stacking_step
 
         if args.config or args.box or args.mode:
             raise CommandError("give either --curriculum or --config or --box/--mode")
@@ -149,7 +149,7 @@ def stacking_config_from_args(args: argparse.Namespace) -> Any:
 
 
 def _run_stacking(args: argparse.Namespace) -> int:
-    from generator.stacking import make
+    from chaingeo.generator.stacking import make
 
     return run_job(args, "stacking", make, stacking_config_from_args(args))
 
@@ -167,7 +167,7 @@ def _register_suite(fam: Any) -> None:
 
 def _run_suite(args: argparse.Namespace) -> int:
     from chaingeo.envs.pictures import level_pictures
-    from generator.suite import build_suite
+    from chaingeo.generator.suite import build_suite
 
     try:
         summaries = build_suite(
@@ -217,9 +217,9 @@ def _register_puzzle(fam: Any) -> None:
 
 
 def _run_puzzle(args: argparse.Namespace) -> int:
-    from generator.config import PuzzleConfig
-    from generator.curriculum import PUZZLE_STEPS, puzzle_step
-    from generator.puzzle import make
+    from chaingeo.generator.config import PuzzleConfig
+    from chaingeo.generator.curriculum import PUZZLE_STEPS, puzzle_step
+    from chaingeo.generator.puzzle import make
 
     fields: dict[str, Any] = {"shape": "burr6", "min_level": 1}
     if args.curriculum is not None:
@@ -244,7 +244,7 @@ def _register_puzzle_suite(fam: Any) -> None:
 def _run_puzzle_suite(args: argparse.Namespace) -> int:
     import sys
 
-    from generator.puzzle_suite import build_puzzle_suite
+    from chaingeo.generator.puzzle_suite import build_puzzle_suite
 
     try:
         levels = build_puzzle_suite(

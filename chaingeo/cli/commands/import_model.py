@@ -1,7 +1,7 @@
 """``chain import``: a CHAIN puzzle model (URDF + OBJ parts) as a ``chain-level/1`` file.
 
 The importer (:mod:`chaingeo.core.formats.models`) puts the parts on the lattice;
-:mod:`generator.imported` adds what needs the solvers: a puzzle's level and optimal plan (with
+:mod:`chaingeo.generator.imported` adds what needs the solvers: a puzzle's level and optimal plan (with
 caps) or a stacking model's packing. A model that is not on a lattice, or a puzzle that does
 not come apart, is an error and nothing is written.
 
@@ -23,8 +23,8 @@ from chaingeo.cli.errors import CommandError
 if TYPE_CHECKING:
     from chaingeo.core.formats.models import ImportedModel
     from chaingeo.core.level import Level
-    from solvers.disassemble import Analysis
-    from solvers.partsearch import SearchLimits
+    from chaingeo.solvers.disassemble import Analysis
+    from chaingeo.solvers.partsearch import SearchLimits
 
 
 def register(sub: Any) -> None:
@@ -84,7 +84,7 @@ class ModelReport:
 
 
 def limits_of(args: argparse.Namespace) -> SearchLimits:
-    from solvers.partsearch import SearchLimits
+    from chaingeo.solvers.partsearch import SearchLimits
 
     return SearchLimits(
         max_states=args.max_states,
@@ -94,9 +94,9 @@ def limits_of(args: argparse.Namespace) -> SearchLimits:
 
 
 def build_level(model: ImportedModel, args: argparse.Namespace) -> Level:
-    """The verified level of an imported model (:mod:`generator.imported`: solvers find the
+    """The verified level of an imported model (:mod:`chaingeo.generator.imported`: solvers find the
     plan or the packing)."""
-    from generator.imported import imported_puzzle_level, imported_stacking_level
+    from chaingeo.generator.imported import imported_puzzle_level, imported_stacking_level
 
     if model.kind == "stacking":
         return imported_stacking_level(model)
@@ -110,7 +110,7 @@ def report_model(folder: Path, args: argparse.Namespace) -> ModelReport:
     """Import one model and, for a puzzle, analyse it under the command's caps."""
     from chaingeo.core.formats.models import ModelImportError, import_model
     from chaingeo.core.kinematics import SearchLimitError
-    from solvers.analysis import analyze_puzzle
+    from chaingeo.solvers.analysis import analyze_puzzle
 
     try:
         model = import_model(folder, args.kind)

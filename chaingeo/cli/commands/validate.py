@@ -52,9 +52,9 @@ def recheck_optimal(level: Level) -> int:
     :class:`BadBlocks` when the level's ``stats.blocks`` is malformed."""
     from chaingeo.core.kinematics import SearchLimitError
     from chaingeo.core.limits import RECHECK_MAX_STATES
-    from solvers.analysis import analyze_level, level_blocks
-    from solvers.movement import MAX_PIECES
-    from solvers.partsearch import SearchLimits
+    from chaingeo.solvers.analysis import analyze_level, level_blocks
+    from chaingeo.solvers.movement import MAX_PIECES
+    from chaingeo.solvers.partsearch import SearchLimits
 
     if level.family != "puzzle":
         return len(level.pieces)
