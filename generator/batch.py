@@ -51,8 +51,8 @@ class GenerationJob:
     """What to generate: ``count`` levels of ``family`` from items ``first_index`` onwards.
 
     ``make`` and ``pictures`` must be module-level functions (they travel to workers by name).
-    ``held_out``: split signatures (:mod:`chaingeo.generator.signature`) never accepted, each such level
-    counted as :data:`HELD_OUT` (a train split holds out the shipped suite).
+    ``held_out``: split signatures (:mod:`chaingeo.generator.signature`) never accepted, each such
+    level counted as :data:`HELD_OUT` (a train split holds out the shipped suite).
     """
 
     family: str

@@ -2,7 +2,8 @@
 
 Shared by the layout search (:mod:`chaingeo.generator.puzzle`) and the cube search
 (:mod:`chaingeo.generator.cubes`): a candidate is a list of pieces (assembled position) with the
-BurrTools-style analysis of :func:`chaingeo.solvers.disassemble.analyze`, scored by (level, total moves).
+BurrTools-style analysis of :func:`chaingeo.solvers.motion.disassemble.analyze`, scored by (level,
+total moves).
 """
 
 from __future__ import annotations
@@ -12,8 +13,8 @@ from collections.abc import Sequence
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.generator.config import PuzzleConfig
-from chaingeo.solvers.disassemble import Analysis, analyze
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis, analyze
 
 Score = tuple[int, int]
 

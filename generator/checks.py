@@ -79,7 +79,7 @@ def level_problems(level: Level, config: StackingConfig) -> list[str]:
         out.append(f"stats record {recorded} nodes to the first packing, the engine takes {nodes}")
     if figures.get("solutions") is not None:
         budget = 2 * int(figures.get("count_budget") or 0) or None
-        counted = packing.count_packings(shapes, level.box, budget)
+        counted = packing.counted_packings(shapes, level.box, budget)
         if counted != (figures["solutions"], figures.get("distinct")):
             out.append(
                 f"stats record {figures['solutions']} packings ({figures.get('distinct')} "

@@ -35,8 +35,9 @@ from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Assembly, SearchLimitError
 from chaingeo.generator.candidate import Candidate, evaluate, piece_names, probe_limits
 from chaingeo.generator.config import PuzzleConfig
-from chaingeo.solvers.disassemble import fast_legal_moves
-from chaingeo.solvers.partsearch import Deadline, PartSearch, PieceTable, Removal
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.motion.disassemble import fast_legal_moves
+from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable, Removal
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]

@@ -1,8 +1,8 @@
 """Deep and large generated puzzles: maze burrs (level grows with the maze) and towers of burr
 units played with single-piece moves (o_i proven by the block bound).
 
-Both give :class:`chaingeo.generator.candidate.Candidate` objects to :func:`chaingeo.generator.puzzle.make`,
-which builds and verifies the level like any other.
+Both give :class:`chaingeo.generator.candidate.Candidate` objects to
+:func:`chaingeo.generator.puzzle.make`, which builds and verifies the level like any other.
 """
 
 from __future__ import annotations
@@ -17,18 +17,19 @@ from chaingeo.core.kinematics import Move, SearchLimitError
 from chaingeo.generator.candidate import Candidate, evaluate
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.maze import maze_search, runs, with_exit
-from chaingeo.solvers.disassemble import analyze, translations
+from chaingeo.solvers.motion.disassemble import analyze, translations
 
 #: Towers of burr units; with single-piece moves (max_group=1) they are built unit by unit and
-#: their o_i is proven with the block bound (:mod:`chaingeo.solvers.blockbound`), one block per unit.
+#: their o_i is proven with the block bound (:mod:`chaingeo.solvers.optimal.blockbound`), one block
+#: per unit.
 TOWERS = {"burr12": 2, "burr18": 3, "burr24": 4, "burr36": 6}
 
 UnitSearch = Callable[[PuzzleConfig, np.random.Generator], Candidate | None]
 
 
 def maze_candidate(config: PuzzleConfig, n: int, rng: np.random.Generator) -> Candidate | None:
-    """A maze burr (:mod:`chaingeo.generator.maze`): ``hill_steps`` random walks, the one with the most
-    straight runs kept; its level is measured by the solver and must equal the runs."""
+    """A maze burr (:mod:`chaingeo.generator.maze`): ``hill_steps`` random walks, the one with the
+    most straight runs kept; its level is measured by the solver and must equal the runs."""
     found = maze_search(n, config.min_level, config.hill_steps, rng)
     if found is None:
         return None
@@ -55,7 +56,7 @@ def tower_candidate(
     stacked. A unit is kept when its optimal plan never moves down and leaves one of its
     z-sticks (slots 4, 5) unmoved to the end, so that the tower can be taken apart unit by unit
     from the top in the block bound's number of moves, each unit's last piece touching the unit
-    below as it leaves (:mod:`chaingeo.solvers.blockbound`)."""
+    below as it leaves (:mod:`chaingeo.solvers.optimal.blockbound`)."""
     unit_config = replace(config, shape="burr6", min_level=1)
     shapes: list[Shape] = []
     for u in range(units):

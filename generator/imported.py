@@ -1,8 +1,8 @@
 """Levels made from CHAIN's published models: the importer's lattice pieces plus what needs
 the solvers (a puzzle's level and optimal plan, a stacking model's packing).
 
-One place for ``chain import`` and for the puzzle suite (:mod:`chaingeo.generator.puzzle_suite`), so an
-imported level in the suite is byte for byte what ``chain import`` writes for the same model
+One place for ``chain import`` and for the puzzle suite (:mod:`chaingeo.generator.puzzle_suite`), so
+an imported level in the suite is byte for byte what ``chain import`` writes for the same model
 and options.
 """
 
@@ -19,9 +19,9 @@ from chaingeo.core.formats.models import (
 from chaingeo.core.level import Difficulty, Level
 from chaingeo.generator.puzzle import difficulty_of
 from chaingeo.solvers.analysis import analyze_puzzle
-from chaingeo.solvers.cover import first_solution
-from chaingeo.solvers.disassemble import Analysis
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.cover.packings import first_packing
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis
 
 #: The caps of ``chain import`` (its ``--max-states`` / ``--max-total-states`` / ``--seconds``).
 IMPORT_LIMITS = SearchLimits(max_states=500_000, seconds=120.0, max_total_states=3_000_000)
@@ -41,7 +41,7 @@ def imported_stacking_level(model: ImportedModel, level_id: str | None = None) -
     """The stacking level of a model laid out beside its container, packed by exact cover.
     Raises :class:`ModelImportError` when the pieces do not pack the box."""
     assert model.box is not None
-    sol = first_solution(model.shapes, model.box, reflections=False)
+    sol = first_packing(model.shapes, model.box, reflections=False)
     if sol is None:
         raise ModelImportError(
             model.model, "box", f"the pieces do not pack the {list(model.box)} box"

@@ -1,4 +1,4 @@
-"""The generator's thin layer over the exact-cover engine (:mod:`chaingeo.solvers.cover`).
+"""The generator's thin layer over the exact-cover engine (:mod:`chaingeo.solvers.cover.packings`).
 
 Two questions are asked of it: how hard is a packing to find (nodes of a plain dancing-links
 search with MRV column choice to the first packing, the CHAIN generator's difficulty proxy;
@@ -18,12 +18,12 @@ from typing import Any, Final
 import numpy as np
 
 from chaingeo.core.geometry import Shape
-from chaingeo.solvers.cover import (
+from chaingeo.solvers.cover.packings import (
     CoverLimitError,
     CoverSearch,
-    count_solutions,
+    count_packings,
     cover_problem,
-    random_solutions,
+    random_packings,
 )
 
 #: Engine whose node counts are the difficulty proxy (fixed: node counts differ by engine).
@@ -76,13 +76,13 @@ def search_effort(
     (the count is then None) and 0 skips it."""
     if count_limit <= 0:
         return SearchEffort(nodes_first, None, None, 0)
-    counted = count_packings(shapes, box, count_limit)
+    counted = counted_packings(shapes, box, count_limit)
     if counted is None:
         return SearchEffort(nodes_first, None, None, count_limit)
     return SearchEffort(nodes_first, counted[0], counted[1], count_limit)
 
 
-def count_packings(
+def counted_packings(
     shapes: Sequence[Shape], box: Sequence[int], node_limit: int | None
 ) -> tuple[int, int | None] | None:
     """``(packings, distinct packings)``, or None when the count needs more than
@@ -91,7 +91,7 @@ def count_packings(
     try:
         # Pinned engine, no symmetry reduction: whether a count finishes inside the budget must
         # not change when the automatic engine or its anchoring gets faster.
-        res = count_solutions(
+        res = count_packings(
             _named(shapes)[0], dims, node_limit=node_limit, engine=EFFORT_ENGINE, symmetry=False
         )
     except CoverLimitError:
@@ -99,7 +99,7 @@ def count_packings(
     return res.solutions, res.distinct
 
 
-def random_packings(
+def seeded_packings(
     shapes: Sequence[Shape], box: Sequence[int], seed: int, limit: int
 ) -> Iterator[list[Shape]]:
     """Up to ``limit`` packings of ``shapes`` in a seeded random order, placements aligned to
@@ -107,7 +107,7 @@ def random_packings(
     pieces, names = _named(shapes)
     dims = tuple(int(v) for v in box)
     rng = np.random.default_rng(seed)
-    for n, sol in enumerate(random_solutions(pieces, dims, rng, engine=EFFORT_ENGINE)):
+    for n, sol in enumerate(random_packings(pieces, dims, rng, engine=EFFORT_ENGINE)):
         if n >= limit:
             return
         placed = dict(sol.placements)

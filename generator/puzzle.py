@@ -40,7 +40,7 @@ from chaingeo.generator.maze import parse_maze_shape
 from chaingeo.generator.result import Rejection
 from chaingeo.generator.standard_burr import standard_burr_search
 from chaingeo.solvers.analysis import BLOCKS_KEY, analyze_puzzle
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
 
 GENERATOR = "chaingeo.generator.puzzle"
 VERSION = "1"
@@ -131,9 +131,9 @@ def puzzle_level(
     (the assembly optimum equals the disassembly optimum: the two state graphs are mirror
     images). Raises :class:`SearchLimitError` when o_i cannot be computed within ``limits``.
     ``blocks`` (indices into ``shapes``, a stack of units along z; single-piece moves only)
-    proves o_i with the block bound of :mod:`chaingeo.solvers.blockbound` instead of searching; the
-    level carries them (``stats["blocks"]``) so that :func:`chaingeo.solvers.analysis.analyze_level`
-    analyses it the same way.
+    proves o_i with the block bound of :mod:`chaingeo.solvers.optimal.blockbound` instead of
+    searching; the level carries them (``stats["blocks"]``) so that
+    :func:`chaingeo.solvers.analysis.analyze_level` analyses it the same way.
     """
     base = np.min(np.concatenate([s.voxels for s in shapes]), axis=0)
     placed = [s.translate(-base) for s in shapes]

@@ -4,13 +4,14 @@
 entry, listed in :data:`SUITE`:
 
 * :class:`ModelEntry`: one of CHAIN's published puzzle models (``DIR/NAME``, the folder of
-  ``chain import``), imported by :func:`chaingeo.generator.imported.imported_puzzle_level` exactly as
-  ``chain import`` does; its tier is what the solver's figures give, and the build stops when
+  ``chain import``), imported by :func:`chaingeo.generator.imported.imported_puzzle_level` exactly
+  as ``chain import`` does; its tier is what the solver's figures give, and the build stops when
   that is not the entry's tier.
 * :class:`SuiteEntry`: a generator configuration and seed; items ``0, 1, 2, ...`` of the seed
-  are made with :func:`chaingeo.generator.puzzle.make` and the first ones whose tier (from the solver's
-  figures, :func:`chaingeo.generator.puzzle.difficulty_of`) is the entry's and whose signature is new
-  within the entry are kept. A puzzle made by two entries stops the build (change a seed).
+  are made with :func:`chaingeo.generator.puzzle.make` and the first ones whose tier (from the
+  solver's figures, :func:`chaingeo.generator.puzzle.difficulty_of`) is the entry's and whose
+  signature is new within the entry are kept. A puzzle made by two entries stops the build (change a
+  seed).
 
 Entries are independent, so they run in parallel; ids are then given in :data:`SUITE` order.
 Every search is bounded by state caps only, never by time, so every machine makes the same
@@ -31,7 +32,7 @@ from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.imported import imported_puzzle_level
 from chaingeo.generator.puzzle import make
 from chaingeo.generator.result import Rejection
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
 
 Goal = Literal["disassemble", "assemble"]
 

@@ -239,7 +239,7 @@ def _attempt_easy(
     pieces = sorted(drawn, key=lambda s: (len(s), s.cells))
     found_any = False
     seed = int(rng.integers(2**63))
-    for placements in packing.random_packings(pieces, config.box, seed, config.easy_packings):
+    for placements in packing.seeded_packings(pieces, config.box, seed, config.easy_packings):
         found_any = True
         outcome = _finish(config, placements, 0)
         if not isinstance(outcome, str) or outcome != "no-linear-assembly":

@@ -8,16 +8,16 @@ the classic three-pairs arrangement of :data:`chaingeo.core.piecesets.burrs.SLOT
 lengthened by one unit at both ends (8 x 8 x 8 bounding cube).
 
 A *design* says, for each of the 32 cells where two or three sticks cross, which stick owns it
-or that it stays empty (:class:`chaingeo.generator.layouts.Layout`). Those cells are exactly the 12 inner
-cubes of each stick, so every piece is a 2x2x8 stick minus any subset of its inner cubes (holey
-pieces, not only notchable ones) and any design is a non-overlapping assembly. A piece must stay
-connected; that test runs on 32-bit masks (one bit per cell of the stick), memoised per code.
+or that it stays empty (:class:`chaingeo.generator.layouts.Layout`). Those cells are exactly the 12
+inner cubes of each stick, so every piece is a 2x2x8 stick minus any subset of its inner cubes
+(holey pieces, not only notchable ones) and any design is a non-overlapping assembly. A piece must
+stay connected; that test runs on 32-bit masks (one bit per cell of the stick), memoised per code.
 
 The search (:func:`standard_burr_search`) is simulated annealing on single cubes with restarts:
 each restart draws a random connected design that comes apart, then changes one cube at a time
 (give it to another stick, or empty it), scoring by (level, moves) from
-:func:`chaingeo.solvers.disassemble.analyze` and accepting a worse design with a probability that falls
-to zero over the restart (a pure hill climb at the end). Designs that do not come apart
+:func:`chaingeo.solvers.motion.disassemble.analyze` and accepting a worse design with a probability
+that falls to zero over the restart (a pure hill climb at the end). Designs that do not come apart
 completely are never accepted. With ``unique`` the kept design must also assemble in exactly
 one way (:func:`assembly_counts`). Only state caps bound the work, so a (seed, index) gives the
 same design on every machine.
@@ -38,10 +38,12 @@ from chaingeo.core.piecesets.burrs import SLOTS
 from chaingeo.generator.candidate import Candidate, Score, evaluate, piece_names, probe_limits
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.layouts import Layout
-from chaingeo.solvers.assemble import iter_assemblies
-from chaingeo.solvers.disassemble import Analysis, analyze
-from chaingeo.solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
-from chaingeo.solvers.problem import PieceSpec
+from chaingeo.solvers.assembly.assemble import iter_assemblies
+from chaingeo.solvers.cover.problem import PieceSpec
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis, analyze
+from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable
 
 #: Stick length of Cutler's standard six-piece burr.
 STICK_LENGTH = 8

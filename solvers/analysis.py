@@ -1,15 +1,16 @@
 """One way to analyse a puzzle: the level (BurrTools' notation), the moves and o_i.
 
 Everything that analyses a puzzle level goes through here: ``chain analyze``, the generator
-(:func:`chaingeo.generator.puzzle.puzzle_level`), the suite tests and the bench. A level that carries
-the structure a proven bound needs (``stats["blocks"]``: towers of burr units) is analysed with
-it, everywhere: the block bound of :mod:`chaingeo.solvers.blockbound` for moves of one piece, the search
-under the class bound of :mod:`chaingeo.solvers.classsearch` for moves of several; every other puzzle
-with the plain optimal search of :mod:`chaingeo.solvers.disassemble`.
+(:func:`chaingeo.generator.puzzle.puzzle_level`), the suite tests and the bench. A level that
+carries the structure a proven bound needs (``stats["blocks"]``: towers of burr units) is analysed
+with it, everywhere: the block bound of :mod:`chaingeo.solvers.optimal.blockbound` for moves of one
+piece, the search under the class bound of :mod:`chaingeo.solvers.optimal.classsearch` for moves of
+several; every other puzzle with the plain optimal search of
+:mod:`chaingeo.solvers.motion.disassemble`.
 
 *Time*: ``limits.seconds`` bounds one whole analysis. :func:`level_figures` and
-:func:`xmpuzzle_figures` (``chain analyze``) make one :class:`chaingeo.solvers.deadline.Deadline` and
-hand it to everything they run (the enumeration of assemblies, every disassembly, the optimal
+:func:`xmpuzzle_figures` (``chain analyze``) make one :class:`chaingeo.solvers.deadline.Deadline`
+and hand it to everything they run (the enumeration of assemblies, every disassembly, the optimal
 search), so the whole command stops with a :class:`SearchLimitError` naming ``seconds`` once
 it is spent (a spent optimal search alone is reported as ``optimal_error``).
 """
@@ -24,14 +25,14 @@ from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.rules import PuzzleRules
-from chaingeo.solvers.btassemble import Mirrors, bt_packing_spec, piece_groups
-from chaingeo.solvers.btcount import BTReport, count_bt
-from chaingeo.solvers.constrained import Packing, compile_packing
+from chaingeo.solvers.assembly.btassemble import Mirrors, bt_packing_spec, piece_groups
+from chaingeo.solvers.assembly.btcount import BTReport, count_bt
+from chaingeo.solvers.assembly.groups import PieceGroups, analyze_grouped
+from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.disassemble import Analysis, Rods, analyze
-from chaingeo.solvers.groups import PieceGroups, analyze_grouped
-from chaingeo.solvers.movement import MAX_PIECES
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis, Rods, analyze
+from chaingeo.solvers.motion.movement import MAX_PIECES
 
 if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imports
     from chaingeo.core.level import Level
@@ -79,13 +80,15 @@ def analyze_puzzle(
     if blocks is not None and turns:
         raise ValueError("blocks prove o_i for translations only, not with turns")
     if blocks is not None and max_group != 1:
-        from chaingeo.solvers.classsearch import analyze_by_classes  # levels with blocks only
+        from chaingeo.solvers.optimal.classsearch import (
+            analyze_by_classes,  # levels with blocks only
+        )
 
         return analyze_by_classes(
             shapes, blocks, max_group=max_group, limits=limits, deadline=deadline
         )
     if blocks is not None:
-        from chaingeo.solvers.blockbound import analyze_by_blocks  # levels with blocks only
+        from chaingeo.solvers.optimal.blockbound import analyze_by_blocks  # levels with blocks only
 
         return analyze_by_blocks(
             shapes, blocks, limits=limits, stacked=True, search=False, deadline=deadline
@@ -284,10 +287,10 @@ def problem_figures(
     deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """What ``chain analyze`` prints for one problem of a BurrTools puzzle: BurrTools'
-    assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.btassemble`), then level, moves
-    and o_i of the first solution (with ``assemble`` off: of the first stored assembly). With
-    piece groups o_i is not searched (``optimal_error`` says so). Everything runs within
-    ``deadline`` (default: one of ``limits.seconds``)."""
+    assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.assembly.btassemble`), then
+    level, moves and o_i of the first solution (with ``assemble`` off: of the first stored
+    assembly). With piece groups o_i is not searched (``optimal_error`` says so). Everything runs
+    within ``deadline`` (default: one of ``limits.seconds``)."""
     if deadline is None:
         deadline = Deadline(limits.seconds)
     prob = puzzle.problem(index)
@@ -298,8 +301,8 @@ def problem_figures(
     if assemble:
         packing = compile_packing(bt_packing_spec(puzzle, index))
         rep = count_figures(packing, out, mirrors, None, limits, deadline, f"problem {index}: ")
-        if rep.first_solution is not None:
-            found, first = (rep.first_solution, piece_groups(packing)), rep.first_analysis
+        if rep.first_packing is not None:
+            found, first = (rep.first_packing, piece_groups(packing)), rep.first_analysis
         if not rep.complete:
             deadline = grace_deadline(limits)
             found = found or _stored_assembly(puzzle, index)

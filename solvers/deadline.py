@@ -1,8 +1,9 @@
 """The wall-clock budget of one analysis, shared by every search in it.
 
 One :class:`Deadline` is made per analysis (``SearchLimits.seconds``) and handed down to every
-search it runs: the exact-cover enumeration of assemblies (:class:`chaingeo.solvers.search.CoverSearch`)
-and the disassembly searches (:mod:`chaingeo.solvers.disassemble`, :mod:`chaingeo.solvers.partsearch`). Numba
+search it runs: the exact-cover enumeration of assemblies
+(:class:`chaingeo.solvers.cover.search.CoverSearch`) and the disassembly searches
+(:mod:`chaingeo.solvers.motion.disassemble`, :mod:`chaingeo.solvers.motion.partsearch`). Numba
 kernels cannot read the clock, so each of them stops after a budget of work and the Python side
 checks the deadline between two calls.
 """

@@ -145,7 +145,7 @@ def test_counting_cut_short_keeps_the_known_assembly_s_figures() -> None:
     from chaingeo.core.level import load_level
     from chaingeo.solvers.analysis import level_figures, problem_figures
     from chaingeo.solvers.deadline import Deadline
-    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.limits import SearchLimits
 
     level = load_level(shipped_levels("puzzle") / "puzzle-mid-04-burr12.json")
     limits = SearchLimits(seconds=30.0)

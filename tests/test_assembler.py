@@ -9,8 +9,8 @@ import pytest
 
 from chaingeo.cli.main import main
 from chaingeo.core.geometry import Shape
-from chaingeo.solvers.assemble import count_solutions, iter_assemblies
-from chaingeo.solvers.problem import PieceSpec
+from chaingeo.solvers.assembly.assemble import count_assemblies, iter_assemblies
+from chaingeo.solvers.cover.problem import PieceSpec
 from tests.shared_files import BT, needs_files
 
 
@@ -24,7 +24,7 @@ def test_small_assemblies_and_solutions() -> None:
     for a in asms:
         cells = [c for s in a.values() for c in s.cells]
         assert sorted(cells) == sorted(target.cells)
-    report = count_solutions(pieces, target)
+    report = count_assemblies(pieces, target)
     assert report.assemblies == len(asms) and report.solutions == len(asms)
 
 

@@ -1,5 +1,5 @@
-"""A* with pattern databases (solvers/astar.py): optimal against the branch-and-bound search,
-admissible and consistent heuristic, plans the reference kinematics replays, caps."""
+"""A* with pattern databases (solvers/optimal/astar.py): optimal against the branch-and-bound
+search, admissible and consistent heuristic, plans the reference kinematics replays, caps."""
 
 from __future__ import annotations
 
@@ -17,8 +17,8 @@ from chaingeo.core.kinematics import (
     reference_optimal_disassembly,
     replay_disassembly,
 )
-from chaingeo.solvers.astar import AStarLimits, Heuristic, astar_optimal
-from chaingeo.solvers.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.optimal.astar import AStarLimits, Heuristic, astar_optimal
 from tests.puzzle_strategies import random_partition, small_scenes
 from tests.shared_files import BT, needs_files
 from tests.test_disassemble import SCENE, random_walk

@@ -15,8 +15,8 @@ from chaingeo.envs.machines import new_state
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.puzzle import make
 from chaingeo.generator.result import Rejection
-from chaingeo.solvers.blockbound import analyze_by_blocks, block_lower_bound
-from chaingeo.solvers.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.optimal.blockbound import analyze_by_blocks, block_lower_bound
 
 
 @cache

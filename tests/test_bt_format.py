@@ -302,7 +302,7 @@ def test_any_readable_problem_is_analysed_or_refused_with_a_value_error(puzzle: 
     parts, colours), the analysis answers or raises a ValueError saying why."""
     from chaingeo.core.kinematics import SearchLimitError
     from chaingeo.solvers.analysis import problem_figures
-    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.limits import SearchLimits
 
     back = parse_xmpuzzle(xmpuzzle_bytes(puzzle))
     for i in range(len(back.problems)):

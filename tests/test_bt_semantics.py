@@ -16,18 +16,18 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.generator.bt_examples import EXAMPLES, staircase
 from chaingeo.generator.maze import runs, with_exit
-from chaingeo.solvers.btassemble import (
+from chaingeo.solvers.assembly.btassemble import (
     Mirrors,
     bt_packing_spec,
     disassemble,
     iter_classes,
     named_assembly,
 )
-from chaingeo.solvers.btcount import StuckCheck, count_bt
-from chaingeo.solvers.constrained import compile_packing
-from chaingeo.solvers.disassemble import Separation, Separations, _Solver, analyze
-from chaingeo.solvers.groups import PieceGroups, assignable
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.assembly.btcount import StuckCheck, count_bt
+from chaingeo.solvers.assembly.groups import PieceGroups, assignable
+from chaingeo.solvers.cover.constrained import compile_packing
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Separation, Separations, _Solver, analyze
 from tests import bt_reference as ref
 from tests.bt_instances import random_puzzle, reference_parts
 from tests.test_disassemble import _level_or_error
@@ -166,8 +166,8 @@ def test_ring_maze_level_is_the_mazes_runs() -> None:
     report = count_bt(packing)
     assert (report.assemblies, report.solutions) == (2, 2)
     assert report.first_analysis is not None and report.first_analysis.level == "17"
-    assert report.first_solution is not None
-    pin_and_ring = {n: s for n, s in report.first_solution.items() if len(s) < 20}
+    assert report.first_packing is not None
+    pin_and_ring = {n: s for n, s in report.first_packing.items() if len(s) < 20}
     assert len(pin_and_ring) == 2
     assert not analyze(pin_and_ring, optimal=False).disassemblable  # the ring never comes off
 

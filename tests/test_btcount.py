@@ -1,6 +1,6 @@
-"""BurrTools' verdicts on rows (chaingeo.solvers.btcount.RowVerdicts) against the general path: the
-same image, the same counts, the same level strings in the same order, on puzzles we did not
-hand-make (seeded random boxes cut into pieces, congruent and mirror pieces, holes) and on the
+"""BurrTools' verdicts on rows (chaingeo.solvers.assembly.btcount.RowVerdicts) against the general
+path: the same image, the same counts, the same level strings in the same order, on puzzles we did
+not hand-make (seeded random boxes cut into pieces, congruent and mirror pieces, holes) and on the
 feature examples and shipped levels."""
 
 from __future__ import annotations
@@ -14,15 +14,15 @@ from chaingeo.core.formats.bt_level import level_puzzle
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.level import load_level
 from chaingeo.generator.bt_examples import EXAMPLES
-from chaingeo.solvers.btassemble import (
+from chaingeo.solvers.assembly.btassemble import (
     BTFrame,
     Mirrors,
     bt_packing_spec,
     iter_classes,
     named_assembly,
 )
-from chaingeo.solvers.btcount import RowVerdicts, count_bt
-from chaingeo.solvers.constrained import compile_packing
+from chaingeo.solvers.assembly.btcount import RowVerdicts, count_bt
+from chaingeo.solvers.cover.constrained import compile_packing
 from tests.burrtxt import random_puzzle
 
 LEVELS = Path(__file__).resolve().parents[1] / "levels" / "puzzle"
@@ -37,7 +37,7 @@ def _same_counts(puzzle: BTPuzzle, mirrors: Mirrors) -> None:
     slow = count_bt(packing, mirrors=mirrors, levels=slow_levels, fast=False)
     assert (fast.assemblies, fast.solutions) == (slow.assemblies, slow.solutions)
     assert fast_levels == slow_levels
-    assert fast.first_solution == slow.first_solution
+    assert fast.first_packing == slow.first_packing
 
 
 def _same_images(puzzle: BTPuzzle, most: int = 200) -> int:

@@ -12,8 +12,8 @@ from chaingeo.core.piecesets.burrs import (
     solid_burr_pieces,
     solid_knot,
 )
-from chaingeo.solvers.assemble import count_solutions, solid_burr_codes
-from chaingeo.solvers.problem import PieceSpec
+from chaingeo.solvers.assembly.assemble import count_assemblies, solid_burr_codes
+from chaingeo.solvers.cover.problem import PieceSpec
 from tests.shared_files import BT, needs_files
 
 
@@ -26,7 +26,7 @@ def test_family_sizes() -> None:
 
 def test_314_solid_six_piece_burrs() -> None:
     pieces = [PieceSpec(s, n, 0, 6) for n, s in solid_burr_pieces().items()]
-    report = count_solutions(pieces, solid_knot())
+    report = count_assemblies(pieces, solid_knot())
     assert (report.assemblies, report.solutions) == (1063, 314)
 
 

@@ -19,7 +19,7 @@ from chaingeo.core.formats.burrtools import (
 )
 from chaingeo.core.geometry import ROTATIONS, Shape
 from chaingeo.core.piecesets.burrs import six_piece_family, solid_knot
-from chaingeo.solvers.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze
 from tests.shared_files import BT, needs_files
 
 

@@ -25,10 +25,10 @@ from chaingeo.core.formats.burrtools import read_xmpuzzle
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.rules import PuzzleRules
-from chaingeo.solvers.btassemble import bt_packing_spec
-from chaingeo.solvers.btcount import count_bt
-from chaingeo.solvers.constrained import compile_packing
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.assembly.btassemble import bt_packing_spec
+from chaingeo.solvers.assembly.btcount import count_bt
+from chaingeo.solvers.cover.constrained import compile_packing
+from chaingeo.solvers.limits import SearchLimits
 from tests import burrtxt as bt
 from tests.shared_files import BT
 
@@ -150,7 +150,7 @@ def test_a_level_string_is_the_one_burrtxt_prints_for_its_assembly() -> None:
 
 
 def _own_level(level: Level) -> str | None:
-    from chaingeo.solvers.disassemble import analyze
+    from chaingeo.solvers.motion.disassemble import analyze
 
     return analyze(level.shapes, optimal=False).level
 

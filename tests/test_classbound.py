@@ -1,6 +1,6 @@
-"""The class bound (solvers/classbound.py): at most the exact optimum with multi-piece moves, on
-random scenes with random blocks and on generated burrs; exact on the suite's 12-piece tower;
-its figures on the suite's 36-piece towers played with multi-piece moves."""
+"""The class bound (solvers/optimal/classbound.py): at most the exact optimum with multi-piece
+moves, on random scenes with random blocks and on generated burrs; exact on the suite's 12-piece
+tower; its figures on the suite's 36-piece towers played with multi-piece moves."""
 
 from __future__ import annotations
 
@@ -16,8 +16,9 @@ from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import Level, load_level
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.puzzle import make
-from chaingeo.solvers.blockbound import end_first_plan
-from chaingeo.solvers.classbound import (
+from chaingeo.solvers.motion.disassemble import analyze, translations
+from chaingeo.solvers.optimal.blockbound import end_first_plan
+from chaingeo.solvers.optimal.classbound import (
     MAX_BUDGET,
     ClassVector,
     Packing,
@@ -27,7 +28,6 @@ from chaingeo.solvers.classbound import (
     join,
     total,
 )
-from chaingeo.solvers.disassemble import analyze, translations
 from tests.puzzle_strategies import random_blocks, small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"

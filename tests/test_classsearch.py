@@ -1,4 +1,4 @@
-"""The search under the class bound (solvers/classsearch.py): the exact optimum of the
+"""The search under the class bound (solvers/optimal/classsearch.py): the exact optimum of the
 branch-and-bound search on random scenes with random blocks, plans that replay, the suite's
 towers with multi-piece moves closed (the 36-piece puzzle-hard-09 at its bound 38), caps."""
 
@@ -16,9 +16,9 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import load_level
 from chaingeo.solvers.analysis import analyze_level
-from chaingeo.solvers.classbound import band_blocks, class_lower_bound
-from chaingeo.solvers.classsearch import ClassSearchLimits, class_search_optimal
-from chaingeo.solvers.disassemble import analyze, translations
+from chaingeo.solvers.motion.disassemble import analyze, translations
+from chaingeo.solvers.optimal.classbound import band_blocks, class_lower_bound
+from chaingeo.solvers.optimal.classsearch import ClassSearchLimits, class_search_optimal
 from tests.puzzle_strategies import random_blocks, small_scenes
 
 SUITE = Path(__file__).resolve().parents[1] / "levels" / "puzzle"

@@ -10,21 +10,21 @@ from hypothesis import strategies as st
 from chaingeo.core.geometry import Shape, box_cells, box_symmetries
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.piecesets import BEDLAM, PENTOMINOES, SOMA
-from chaingeo.solvers.cover import (
+from chaingeo.solvers.cover.packings import (
     CoverError,
     CoverLimitError,
     PieceSpec,
     Solution,
     anchor_plan,
     canonical_forms,
-    count_solutions,
+    count_packings,
     cover_problem,
-    first_solution,
-    iter_solutions,
-    random_solutions,
+    first_packing,
+    iter_packings,
+    random_packings,
 )
-from chaingeo.solvers.placements import placements, target_symmetries
-from chaingeo.solvers.search import Engine
+from chaingeo.solvers.cover.placements import placements, target_symmetries
+from chaingeo.solvers.cover.search import Engine
 from tests import cover_reference as ref
 from tests.strategies import polycubes
 
@@ -36,19 +36,19 @@ L_TROMINO = Shape([(0, 0, 0), (1, 0, 0), (0, 1, 0)])
 
 @pytest.mark.parametrize("engine", ENGINES)
 def test_soma_cube(engine: Engine) -> None:
-    r = count_solutions(SOMA.pieces, (3, 3, 3), engine=engine)
+    r = count_packings(SOMA.pieces, (3, 3, 3), engine=engine)
     assert (r.solutions, r.distinct, r.symmetry_order) == (11520, 240, 48)
     assert r.stats.nodes > 0 and r.stats.engine == engine
 
 
 def test_soma_without_symmetry_reduction_agrees() -> None:
-    r = count_solutions(SOMA.pieces, (3, 3, 3), symmetry=False, distinct=True)
+    r = count_packings(SOMA.pieces, (3, 3, 3), symmetry=False, distinct=True)
     assert (r.solutions, r.distinct, r.anchor) == (11520, 240, None)
 
 
 def test_soma_rotations_only() -> None:
     # Rotations alone never fix a Soma packing, so each class has 24 members.
-    r = count_solutions(SOMA.pieces, (3, 3, 3), reflections=False)
+    r = count_packings(SOMA.pieces, (3, 3, 3), reflections=False)
     assert (r.solutions, r.distinct, r.symmetry_order) == (11520, 480, 24)
 
 
@@ -62,18 +62,18 @@ def _known(box: tuple[int, int, int]) -> tuple[int | None, int]:
     [((6, 10, 1), "auto"), ((5, 12, 1), "auto"), ((5, 12, 1), "dlx"), ((2, 5, 6), "auto")],
 )
 def test_pentomino_packings(box: tuple[int, int, int], engine: Engine) -> None:
-    r = count_solutions(PENTOMINOES.pieces, box, engine=engine)
+    r = count_packings(PENTOMINOES.pieces, box, engine=engine)
     assert (r.solutions, r.distinct) == _known(box)
 
 
 def test_solid_pentominoes_3x4x5() -> None:
-    r = count_solutions(PENTOMINOES.pieces, (3, 4, 5))
+    r = count_packings(PENTOMINOES.pieces, (3, 4, 5))
     assert (r.solutions, r.distinct) == _known((3, 4, 5))
 
 
 @pytest.mark.slow
 def test_bedlam_cube() -> None:
-    r = count_solutions(BEDLAM.pieces, (4, 4, 4))
+    r = count_packings(BEDLAM.pieces, (4, 4, 4))
     # No reflection maps the (chiral) Bedlam set to itself: classes have 24 members.
     assert (r.distinct, r.symmetry_order, r.solutions) == (19186, 24, 19186 * 24)
 
@@ -102,7 +102,7 @@ def test_domino_tilings_are_fibonacci(engine: Engine, n: int) -> None:
     fib = [1, 1]
     while len(fib) <= n:
         fib.append(fib[-1] + fib[-2])
-    r = count_solutions([PieceSpec(DOMINO, "d", 0, n)], (2, n, 1), engine=engine)
+    r = count_packings([PieceSpec(DOMINO, "d", 0, n)], (2, n, 1), engine=engine)
     assert r.solutions == fib[n]
 
 
@@ -111,7 +111,7 @@ def test_multiplicity_ranges(engine: Engine) -> None:
     line = (3, 1, 1)
 
     def count(*specs: PieceSpec) -> int:
-        return count_solutions(list(specs), line, engine=engine, distinct=False).solutions
+        return count_packings(list(specs), line, engine=engine, distinct=False).solutions
 
     # mmm, dm, md
     assert count(PieceSpec(MONO, "m", 0, 3), PieceSpec(DOMINO, "d", 0, 1)) == 3
@@ -124,9 +124,9 @@ def test_multiplicity_ranges(engine: Engine) -> None:
 def test_identical_pieces_are_not_permuted() -> None:
     # Two L trominoes tile a 2x3 rectangle in exactly 2 ways; given as two named pieces they
     # are merged, and each solution names both.
-    r = count_solutions({"A": L_TROMINO, "B": L_TROMINO}, (3, 2, 1))
+    r = count_packings({"A": L_TROMINO, "B": L_TROMINO}, (3, 2, 1))
     assert r.solutions == 2
-    sols = list(iter_solutions({"A": L_TROMINO, "B": L_TROMINO}, (3, 2, 1)))
+    sols = list(iter_packings({"A": L_TROMINO, "B": L_TROMINO}, (3, 2, 1)))
     assert len(sols) == 2
     assert all([n for n, _ in s.placements] == ["A", "B"] for s in sols)
 
@@ -137,19 +137,19 @@ def test_optional_cells(engine: Engine) -> None:
     d = [PieceSpec(DOMINO, "d")]
     one_end = Shape([(2, 0, 0)])
     both_ends = Shape([(0, 0, 0), (2, 0, 0)])
-    assert count_solutions(d, line, optional=one_end, engine=engine).solutions == 1
-    assert count_solutions(d, line, optional=both_ends, engine=engine).solutions == 2
+    assert count_packings(d, line, optional=one_end, engine=engine).solutions == 1
+    assert count_packings(d, line, optional=both_ends, engine=engine).solutions == 2
 
 
 def test_irregular_target() -> None:
     # A plus-shaped target and the X pentomino: one placement.
     x = PENTOMINOES.pieces["X"]
-    r = count_solutions([x], x.translate((4, 5, 6)))
+    r = count_packings([x], x.translate((4, 5, 6)))
     assert (r.solutions, r.distinct, r.symmetry_order) == (1, 1, 1)
 
 
 def test_solution_objects_tile_the_target() -> None:
-    sol = first_solution(SOMA.pieces, (3, 3, 3))
+    sol = first_packing(SOMA.pieces, (3, 3, 3))
     assert sol is not None
     assert sorted(n for n, _ in sol.placements) == sorted(SOMA.pieces)
     cells = [c for s in sol.shapes for c in s.cells]
@@ -159,36 +159,36 @@ def test_solution_objects_tile_the_target() -> None:
 
 
 def test_no_solution() -> None:
-    assert first_solution([DOMINO], (3, 1, 1)) is None
-    assert count_solutions([DOMINO], (3, 1, 1)).solutions == 0
+    assert first_packing([DOMINO], (3, 1, 1)) is None
+    assert count_packings([DOMINO], (3, 1, 1)).solutions == 0
 
 
 @pytest.mark.parametrize("engine", ENGINES)
 def test_node_limit(engine: Engine) -> None:
     with pytest.raises(CoverLimitError) as info:
-        count_solutions(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=50, symmetry=False)
+        count_packings(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=50, symmetry=False)
     assert isinstance(info.value, SearchLimitError)
     assert info.value.stats.nodes <= 50
     got = []
     with pytest.raises(CoverLimitError):
-        for s in iter_solutions(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=100_000):
+        for s in iter_packings(SOMA.pieces, (3, 3, 3), engine=engine, node_limit=100_000):
             got.append(s)
     assert 0 < len(got) < 11520
     # Within the limit nothing is raised.
-    assert count_solutions([DOMINO], (2, 1, 1), node_limit=1).solutions == 1
+    assert count_packings([DOMINO], (2, 1, 1), node_limit=1).solutions == 1
 
 
 def test_bad_input() -> None:
     with pytest.raises(CoverError):
-        count_solutions([], (2, 2, 2))
+        count_packings([], (2, 2, 2))
     with pytest.raises(CoverError):
-        count_solutions([DOMINO], (2, 0, 2))
+        count_packings([DOMINO], (2, 0, 2))
     with pytest.raises(CoverError):
-        count_solutions([PieceSpec(DOMINO, "d", 2, 1)], (2, 1, 1))
+        count_packings([PieceSpec(DOMINO, "d", 2, 1)], (2, 1, 1))
     with pytest.raises(CoverError):
-        count_solutions([DOMINO], (9, 9, 1), engine="bitboard-first")
+        count_packings([DOMINO], (9, 9, 1), engine="bitboard-first")
     with pytest.raises(CoverError):
-        count_solutions({"a": DOMINO}, (2, 1, 1), node_limit=-1)
+        count_packings({"a": DOMINO}, (2, 1, 1), node_limit=-1)
 
 
 @pytest.mark.parametrize("engine", ENGINES)
@@ -197,24 +197,24 @@ def test_random_order_is_seeded_and_complete(engine: Engine) -> None:
 
     def run(seed: int) -> list[tuple[int, ...]]:
         rng = np.random.default_rng(np.random.SeedSequence([seed, 0]))
-        sols = random_solutions(dominoes, (4, 4, 1), rng, engine=engine)
+        sols = random_packings(dominoes, (4, 4, 1), rng, engine=engine)
         return [s.rows for s in sols]
 
     a, b, c = run(7), run(7), run(8)
     assert a == b
     assert a != c
-    fixed = [s.rows for s in iter_solutions(dominoes, (4, 4, 1), engine=engine)]
+    fixed = [s.rows for s in iter_packings(dominoes, (4, 4, 1), engine=engine)]
     assert len(a) == 36 and sorted(a) == sorted(fixed) and a != fixed
     # On a big instance the first few differ between seeds and repeat for the same seed.
     rng1, rng2 = (np.random.default_rng(np.random.SeedSequence([3, i])) for i in (0, 0))
     first = [
-        next(random_solutions(SOMA.pieces, (3, 3, 3), r, engine=engine)).rows for r in (rng1, rng2)
+        next(random_packings(SOMA.pieces, (3, 3, 3), r, engine=engine)).rows for r in (rng1, rng2)
     ]
     assert first[0] == first[1]
 
 
 def test_distinct_iteration() -> None:
-    sols = list(iter_solutions(SOMA.pieces, (3, 3, 3), distinct=True))
+    sols = list(iter_packings(SOMA.pieces, (3, 3, 3), distinct=True))
     assert len(sols) == 240
 
 
@@ -265,13 +265,13 @@ def test_engines_agree_with_naive_oracle(
     expected_distinct = ref.distinct(sols, merged, target, mirrors, opt)
     for engine in ENGINES:
         for symmetry in (True, False):
-            r = count_solutions(problem, engine=engine, symmetry=symmetry)
+            r = count_packings(problem, engine=engine, symmetry=symmetry)
             assert (r.solutions, r.distinct) == (len(sols), expected_distinct), (engine, symmetry)
 
 
 def test_distinct_iteration_with_symmetry_reduction() -> None:
-    plain = list(iter_solutions(SOMA.pieces, (3, 3, 3), distinct=True))
-    reduced = list(iter_solutions(SOMA.pieces, (3, 3, 3), distinct=True, symmetry=True))
+    plain = list(iter_packings(SOMA.pieces, (3, 3, 3), distinct=True))
+    reduced = list(iter_packings(SOMA.pieces, (3, 3, 3), distinct=True, symmetry=True))
     problem = cover_problem(SOMA.pieces, (3, 3, 3))
 
     def forms(sols: list[Solution]) -> set[bytes]:
@@ -296,9 +296,9 @@ def test_cell_anchor_matches_plain_count(reflections: bool) -> None:
     problem = cover_problem(specs, target, reflections=reflections)
     plan = anchor_plan(problem)
     assert plan is not None and plan.label.startswith("cell")
-    reduced = count_solutions(problem)
-    plain = count_solutions(problem, symmetry=False)
+    reduced = count_packings(problem)
+    plain = count_packings(problem, symmetry=False)
     assert (reduced.solutions, reduced.distinct) == (plain.solutions, plain.distinct)
     assert reduced.stats.nodes < plain.stats.nodes
-    sols = list(iter_solutions(problem, distinct=True, symmetry=True))
+    sols = list(iter_packings(problem, distinct=True, symmetry=True))
     assert len(sols) == plain.distinct

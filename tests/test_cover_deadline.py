@@ -28,23 +28,23 @@ from chaingeo.core.formats.burrtools import (
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.piecesets import SOMA
-from chaingeo.solvers import assemble
-from chaingeo.solvers.btassemble import bt_packing_spec, iter_classes
-from chaingeo.solvers.btcount import count_bt
-from chaingeo.solvers.constrained import compile_packing
-from chaingeo.solvers.cover import (
+from chaingeo.solvers.assembly import assemble
+from chaingeo.solvers.assembly.btassemble import bt_packing_spec, iter_classes
+from chaingeo.solvers.assembly.btcount import count_bt
+from chaingeo.solvers.cover.constrained import compile_packing
+from chaingeo.solvers.cover.packings import (
     CoverLimitError,
     CoverSearch,
     PieceSpec,
-    count_solutions,
+    count_packings,
     cover_problem,
-    first_solution,
-    iter_solutions,
+    first_packing,
+    iter_packings,
 )
+from chaingeo.solvers.cover.problem import CoverProblem
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.disassemble import analyze
-from chaingeo.solvers.partsearch import SearchLimits
-from chaingeo.solvers.problem import CoverProblem
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import analyze
 from tests.test_cover import instances
 from tests.test_cover_kernels import wide_instances
 
@@ -219,13 +219,13 @@ def test_a_hopeless_search_stops_at_the_time_limit(engine: str) -> None:
 
 def test_every_entry_point_takes_the_deadline() -> None:
     target, pieces = HOPELESS
-    _stops(lambda: count_solutions(pieces, target, deadline=Deadline(0.1)), 0.1)
-    _stops(lambda: list(iter_solutions(pieces, target, deadline=Deadline(0.1))), 0.1)
-    _stops(lambda: first_solution(pieces, target, deadline=Deadline(0.1)), 0.1)
+    _stops(lambda: count_packings(pieces, target, deadline=Deadline(0.1)), 0.1)
+    _stops(lambda: list(iter_packings(pieces, target, deadline=Deadline(0.1))), 0.1)
+    _stops(lambda: first_packing(pieces, target, deadline=Deadline(0.1)), 0.1)
     box, ells = COUNTLESS
-    _stops(lambda: count_solutions(ells, box, distinct=False, deadline=Deadline(0.1)), 0.1)
+    _stops(lambda: count_packings(ells, box, distinct=False, deadline=Deadline(0.1)), 0.1)
     # the assembler of our levels: enumeration and disassembly under limits.seconds
-    _stops(lambda: assemble.count_solutions(pieces, target, limits=SearchLimits(seconds=0.1)), 0.1)
+    _stops(lambda: assemble.count_assemblies(pieces, target, limits=SearchLimits(seconds=0.1)), 0.1)
 
 
 def _bricks(tmp: Path) -> Path:

@@ -12,15 +12,15 @@ from hypothesis import strategies as st
 
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.piecesets import PENTOMINOES, SOMA
-from chaingeo.solvers.cover import (
+from chaingeo.solvers.cover.packings import (
     CoverLimitError,
     CoverSearch,
     PieceSpec,
-    count_solutions,
+    count_packings,
     cover_problem,
 )
-from chaingeo.solvers.problem import CoverProblem
-from chaingeo.solvers.search import choose_kernel
+from chaingeo.solvers.cover.problem import CoverProblem
+from chaingeo.solvers.cover.search import choose_kernel
 from tests.strategies import polycubes
 from tests.test_cover import instances
 
@@ -56,7 +56,7 @@ def test_kernels_list_the_same_solutions(
     sets = {k: _solution_set(problem, k) for k in KERNELS}
     assert sets["dlx"] == sets["bitboard-first"] == sets["bitboard-mrv"]
     for k in KERNELS:  # and with symmetry reduction
-        r = count_solutions(problem, engine=k)  # type: ignore[arg-type]
+        r = count_packings(problem, engine=k)  # type: ignore[arg-type]
         assert r.solutions == len(sets["dlx"]), k
 
 
@@ -99,7 +99,7 @@ def test_rods_across_the_word_boundary() -> None:
     expected = sum(comb(a + b, a) for a in range(24) for b in range(15) if 3 * a + 5 * b == 70)
     specs = [PieceSpec(_rod(3), "r3", 0, 30), PieceSpec(_rod(5), "r5", 0, 20)]
     for engine in ("auto", "dlx", "bitboard", "bitboard-mrv"):
-        r = count_solutions(specs, (1, 1, 70), engine=engine, distinct=False)
+        r = count_packings(specs, (1, 1, 70), engine=engine, distinct=False)
         assert r.solutions == expected == 63862, engine
 
 

@@ -29,7 +29,7 @@ from chaingeo.generator.cubes import (
 )
 from chaingeo.generator.puzzle import make
 from chaingeo.generator.result import Rejection
-from chaingeo.solvers.partsearch import PieceTable
+from chaingeo.solvers.motion.partsearch import PieceTable
 
 EASY = PuzzleConfig(shape="cube3", pieces=3, min_level=2, hole_rate=0.3, hill_steps=10)
 

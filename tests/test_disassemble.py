@@ -19,9 +19,17 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
     state_key,
 )
-from chaingeo.solvers import disassemble
-from chaingeo.solvers.disassemble import Separation, Separations, _Solver, analyze, fast_legal_moves
-from chaingeo.solvers.partsearch import Deadline, PartSearch, PieceTable, SearchLimits
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import disassemble
+from chaingeo.solvers.motion.disassemble import (
+    Separation,
+    Separations,
+    _Solver,
+    analyze,
+    fast_legal_moves,
+)
+from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable
 from tests.puzzle_strategies import small_scenes
 
 SCENE = {
@@ -143,10 +151,11 @@ def test_level_kernel_matches_python_search(
     total: int | None,
     separations: Separations,
 ) -> None:
-    """The one-call level kernels (BurrTools' first separation, :mod:`chaingeo.solvers.btsearch`, and
-    any separation, :mod:`chaingeo.solvers.levelsearch`) find the same tree, with the same state count
-    (or the same cap error), as the Python searches they stand for, also when they outgrow
-    their buffers or their node budget."""
+    """The one-call level kernels (BurrTools' first separation,
+    :mod:`chaingeo.solvers.motion.btsearch`, and any separation,
+    :mod:`chaingeo.solvers.motion.levelsearch`) find the same tree, with the same state count (or
+    the same cap error), as the Python searches they stand for, also when they outgrow their buffers
+    or their node budget."""
     if len(shapes) < 2:
         return
     limits = SearchLimits(max_total_states=total)
@@ -191,7 +200,7 @@ def test_limits_raise_clear_errors() -> None:
 def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, steps: int) -> None:
     """Cutler's pairwise matrix from the numba kernel equals the reference blocking_matrix."""
     from chaingeo.core.kinematics import DIRECTIONS, blocking_matrix
-    from chaingeo.solvers import movement
+    from chaingeo.solvers.motion import movement
 
     state = random_walk(shapes, seed, steps)
     table = PieceTable(state.shapes)

@@ -17,7 +17,7 @@ from chaingeo.cli.main import main
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level_reader import LevelError
 from chaingeo.core.limits import LimitError
-from chaingeo.solvers.search import CoverLimitError
+from chaingeo.solvers.cover.search import CoverLimitError
 
 PACKAGES = ("chaingeo",)
 
@@ -44,7 +44,7 @@ def _defined_exceptions() -> dict[str, type[Exception]]:
 def test_every_exception_defined_in_the_project_is_a_chaingeo_error() -> None:
     found = _defined_exceptions()
     assert len(found) >= 40  # the walk reaches every subpackage, not just the top
-    assert "chaingeo.solvers.search.CoverLimitError" in found
+    assert "chaingeo.solvers.cover.search.CoverLimitError" in found
     assert sorted(n for n, e in found.items() if not issubclass(e, ChainGeoError)) == []
 
 

@@ -26,7 +26,7 @@ from chaingeo.core.formats.burrtools import BurrToolsError, parse_xmpuzzle, read
 from chaingeo.core.geometry import Shape, puzzle_signature
 from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
 from chaingeo.core.suite import shipped_levels
-from chaingeo.solvers.movement import MAX_PIECES
+from chaingeo.solvers.motion.movement import MAX_PIECES
 from tests.env_levels import tiny_level
 
 BURR = shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"
@@ -300,9 +300,9 @@ def test_analyze_reports_a_part_past_the_kernel_bound_unsearched(
 
 
 def test_a_piece_longer_than_255_cells_is_counted(tmp_path: Path) -> None:
-    from chaingeo.solvers.assemble import count_solutions
-    from chaingeo.solvers.problem import PieceSpec
+    from chaingeo.solvers.assembly.assemble import count_assemblies
+    from chaingeo.solvers.cover.problem import PieceSpec
 
     rod = Shape([(x, 0, 0) for x in range(300)])
-    report = count_solutions([PieceSpec(rod, "rod")], rod)
+    report = count_assemblies([PieceSpec(rod, "rod")], rod)
     assert report.assemblies == 1

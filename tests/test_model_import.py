@@ -21,9 +21,9 @@ from chaingeo.core.formats.models import (
 )
 from chaingeo.core.kinematics import replay_disassembly
 from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
-from chaingeo.solvers.cover import first_solution
-from chaingeo.solvers.disassemble import Analysis, analyze
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.cover.packings import first_packing
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis, analyze
 from tests.shared_files import MODELS, needs_models
 
 #: What each model must give: kind and cells per part (in part order), or the refusal.
@@ -108,7 +108,7 @@ def test_level_validates_round_trips_and_replays(
     assert isinstance(model, ImportedModel)
     if model.kind == "stacking":
         assert model.box == (3, 3, 3)
-        sol = first_solution(model.shapes, model.box, reflections=False)
+        sol = first_packing(model.shapes, model.box, reflections=False)
         assert sol is not None
         level = model_stacking_level(model, dict(sol.placements), difficulty="hard")
     else:

@@ -17,7 +17,7 @@ from chaingeo.generator.imported import imported_puzzle_level
 from chaingeo.generator.puzzle import difficulty_of
 from chaingeo.generator.puzzle_suite import MODEL_LIMITS
 from chaingeo.solvers.analysis import analyze_level
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
 from tests.env_levels import design_of
 from tests.shared_files import MODELS, needs_models
 

@@ -39,7 +39,7 @@ from chaingeo.envs.actions import (
 )
 from chaingeo.envs.puzzle import PuzzleState
 from chaingeo.envs.puzzle_actions import reference_actions
-from chaingeo.solvers.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze
 from tests.env_levels import puzzle_levels
 from tests.test_turn_search import luban3
 

@@ -1,6 +1,6 @@
-"""Rows no cover can hold (chaingeo.solvers.rowreduce): removing them changes no solution, on puzzles we
-did not make (seeded random boxes cut into pieces, with holes and congruent pieces), and on a
-36-piece burr they are BurrTools' own figure (burrTxt -r: "removed 3688 rows")."""
+"""Rows no cover can hold (chaingeo.solvers.cover.rowreduce): removing them changes no solution, on
+puzzles we did not make (seeded random boxes cut into pieces, with holes and congruent pieces), and
+on a 36-piece burr they are BurrTools' own figure (burrTxt -r: "removed 3688 rows")."""
 
 from __future__ import annotations
 
@@ -13,11 +13,11 @@ import pytest
 from chaingeo.core.formats.bt_level import level_puzzle
 from chaingeo.core.level import load_level
 from chaingeo.generator.bt_examples import EXAMPLES
-from chaingeo.solvers.btassemble import bt_packing_spec, iter_classes
-from chaingeo.solvers.constrained import compile_packing
-from chaingeo.solvers.problem import CoverProblem
-from chaingeo.solvers.rowreduce import live_rows
-from chaingeo.solvers.search import CoverSearch
+from chaingeo.solvers.assembly.btassemble import bt_packing_spec, iter_classes
+from chaingeo.solvers.cover.constrained import compile_packing
+from chaingeo.solvers.cover.problem import CoverProblem
+from chaingeo.solvers.cover.rowreduce import live_rows
+from chaingeo.solvers.cover.search import CoverSearch
 from tests.burrtxt import random_puzzle
 
 LEVELS = Path(__file__).resolve().parents[1] / "levels" / "puzzle"

@@ -20,7 +20,7 @@ from chaingeo.generator.standard_burr import (
     design_pieces,
     standard_layout,
 )
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
 
 #: A short search (one restart of 200 changes): low levels, quick to re-check by pure Python.
 SMALL = PuzzleConfig(shape="burr6x8", hill_steps=200, restarts=1)

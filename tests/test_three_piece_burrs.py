@@ -27,8 +27,8 @@ from chaingeo.core.level import Level, level_bytes, load_level
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.layouts import Layout, get_layout, three_crossing
 from chaingeo.generator.puzzle import difficulty_of, make
-from chaingeo.solvers.disassemble import analyze
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import analyze
 
 #: (config, seed, index) of one quick item per layout that the generator accepts (found by the
 #: histograms in the README: burr3 item 8 of seed 1 is a level-4 burr, plate3 item 27 level 3).

@@ -18,10 +18,11 @@ from chaingeo.core.kinematics import (
     replay_disassembly,
     state_key,
 )
-from chaingeo.solvers.disassemble import analyze, fast_legal_moves
-from chaingeo.solvers.partsearch import Deadline, SearchLimits
-from chaingeo.solvers.turnmoves import TurnTable
-from chaingeo.solvers.turnsearch import TurnPartSearch, fast_legal_turns
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import analyze, fast_legal_moves
+from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion.turnsearch import TurnPartSearch, fast_legal_turns
 from tests.puzzle_strategies import small_scenes
 
 

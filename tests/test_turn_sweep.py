@@ -1,5 +1,6 @@
-"""The fast turn sweep (:mod:`chaingeo.solvers.sweep`, the turn kernel beyond its table, the env's turn
-checks) against the Python reference :mod:`chaingeo.core.turns`, and its cost as pieces wander."""
+"""The fast turn sweep (:mod:`chaingeo.solvers.motion.sweep`, the turn kernel beyond its table, the
+env's turn checks) against the Python reference :mod:`chaingeo.core.turns`, and its cost as pieces
+wander."""
 
 from __future__ import annotations
 
@@ -20,9 +21,9 @@ from chaingeo.core.turns import AXES, TurnMove, square_hit, swept_squares
 from chaingeo.envs import puzzle_actions
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import EpisodeTask, run_episode
-from chaingeo.solvers import sweep
-from chaingeo.solvers.turnmoves import TurnTable
-from chaingeo.solvers.turnsearch import fast_legal_turns, turn_problem, turn_rows
+from chaingeo.solvers.motion import sweep
+from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion.turnsearch import fast_legal_turns, turn_problem, turn_rows
 from tests.puzzle_strategies import small_scenes
 from tests.test_turn_search import random_walk
 

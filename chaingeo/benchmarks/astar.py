@@ -5,14 +5,15 @@ shared, so compare the ratios of one run, not seconds across runs). Instances: t
 suite levels of at most 12 pieces (their own ``max_group``), AlPackino (problem 0 of
 ``../shared/burrtools/AlPackino.xmpuzzle``, when present) and the 36-piece towers of the suite
 played with multi-piece moves (``max_group`` None instead of the file's 1). On towers (levels
-named ``burr12`` ... ``burr36``) the class bound of :mod:`chaingeo.solvers.classbound` over the burr units
-is printed too (``class_bound``, its ``class_bound_classes`` and seconds), and ``plan_moves``,
-the shorter of the BurrTools-style plan and the units taken out one by one from the ends of the
-stack (each by its own optimal plan, :func:`chaingeo.solvers.blockbound.end_first_plan`, replayed with
-the reference kinematics): o_i lies between them. Then the search under the class bound
-(:mod:`chaingeo.solvers.classsearch`) closes the gap: ``class_search_o_i`` (its plan replayed),
-``class_search_nodes`` and ``class_search_seconds``, or ``class_search_bound`` when it stops at
-its cap (``CHAIN_BENCH_CLASS_SEARCH_SECONDS``, default 900).
+named ``burr12`` ... ``burr36``) the class bound of :mod:`chaingeo.solvers.optimal.classbound` over
+the burr units is printed too (``class_bound``, its ``class_bound_classes`` and seconds), and
+``plan_moves``, the shorter of the BurrTools-style plan and the units taken out one by one from the
+ends of the stack (each by its own optimal plan,
+:func:`chaingeo.solvers.optimal.blockbound.end_first_plan`, replayed with the reference kinematics):
+o_i lies between them. Then the search under the class bound
+(:mod:`chaingeo.solvers.optimal.classsearch`) closes the gap: ``class_search_o_i`` (its plan
+replayed), ``class_search_nodes`` and ``class_search_seconds``, or ``class_search_bound`` when it
+stops at its cap (``CHAIN_BENCH_CLASS_SEARCH_SECONDS``, default 900).
 
 Per instance and search: ``o_i`` (or the cap it stopped at), ``seconds``, and the states:
 ``astar_expanded`` / ``astar_stored`` whole states, ``bfs_states`` the states the
@@ -21,7 +22,8 @@ branch-and-bound search stored over all its part searches (:attr:`Analysis.state
 (a warm-up runs first). Caps: ``CHAIN_BENCH_ASTAR_STATES`` stored A* states (default
 2,000,000) and ``CHAIN_BENCH_ASTAR_SECONDS`` per search (default 60); ``CHAIN_BENCH_ASTAR_ONLY``:
 run only the instances whose name contains it. ``--quick``: three suite levels only.
-A* expands partially (:mod:`chaingeo.solvers.astar`), so ``astar_expanded`` counts partial expansions.
+A* expands partially (:mod:`chaingeo.solvers.optimal.astar`), so ``astar_expanded`` counts partial
+expansions.
 """
 
 from __future__ import annotations
@@ -75,9 +77,9 @@ def _class_bound(name: str, shapes: Mapping[str, Shape]) -> dict[str, object]:
     """Class bound and plan length of a tower of burr units (six layers each)."""
     if not re.search(r"burr(12|18|24|36)\b", name):
         return {}
-    from chaingeo.solvers.blockbound import end_first_plan
-    from chaingeo.solvers.classbound import band_blocks, class_lower_bound
-    from chaingeo.solvers.disassemble import analyze, translations
+    from chaingeo.solvers.motion.disassemble import analyze, translations
+    from chaingeo.solvers.optimal.blockbound import end_first_plan
+    from chaingeo.solvers.optimal.classbound import band_blocks, class_lower_bound
 
     t0 = time.perf_counter()
     blocks = band_blocks(shapes, 6)
@@ -101,7 +103,7 @@ def _class_bound(name: str, shapes: Mapping[str, Shape]) -> dict[str, object]:
 def _class_search(shapes: Mapping[str, Shape], blocks: list[list[str]]) -> dict[str, object]:
     """o_i by the search under the class bound, its plan replayed, or its proven bound."""
     from chaingeo.core.kinematics import replay_disassembly
-    from chaingeo.solvers.classsearch import ClassSearchLimits, class_search_optimal
+    from chaingeo.solvers.optimal.classsearch import ClassSearchLimits, class_search_optimal
 
     seconds = float(os.environ.get("CHAIN_BENCH_CLASS_SEARCH_SECONDS", "900"))
     t0 = time.perf_counter()
@@ -125,7 +127,7 @@ def _class_search(shapes: Mapping[str, Shape], blocks: list[list[str]]) -> dict[
 def _astar(
     shapes: Mapping[str, Shape], max_group: int | None, states: int, seconds: float
 ) -> dict[str, object]:
-    from chaingeo.solvers.astar import AStarLimits, astar_optimal
+    from chaingeo.solvers.optimal.astar import AStarLimits, astar_optimal
 
     t0 = time.perf_counter()
     limits = AStarLimits(max_states=states, seconds=seconds)
@@ -150,8 +152,8 @@ def _astar(
 
 
 def _bfs(shapes: Mapping[str, Shape], max_group: int | None, seconds: float) -> dict[str, object]:
-    from chaingeo.solvers.disassemble import analyze
-    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.limits import SearchLimits
+    from chaingeo.solvers.motion.disassemble import analyze
 
     t0 = time.perf_counter()
     try:

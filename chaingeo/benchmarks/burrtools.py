@@ -10,14 +10,15 @@ no BurrTools figure and the same code in both engines) and ``previous`` the engi
 BurrTools' semantics, timed in the same run:
 
 * on a problem with colour rules, ``previous`` counts without them and filters after: every
-  packing of the uncoloured problem (:func:`chaingeo.solvers.cover.iter_solutions`), each coloured
-  orientation of each piece checked voxel by voxel, classes of the survivors under the
+  packing of the uncoloured problem (:func:`chaingeo.solvers.cover.packings.iter_packings`), each
+  coloured orientation of each piece checked voxel by voxel, classes of the survivors under the
   coloured result's symmetries, then the disassembler on those classes only (the same figures
   as ours, reached the slow way);
-* elsewhere ``previous`` is the old ``chain analyze`` (:func:`chaingeo.solvers.assemble.count_solutions`
-  on the uncoloured, ungrouped problem): its figures differ where groups, hole caps or pieces
-  lying wholly on variable cells matter (the ring maze: 0 assemblies, the ring is never
-  placed; the linked rings: no solution, the rings never come apart).
+* elsewhere ``previous`` is the old ``chain analyze``
+  (:func:`chaingeo.solvers.assembly.assemble.count_assemblies` on the uncoloured, ungrouped
+  problem): its figures differ where groups, hole caps or pieces lying wholly on variable cells
+  matter (the ring maze: 0 assemblies, the ring is never placed; the linked rings: no solution, the
+  rings never come apart).
 
 ``speedup`` is previous / ours (wall clock; the best of ``--repeat`` runs, a run over 10 s not
 repeated; ``agree`` says whether the previous engine's figures are ours). Every run builds
@@ -88,8 +89,8 @@ def previous_plain(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> d
     """The old ``chain analyze`` on a ``.xmpuzzle`` problem: colours, groups and hole caps
     unknown to it."""
     from chaingeo.solvers.analysis import disassembly_figures
-    from chaingeo.solvers.assemble import count_solutions
-    from chaingeo.solvers.problem import PieceSpec
+    from chaingeo.solvers.assembly.assemble import count_assemblies
+    from chaingeo.solvers.cover.problem import PieceSpec
 
     prob = puzzle.problem(index)
     result = puzzle.shapes[prob.result]
@@ -98,7 +99,7 @@ def previous_plain(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> d
         for k, p in enumerate(prob.parts)
         if len(puzzle.shapes[p.shape].filled)
     ]
-    rep = count_solutions(
+    rep = count_assemblies(
         pieces,
         result.cells,
         optional=result.variable if len(result.variable) else None,
@@ -106,9 +107,9 @@ def previous_plain(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) -> d
         limits=limits,
     )
     out: dict[str, Any] = {"assemblies": rep.assemblies, "solutions": rep.solutions}
-    if rep.first_solution is not None:
+    if rep.first_packing is not None:
         figures = disassembly_figures(
-            rep.first_solution, max_group=None, limits=limits, optimal=False
+            rep.first_packing, max_group=None, limits=limits, optimal=False
         )
         out.update(level=figures["level"], moves=figures["moves"])
     return out
@@ -146,10 +147,10 @@ def previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) ->
     import itertools
 
     from chaingeo.solvers.analysis import disassembly_figures
-    from chaingeo.solvers.cover import iter_solutions
-    from chaingeo.solvers.disassemble import analyze
-    from chaingeo.solvers.placements import target_symmetries
-    from chaingeo.solvers.problem import PieceSpec
+    from chaingeo.solvers.cover.packings import iter_packings
+    from chaingeo.solvers.cover.placements import target_symmetries
+    from chaingeo.solvers.cover.problem import PieceSpec
+    from chaingeo.solvers.motion.disassemble import analyze
 
     prob = puzzle.problem(index)
     res = puzzle.shapes[prob.result]
@@ -173,7 +174,7 @@ def previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) ->
     seen: set[frozenset[Voxels]] = set()
     reps: list[frozenset[Voxels]] = []
     optional = res.variable if len(res.variable) else None
-    for sol in iter_solutions(specs, res.cells, optional=optional, reflections=False):
+    for sol in iter_packings(specs, res.cells, optional=optional, reflections=False):
         choices = []
         for slot, placed in sol.placements:
             shape = coloured[slot.split("#")[0]]
@@ -216,8 +217,8 @@ def _image(m: np.ndarray, t: np.ndarray, c: tuple[int, int, int]) -> tuple[int, 
 
 def _from_scratch() -> None:
     """Forget the placements and problems the engines cache, so every run builds its own."""
-    from chaingeo.solvers.placements import _placements, target_index
-    from chaingeo.solvers.problem import _cover_problem
+    from chaingeo.solvers.cover.placements import _placements, target_index
+    from chaingeo.solvers.cover.problem import _cover_problem
 
     for cached in (_placements, target_index, _cover_problem):
         cached.cache_clear()
@@ -243,10 +244,10 @@ def _warm_up() -> None:
     """Compile every kernel both engines use (bit-board, dancing links, movement)."""
     from chaingeo.generator.bt_examples import linked_rings
     from chaingeo.solvers.analysis import problem_figures
-    from chaingeo.solvers.btassemble import bt_packing_spec
-    from chaingeo.solvers.constrained import compile_packing
-    from chaingeo.solvers.partsearch import SearchLimits
-    from chaingeo.solvers.search import CoverSearch
+    from chaingeo.solvers.assembly.btassemble import bt_packing_spec
+    from chaingeo.solvers.cover.constrained import compile_packing
+    from chaingeo.solvers.cover.search import CoverSearch
+    from chaingeo.solvers.limits import SearchLimits
 
     puzzle = linked_rings()
     problem_figures(puzzle, 0, SearchLimits(), True, True)
@@ -256,8 +257,8 @@ def _warm_up() -> None:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.solvers.analysis import problem_figures
-    from chaingeo.solvers.btassemble import Mirrors
-    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.assembly.btassemble import Mirrors
+    from chaingeo.solvers.limits import SearchLimits
 
     seconds = float(os.environ.get("CHAIN_BENCH_BT_SECONDS", "5" if args.quick else "120"))
     limits = SearchLimits(seconds=seconds)

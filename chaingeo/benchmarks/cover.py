@@ -1,6 +1,6 @@
 """``chain bench cover``: our exact-cover engine against the PyPI package ``xcover``.
 
-Each instance is counted three ways in the same process: ``reduced`` is ``count_solutions`` as
+Each instance is counted three ways in the same process: ``reduced`` is ``count_packings`` as
 ``chain cover`` runs it (symmetry reduction, automatic engine, problem built from scratch);
 ``raw`` is our engine enumerating every solution without symmetry reduction (the same work
 xcover does; the kernel the automatic rule picked, its nodes and work units per second are
@@ -70,7 +70,7 @@ def _best(fn: Callable[[], int], repeat: int) -> tuple[float, int]:
 
 
 def _clear_caches() -> None:
-    from chaingeo.solvers import placements, problem
+    from chaingeo.solvers.cover import placements, problem
 
     problem._cover_problem.cache_clear()
     placements._placements.cache_clear()
@@ -81,13 +81,13 @@ def _warm_up() -> None:
     """Compile (or load) every kernel on a tiny instance, outside the timed region."""
     from xcover import covers
 
-    from chaingeo.solvers.cover import count_solutions
-    from chaingeo.solvers.problem import cover_problem
-    from chaingeo.solvers.search import CoverSearch
+    from chaingeo.solvers.cover.packings import count_packings
+    from chaingeo.solvers.cover.problem import cover_problem
+    from chaingeo.solvers.cover.search import CoverSearch
 
     domino = Shape([(0, 0, 0), (1, 0, 0)])
     for engine in ("bitboard-first", "bitboard-mrv", "dlx"):
-        count_solutions({"a": domino, "b": domino}, (2, 2, 1), engine=engine)
+        count_packings({"a": domino, "b": domino}, (2, 2, 1), engine=engine)
         for box in ((2, 2, 1), (2, 2, 17)):  # one-word and multi-word masks
             if engine != "bitboard-first" or box[2] == 1:
                 CoverSearch(cover_problem([domino, domino], box), engine=engine).count()
@@ -97,9 +97,9 @@ def _warm_up() -> None:
 def run(args: argparse.Namespace) -> int:
     from xcover import covers
 
-    from chaingeo.solvers.cover import count_solutions
-    from chaingeo.solvers.problem import cover_problem
-    from chaingeo.solvers.search import CoverSearch, CoverStats
+    from chaingeo.solvers.cover.packings import count_packings
+    from chaingeo.solvers.cover.problem import cover_problem
+    from chaingeo.solvers.cover.search import CoverSearch, CoverStats
 
     instances = list(INSTANCES)
     if os.environ.get("CHAIN_BENCH_COVER_BEDLAM") == "1":
@@ -122,7 +122,7 @@ def run(args: argparse.Namespace) -> int:
 
         def ours(inst: Instance = inst) -> int:
             _clear_caches()
-            r = count_solutions(inst.pieces, inst.box)
+            r = count_packings(inst.pieces, inst.box)
             if inst.solutions is not None and r.solutions != inst.solutions:
                 raise AssertionError(f"{inst.name}: {r.solutions} solutions")
             if r.distinct != inst.distinct:

@@ -2,8 +2,8 @@
 legal turns, against the pure-Python reference timed in the same run.
 
 ``turns``: the legal turns at the first positions of that episode, ``ours`` (the numba kernel,
-:func:`chaingeo.solvers.turnsearch.turn_rows`, made into actions as the environment does) against
-``reference`` (:func:`chaingeo.core.kinematics.legal_turns`, seconds per position), checked
+:func:`chaingeo.solvers.motion.turnsearch.turn_rows`, made into actions as the environment does)
+against ``reference`` (:func:`chaingeo.core.kinematics.legal_turns`, seconds per position), checked
 equal; ``speedup`` = reference / ours on the same positions. ``episode``: the random agent's
 whole episode (seed 0, as ``chain eval --agent random`` plays it) on the shipped puzzle level
 whose rules allow turns, where the parts drift wider than the stencil table reaches; ``ratio`` =
@@ -27,7 +27,7 @@ from chaingeo.envs.puzzle import PuzzleState
 from chaingeo.envs.puzzle_actions import turn_actions
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import EpisodeTask, run_episode
-from chaingeo.solvers.turnmoves import TurnTable
+from chaingeo.solvers.motion.turnmoves import TurnTable
 
 
 def _episode(level: Level, repeat: int) -> tuple[float, float, dict[str, Any]]:

@@ -1,6 +1,7 @@
 """Progress of a long command on standard error: silent for the first few seconds, then a line
 every few seconds saying how long it has run and what it is doing, so a long analysis is never
-a silent one. The work writes a :class:`chaingeo.solvers.deadline.Progress`; a daemon thread reads it."""
+a silent one. The work writes a :class:`chaingeo.solvers.deadline.Progress`; a daemon thread reads
+it."""
 
 from __future__ import annotations
 

@@ -6,14 +6,15 @@ an agent looks at a few. So they come in sorted lazy blocks inside an
 :class:`~chaingeo.envs.action_list.ActionList`:
 
 * :class:`MoveRange`: one group along one direction, distances ``1..kmax`` (then ``inf`` when
-  it can leave), from the numba movement analysis (:func:`chaingeo.solvers.disassemble.move_rows`,
-  tested equal to the reference :func:`chaingeo.core.kinematics.legal_moves`);
+  it can leave), from the numba movement analysis
+  (:func:`chaingeo.solvers.motion.disassemble.move_rows`, tested equal to the reference
+  :func:`chaingeo.core.kinematics.legal_moves`);
 * :class:`InsertionBlock`: one part coming in along one direction into another part, every
   landing place, from a numba kernel equal to the reference
   :func:`chaingeo.core.kinematics.insertion_shifts`;
 * where the rules allow turns, one sorted list of :class:`~chaingeo.envs.actions.TurnAction`
-  from the numba turn kernel (:func:`chaingeo.solvers.turnsearch.turn_rows`, tested equal to the
-  reference :func:`chaingeo.core.kinematics.legal_turns`), after every move.
+  from the numba turn kernel (:func:`chaingeo.solvers.motion.turnsearch.turn_rows`, tested equal to
+  the reference :func:`chaingeo.core.kinematics.legal_turns`), after every move.
 
 Pieces a turn left in another orientation are read through :func:`oriented_table` (the
 translation kernels see each piece as it stands now).
@@ -42,10 +43,10 @@ from chaingeo.core.kinematics import (
 from chaingeo.core.turns import AXES, TurnMove
 from chaingeo.envs.action_list import ActionList
 from chaingeo.envs.actions import Action, FinishAction, MoveAction, TurnAction
-from chaingeo.solvers.disassemble import move_rows
-from chaingeo.solvers.partsearch import PieceTable
-from chaingeo.solvers.turnmoves import TurnTable
-from chaingeo.solvers.turnsearch import turn_rows
+from chaingeo.solvers.motion.disassemble import move_rows
+from chaingeo.solvers.motion.partsearch import PieceTable
+from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion.turnsearch import turn_rows
 
 #: Movable groups along one direction before a state's action list gives up with a
 #: SearchLimitError (a loose part of n pieces has up to 2**n - 2).

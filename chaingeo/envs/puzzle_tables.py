@@ -10,8 +10,8 @@ from chaingeo.core.kinematics import Assembly, disassembly_of_assembly_plan
 from chaingeo.core.level import Level, PuzzleSolution
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.envs.puzzle_turns import PartKey, turned_part_key
-from chaingeo.solvers.partsearch import PieceTable
-from chaingeo.solvers.turnmoves import TurnTable
+from chaingeo.solvers.motion.partsearch import PieceTable
+from chaingeo.solvers.motion.turnmoves import TurnTable
 
 PositionKey = tuple[PartKey, ...]
 

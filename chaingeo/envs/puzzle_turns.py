@@ -1,9 +1,9 @@
 """Turns in the puzzle state machine (levels whose rules allow them).
 
 A turn is legal exactly when :meth:`chaingeo.core.kinematics.Assembly.turn_problem` says so
-(decided by its fast equal, :func:`chaingeo.solvers.turnsearch.turn_problem`), in both goals: it turns a
-proper group of one part (never a whole part: parts apart never interact, and assembling is
-disassembly played backwards, where no part turns alone). Text may leave the centre open
+(decided by its fast equal, :func:`chaingeo.solvers.motion.turnsearch.turn_problem`), in both goals:
+it turns a proper group of one part (never a whole part: parts apart never interact, and assembling
+is disassembly played backwards, where no part turns alone). Text may leave the centre open
 (``rotate red z +90``): it resolves to the only legal centre for that group, axis and sense, else
 it is ambiguous and lists the candidates, else illegal with the reason.
 """
@@ -24,7 +24,7 @@ from chaingeo.envs.actions import (
     TurnRequest,
     rules_text,
 )
-from chaingeo.solvers.turnsearch import turn_problem as turn_sweep_problem
+from chaingeo.solvers.motion.turnsearch import turn_problem as turn_sweep_problem
 
 NO_TURNS = "this level does not allow turns; use move or finish"
 

@@ -168,7 +168,7 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
     from chaingeo.core.kinematics import SearchLimitError
     from chaingeo.solvers.analysis import level_figures, xmpuzzle_figures
     from chaingeo.solvers.deadline import Deadline
-    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.limits import SearchLimits
 
     limits = SearchLimits(
         max_states=args.max_states, seconds=args.seconds, optimal_seconds=args.optimal_seconds

@@ -8,9 +8,9 @@ rules BurrTools cannot express (turns, a cap on group size) are named on standar
 
 ``--from chain`` (or ``--to chain-level``) reads CHAIN's level file as CHAIN writes it: packed
 (the cells fill the box) or in tray form (each piece where it lies beside the box). A tray
-file is packed here with the exact-cover engine (``chaingeo.solvers.cover.first_solution``, the pieces
-as free shapes, rotations only as in CHAIN); the level keeps CHAIN's piece ids and is verified
-like any level file before it is written. ``--rules chain`` gives it CHAIN's rules profile.
+file is packed here with the exact-cover engine (``chaingeo.solvers.cover.packings.first_packing``,
+the pieces as free shapes, rotations only as in CHAIN); the level keeps CHAIN's piece ids and is
+verified like any level file before it is written. ``--rules chain`` gives it CHAIN's rules profile.
 """
 
 from __future__ import annotations
@@ -140,14 +140,14 @@ def import_chain_file(
 def pack(spec: ChainStacking, source: str) -> list[Shape]:
     """A packing of the file's pieces into its box (piece ``i`` first at index ``i``)."""
     from chaingeo.core.level import LevelError
-    from chaingeo.solvers.cover import CoverError, CoverLimitError, first_solution
+    from chaingeo.solvers.cover.packings import CoverError, CoverLimitError, first_packing
 
     volume = spec.box[0] * spec.box[1] * spec.box[2]
     cubes = sum(len(s) for s in spec.pieces)
     if cubes != volume:
         raise LevelError(source, "pieces", f"{cubes} cubes in all cannot fill a {spec.box} box")
     try:
-        solution = first_solution(spec.shapes, spec.box, node_limit=PACK_NODE_LIMIT)
+        solution = first_packing(spec.shapes, spec.box, node_limit=PACK_NODE_LIMIT)
     except CoverLimitError:
         raise LevelError(
             source, "pieces", f"no packing found within {PACK_NODE_LIMIT} search nodes"

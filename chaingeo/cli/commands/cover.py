@@ -87,7 +87,7 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.geometry import Shape
-    from chaingeo.solvers.cover import CoverLimitError, count_solutions
+    from chaingeo.solvers.cover.packings import CoverLimitError, count_packings
 
     pieces, level_box = load_pieces(args.pieces)
     if args.box is not None:
@@ -96,10 +96,10 @@ def run(args: argparse.Namespace) -> int:
         box = level_box
     else:
         raise CommandError("--box is required unless --pieces is a stacking level file")
-    count_solutions([Shape([(0, 0, 0)])], (1, 1, 1), engine=args.engine)  # load the JIT
+    count_packings([Shape([(0, 0, 0)])], (1, 1, 1), engine=args.engine)  # load the JIT
     t0 = time.perf_counter()
     try:
-        result = count_solutions(
+        result = count_packings(
             pieces,
             box,
             distinct=not args.no_distinct,

@@ -55,7 +55,8 @@ def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
 
 
 def add_curriculum_option(p: argparse.ArgumentParser, family: str) -> None:
-    """``--curriculum K``: step K of the family's easy-to-hard list (chaingeo.generator.curriculum)."""
+    """``--curriculum K``: step K of the family's easy-to-hard list
+    (chaingeo.generator.curriculum)."""
     from chaingeo.generator.curriculum import CURRICULA
 
     p.add_argument(

@@ -1,8 +1,8 @@
 """``chain import``: a CHAIN puzzle model (URDF + OBJ parts) as a ``chain-level/1`` file.
 
 The importer (:mod:`chaingeo.core.formats.models`) puts the parts on the lattice;
-:mod:`chaingeo.generator.imported` adds what needs the solvers: a puzzle's level and optimal plan (with
-caps) or a stacking model's packing. A model that is not on a lattice, or a puzzle that does
+:mod:`chaingeo.generator.imported` adds what needs the solvers: a puzzle's level and optimal plan
+(with caps) or a stacking model's packing. A model that is not on a lattice, or a puzzle that does
 not come apart, is an error and nothing is written.
 
 ``chain import --report ROOT`` imports every model folder under ROOT and prints one table row
@@ -23,8 +23,8 @@ from chaingeo.cli.errors import CommandError
 if TYPE_CHECKING:
     from chaingeo.core.formats.models import ImportedModel
     from chaingeo.core.level import Level
-    from chaingeo.solvers.disassemble import Analysis
-    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.limits import SearchLimits
+    from chaingeo.solvers.motion.disassemble import Analysis
 
 
 def register(sub: Any) -> None:
@@ -84,7 +84,7 @@ class ModelReport:
 
 
 def limits_of(args: argparse.Namespace) -> SearchLimits:
-    from chaingeo.solvers.partsearch import SearchLimits
+    from chaingeo.solvers.limits import SearchLimits
 
     return SearchLimits(
         max_states=args.max_states,

@@ -497,8 +497,8 @@ def model_puzzle_level(
 ) -> Level:
     """A verified puzzle level from an imported model and an optimal disassembly plan found by
     the caller (o_i = its length); for 'assemble' the plan is reversed with each move inverted,
-    as :func:`chaingeo.generator.puzzle.puzzle_level` does. With ``turns`` the rules allow turns and the
-    pieces carry their round rods (a level without turns carries none: they change nothing
+    as :func:`chaingeo.generator.puzzle.puzzle_level` does. With ``turns`` the rules allow turns and
+    the pieces carry their round rods (a level without turns carries none: they change nothing
     there)."""
     if model.kind != "puzzle":
         raise ValueError(f"{model.model} is a {model.kind} model, not a puzzle")

@@ -119,7 +119,8 @@ def solid_knot() -> Shape:
 
 #: Codes (see :func:`burr_piece`) of the 25 notchable pieces that occur in a solid six-piece
 #: burr: every assembly of the notchable family (each piece 0..6 times) into the Solid Knot uses
-#: only these. Computed by :func:`chaingeo.solvers.assemble.solid_burr_codes` (a slow test recomputes it).
+#: only these. Computed by :func:`chaingeo.solvers.assembly.assemble.solid_burr_codes` (a slow test
+#: recomputes it).
 SOLID_BURR_CODES: Final[tuple[int, ...]] = (
     0, 3, 12, 15, 51, 60, 63, 195, 207, 255, 316, 572, 1303,
     1311, 1335, 1340, 1343, 1492, 1495, 1500, 1503, 1524, 1527, 1532, 1535,

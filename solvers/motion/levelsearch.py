@@ -2,10 +2,11 @@
 
 Python set-up per part search (arrays, removals, splits, moves) cost ~40 us, several times the
 search itself on a six-piece burr, so the whole recursion runs here: breadth first to the first
-layer with removals (:func:`chaingeo.solvers.movement.expand`), removals tried single pieces first, then
-both parts recursively, memoised per part configuration; the result is a flat tree that
-:mod:`chaingeo.solvers.disassemble` decodes. Same order, tie-breaks and caps as its Python original,
-which still serves turning pieces and piece groups (:meth:`chaingeo.solvers.disassemble._Solver.greedy`).
+layer with removals (:func:`chaingeo.solvers.motion.movement.expand`), removals tried single pieces
+first, then both parts recursively, memoised per part configuration; the result is a flat tree that
+:mod:`chaingeo.solvers.motion.disassemble` decodes. Same order, tie-breaks and caps as its Python
+original, which still serves turning pieces and piece groups
+(:meth:`chaingeo.solvers.motion.disassemble._Solver.greedy`).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.jit import njit
-from chaingeo.solvers import movement as mv
+from chaingeo.solvers.motion import movement as mv
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]
@@ -37,7 +38,8 @@ _FIRST_CAP = 64
 def part_arrays(
     vox_all: I64, starts_all: I64, lo_all: I64, hi_all: I64, members: I64
 ) -> tuple[I64, I64, I64, I64]:
-    """The part's rows of the piece table (:meth:`chaingeo.solvers.partsearch.PieceTable.part_arrays`)."""
+    """The part's rows of the piece table
+    (:meth:`chaingeo.solvers.motion.partsearch.PieceTable.part_arrays`)."""
     k = members.shape[0]
     starts = np.zeros(k + 1, dtype=np.int64)
     for i in range(k):

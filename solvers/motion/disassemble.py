@@ -1,13 +1,13 @@
 """Disassembly search: the BurrTools level, and the optimal full disassembly o_i.
 
 Semantics are those of :mod:`chaingeo.core.kinematics` (the reference); the search itself runs on
-:mod:`chaingeo.solvers.movement` (numba). Two questions are answered:
+:mod:`chaingeo.solvers.motion.movement` (numba). Two questions are answered:
 
 * **Level** (BurrTools' notation, e.g. ``"4.9.3"``): by default BurrTools' own answer
-  (``separations="first"``, :mod:`chaingeo.solvers.btsearch`): breadth first in its search order to the
-  first separation, then the same in each part; if a part cannot be taken apart, the assembly
-  cannot either (``disassembler_a.cpp``, ``checkSubproblems``). ``separations="any"``: breadth
-  first to the first removal whose two parts can both be taken apart in turn (single pieces
+  (``separations="first"``, :mod:`chaingeo.solvers.motion.btsearch`): breadth first in its search
+  order to the first separation, then the same in each part; if a part cannot be taken apart, the
+  assembly cannot either (``disassembler_a.cpp``, ``checkSubproblems``). ``separations="any"``:
+  breadth first to the first removal whose two parts can both be taken apart in turn (single pieces
   first), a stuck part's whole component remembered so that no state is searched twice. The
   first number is the fewest moves until something comes free; the text lists the moves of
   each separation, the part left behind before the part removed, omitting sub-trees made only
@@ -30,20 +30,21 @@ import numpy as np
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import DIRECTIONS, Move, SearchLimitError
 from chaingeo.core.turns import TurnMove
-from chaingeo.solvers import btsearch as bt
-from chaingeo.solvers import levelsearch as ls
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers.btorient import BTImage, symmetries_of
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.partsearch import DIRECTION_NAMES, PartSearch, PieceTable, SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import btsearch as bt
+from chaingeo.solvers.motion import levelsearch as ls
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion.btorient import BTImage, symmetries_of
+from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PartSearch, PieceTable
 
-# Per-state helpers, at home in chaingeo.solvers.partsearch, still importable from here.
-from chaingeo.solvers.partsearch import fast_legal_moves as fast_legal_moves
-from chaingeo.solvers.partsearch import move_rows as move_rows
+# Per-state helpers, at home in chaingeo.solvers.motion.partsearch, still importable from here.
+from chaingeo.solvers.motion.partsearch import fast_legal_moves as fast_legal_moves
+from chaingeo.solvers.motion.partsearch import move_rows as move_rows
 
 if TYPE_CHECKING:  # imported when a puzzle turns: most never do
-    from chaingeo.solvers.turnmoves import TurnTable
-    from chaingeo.solvers.turnsearch import TurnPartSearch
+    from chaingeo.solvers.motion.turnmoves import TurnTable
+    from chaingeo.solvers.motion.turnsearch import TurnPartSearch
 
 __all__ = [
     "Analysis",
@@ -136,9 +137,9 @@ class _Solver:
     """Searches of one puzzle, sharing the piece table, the caps, the deadline and memos.
 
     With ``turns`` a part's configuration is ``(n, 4)`` poses (offset, rotation index) in real
-    coordinates, searched by :class:`chaingeo.solvers.turnsearch.TurnPartSearch`; plans then name turn
-    centres in real coordinates, so memo keys keep the absolute poses. ``deadline``: the one
-    the whole analysis shares (default: a new one of ``limits.seconds``)."""
+    coordinates, searched by :class:`chaingeo.solvers.motion.turnsearch.TurnPartSearch`; plans then
+    name turn centres in real coordinates, so memo keys keep the absolute poses. ``deadline``: the
+    one the whole analysis shares (default: a new one of ``limits.seconds``)."""
 
     def __init__(
         self,
@@ -159,7 +160,7 @@ class _Solver:
         self.separations: Separations = "any" if turns or max_group is not None else separations
         self.turn_table: TurnTable | None = None
         if turns:
-            from chaingeo.solvers.turnmoves import TurnTable
+            from chaingeo.solvers.motion.turnmoves import TurnTable
 
             self.turn_table = TurnTable(shapes, rods or {})
         self.max_group = max_group
@@ -187,7 +188,7 @@ class _Solver:
     def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch | TurnPartSearch:
         self.check_total()
         if self.turn_table is not None:
-            from chaingeo.solvers.turnsearch import TurnPartSearch
+            from chaingeo.solvers.motion.turnsearch import TurnPartSearch
 
             return TurnPartSearch(
                 self.turn_table,
@@ -238,8 +239,9 @@ class _Solver:
 
     def first(self, members: tuple[int, ...], offsets: np.ndarray) -> Separation | None:
         """BurrTools' tree of a part: its first separation in BurrTools' order
-        (:func:`chaingeo.solvers.btsearch.first_split`), then the part left and the part removed, each
-        through :meth:`subpart`; None when either cannot be done (``checkSubproblems``)."""
+        (:func:`chaingeo.solvers.motion.btsearch.first_split`), then the part left and the part
+        removed, each through :meth:`subpart`; None when either cannot be done
+        (``checkSubproblems``)."""
         k = self.key(members, offsets)
         if k in self.first_memo:
             return self.first_memo[k]
@@ -317,7 +319,7 @@ class _Solver:
 
     def raise_status(self, status: int, info: int) -> None:
         """The :class:`SearchLimitError` of a level kernel's cap status (both kernels use
-        :mod:`chaingeo.solvers.levelsearch`'s codes)."""
+        :mod:`chaingeo.solvers.motion.levelsearch`'s codes)."""
         lim = self.limits
         if status == ls.TOTAL_CAP:
             raise SearchLimitError(
@@ -337,8 +339,8 @@ class _Solver:
 
     def any_tree(self) -> Separation | None:
         """:meth:`greedy` of the whole assembled puzzle (translations only, no piece groups)
-        in one kernel call (:func:`chaingeo.solvers.levelsearch.greedy`), decoded into a tree. Past
-        :data:`KERNEL_NODES` expanded nodes it hands over to :meth:`greedy`, which checks
+        in one kernel call (:func:`chaingeo.solvers.motion.levelsearch.greedy`), decoded into a
+        tree. Past :data:`KERNEL_NODES` expanded nodes it hands over to :meth:`greedy`, which checks
         the deadline between chunks (the kernel cannot read the clock)."""
         n = len(self.table.names)
         lim = self.limits
@@ -371,7 +373,8 @@ class _Solver:
         self, members: tuple[int, ...], offsets: np.ndarray
     ) -> tuple[bool, Separation | None]:
         """Whether a part a separation leaves can be taken apart, and its tree (None: nothing
-        left to do). The hook :mod:`chaingeo.solvers.groups` overrides for BurrTools' piece groups."""
+        left to do). The hook :mod:`chaingeo.solvers.assembly.groups` overrides for BurrTools' piece
+        groups."""
         if len(members) == 1:
             return True, None
         tree = self.part_tree(members, offsets)
@@ -435,8 +438,8 @@ class _Solver:
 def _bt_frame_tree(shapes: Mapping[str, Shape], solver: _Solver) -> Separation | None:
     """BurrTools' tree of the puzzle as :func:`chaingeo.core.formats.bt_write.assembled_puzzle`
     writes it (each piece its own shape, the union the result): searched in the symmetric image
-    BurrTools' assembler reports (:class:`chaingeo.solvers.btorient.BTImage`), its moves turned back
-    into the puzzle's own frame."""
+    BurrTools' assembler reports (:class:`chaingeo.solvers.motion.btorient.BTImage`), its moves
+    turned back into the puzzle's own frame."""
     names = sorted(shapes)
     grids = {k: shapes[k].normalized().voxels for k in names}
     union = np.concatenate([shapes[k].voxels for k in names])
@@ -485,7 +488,8 @@ def _move(names: tuple[str, ...], group: int, direction: int, k: int) -> Move:
 def _decode(
     names: tuple[str, ...], nodes: list[list[int]], moves: list[list[int]], root: int
 ) -> Separation | None:
-    """The tree :func:`chaingeo.solvers.levelsearch.greedy` left in ``nodes``/``moves`` from ``root``."""
+    """The tree :func:`chaingeo.solvers.motion.levelsearch.greedy` left in ``nodes``/``moves`` from
+    ``root``."""
     built: dict[int, Separation] = {}
 
     def build(i: int) -> Separation | None:
@@ -516,11 +520,11 @@ def analyze(
 ) -> Analysis:
     """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
     state (every piece at offset zero, one part). ``lower_bound``: a *proven* lower bound on
-    o_i (e.g. :func:`chaingeo.solvers.blockbound.block_lower_bound`); the search stops at a plan that
-    meets it, and a plan below it raises ``ValueError`` (the bound was not a bound). With
-    ``turns`` groups may also turn (:mod:`chaingeo.solvers.turnsearch`; ``rods``: the round rods of each
-    piece, which spin in place). ``deadline``: shared with the caller's other searches (default:
-    one of ``limits.seconds`` for this analysis alone). ``separations``: BurrTools' level
+    o_i (e.g. :func:`chaingeo.solvers.optimal.blockbound.block_lower_bound`); the search stops at a
+    plan that meets it, and a plan below it raises ``ValueError`` (the bound was not a bound). With
+    ``turns`` groups may also turn (:mod:`chaingeo.solvers.motion.turnsearch`; ``rods``: the round
+    rods of each piece, which spin in place). ``deadline``: shared with the caller's other searches
+    (default: one of ``limits.seconds`` for this analysis alone). ``separations``: BurrTools' level
     (``"first"``, the default; with turns or ``max_group`` always ``"any"``) or ``"any"``;
     ``order``: the pieces in BurrTools' order (default: sorted names). Where BurrTools' first
     separation leaves a part that cannot come apart, ``fallback`` answers with any separation

@@ -2,11 +2,11 @@
 decides which of them can actually be taken apart ('assemblies' and 'solutions' as BurrTools
 counts them).
 
-Assemblies come from the exact-cover engine (:mod:`chaingeo.solvers.cover`) with every rotation of every
-piece, one per class of the target's rotations (symmetric duplicates removed; mirror images are
-kept apart, BurrTools' default). A *solution* is an assembly the disassembler can take apart
-completely under the reference kinematics. :func:`count_solutions` runs the enumeration and
-every disassembly under one :class:`chaingeo.solvers.deadline.Deadline` (``limits.seconds``).
+Assemblies come from the exact-cover engine (:mod:`chaingeo.solvers.cover.packings`) with every
+rotation of every piece, one per class of the target's rotations (symmetric duplicates removed;
+mirror images are kept apart, BurrTools' default). A *solution* is an assembly the disassembler can
+take apart completely under the reference kinematics. :func:`count_assemblies` runs the enumeration
+and every disassembly under one :class:`chaingeo.solvers.deadline.Deadline` (``limits.seconds``).
 """
 
 from __future__ import annotations
@@ -16,18 +16,18 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 from chaingeo.core.geometry import Shape
-from chaingeo.solvers.cover import iter_solutions
+from chaingeo.solvers.cover.packings import iter_packings
+from chaingeo.solvers.cover.problem import PieceSpec
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.disassemble import Analysis, analyze
-from chaingeo.solvers.partsearch import SearchLimits
-from chaingeo.solvers.problem import PieceSpec
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis, analyze
 
 
 @dataclass(frozen=True)
 class AssemblyReport:
     assemblies: int
     solutions: int
-    first_solution: dict[str, Shape] | None
+    first_packing: dict[str, Shape] | None
     seconds: float
     solution_list: tuple[dict[str, Shape], ...] = ()
 
@@ -45,7 +45,7 @@ def iter_assemblies(
     ``mirror_distinct`` is False), as ``{piece name: placed voxels}``. Copies of one piece are
     named ``name``, ``name_2``, ... in placement order. Past ``deadline`` the enumeration
     stops with its ``SearchLimitError``."""
-    solutions = iter_solutions(
+    solutions = iter_packings(
         list(pieces),
         target,
         distinct=True,
@@ -66,7 +66,7 @@ def iter_assemblies(
         yield out
 
 
-def count_solutions(
+def count_assemblies(
     pieces: Sequence[PieceSpec],
     target: Shape,
     *,

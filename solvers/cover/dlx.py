@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from chaingeo.core.jit import njit
-from chaingeo.solvers.kernels import (
+from chaingeo.solvers.cover.kernels import (
     DONE,
     FRESH,
     LIMIT,
@@ -35,8 +35,8 @@ from chaingeo.solvers.kernels import (
     shuffle_prefix,
     store_solution,
 )
-from chaingeo.solvers.placements import Int32Array
-from chaingeo.solvers.problem import CoverProblem
+from chaingeo.solvers.cover.placements import Int32Array
+from chaingeo.solvers.cover.problem import CoverProblem
 
 PRIMARY, SECONDARY, COUNTER = 0, 1, 2
 

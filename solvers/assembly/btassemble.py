@@ -1,5 +1,5 @@
-"""BurrTools' assembler on a compiled packing (:mod:`chaingeo.solvers.constrained`): assemblies, mirror
-images, holes, and the solutions the disassembler takes apart.
+"""BurrTools' assembler on a compiled packing (:mod:`chaingeo.solvers.cover.constrained`):
+assemblies, mirror images, holes, and the solutions the disassembler takes apart.
 
 *Assemblies* are counted as BurrTools counts them: one per class of the result's symmetries
 (rotations; colours and variable cells kept). ``mirrors="keep"`` keeps mirror images apart
@@ -11,14 +11,15 @@ variable cells empty.
 
 The search is cut by symmetry first: an anchor (a piece used exactly once, else a fixed cell
 and the rotations keeping it in place) keeps one placement per orbit, so every class is met at
-least once; canonical keys (:func:`chaingeo.solvers.constrained.canonical_keys`) then keep each class
-once, the first met in the engine's fixed order. *Solutions* are the classes the disassembler
-takes apart (:func:`chaingeo.solvers.disassemble.analyze`; with piece groups
-:func:`chaingeo.solvers.groups.analyze_grouped`), under the same moves as everything else here.
+least once; canonical keys (:func:`chaingeo.solvers.cover.constrained.canonical_keys`) then keep
+each class once, the first met in the engine's fixed order. *Solutions* are the classes the
+disassembler takes apart (:func:`chaingeo.solvers.motion.disassemble.analyze`; with piece groups
+:func:`chaingeo.solvers.assembly.groups.analyze_grouped`), under the same moves as everything else
+here.
 
 *Time*: :func:`count_bt` runs the enumeration and every disassembly under one
-:class:`chaingeo.solvers.deadline.Deadline` (the caller's, else one of ``limits.seconds``); past it a
-:class:`SearchLimitError` naming ``seconds`` is raised, wherever the time went.
+:class:`chaingeo.solvers.deadline.Deadline` (the caller's, else one of ``limits.seconds``); past it
+a :class:`SearchLimitError` naming ``seconds`` is raised, wherever the time went.
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ import numpy as np
 
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
-from chaingeo.solvers.btorient import BTImage
-from chaingeo.solvers.constrained import (
+from chaingeo.solvers.assembly.groups import PieceGroups, analyze_grouped
+from chaingeo.solvers.cover.constrained import (
     ColoredPiece,
     ColorRules,
     Packing,
@@ -40,14 +41,14 @@ from chaingeo.solvers.constrained import (
     PartSpec,
     canonical_keys,
 )
+from chaingeo.solvers.cover.placements import Int32Array
+from chaingeo.solvers.cover.problem import CoverError
+from chaingeo.solvers.cover.rowreduce import live_rows
+from chaingeo.solvers.cover.search import CoverSearch
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.disassemble import Analysis, Separations, analyze
-from chaingeo.solvers.groups import PieceGroups, analyze_grouped
-from chaingeo.solvers.partsearch import SearchLimits
-from chaingeo.solvers.placements import Int32Array
-from chaingeo.solvers.problem import CoverError
-from chaingeo.solvers.rowreduce import live_rows
-from chaingeo.solvers.search import CoverSearch
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.btorient import BTImage
+from chaingeo.solvers.motion.disassemble import Analysis, Separations, analyze
 
 Mirrors = Literal["keep", "drop"]
 
@@ -95,8 +96,8 @@ class Anchor:
 def choose_anchor(packing: Packing) -> Anchor | None:
     """One placement per rotation orbit of a piece used exactly once, else of the rows through
     a fixed cell (under the rotations fixing it); None without symmetry. Among pieces, as the
-    engine does (:func:`chaingeo.solvers.cover.anchor_plan`): the fewest orientations first (the most
-    symmetric piece, Knuth's choice for pentominoes), then the fewest representatives per
+    engine does (:func:`chaingeo.solvers.cover.packings.anchor_plan`): the fewest orientations first
+    (the most symmetric piece, Knuth's choice for pentominoes), then the fewest representatives per
     placement, then the fewest representatives."""
     maps = packing.row_maps(False)
     if len(maps) == 1 or packing.n_rows == 0:
@@ -218,7 +219,7 @@ def named_assembly(packing: Packing, rows: Int32Array) -> dict[str, Shape]:
 
 class BTFrame:
     """Turns an assembly into the symmetric image BurrTools' assembler reports
-    (:class:`chaingeo.solvers.btorient.BTImage`), whose disassembly BurrTools prints."""
+    (:class:`chaingeo.solvers.motion.btorient.BTImage`), whose disassembly BurrTools prints."""
 
     def __init__(self, packing: Packing) -> None:
         spec = packing.spec
@@ -266,8 +267,8 @@ def disassemble(
     """The disassembler's verdict on one assembly (level and moves), groups honoured
     (``groups``: :func:`piece_groups` of the packing, when the caller has it already;
     ``deadline``: the analysis' shared one, else one of ``limits.seconds``;
-    ``separations``: see :func:`chaingeo.solvers.disassemble.analyze`). Pieces are searched in the
-    assembly's order (:func:`named_assembly`: BurrTools')."""
+    ``separations``: see :func:`chaingeo.solvers.motion.disassemble.analyze`). Pieces are searched
+    in the assembly's order (:func:`named_assembly`: BurrTools')."""
     groups = piece_groups(packing) if groups is None else groups
     order = list(assembly)
     if groups.any():

@@ -26,7 +26,8 @@ U64 = npt.NDArray[np.uint64]
 
 #: "Never meets": larger than any real gap.
 INF = 1 << 40
-#: Status codes returned by :func:`expand` (5 and 6 are :mod:`chaingeo.solvers.turnmoves`' own).
+#: Status codes returned by :func:`expand` (5 and 6 are :mod:`chaingeo.solvers.motion.turnmoves`'
+#: own).
 DONE, NEED_STATES, NEED_SEPS, TOO_MANY_GROUPS, NEED_MOVES, PAUSED = 0, 1, 2, 3, 4, 7
 #: Most pieces one part may hold (groups are 64-bit masks).
 MAX_PIECES = 63

@@ -8,8 +8,8 @@ on an unused exact-once piece when that piece has fewer fitting placements than 
 puts a symmetry-reduced anchor first and awkward pieces early. A placement is rejected when it
 cuts off an empty region that no set of pieces could fill (smaller than the smallest piece or
 not a multiple of the gcd of the piece sizes; box targets without optional cells). Piece types
-carry count ranges exactly as in :mod:`chaingeo.solvers.dlx` (checked against ``hi`` on the way down,
-against ``lo`` at a full cover).
+carry count ranges exactly as in :mod:`chaingeo.solvers.cover.dlx` (checked against ``hi`` on the
+way down, against ``lo`` at a full cover).
 
 ``nodes`` counts rows placed; ``updates`` counts rows tested (the bit-board's unit of work).
 """
@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from chaingeo.core.jit import njit
-from chaingeo.solvers.kernels import (
+from chaingeo.solvers.cover.kernels import (
     DONE,
     FRESH,
     LIMIT,
@@ -34,8 +34,8 @@ from chaingeo.solvers.kernels import (
     shuffle_prefix,
     store_solution,
 )
-from chaingeo.solvers.placements import Int32Array
-from chaingeo.solvers.problem import CoverProblem
+from chaingeo.solvers.cover.placements import Int32Array
+from chaingeo.solvers.cover.problem import CoverProblem
 
 MAX_CELLS = 64
 #: Levels (from the root) at which the search branches on whichever of the first empty cell and
@@ -166,7 +166,7 @@ def bitboard_run(
     regs: Any, rng: Any, shuffle: bool,
     out: Any, max_store: int, stop_after: int, node_limit: int,
 ) -> int:  # fmt: skip
-    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.dlx.dlx_run`.
+    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`.
 
     ``pos[k]``/``end[k]`` index ``cand`` (fixed order) or level ``k``'s slice of ``perm``
     (random order, ``width`` entries per level).

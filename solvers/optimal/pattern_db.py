@@ -6,7 +6,7 @@ part; ``g_S(X)`` is the fewest moves that take every piece of ``S`` apart from `
 rules of :mod:`chaingeo.core.kinematics` (same ``max_group``). :class:`PatternDB` holds ``g_S`` for
 every one-part state it has met, in one open-addressing table keyed by
 ``(subset id, offsets of S[1], S[2] relative to S[0])``; why these values bound the whole
-puzzle's distance is proven in :mod:`chaingeo.solvers.astar`.
+puzzle's distance is proven in :mod:`chaingeo.solvers.optimal.astar`.
 
 A table entry is filled by an exact search of the sub-puzzle from a state ``X`` (forward
 breadth first, numba): every state reachable from ``X`` is enumerated with its moves, so the
@@ -26,8 +26,9 @@ import numpy.typing as npt
 
 from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers.partsearch import Deadline, PieceTable
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion.partsearch import PieceTable
 
 I64 = npt.NDArray[np.int64]
 I32 = npt.NDArray[np.int32]
@@ -281,7 +282,8 @@ class PatternDB:
 
     ``family[i]`` is the sorted global piece indices of subset ``i``; every pair inside a
     triple of the family must be in the family too (the pair tables give the triples' removal
-    costs, and :mod:`chaingeo.solvers.astar`'s consistency proof needs the family closed downwards).
+    costs, and :mod:`chaingeo.solvers.optimal.astar`'s consistency proof needs the family closed
+    downwards).
     """
 
     def __init__(

@@ -1,6 +1,6 @@
 """A* over whole disassembly states: o_i, the fewest moves that take every piece apart.
 
-**The problem** (the quantity :func:`chaingeo.solvers.disassemble.analyze` computes with
+**The problem** (the quantity :func:`chaingeo.solvers.motion.disassemble.analyze` computes with
 ``optimal=True``; rules of :mod:`chaingeo.core.kinematics`). A state is a partition of the pieces
 into *parts* plus, per part, its pieces' offsets relative to the part's first piece. A move
 translates a proper sub-group ``G`` of one part ``P`` along an axis by ``k >= 1`` (legal when
@@ -27,8 +27,8 @@ expansions.
 
 **Heuristic.** For a subset ``S`` of a part ``P`` (a pair or a triple), ``g_S(X)`` is the fewest
 moves that take ``S`` apart when every other piece is gone, from the one-part state ``X`` with
-``S``'s offsets (exact, from :mod:`chaingeo.solvers.pattern_db`); ``pi_S(s)`` is that state at ``s``.
-For a whole state ``s``::
+``S``'s offsets (exact, from :mod:`chaingeo.solvers.optimal.pattern_db`); ``pi_S(s)`` is that state
+at ``s``. For a whole state ``s``::
 
     h(s) = sum over parts P of  max( |P| - 1,  max over S in F, S within P of
                                      g_S(pi_S(s)) + |P| - |S| )
@@ -65,8 +65,8 @@ closed under taking subsets (every pair of a triple in ``F`` is in ``F``). At a 
 *Not used:* adding ``g`` over disjoint subsets of one part. With multi-piece moves one move of
 ``G`` moves both ``S1`` and ``S2`` (``G`` meets ``S1``, the rest meets ``S2``), so the sum can
 overshoot; only the sum over *parts* is used. (With ``max_group=1`` it does hold:
-:mod:`chaingeo.solvers.blockbound`.) Nor ``|S| >= 4``: two restricted parts of two pieces each could
-both move at once, breaking Lemma 1.
+:mod:`chaingeo.solvers.optimal.blockbound`.) Nor ``|S| >= 4``: two restricted parts of two pieces
+each could both move at once, breaking Lemma 1.
 """
 
 from __future__ import annotations
@@ -78,10 +78,11 @@ import numpy as np
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, Move
-from chaingeo.solvers import astar_kernel as ak
-from chaingeo.solvers.astar_kernel import AStarLimits
-from chaingeo.solvers.partsearch import DIRECTION_NAMES, Deadline, PieceTable
-from chaingeo.solvers.pattern_db import DEAD, KEY_WIDTH, PatternDB
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable
+from chaingeo.solvers.optimal import astar_kernel as ak
+from chaingeo.solvers.optimal.astar_kernel import AStarLimits
+from chaingeo.solvers.optimal.pattern_db import DEAD, KEY_WIDTH, PatternDB
 
 __all__ = ["AStarLimits", "AStarResult", "Heuristic", "astar_optimal", "default_family"]
 
@@ -133,7 +134,8 @@ def default_family(table: PieceTable, triples: bool = True) -> list[tuple[int, .
 
 class Heuristic:
     """``h`` of the module docstring for any state of one puzzle (for tests and tools; the
-    search evaluates the same function in numba, :func:`chaingeo.solvers.astar_kernel.part_h`)."""
+    search evaluates the same function in numba,
+    :func:`chaingeo.solvers.optimal.astar_kernel.part_h`)."""
 
     def __init__(
         self,

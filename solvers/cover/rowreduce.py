@@ -15,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.jit import njit
-from chaingeo.solvers.problem import CoverProblem
+from chaingeo.solvers.cover.problem import CoverProblem
 
 I64 = npt.NDArray[np.int64]
 B1 = npt.NDArray[np.bool_]

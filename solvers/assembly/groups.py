@@ -10,7 +10,7 @@ taking it apart further when
    often than its count there.
 
 The whole puzzle is always searched (a first separation is needed). :class:`GroupedSolver` is
-the plain disassembler (:mod:`chaingeo.solvers.disassemble`) with that rule at its one hook
+the plain disassembler (:mod:`chaingeo.solvers.motion.disassemble`) with that rule at its one hook
 (``subpart``); rule 2's counts are shared by everything one analysis accepts, and a part
 accepted on a branch that is later abandoned keeps its share (BurrTools never abandons one: it
 stops at the first separation, the default here too). The optimal full disassembly (o_i) is not
@@ -26,8 +26,8 @@ import numpy as np
 
 from chaingeo.core.geometry import Shape
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.disassemble import Analysis, Separation, Separations, _Solver
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis, Separation, Separations, _Solver
 
 #: A piece's groups: ``(group id, count)`` pairs of its shape (the count is the shape's).
 GroupSpec = tuple[tuple[int, int], ...]
@@ -132,7 +132,8 @@ def analyze_grouped(
     order: Sequence[str] | None = None,
 ) -> Analysis:
     """Level and moves of an assembly under the group rule (``optimal_steps`` is None;
-    ``deadline``, ``separations``, ``order``: as in :func:`chaingeo.solvers.disassemble.analyze`)."""
+    ``deadline``, ``separations``, ``order``: as in
+    :func:`chaingeo.solvers.motion.disassemble.analyze`)."""
     solver = GroupedSolver(
         shapes, groups, max_group, limits or SearchLimits(), deadline, separations, order
     )

@@ -1,8 +1,9 @@
 """Shared pieces of the numba search kernels: status codes, register layout, a seeded PRNG.
 
-Both engines (:mod:`chaingeo.solvers.dlx`, :mod:`chaingeo.solvers.bitboard`) run a resumable depth-first search:
-all search state lives in arrays owned by the Python wrapper, so a call can stop after a batch
-of solutions (or at a node limit) and a later call continues exactly where it stopped.
+Both engines (:mod:`chaingeo.solvers.cover.dlx`, :mod:`chaingeo.solvers.cover.bitboard`) run a
+resumable depth-first search: all search state lives in arrays owned by the Python wrapper, so a
+call can stop after a batch of solutions (or at a node limit) and a later call continues exactly
+where it stopped.
 """
 
 from __future__ import annotations

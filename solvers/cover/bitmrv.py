@@ -6,18 +6,19 @@ into bit-sliced counters (four planes and a saturation plane), so at the end of 
 of alive rows through every empty cell is known up to 15 without a loop over cells. The search
 then branches on the empty mandatory cell with the fewest alive rows (ties: lowest bit, i.e.
 first in scan order), or on an unused exact-once piece when that piece has at most as many
-alive rows (pieces win ties, as in :mod:`chaingeo.solvers.dlx`). When every empty cell has 16 or more
-rows (near the root only: 21 thousand of 3.4 million nodes on the 2x5x6 solid pentominoes) the
-counts are taken exactly, cell by cell. A cell with no alive row,
+alive rows (pieces win ties, as in :mod:`chaingeo.solvers.cover.dlx`). When every empty cell has 16
+or more rows (near the root only: 21 thousand of 3.4 million nodes on the 2x5x6 solid pentominoes)
+the counts are taken exactly, cell by cell. A cell with no alive row,
 an exact-once piece with no alive row, or a piece type with fewer alive rows than it still needs
 ends the branch at once; so does, in box targets of one word, a placement that cuts off an empty
-region no set of pieces can fill (:func:`chaingeo.solvers.bitboard.regions_ok`, same scan order).
+region no set of pieces can fill (:func:`chaingeo.solvers.cover.bitboard.regions_ok`, same scan
+order).
 
 Targets over 64 cells use ``W = ceil(cells / 64)`` words per mask (:func:`mrv_wide_run`); the
 one-word kernel :func:`mrv_run` is the same algorithm on scalars. Piece types carry count ranges
-exactly as in :mod:`chaingeo.solvers.dlx`. ``nodes`` counts rows placed (as in the DLX kernel: a row that
-completes a cover or ends in a dead end counts too); ``updates`` counts rows tested by the
-filter (the unit of work here).
+exactly as in :mod:`chaingeo.solvers.cover.dlx`. ``nodes`` counts rows placed (as in the DLX kernel:
+a row that completes a cover or ends in a dead end counts too); ``updates`` counts rows tested by
+the filter (the unit of work here).
 """
 
 from __future__ import annotations
@@ -27,8 +28,8 @@ from typing import Any
 import numpy as np
 
 from chaingeo.core.jit import njit
-from chaingeo.solvers.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
-from chaingeo.solvers.kernels import (
+from chaingeo.solvers.cover.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
+from chaingeo.solvers.cover.kernels import (
     DONE,
     FRESH,
     LIMIT,
@@ -41,8 +42,8 @@ from chaingeo.solvers.kernels import (
     shuffle_prefix,
     store_solution,
 )
-from chaingeo.solvers.placements import Int32Array
-from chaingeo.solvers.problem import CoverProblem
+from chaingeo.solvers.cover.placements import Int32Array
+from chaingeo.solvers.cover.problem import CoverProblem
 
 _ONE = np.uint64(1)
 _NONE = np.uint64(0)
@@ -177,7 +178,7 @@ def mrv_run(
     regs: Any, rng: Any, shuffle: bool,
     out: Any, max_store: int, stop_after: int, node_limit: int,
 ) -> int:  # fmt: skip
-    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.dlx.dlx_run`.
+    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`.
 
     Level ``k`` has the alive rows ``live[lstart[k] : lstart[k + 1]]``, occupancy ``occ[k]``
     and branches ``br[k, :nbr[k]]`` (tried up to ``pos[k]``).

@@ -42,8 +42,8 @@ from collections.abc import Mapping, Sequence
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, Move, MoveError, SearchLimitError
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.disassemble import Analysis, analyze, translations
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.disassemble import Analysis, analyze, translations
 
 
 def block_lower_bound(
@@ -169,9 +169,9 @@ def analyze_by_blocks(
     search: bool = True,
     deadline: Deadline | None = None,
 ) -> Analysis:
-    """:func:`chaingeo.solvers.disassemble.analyze` with single-piece moves and the block bound: a plan
-    whose length meets the bound is optimal. Tried in turn: the BurrTools-style plan, (when
-    ``stacked``: the blocks form a stack along z, see :func:`end_first_plan`) the stack taken
+    """:func:`chaingeo.solvers.motion.disassemble.analyze` with single-piece moves and the block
+    bound: a plan whose length meets the bound is optimal. Tried in turn: the BurrTools-style plan,
+    (when ``stacked``: the blocks form a stack along z, see :func:`end_first_plan`) the stack taken
     apart from its ends, and (when ``search``) the exact search, which stops once it meets
     the bound; without it, :class:`SearchLimitError` when no quick plan meets the bound.
     ``deadline``: one for all of these searches (default: one of ``limits.seconds``)."""

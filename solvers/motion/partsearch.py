@@ -2,8 +2,8 @@
 
 A *part* is a set of pieces still to be taken apart; its states are the pieces' offsets relative
 to its first piece. :class:`PartSearch` grows the search one depth layer at a time (numba does
-the expansion, :mod:`chaingeo.solvers.movement`), remembers each state's parent and the move that made
-it, and collects every removal (a move that splits the part) seen on the way.
+the expansion, :mod:`chaingeo.solvers.motion.movement`), remembers each state's parent and the move
+that made it, and collects every removal (a move that splits the part) seen on the way.
 """
 
 from __future__ import annotations
@@ -15,28 +15,11 @@ import numpy as np
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers.deadline import Deadline as Deadline  # re-exported: its historical home
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import movement as mv
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
-
-
-@dataclass(frozen=True)
-class SearchLimits:
-    """Caps that turn an endless search into a :class:`SearchLimitError` with a clear message.
-
-    ``max_states`` caps one part's breadth-first search; ``seconds`` the whole analysis;
-    ``group_limit`` the movable groups per direction in one state; ``max_total_states`` the
-    states of all searches of one analysis together (unlike time, the same on every machine);
-    ``optimal_seconds`` the search for o_i within an analysis (None: the analysis' own time),
-    so that a hard o_i does not hold back figures that are known already.
-    """
-
-    max_states: int = 2_000_000
-    seconds: float | None = 120.0
-    group_limit: int = 4096
-    max_total_states: int | None = None  # over every search of one analysis (deterministic)
-    optimal_seconds: float | None = None
 
 
 class PieceTable:

@@ -1,14 +1,15 @@
 """o_i with multi-piece moves: iterative deepening under the class bound.
 
 Towers of burr units played with moves that may carry any group of pieces have state spaces far
-beyond breadth-first search, and A* with pair databases (:mod:`chaingeo.solvers.astar`) proves only 36
-on the suite's 36-piece towers. The class bound of :mod:`chaingeo.solvers.classbound` is much closer; as
-the heuristic of a depth-first iterative deepening search it closes them (figures: README,
-"Class search", and ``chain bench astar``).
+beyond breadth-first search, and A* with pair databases (:mod:`chaingeo.solvers.optimal.astar`)
+proves only 36 on the suite's 36-piece towers. The class bound of
+:mod:`chaingeo.solvers.optimal.classbound` is much closer; as the heuristic of a depth-first
+iterative deepening search it closes them (figures: README, "Class search", and ``chain bench
+astar``).
 
-**Problem** as in :mod:`chaingeo.solvers.astar`: a state is a partition of the pieces into parts with
-offsets; a move carries a proper group of one part one or more steps along an axis, or away for
-good (a *removal*, which splits the part); parts never interact again, so the distance of a
+**Problem** as in :mod:`chaingeo.solvers.optimal.astar`: a state is a partition of the pieces into
+parts with offsets; a move carries a proper group of one part one or more steps along an axis, or
+away for good (a *removal*, which splits the part); parts never interact again, so the distance of a
 state is the sum of its parts' distances ``d(P)``.
 
 **Heuristic.** For one part ``P`` (its pieces at their offsets) and blocks ``B_1 .. B_k`` (a
@@ -24,8 +25,8 @@ every child, whatever ``h`` says of them.)
 
 **Search.** ``within(P, r)`` finds a plan of at most ``r`` moves for part ``P`` or proves there
 is none. It prunes when ``h(P) > r`` or a memoised lower bound on ``d(P)`` exceeds ``r``; else
-it tries every legal move of ``P`` (:func:`chaingeo.solvers.movement.node_moves`: one of each group / rest
-pair, every finite distance, and the removal), smallest ``f = 1 + bound(child)`` first,
+it tries every legal move of ``P`` (:func:`chaingeo.solvers.motion.movement.node_moves`: one of each
+group / rest pair, every finite distance, and the removal), smallest ``f = 1 + bound(child)`` first,
 removals first among equals. A finite move needs ``within(P', r - 1)``. A removal into ``P1``
 and ``P2`` needs ``d(P1) + d(P2) <= r - 1``: ``d(P1)`` is found exactly (deepening from its
 bound up to ``r - 1 - h(P2)``), then ``within(P2, r - 1 - d(P1))``. When every child fails,
@@ -44,11 +45,12 @@ import numpy as np
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Move, SearchLimitError
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers.classbound import MAX_BUDGET, ClassVectors, moved
 from chaingeo.solvers.deadline import Deadline, deadline_of
-from chaingeo.solvers.disassemble import Analysis, analyze
-from chaingeo.solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion.disassemble import Analysis, analyze
+from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable
+from chaingeo.solvers.optimal.classbound import MAX_BUDGET, ClassVectors, moved
 
 Offsets = np.ndarray
 Key = tuple[tuple[int, ...], bytes]
@@ -266,8 +268,8 @@ def class_search_optimal(
 ) -> ClassSearchResult:
     """o_i of ``shapes`` (assembled as given) and an optimal plan, by the search of the module
     docstring with the class bound over ``blocks`` (a partition of the piece names; for a
-    tower of burr units, :func:`chaingeo.solvers.classbound.band_blocks`). ``deadline``: shared with
-    the caller's other searches (default: one of ``limits.seconds``).
+    tower of burr units, :func:`chaingeo.solvers.optimal.classbound.band_blocks`). ``deadline``:
+    shared with the caller's other searches (default: one of ``limits.seconds``).
 
     Raises ``ValueError`` when the blocks are not a partition, and :class:`SearchLimitError`
     at a cap, naming the proven lower bound (``"proven lower bound N"``). A puzzle that never
@@ -316,8 +318,8 @@ def analyze_by_classes(
     limits: SearchLimits | None = None,
     deadline: Deadline | None = None,
 ) -> Analysis:
-    """:func:`chaingeo.solvers.disassemble.analyze` of a puzzle made of ``blocks`` with moves of several
-    pieces: level and moves from the BurrTools-style search, o_i and its plan from
+    """:func:`chaingeo.solvers.motion.disassemble.analyze` of a puzzle made of ``blocks`` with moves
+    of several pieces: level and moves from the BurrTools-style search, o_i and its plan from
     :func:`class_search_optimal` (``states`` counts both). Its caps come from ``limits``:
     ``max_total_states`` (default 1,000,000) expanded states, ``max_states`` class-vector
     states, one deadline of ``seconds`` for both searches."""

@@ -1,4 +1,5 @@
-"""The numba side of :mod:`chaingeo.solvers.astar`: heuristic, heap, expansion, and the resumable loop.
+"""The numba side of :mod:`chaingeo.solvers.optimal.astar`: heuristic, heap, expansion, and the
+resumable loop.
 
 A whole state is one ``int16`` row of ``4 n``: ``row[i]`` is the label of piece ``i``'s part
 (its smallest piece index), ``row[n + 3 i + t]`` its offset relative to that piece. The loop
@@ -19,12 +20,13 @@ import numpy.typing as npt
 
 from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers.pattern_db import DEAD, KEY_WIDTH, lookup
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.optimal.pattern_db import DEAD, KEY_WIDTH, lookup
 
 if TYPE_CHECKING:
-    from chaingeo.solvers.partsearch import Deadline, PieceTable
-    from chaingeo.solvers.pattern_db import PatternDB
+    from chaingeo.solvers.deadline import Deadline
+    from chaingeo.solvers.motion.partsearch import PieceTable
+    from chaingeo.solvers.optimal.pattern_db import PatternDB
 
 I64 = npt.NDArray[np.int64]
 I32 = npt.NDArray[np.int32]
@@ -60,9 +62,9 @@ def part_h(
     row: I16, n: int, label: int, size: int, fam: I64, n_fam: int,
     pkeys: I16, pvals: I32, ptable: I64, key: I16, miss: I16,
 ) -> int:  # fmt: skip
-    """The term of one part (module docstring of :mod:`chaingeo.solvers.astar`); -1 when a pattern
-    database entry is missing (its key is written to ``miss``), ``DEAD`` when some subset can
-    never come apart."""
+    """The term of one part (module docstring of :mod:`chaingeo.solvers.optimal.astar`); -1 when a
+    pattern database entry is missing (its key is written to ``miss``), ``DEAD`` when some subset
+    can never come apart."""
     if size < 2:
         return 0
     h = size - 1

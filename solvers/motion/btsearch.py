@@ -28,9 +28,10 @@ import numpy.typing as npt
 
 from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Move, SearchLimitError
-from chaingeo.solvers import movement as mv
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.levelsearch import (
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion.levelsearch import (
     EXPANDED,
     GROUP_CAP,
     INFO,
@@ -41,7 +42,7 @@ from chaingeo.solvers.levelsearch import (
     TOTAL_CAP,
     _record,
 )
-from chaingeo.solvers.partsearch import DIRECTION_NAMES, PieceTable, SearchLimits, part_size
+from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable, part_size
 
 I64 = npt.NDArray[np.int64]
 I16 = npt.NDArray[np.int16]
@@ -137,8 +138,8 @@ def part_search(
     added stay, as BurrTools would have added them in the same order). ``move`` rows: mask,
     direction, distance of the move that found each state. The part's pieces are the table
     rows ``members`` (``vox`` ... ``hi``: the whole puzzle's :class:`PieceTable` arrays), their
-    pair gaps kept in ``memo_rel``/``memo_gap`` (:func:`chaingeo.solvers.movement.memo_pair_gaps`).
-    Returns a status code."""
+    pair gaps kept in ``memo_rel``/``memo_gap``
+    (:func:`chaingeo.solvers.motion.movement.memo_pair_gaps`). Returns a status code."""
     k = members.shape[0]
     half = k // 2
     gaps = np.empty((3, k, k), dtype=np.int64)
@@ -239,7 +240,7 @@ def part_search(
 #: nodes to expand in the call, max_total_states (-1: none).
 MAX_STATES, GROUP_LIMIT, BUDGET, MAX_TOTAL = 0, 1, 2, 3
 #: ``ctx`` of :func:`first_tree` has the slots and status codes of
-#: :func:`chaingeo.solvers.levelsearch.greedy` (its tree is decoded the same way); no memo.
+#: :func:`chaingeo.solvers.motion.levelsearch.greedy` (its tree is decoded the same way); no memo.
 
 
 @njit(cache=True)

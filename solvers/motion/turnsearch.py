@@ -1,19 +1,20 @@
 """Breadth-first search of one part with translations *and* turns (levels whose rules allow
-turns; the translation-only search stays :class:`chaingeo.solvers.partsearch.PartSearch`).
+turns; the translation-only search stays :class:`chaingeo.solvers.motion.partsearch.PartSearch`).
 
 A turned piece changes orientation, so a state is every piece's *pose*: a rotation index (into
 :data:`chaingeo.core.geometry.ROTATIONS`) and an offset, pieces pre-rotated in
-:class:`chaingeo.solvers.turnmoves.TurnTable`. The first piece (the anchor) never moves: when it belongs
-to the group that moves, the rest moves the opposite way (for a turn: turns back about the same
-line), which is the same relative motion. States are therefore seen in a *search frame* that
-differs from the real positions by a rigid motion ``T`` (a rotation and a translation, in
+:class:`chaingeo.solvers.motion.turnmoves.TurnTable`. The first piece (the anchor) never moves: when
+it belongs to the group that moves, the rest moves the opposite way (for a turn: turns back about
+the same line), which is the same relative motion. States are therefore seen in a *search frame*
+that differs from the real positions by a rigid motion ``T`` (a rotation and a translation, in
 doubled cell units), tracked along each path: a move recorded in the search frame is reported
 as the group's own move mapped by ``T``, and when the anchor's group moved, ``T`` composes with
 that motion. Removals, plans and the poses handed to sub-searches are all in real coordinates,
 so they replay as they are with :mod:`chaingeo.core.kinematics`.
 
-Same interface as :class:`~chaingeo.solvers.partsearch.PartSearch` (poses are ``(n, 4)`` rows: offset,
-then rotation index); the expansion is the numba kernel :func:`chaingeo.solvers.turnmoves.expand_turns`.
+Same interface as :class:`~chaingeo.solvers.motion.partsearch.PartSearch` (poses are ``(n, 4)``
+rows: offset, then rotation index); the expansion is the numba kernel
+:func:`chaingeo.solvers.motion.turnmoves.expand_turns`.
 """
 
 from __future__ import annotations
@@ -25,10 +26,12 @@ import numpy as np
 from chaingeo.core.geometry import ROTATIONS, rotation_index
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers import turnmoves as tm
-from chaingeo.solvers.partsearch import Deadline, Removal, SearchLimits, Split, part_size
-from chaingeo.solvers.sweep import FAR_LIMIT, Stencils, stencils, swept_through
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import turnmoves as tm
+from chaingeo.solvers.motion.partsearch import Removal, Split, part_size
+from chaingeo.solvers.motion.sweep import FAR_LIMIT, Stencils, stencils, swept_through
 
 _DIR_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 _DIR_VECS = np.array([DIRECTIONS[d] for d in _DIR_NAMES], dtype=np.int64)
@@ -108,7 +111,7 @@ class TurnPartSearch:
     def expand_layers(self, max_depth: int | None = None) -> list[Removal]:
         """Layer after layer up to the first with removals (returned); ``[]`` once every state
         is expanded or the next layer would be deeper than ``max_depth`` (as
-        :meth:`chaingeo.solvers.partsearch.PartSearch.expand_layers`)."""
+        :meth:`chaingeo.solvers.motion.partsearch.PartSearch.expand_layers`)."""
         while not self.exhausted and (max_depth is None or self.depth <= max_depth):
             found = self.expand_layer()
             if found:
@@ -266,9 +269,9 @@ def turn_rows(
 ) -> list[tuple[tuple[str, ...], np.ndarray]]:
     """The legal turns of ``state`` in the kernel's raw form: per part of two or more pieces,
     its piece names (sorted) and int64 rows ``(mask, axis, sense, c0, c1, c2)`` (see
-    :func:`chaingeo.solvers.turnmoves.node_turns`). ``table`` holds the state's pieces and rods; ``st``
-    is the stencil table (the one of :func:`chaingeo.solvers.sweep.stencils` unless a test asks for
-    another reach)."""
+    :func:`chaingeo.solvers.motion.turnmoves.node_turns`). ``table`` holds the state's pieces and
+    rods; ``st`` is the stencil table (the one of :func:`chaingeo.solvers.motion.sweep.stencils`
+    unless a test asks for another reach)."""
     out: list[tuple[tuple[str, ...], np.ndarray]] = []
     st = stencils() if st is None else st
     for part in sorted(state.parts, key=lambda p: sorted(p)):
@@ -320,8 +323,8 @@ def fast_legal_turns(
 
 def turn_problem(state: Assembly, move: TurnMove) -> str | None:
     """:meth:`chaingeo.core.kinematics.Assembly.turn_problem` (the same answer, the same words)
-    from the exact pair test of :mod:`chaingeo.solvers.sweep`, whose cost does not grow with how far the
-    group stands from the axis (the reference lists every cell each cell sweeps)."""
+    from the exact pair test of :mod:`chaingeo.solvers.motion.sweep`, whose cost does not grow with
+    how far the group stands from the axis (the reference lists every cell each cell sweeps)."""
     a = move.axis_index
     group = [c for n in move.pieces for c in state.cells_of(n)]
     if not centre_inside(group, a, move.centre2):

@@ -1,7 +1,7 @@
 """Packing problems with BurrTools' constraints, compiled to exact-cover rows.
 
-On top of the plain engine's problem (:mod:`chaingeo.solvers.problem`): voxels carry colours and a
-placement is a row only when every coloured piece voxel may sit on the result voxel under it
+On top of the plain engine's problem (:mod:`chaingeo.solvers.cover.problem`): voxels carry colours
+and a placement is a row only when every coloured piece voxel may sit on the result voxel under it
 (:class:`ColorRules`, BurrTools' ``<bitmap>``); result cells may be *variable* (covered at most
 once, the secondary columns of the engine; when a piece fits wholly on variable cells, where
 the kernels never branch, variable cells become fixed ones covered by a piece or a *hole*,
@@ -10,12 +10,12 @@ one type whose copies are interchangeable. A piece is a coloured voxel set, so a
 shape is symmetric but whose colouring is not has more orientations than its shape; rows are
 ``(type, coloured placement)`` and two rows may cover the same cells.
 
-Rows are filtered here, before the kernels (:mod:`chaingeo.solvers.bitboard`, :mod:`chaingeo.solvers.dlx`), and
-the engine searches them as they are. Symmetry is this module's business: the group is the
-result's own (cells, variable marks and colours kept) and acts on rows by :meth:`row_maps`;
-a reflection sends a row to its mirror piece's row when that piece is in the problem (else
--1), and :func:`canonical_keys` picks one key per orbit of an assembly, so two assemblies are
-the same exactly when a symmetry maps one onto the other.
+Rows are filtered here, before the kernels (:mod:`chaingeo.solvers.cover.bitboard`,
+:mod:`chaingeo.solvers.cover.dlx`), and the engine searches them as they are. Symmetry is this
+module's business: the group is the result's own (cells, variable marks and colours kept) and acts
+on rows by :meth:`row_maps`; a reflection sends a row to its mirror piece's row when that piece is
+in the problem (else -1), and :func:`canonical_keys` picks one key per orbit of an assembly, so two
+assemblies are the same exactly when a symmetry maps one onto the other.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ import numpy as np
 
 from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
 from chaingeo.core.jit import njit
-from chaingeo.solvers.placements import Int32Array, IntArray, Placements, target_index
-from chaingeo.solvers.problem import CoverError, CoverProblem, PieceType
+from chaingeo.solvers.cover.placements import Int32Array, IntArray, Placements, target_index
+from chaingeo.solvers.cover.problem import CoverError, CoverProblem, PieceType
 
 Cell = tuple[int, int, int]
 #: Colour codes pack ``cell * COLOR_BASE + colour`` (BurrTools has at most 63 colours).

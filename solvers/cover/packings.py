@@ -4,11 +4,11 @@ Public API (pieces: a ``{name: Shape}`` mapping, a list of :class:`Shape`, or a 
 :class:`PieceSpec` with ``min``/``max`` copies; target: any :class:`Shape` or box sizes
 ``(a, b, c)``; ``optional``: target cells that may stay empty)::
 
-    count_solutions(pieces, target, *, distinct=True, reflections=True, optional=None,
+    count_packings(pieces, target, *, distinct=True, reflections=True, optional=None,
                     engine="auto", node_limit=None, symmetry=True) -> CoverResult
-    iter_solutions(pieces, target, *, distinct=False, symmetry=False, ...) -> Iterator[Solution]
-    first_solution(pieces, target, ...) -> Solution | None
-    random_solutions(pieces, target, rng, ...) -> Iterator[Solution]
+    iter_packings(pieces, target, *, distinct=False, symmetry=False, ...) -> Iterator[Solution]
+    first_packing(pieces, target, ...) -> Solution | None
+    random_packings(pieces, target, rng, ...) -> Iterator[Solution]
     cover_problem(pieces, target, ...) -> CoverProblem   # compiled + cached, reusable
     CoverSearch(problem, rows=None, engine=..., rng=..., node_limit=...)  # low level
 
@@ -25,14 +25,14 @@ per orbit of the group. Then ``solutions = sum(orbit size x solutions with that 
 exactly. With an achiral unique piece under the whole group, ``distinct`` is the number of
 free-orbit solutions plus the distinct canonical forms of the few solutions whose anchor
 placement is itself symmetric; otherwise the reduced solutions are enumerated and
-canonicalised (:func:`canonical_forms`). ``iter_solutions(distinct=True, symmetry=True)``
+canonicalised (:func:`canonical_forms`). ``iter_packings(distinct=True, symmetry=True)``
 lists one solution per class from the reduced search (the default keeps the plain order).
 
 *Engines*: ``"bitboard"`` (the default, as ``"auto"``) or ``"dlx"`` (dancing links, MRV). The
 bit-board branches on the first empty cell (``"bitboard-first"``, at most 64 cells) or on the
 most constrained cell (``"bitboard-mrv"``, any size); ``"bitboard"`` picks between them by the
-rule of :func:`chaingeo.solvers.search.first_cell_wins` (first cell for one-layer targets and targets of
-at most 32 cells). Every function
+rule of :func:`chaingeo.solvers.cover.search.first_cell_wins` (first cell for one-layer targets and
+targets of at most 32 cells). Every function
 also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``target``).
 ``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
 the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a
@@ -50,9 +50,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
-from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.placements import Int32Array
-from chaingeo.solvers.problem import (
+from chaingeo.solvers.cover.placements import Int32Array
+from chaingeo.solvers.cover.problem import (
     CoverError,
     CoverProblem,
     PiecesLike,
@@ -60,7 +59,8 @@ from chaingeo.solvers.problem import (
     TargetLike,
     cover_problem,
 )
-from chaingeo.solvers.search import CoverLimitError, CoverSearch, CoverStats, Engine
+from chaingeo.solvers.cover.search import CoverLimitError, CoverSearch, CoverStats, Engine
+from chaingeo.solvers.deadline import Deadline
 
 __all__ = [
     "AnchorPlan",
@@ -74,11 +74,11 @@ __all__ = [
     "Solution",
     "anchor_plan",
     "canonical_forms",
-    "count_solutions",
+    "count_packings",
     "cover_problem",
-    "first_solution",
-    "iter_solutions",
-    "random_solutions",
+    "first_packing",
+    "iter_packings",
+    "random_packings",
 ]
 
 
@@ -250,7 +250,7 @@ def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, reps: Int32Array) 
     return np.flatnonzero(keep).astype(np.int32)
 
 
-def count_solutions(
+def count_packings(
     pieces: PiecesLike | CoverProblem,
     target: TargetLike | None = None,
     *,
@@ -356,7 +356,7 @@ def _problem(
     return cover_problem(pieces, target, optional=optional, reflections=reflections)
 
 
-def iter_solutions(
+def iter_packings(
     pieces: PiecesLike | CoverProblem,
     target: TargetLike | None = None,
     *,
@@ -393,7 +393,7 @@ def iter_solutions(
             yield make_solution(problem, sol)
 
 
-def first_solution(
+def first_packing(
     pieces: PiecesLike | CoverProblem,
     target: TargetLike | None = None,
     *,
@@ -411,7 +411,7 @@ def first_solution(
     return None
 
 
-def random_solutions(
+def random_packings(
     pieces: PiecesLike | CoverProblem,
     target: TargetLike | None = None,
     rng: np.random.Generator | None = None,
@@ -428,7 +428,7 @@ def random_solutions(
     SplitMix64 seeded from one draw of ``rng``).
     """
     if rng is None:
-        raise CoverError("rng: random_solutions needs a numpy.random.Generator")
+        raise CoverError("rng: random_packings needs a numpy.random.Generator")
     problem = _problem(pieces, target, optional, reflections)
     search = CoverSearch(problem, engine=engine, rng=rng, node_limit=node_limit, deadline=deadline)
     for block in search.batches(1):

@@ -22,7 +22,7 @@ import numpy as np
 
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import Shape, box_cells
-from chaingeo.solvers.placements import (
+from chaingeo.solvers.cover.placements import (
     Int32Array,
     IntArray,
     Placements,

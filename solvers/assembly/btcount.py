@@ -1,14 +1,15 @@
 """BurrTools' verdict on many assemblies of one packing, straight from the assembler's rows.
 
 Counting solutions asks the same question of every assembly: does BurrTools' first-separation
-disassembler (:func:`chaingeo.solvers.btsearch.first_tree`) take it apart? The general path builds
-named shapes, the symmetric image BurrTools reports (:class:`chaingeo.solvers.btassemble.BTFrame`), a
-:class:`chaingeo.solvers.partsearch.PieceTable` and a decoded tree for each one (~0.1 ms of Python a
-time). Here the same image is chosen on row indices (a symmetry maps rows to rows:
-:meth:`chaingeo.solvers.constrained.Packing.row_maps`), every row's voxels are sorted for the gap kernel
-once, and one kernel call gathers the pieces and runs the disassembler. Whatever this path does
-not model (a symmetry image outside the rows, a search past its node budget or a cap) goes to
-the general path, which answers exactly as before.
+disassembler (:func:`chaingeo.solvers.motion.btsearch.first_tree`) take it apart? The general path
+builds named shapes, the symmetric image BurrTools reports
+(:class:`chaingeo.solvers.assembly.btassemble.BTFrame`), a
+:class:`chaingeo.solvers.motion.partsearch.PieceTable` and a decoded tree for each one (~0.1 ms of
+Python a time). Here the same image is chosen on row indices (a symmetry maps rows to rows:
+:meth:`chaingeo.solvers.cover.constrained.Packing.row_maps`), every row's voxels are sorted for the
+gap kernel once, and one kernel call gathers the pieces and runs the disassembler. Whatever this
+path does not model (a symmetry image outside the rows, a search past its node budget or a cap) goes
+to the general path, which answers exactly as before.
 """
 
 from __future__ import annotations
@@ -22,10 +23,7 @@ import numpy.typing as npt
 from chaingeo.core.geometry import Shape
 from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.solvers import btsearch as bt
-from chaingeo.solvers import levelsearch as ls
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers.btassemble import (
+from chaingeo.solvers.assembly.btassemble import (
     BTFrame,
     Mirrors,
     choose_anchor,
@@ -34,10 +32,13 @@ from chaingeo.solvers.btassemble import (
     named_assembly,
     piece_groups,
 )
-from chaingeo.solvers.constrained import Packing
+from chaingeo.solvers.cover.constrained import Packing
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.disassemble import KERNEL_NODES, Analysis, Separations
-from chaingeo.solvers.partsearch import SearchLimits
+from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import btsearch as bt
+from chaingeo.solvers.motion import levelsearch as ls
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion.disassemble import KERNEL_NODES, Analysis, Separations
 
 I64 = npt.NDArray[np.int64]
 Int32Array = npt.NDArray[np.int32]
@@ -52,8 +53,8 @@ def rows_tree(
     rows: I64, row_ptr: I64, row_vox: I64, row_lo: I64, row_hi: I64, params: I64, ctx: I64,
     nodes: I64, moves: I64,
 ) -> int:  # fmt: skip
-    """:func:`chaingeo.solvers.btsearch.first_tree` of the pieces placed by ``rows`` (in BurrTools'
-    piece order), gathered from every row's pre-sorted voxels (``row_vox[a]``, rows
+    """:func:`chaingeo.solvers.motion.btsearch.first_tree` of the pieces placed by ``rows`` (in
+    BurrTools' piece order), gathered from every row's pre-sorted voxels (``row_vox[a]``, rows
     ``row_ptr[r]:row_ptr[r + 1]``) and bounding boxes."""
     vox, starts, lo, hi = ls.part_arrays(row_vox, row_ptr, row_lo, row_hi, rows)
     start = np.zeros((rows.shape[0], 3), dtype=np.int64)
@@ -62,7 +63,7 @@ def rows_tree(
 
 def level_of(nodes: I64, root: int) -> str:
     """BurrTools' level string of a :func:`rows_tree` tree (as
-    :meth:`chaingeo.solvers.disassemble.Separation.level_text`)."""
+    :meth:`chaingeo.solvers.motion.disassemble.Separation.level_text`)."""
     multi: dict[int, bool] = {}
 
     def has_multi(i: int) -> bool:
@@ -127,8 +128,9 @@ class RowVerdicts:
         return self.keys[rows]
 
     def image_rows(self, rows: I64) -> I64 | None:
-        """The rows of the image BurrTools disassembles (:class:`chaingeo.solvers.btorient.BTImage`),
-        copies of a type ranked by placement; None where a symmetry leaves the rows."""
+        """The rows of the image BurrTools disassembles
+        (:class:`chaingeo.solvers.motion.btorient.BTImage`), copies of a type ranked by placement;
+        None where a symmetry leaves the rows."""
         if len(self.image.symmetries) < 2:
             return rows
         imgs = self.maps[:, rows]
@@ -179,8 +181,8 @@ class RowVerdicts:
 
 
 class StuckCheck:
-    """:func:`chaingeo.solvers.movement.stuck` on a packing's rows: an assembly in which nothing can
-    move is no solution, so its disassembly search (~0.1 ms of setup) is never built."""
+    """:func:`chaingeo.solvers.motion.movement.stuck` on a packing's rows: an assembly in which
+    nothing can move is no solution, so its disassembly search (~0.1 ms of setup) is never built."""
 
     def __init__(self, packing: Packing) -> None:
         problem = packing.problem
@@ -200,7 +202,7 @@ class StuckCheck:
 class BTReport:
     assemblies: int
     solutions: int
-    first_solution: dict[str, Shape] | None
+    first_packing: dict[str, Shape] | None
     first_analysis: Analysis | None
     seconds: float
     anchor: str | None
@@ -228,8 +230,8 @@ def count_bt(
     """BurrTools' assemblies and solutions of a packing, and the first solution. The search
     and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
     ``limits`` the enumeration has no time limit and each disassembly the default one).
-    ``separations``: see :func:`chaingeo.solvers.disassemble.analyze`; ``levels``, when given, gets
-    every solution's level string in the order found. A cap reached raises its
+    ``separations``: see :func:`chaingeo.solvers.motion.disassemble.analyze`; ``levels``, when
+    given, gets every solution's level string in the order found. A cap reached raises its
     :class:`SearchLimitError`, or with ``partial`` ends the count: the report then holds what
     was counted (lower bounds) and the error. The running counts are kept in the deadline's
     :class:`chaingeo.solvers.deadline.Progress` as the search goes. ``fast``: BurrTools' verdicts on

@@ -4,8 +4,8 @@
 between calls), so a search can hand out solutions in batches, stop at a node limit, and be
 resumed; engines are interchangeable behind it.
 
-*Deadline*: a kernel cannot read the clock, so with a :class:`chaingeo.solvers.deadline.Deadline` the
-search runs in *slices*: each kernel call gets a node budget (its node limit is the nodes so far
+*Deadline*: a kernel cannot read the clock, so with a :class:`chaingeo.solvers.deadline.Deadline`
+the search runs in *slices*: each kernel call gets a node budget (its node limit is the nodes so far
 plus the budget; every kernel stops at a node boundary and resumes exactly there), and the
 deadline is checked before every slice. The budget adapts so that a slice takes about
 :data:`SLICE_SECONDS` (doubled while slices are quicker than half of it, halved when slower than
@@ -25,13 +25,13 @@ from typing import Literal
 import numpy as np
 
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.solvers import kernels
-from chaingeo.solvers.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
-from chaingeo.solvers.bitmrv import MRVArrays, mrv_run, mrv_wide_run
+from chaingeo.solvers.cover import kernels
+from chaingeo.solvers.cover.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
+from chaingeo.solvers.cover.bitmrv import MRVArrays, mrv_run, mrv_wide_run
+from chaingeo.solvers.cover.dlx import DLXArrays, dlx_run
+from chaingeo.solvers.cover.placements import Int32Array
+from chaingeo.solvers.cover.problem import CoverError, CoverProblem
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.dlx import DLXArrays, dlx_run
-from chaingeo.solvers.placements import Int32Array
-from chaingeo.solvers.problem import CoverError, CoverProblem
 
 Engine = Literal["auto", "dlx", "bitboard", "bitboard-first", "bitboard-mrv"]
 Kernel = Literal["dlx", "bitboard-first", "bitboard-mrv"]
@@ -229,7 +229,7 @@ class CoverSearch:
 
     def _kernel(self, out: Int32Array, max_store: int, stop_after: int, node_limit: int) -> int:
         """One call of the search's kernel up to ``node_limit`` nodes in total; solutions go to
-        ``out`` (see :func:`chaingeo.solvers.dlx.dlx_run`)."""
+        ``out`` (see :func:`chaingeo.solvers.cover.dlx.dlx_run`)."""
         a = self._arr
         if isinstance(a, DLXArrays):
             HL, HR, U, D, TOP, RW, S = self._links

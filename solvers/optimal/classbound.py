@@ -1,10 +1,10 @@
 """A proven lower bound on o_i from blocks of pieces when moves may carry several pieces.
 
-With single-piece moves the blocks' own optima add up (:mod:`chaingeo.solvers.blockbound`). With moves of
-several pieces they do not: one move can carry pieces of several blocks at once (in a tower of
-burr units, one slide along x can advance every unit that needs that slide). What still holds
-is that one move has one *class* ``(axis, k)``: its axis and its finite distance. So count, per
-class, how many moves each block needs; a whole plan needs, per class, at least the most any
+With single-piece moves the blocks' own optima add up (:mod:`chaingeo.solvers.optimal.blockbound`).
+With moves of several pieces they do not: one move can carry pieces of several blocks at once (in a
+tower of burr units, one slide along x can advance every unit that needs that slide). What still
+holds is that one move has one *class* ``(axis, k)``: its axis and its finite distance. So count,
+per class, how many moves each block needs; a whole plan needs, per class, at least the most any
 block needs.
 
 **Relaxed values.** For a set ``Y`` of disjoint parts of a block (each a one-part state: pieces
@@ -42,8 +42,8 @@ the maximum over the parts grows by at most ``e_c``, which ``C`` counts for that
 block has ``w_j in V(B_j)``, ``w_j <= C``; hence ``C >= w_1 | ... | w_k`` and the plan has at
 least ``(n - 1) + |w_1 | ... | w_k| >= (n - 1) + M`` moves. QED.
 
-A sum over blocks (:mod:`chaingeo.solvers.blockbound`) is right for single-piece moves only; pairs of
-blocks moved at once are exactly what the maximum per class allows for.
+A sum over blocks (:mod:`chaingeo.solvers.optimal.blockbound`) is right for single-piece moves only;
+pairs of blocks moved at once are exactly what the maximum per class allows for.
 
 **Computing it.** ``V`` restricted to vectors of total at most ``b`` (the *budget*) is found by
 a breadth-first search of finite moves up to depth ``b`` from each one-part state, keeping
@@ -64,8 +64,8 @@ import numpy.typing as npt
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.solvers import movement as mv
-from chaingeo.solvers.partsearch import PieceTable
+from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion.partsearch import PieceTable
 
 #: Counts per class ``((axis, distance), count)``, sorted by class; zero counts left out.
 ClassVector = tuple[tuple[tuple[int, int], int], ...]
@@ -190,7 +190,8 @@ class ClassBound:
 
 class ClassVectors:
     """``V`` of one-part states within a budget, memoised (module docstring); shared with the
-    search of :mod:`chaingeo.solvers.classsearch`, which asks for the blocks of many states."""
+    search of :mod:`chaingeo.solvers.optimal.classsearch`, which asks for the blocks of many
+    states."""
 
     def __init__(
         self, table: PieceTable, max_group: int | None, max_states: int, group_limit: int = 4096
