@@ -25,8 +25,8 @@ from chaingeo.core.level import (
 )
 from chaingeo.core.piecesets import BEDLAM_SOLUTION, SOMA
 from chaingeo.core.rules import PuzzleRules, StackingRules
-from chaingeo.envs.actions import MoveAction
-from chaingeo.envs.puzzle import PuzzleState
+from chaingeo.envs.actions.types import MoveAction
+from chaingeo.envs.machines.puzzle import PuzzleState
 
 # ---------------------------------------------------------------------------------------------
 # Stacking

@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 
 from chaingeo.core.colors import PALETTE
 from chaingeo.core.kinematics import DIRECTIONS, Move
-from chaingeo.envs.action_text import action_from_text, parse_action, parse_text
-from chaingeo.envs.actions import (
+from chaingeo.envs.actions.parse import action_from_text, parse_action, parse_text
+from chaingeo.envs.actions.types import (
     Action,
     ActionError,
     ActionFormatError,

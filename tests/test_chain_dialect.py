@@ -18,8 +18,8 @@ from chaingeo.cli.commands.convert import import_chain_file
 from chaingeo.cli.main import main
 from chaingeo.core import limits
 from chaingeo.core.level import LevelError, level_bytes, parse_level, save_level
-from chaingeo.envs.action_text import parse_text
-from chaingeo.envs.actions import (
+from chaingeo.envs.actions.parse import parse_text
+from chaingeo.envs.actions.types import (
     FinishAction,
     IllegalActionError,
     PickupAction,
@@ -30,8 +30,8 @@ from chaingeo.envs.actions import (
     action_to_json,
 )
 from chaingeo.envs.machines import new_state
+from chaingeo.envs.machines.state import BaseState
 from chaingeo.envs.observation import color_table, instruction
-from chaingeo.envs.state import BaseState
 from tests.env_levels import puzzle_levels, soma_level
 
 DATA = Path(__file__).parent / "data" / "chain_runs"

@@ -28,9 +28,9 @@ from chaingeo.core.level import (
     parse_level,
 )
 from chaingeo.core.rules import CHAIN_CODES, StackingRules
-from chaingeo.envs.actions import StateAction
+from chaingeo.envs.actions.types import StateAction
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.stacking import StackingState
+from chaingeo.envs.machines.stacking import StackingState
 
 DATA = Path(__file__).parent / "data" / "chain_runs"
 RUNS: list[dict[str, Any]] = json.loads((DATA / "runs.json").read_text())["runs"]

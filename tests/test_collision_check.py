@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, MoveError
-from chaingeo.envs.collision_check import move_is_legal, swept_collision
-from chaingeo.envs.mesh import mesh_arrays, piece_mesh
+from chaingeo.envs.render.collision_check import move_is_legal, swept_collision
+from chaingeo.envs.render.mesh import mesh_arrays, piece_mesh
 
 DISTANCES = (1, 2, 3, None)
 

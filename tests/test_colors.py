@@ -16,7 +16,7 @@ from chaingeo.core.colors import (
     min_delta_e00,
     srgb_to_lab,
 )
-from chaingeo.envs.raster import parse_color
+from chaingeo.envs.render.raster import parse_color
 
 LEVELS = Path(__file__).resolve().parent.parent / "levels"
 

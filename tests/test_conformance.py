@@ -13,10 +13,10 @@ from pathlib import Path
 import pytest
 
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution, load_levels
-from chaingeo.envs.action_text import parse_action
-from chaingeo.envs.actions import Action, PlaceAction, action_of_move
+from chaingeo.envs.actions.parse import parse_action
+from chaingeo.envs.actions.types import Action, PlaceAction, action_of_move
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.state import BaseState
+from chaingeo.envs.machines.state import BaseState
 from tests.env_levels import puzzle_levels, stacking_levels
 
 LEVELS_DIR = Path(__file__).resolve().parent.parent / "levels"

@@ -22,7 +22,7 @@ from chaingeo.evaluation.agents.base import AgentError
 from chaingeo.evaluation.agents.http import ChatClient, RetryPolicy
 from chaingeo.evaluation.agents.prompt import extract_action, extract_plan
 from chaingeo.evaluation.hostile_server import Served, serve
-from chaingeo.evaluation.report import load_run
+from chaingeo.evaluation.report.tables import load_run
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from chaingeo.evaluation.sanitize import bound_record, clean, size
 from chaingeo.evaluation.usage import Price, PriceError, PriceTable, Usage

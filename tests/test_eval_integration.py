@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-pytest.importorskip("chaingeo.envs.state")
+pytest.importorskip("chaingeo.envs.machines.state")
 pytest.importorskip("chaingeo.envs.observation")
 
 from chaingeo.cli.main import main

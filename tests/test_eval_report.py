@@ -12,7 +12,7 @@ import pytest
 from chaingeo.cli.main import main
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import ProtocolConfig
-from chaingeo.evaluation.report import find_runs, load_run, table1
+from chaingeo.evaluation.report.tables import find_runs, load_run, table1
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from tests.test_eval_runner import FAKE, _levels
 

@@ -32,9 +32,9 @@ from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.agents.baselines import oracle_plan
 from chaingeo.evaluation.episode import ProtocolConfig
 from chaingeo.evaluation.logs import RunError
-from chaingeo.evaluation.report import find_runs, load_run, table1
+from chaingeo.evaluation.report.site import write_site
+from chaingeo.evaluation.report.tables import find_runs, load_run, table1
 from chaingeo.evaluation.runner import RunConfig, evaluate
-from chaingeo.evaluation.site import write_site
 from chaingeo.evaluation.usage import PriceTable
 from tests.eval_support.fake_openai import Script, fake_openai, reply
 from tests.test_eval_runner import _levels as _fake_levels

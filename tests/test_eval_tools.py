@@ -13,8 +13,8 @@ import pytest
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, stacking_level
 from chaingeo.core.rules import PuzzleRules
-from chaingeo.envs.action_text import parse_text
-from chaingeo.envs.actions import TurnRequest
+from chaingeo.envs.actions.parse import parse_text
+from chaingeo.envs.actions.types import TurnRequest
 from chaingeo.evaluation.agents.base import Agent, AgentSpec, Reply, ToolCall, Turn
 from chaingeo.evaluation.agents.openai_chat import OpenAIAgent, provider_fields, tools_setting
 from chaingeo.evaluation.agents.registry import AGENTS

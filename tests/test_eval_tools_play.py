@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-pytest.importorskip("chaingeo.envs.state")
+pytest.importorskip("chaingeo.envs.machines.state")
 
 from chaingeo.cli.main import main
 from chaingeo.core.colors import assign_colors

@@ -1,5 +1,5 @@
 """The fast drawing path: Pillow's shapes as numba kernels, and the observation pictures it
-draws, byte for byte against :mod:`chaingeo.envs.render` (the reference)."""
+draws, byte for byte against :mod:`chaingeo.envs.render.scene` (the reference)."""
 
 from __future__ import annotations
 
@@ -14,12 +14,12 @@ from hypothesis import strategies as st
 from PIL import Image, ImageDraw
 
 from chaingeo.core.level import Level
-from chaingeo.envs import fastview, rasterjit
 from chaingeo.envs.demos import plan_texts
 from chaingeo.envs.gym import PuzzleEnv, StackingEnv
 from chaingeo.envs.machines import new_state
+from chaingeo.envs.machines.state import BaseState
 from chaingeo.envs.observation import state_images
-from chaingeo.envs.state import BaseState
+from chaingeo.envs.render import fastview, rasterjit
 
 SIZE = 64
 coord = st.floats(-12.0, SIZE + 12.0, allow_nan=False).map(lambda v: round(v * 4) / 4)

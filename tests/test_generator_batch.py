@@ -9,7 +9,7 @@ import pytest
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, load_levels, stacking_level
-from chaingeo.envs.pictures import level_pictures
+from chaingeo.envs.render.pictures import level_pictures
 from chaingeo.generator.batch import SUMMARY_FILE, GenerationError, GenerationJob, run
 from chaingeo.generator.config import get_config
 from chaingeo.generator.result import Rejection

@@ -10,7 +10,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from chaingeo.core.limits import MAX_STACKING_ACTIONS
-from chaingeo.envs.actions import PlaceAction, action_of_move
+from chaingeo.envs.actions.types import PlaceAction, action_of_move
 from chaingeo.envs.gym import CHARSET, PuzzleEnv, StackingEnv
 from tests.env_levels import drop_level, puzzle_levels, soma_level, tiny_level
 

@@ -230,8 +230,8 @@ def test_observation_text_keeps_gymnasiums_layout_and_reads_live() -> None:
     from gymnasium.spaces import Text
     from gymnasium.spaces.utils import flatten
 
+    from chaingeo.envs.actions.text_space import ObservationText
     from chaingeo.envs.gym import CHARSET
-    from chaingeo.envs.text_space import ObservationText
 
     utils: Any = vector_utils  # annotated for arrays, dispatched on the space
     space = ObservationText(64, CHARSET)

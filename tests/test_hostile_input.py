@@ -25,10 +25,10 @@ from chaingeo.core import limits
 from chaingeo.core.kinematics import OPPOSITE
 from chaingeo.core.level import LevelError, load_level
 from chaingeo.core.suite import shipped_levels
-from chaingeo.envs.actions import MoveAction
+from chaingeo.envs.actions.types import MoveAction
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.puzzle import PuzzleState
-from chaingeo.envs.state import BaseState, StepResult
+from chaingeo.envs.machines.puzzle import PuzzleState
+from chaingeo.envs.machines.state import BaseState, StepResult
 
 SECONDS = 1.0  # per agent turn
 LOAD_SECONDS = 3.0  # per malformed level file

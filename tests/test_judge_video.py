@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from chaingeo.cli.main import main
 from chaingeo.core.level import Level
 from chaingeo.core.suite import shipped_levels
-from chaingeo.envs.judge_segment import (
+from chaingeo.envs.worldmodel.judge_segment import (
     U8,
     BoolArray,
     class_masks,
@@ -24,8 +24,13 @@ from chaingeo.envs.judge_segment import (
     palette_model,
     shrink,
 )
-from chaingeo.envs.judge_video import VideoJudgeError, judge_frames, judge_video, read_clip
-from chaingeo.envs.video import puzzle_video, write_gif, write_mp4
+from chaingeo.envs.worldmodel.judge_video import (
+    VideoJudgeError,
+    judge_frames,
+    judge_video,
+    read_clip,
+)
+from chaingeo.envs.worldmodel.video import puzzle_video, write_gif, write_mp4
 from tests.judge_sweep import stacking_levels
 from tests.shared_files import shared_dir
 
@@ -380,8 +385,8 @@ def _blocked_jumps(level: Level) -> list[tuple[int, int, int, int]]:
 @settings(max_examples=3, deadline=None, derandomize=True)
 @given(st.sampled_from(["puzzle-mid-08-burr3", "puzzle-easy-07-burr3"]), st.data())
 def test_a_piece_teleporting_through_another_is_caught(name: str, data: st.DataObject) -> None:
-    from chaingeo.envs.raster import Posed
-    from chaingeo.envs.render import render_frame
+    from chaingeo.envs.render.raster import Posed
+    from chaingeo.envs.render.scene import render_frame
 
     level = _level(name)
     i, axis, sign, k = data.draw(st.sampled_from(_blocked_jumps(level)))

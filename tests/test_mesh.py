@@ -16,7 +16,7 @@ from chaingeo.cli.main import main
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import save_level, stacking_level
 from chaingeo.core.piecesets import BEDLAM_SOLUTION
-from chaingeo.envs.mesh import (
+from chaingeo.envs.render.mesh import (
     FORMATS,
     eroded_mesh,
     export_level,

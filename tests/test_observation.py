@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from chaingeo.core.kinematics import Move
-from chaingeo.envs.actions import MoveAction
+from chaingeo.envs.actions.types import MoveAction
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.observation import observe, scene, state_text
 from tests.env_levels import drop_level, puzzle_levels, soma_level

@@ -12,12 +12,12 @@ from PIL import Image
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import load_level
-from chaingeo.envs.legend import legend_layout
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.observation import TARGET_TITLES, render_state, target_scene
-from chaingeo.envs.pictures import exploded_pieces, render_exploded
-from chaingeo.envs.raster import SHADE, Posed, parse_color
-from chaingeo.envs.render import (
+from chaingeo.envs.render.legend import legend_layout
+from chaingeo.envs.render.pictures import exploded_pieces, render_exploded
+from chaingeo.envs.render.raster import SHADE, Posed, parse_color
+from chaingeo.envs.render.scene import (
     PIECES_TITLE,
     TRAY_TITLE,
     handed_pieces,

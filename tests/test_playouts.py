@@ -14,9 +14,9 @@ import pytest
 
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.rules import PuzzleRules, StackingRules
-from chaingeo.envs.actions import Action
+from chaingeo.envs.actions.types import Action
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.state import BaseState
+from chaingeo.envs.machines.state import BaseState
 
 LEVELS_DIR = Path(__file__).resolve().parent.parent / "levels"
 SHIPPED: list[Level] = load_levels(LEVELS_DIR) if LEVELS_DIR.is_dir() else []

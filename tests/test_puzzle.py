@@ -9,9 +9,14 @@ from hypothesis import strategies as st
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import DIRECTIONS, OPPOSITE, Move, MoveError, legal_moves
 from chaingeo.core.level import Level
-from chaingeo.envs.action_text import parse_action
-from chaingeo.envs.actions import AmbiguousActionError, FinishAction, IllegalActionError, MoveAction
-from chaingeo.envs.puzzle import PuzzleState, normal_key
+from chaingeo.envs.actions.parse import parse_action
+from chaingeo.envs.actions.types import (
+    AmbiguousActionError,
+    FinishAction,
+    IllegalActionError,
+    MoveAction,
+)
+from chaingeo.envs.machines.puzzle import PuzzleState, normal_key
 from tests.env_levels import LOCK3, bfs_plan, puzzle_level, puzzle_levels, tube
 
 

@@ -17,10 +17,10 @@ from chaingeo.core.kinematics import (
     insertion_shifts,
 )
 from chaingeo.core.level import Level, load_levels
-from chaingeo.envs.action_list import ActionList
-from chaingeo.envs.actions import FinishAction, MoveAction
-from chaingeo.envs.puzzle import PuzzleState
-from chaingeo.envs.puzzle_actions import reference_actions, shifts
+from chaingeo.envs.actions.lists import ActionList
+from chaingeo.envs.actions.types import FinishAction, MoveAction
+from chaingeo.envs.machines.puzzle import PuzzleState
+from chaingeo.envs.machines.puzzle_actions import reference_actions, shifts
 from tests.env_levels import design_of, puzzle_levels
 from tests.strategies import polycubes
 

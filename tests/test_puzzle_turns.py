@@ -24,8 +24,8 @@ from chaingeo.core.level import (
 )
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.core.turns import TurnMove
-from chaingeo.envs.action_text import action_from_text, parse_action, parse_text
-from chaingeo.envs.actions import (
+from chaingeo.envs.actions.parse import action_from_text, parse_action, parse_text
+from chaingeo.envs.actions.types import (
     AmbiguousActionError,
     FinishAction,
     IllegalActionError,
@@ -37,8 +37,8 @@ from chaingeo.envs.actions import (
     action_of_move,
     action_to_json,
 )
-from chaingeo.envs.puzzle import PuzzleState
-from chaingeo.envs.puzzle_actions import reference_actions
+from chaingeo.envs.machines.puzzle import PuzzleState
+from chaingeo.envs.machines.puzzle_actions import reference_actions
 from chaingeo.solvers.motion.disassemble import analyze
 from tests.env_levels import puzzle_levels
 from tests.test_turn_search import luban3

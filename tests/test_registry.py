@@ -14,7 +14,7 @@ from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.registry import DuplicateNameError, Registry, UnknownNameError
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.agents.registry import AGENTS, make_agent, register_agent
-from chaingeo.evaluation.judges import JUDGES, make_judge, register_judge
+from chaingeo.evaluation.judges.registry import JUDGES, make_judge, register_judge
 from chaingeo.generator.config import CONFIGS, PuzzleConfig, get_config, register_config
 from chaingeo.generator.layouts import LAYOUTS
 from chaingeo.generator.puzzle import SHAPES, shape_family

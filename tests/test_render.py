@@ -19,8 +19,8 @@ from chaingeo.core.colors import PALETTE
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import stacking_level
 from chaingeo.core.piecesets import BEDLAM_SOLUTION
-from chaingeo.envs.raster import SHADE, parse_color, png_bytes
-from chaingeo.envs.render import (
+from chaingeo.envs.render.raster import SHADE, parse_color, png_bytes
+from chaingeo.envs.render.scene import (
     _FLOOR,
     CAMERAS,
     VIEWS,
@@ -95,7 +95,7 @@ def test_same_bytes_in_a_fresh_interpreter_with_another_hash_seed() -> None:
     ).hexdigest()
     code = (
         "import hashlib, tests.test_render as t\n"
-        "from chaingeo.envs.render import render_views, render_tray\n"
+        "from chaingeo.envs.render.scene import render_views, render_tray\n"
         "b, tr = t._bedlam_half()\n"
         "print(hashlib.sha256(b''.join(render_views(b, (4, 4, 4), size=200).values())"
         " + render_tray(tr, 200)).hexdigest())\n"

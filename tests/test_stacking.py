@@ -9,13 +9,13 @@ from hypothesis import strategies as st
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, stacking_level
 from chaingeo.core.rules import placement_problem
-from chaingeo.envs.actions import (
+from chaingeo.envs.actions.types import (
     FinishAction,
     IllegalActionError,
     PickupAction,
     PlaceAction,
 )
-from chaingeo.envs.stacking import StackingState
+from chaingeo.envs.machines.stacking import StackingState
 from tests.env_levels import bedlam_level, drop_level, soma_level, tiny_level
 
 

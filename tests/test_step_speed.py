@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from chaingeo.envs.demos import plan_texts
 from chaingeo.envs.gym import CHARSET, PuzzleEnv, _ascii
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.puzzle import Insertion, PuzzleState
-from chaingeo.envs.puzzle_tables import normal_key
+from chaingeo.envs.machines.puzzle import Insertion, PuzzleState
+from chaingeo.envs.machines.puzzle_tables import normal_key
 
 LEVELS = [lv for lv in PuzzleEnv(images=False).levels.values() if lv.goal == "assemble"]
 

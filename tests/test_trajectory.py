@@ -20,9 +20,9 @@ from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, state_key
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.rules import StackingRules
 from chaingeo.core.turns import TurnMove
-from chaingeo.envs.actions import MoveAction, PlaceAction, TurnAction
+from chaingeo.envs.actions.types import MoveAction, PlaceAction, TurnAction
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.trajectory import (
+from chaingeo.envs.worldmodel.trajectory import (
     FORMAT,
     TrajectoryError,
     parse_trajectory,
@@ -31,8 +31,8 @@ from chaingeo.envs.trajectory import (
     trajectory_json,
     write_trajectory,
 )
-from chaingeo.envs.trajectory_verdict import Verdict, check_trajectory
-from chaingeo.envs.video import read_plan
+from chaingeo.envs.worldmodel.trajectory_verdict import Verdict, check_trajectory
+from chaingeo.envs.worldmodel.video import read_plan
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.puzzle import make
 

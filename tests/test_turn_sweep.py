@@ -18,7 +18,7 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, legal_turns, oriented
 from chaingeo.core.level import load_level
 from chaingeo.core.turns import AXES, TurnMove, square_hit, swept_squares
-from chaingeo.envs import puzzle_actions
+from chaingeo.envs.machines import puzzle_actions
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import EpisodeTask, run_episode
 from chaingeo.solvers.motion import sweep

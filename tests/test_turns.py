@@ -26,7 +26,7 @@ from chaingeo.core.turns import (
     turn_cells,
     turn_from_json,
 )
-from chaingeo.envs.collision_check import turn_is_legal, turning_collision
+from chaingeo.envs.render.collision_check import turn_is_legal, turning_collision
 from tests.puzzle_strategies import small_scenes
 from tests.test_collision_check import scenes
 

@@ -14,10 +14,10 @@ from PIL import Image
 
 from chaingeo.cli.main import main
 from chaingeo.core.level import Level, StackingSolution, load_level
-from chaingeo.envs.legend import legend_layout
-from chaingeo.envs.raster import SHADE, Posed, parse_color
-from chaingeo.envs.render import render_frame
-from chaingeo.envs.video import (
+from chaingeo.envs.render.legend import legend_layout
+from chaingeo.envs.render.raster import SHADE, Posed, parse_color
+from chaingeo.envs.render.scene import render_frame
+from chaingeo.envs.worldmodel.video import (
     PlanVideo,
     VideoError,
     mp4_available,
@@ -174,7 +174,7 @@ def test_chain_video_command(tmp_path: Path, capsys: pytest.CaptureFixture[str])
 def test_mp4_without_the_extra_says_what_to_install(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import chaingeo.envs.video as video_module
+    import chaingeo.envs.worldmodel.video as video_module
 
     monkeypatch.setattr(video_module, "mp4_available", lambda: False)
     video = plan_video(load_level(STACK), size=128)

@@ -13,8 +13,8 @@ from PIL import Image
 
 from chaingeo.cli.main import main
 from chaingeo.core.level import load_level
-from chaingeo.envs.video import VideoError, plan_video
-from chaingeo.envs.worldmodel import worldmodel_prompt, write_worldmodel
+from chaingeo.envs.worldmodel.prompt import worldmodel_prompt, write_worldmodel
+from chaingeo.envs.worldmodel.video import VideoError, plan_video
 
 LEVELS = Path(__file__).resolve().parent.parent / "levels"
 TURNS = LEVELS / "puzzle" / "puzzle-easy-01-luban-3-piece.json"

@@ -7,8 +7,8 @@ seeded random walk (loose parts, where groups and insertions are most numerous).
 ``PuzzleState.legal_actions()`` on a fresh state (numba movement analysis and insertion kernel,
 actions left lazy) plus building ``CHAIN_BENCH_PICKS`` of them (default 64: what an agent looks
 at); ``reference`` builds the same list one action at a time with the pure-Python kinematics
-(:func:`chaingeo.envs.puzzle_actions.reference_actions`). ``speedup`` = reference / ours on the same
-states in the same run; the two lists are checked equal on the first state of each level.
+(:func:`chaingeo.envs.machines.puzzle_actions.reference_actions`). ``speedup`` = reference / ours on
+the same states in the same run; the two lists are checked equal on the first state of each level.
 JIT compilation is excluded (a warm-up call runs first). ``--quick``: one level, three states.
 """
 
@@ -24,9 +24,9 @@ import numpy as np
 from chaingeo.core.kinematics import Assembly
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.suite import shipped_levels
-from chaingeo.envs.actions import action_of_move
-from chaingeo.envs.puzzle import PuzzleState
-from chaingeo.envs.puzzle_actions import reference_actions
+from chaingeo.envs.actions.types import action_of_move
+from chaingeo.envs.machines.puzzle import PuzzleState
+from chaingeo.envs.machines.puzzle_actions import reference_actions
 
 #: The pure-Python reference takes seconds per state at 12 pieces; larger levels are left out.
 REFERENCE_PIECES = 12

@@ -10,9 +10,9 @@ each), at the environments' default 256 px, under two seeded policies:
   picture new: this times drawing).
 
 Rows with images are timed twice on the very same trajectory: ours (pictures drawn to arrays by
-:mod:`chaingeo.envs.fastview`'s kernels, cached by what they show) and the reference, the old
-path (:mod:`chaingeo.envs.render` through Pillow, every picture encoded to PNG and decoded back,
-nothing cached) in the same run; ``ratio`` = ours / reference steps per second. ``vs today``
+:mod:`chaingeo.envs.render.fastview`'s kernels, cached by what they show) and the reference, the old
+path (:mod:`chaingeo.envs.render.scene` through Pillow, every picture encoded to PNG and decoded
+back, nothing cached) in the same run; ``ratio`` = ours / reference steps per second. ``vs today``
 divides by the single-environment reference of the same family and policy.
 Each environment first plays its trajectory once untimed (level tables built, numba compiled),
 then forgets its pictures and plays it again timed; steps/s counts sub-environment steps, wall
@@ -40,7 +40,7 @@ from chaingeo.envs.demos import plan_texts
 from chaingeo.envs.frames import Frame, png_frames, reference_frames, render_frames
 from chaingeo.envs.gym import ChainEnv, PuzzleEnv, StackingEnv
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.state import BaseState
+from chaingeo.envs.machines.state import BaseState
 
 SEED = 2026
 SIZE = 256

@@ -7,7 +7,7 @@ at its start and halfway along its stored plan (6 states). Strings: a seeded gen
 Unicode numbers, cut and repeated pieces), grammar-shaped noise, random characters (NUL,
 brackets, Unicode digits) and long texts (thousands of digits, deep brackets, repeated cells).
 Each string is played on a fresh clone of the state; the contract (:func:`check_turn`) is: a
-:class:`chaingeo.envs.state.StepResult`, exactly one step counted, one turn logged and the
+:class:`chaingeo.envs.machines.state.StepResult`, exactly one step counted, one turn logged and the
 position unchanged when rejected. Printed: the typed outcomes, the other exceptions (must be
 0), contract violations (must be 0) and the slowest call. ``--quick``: fewer strings and calls.
 
@@ -32,7 +32,7 @@ from typing import Any
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import shipped_levels
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.state import BaseState, StepResult
+from chaingeo.envs.machines.state import BaseState, StepResult
 from chaingeo.evaluation.agents.tools import tool_specs, translate
 from chaingeo.evaluation.drills import fault_table, server_fault_rows
 
@@ -233,7 +233,7 @@ def fuzz_states() -> list[BaseState]:
 
 def _plan_texts(level: Level) -> list[str]:
     from chaingeo.core.level import PuzzleSolution, StackingSolution
-    from chaingeo.envs.actions import PlaceAction
+    from chaingeo.envs.actions.types import PlaceAction
 
     sol = level.solution
     if isinstance(sol, StackingSolution):

@@ -23,8 +23,8 @@ from chaingeo.core.kinematics import Assembly, legal_turns
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.core.suite import shipped_levels
-from chaingeo.envs.puzzle import PuzzleState
-from chaingeo.envs.puzzle_actions import turn_actions
+from chaingeo.envs.machines.puzzle import PuzzleState
+from chaingeo.envs.machines.puzzle_actions import turn_actions
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import EpisodeTask, run_episode
 from chaingeo.solvers.motion.turnmoves import TurnTable

@@ -1,7 +1,7 @@
 """Quarter turns: the centre convention, the turn move, and the exact sweep test.
 
 **Centre convention.** A piece is a set of unit cubes; voxel ``(i, j, k)`` is the cube
-``[i, i+1] x [j, j+1] x [k, k+1]`` (:mod:`chaingeo.envs.mesh`). A quarter turn about a line
+``[i, i+1] x [j, j+1] x [k, k+1]`` (:mod:`chaingeo.envs.render.mesh`). A quarter turn about a line
 parallel to z through ``(px, py)`` maps a cube's centre ``(i+1/2, j+1/2)`` to
 ``(px - (j+1/2-py), py + (i+1/2-px))``, a cube centre again for every ``i, j`` exactly when
 ``px + py`` and ``px - py`` are whole numbers: ``px, py`` are both whole (the line runs along cube
@@ -12,10 +12,10 @@ rod turns in place about its own centre; about one of its edges it swings to the
 so both are moves.
 
 Centres are written in *cell units*: position ``p`` is the centre of cell ``p`` (0-based in code,
-1-based in agent text, :mod:`chaingeo.envs.actions`), so the two coordinates across the axis are
-both whole numbers (the axis through cell centres) or both halves (the axis through cell corners).
-Code keeps them exact as ``centre2``, twice the position: both even or both odd. The coordinate
-along the axis does not matter (the axis is a line) and is stored as 0.
+1-based in agent text, :mod:`chaingeo.envs.actions.types`), so the two coordinates across the axis
+are both whole numbers (the axis through cell centres) or both halves (the axis through cell
+corners). Code keeps them exact as ``centre2``, twice the position: both even or both odd. The
+coordinate along the axis does not matter (the axis is a line) and is stored as 0.
 
 **The sweep test.** A turn of a group is legal when, turning continuously through the 90
 degrees, it never overlaps another piece (touching is allowed). Cubes turning about a line

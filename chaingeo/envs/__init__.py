@@ -1,5 +1,6 @@
-"""The environments: action types and the text parser, the two state machines (stacking and
-puzzles), observations, rendering, meshes and the Gymnasium wrappers.
+"""The environments, in rooms: actions and the text parser (:mod:`.actions`), the two state
+machines (:mod:`.machines`), pictures and meshes (:mod:`.render`), video models
+(:mod:`.worldmodel`); observations, the Gymnasium wrappers and the dataset export beside them.
 
-Built on :mod:`chaingeo.core` and :mod:`solvers`; the evaluation harness sits above.
+Built on :mod:`chaingeo.core` and :mod:`chaingeo.solvers`; the evaluation harness sits above.
 """

@@ -18,7 +18,7 @@ from typing import Any
 
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
-from chaingeo.envs.actions import PlaceAction, action_of_move
+from chaingeo.envs.actions.types import PlaceAction, action_of_move
 
 
 class DemonstrationError(ChainGeoError, RuntimeError):
@@ -78,7 +78,7 @@ def _pngs(frames: dict[str, Any]) -> dict[str, bytes]:
     """PNG bytes of the environment's pixel arrays (pixel-equal to ``render_state``'s PNGs)."""
     from PIL import Image
 
-    from chaingeo.envs.raster import png_bytes
+    from chaingeo.envs.render.raster import png_bytes
 
     return {name: png_bytes(Image.fromarray(frame)) for name, frame in frames.items()}
 

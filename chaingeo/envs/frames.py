@@ -3,8 +3,8 @@
 The Gymnasium environments hand out pixels, not files: encoding every picture to PNG and
 decoding it back cost about a third of the time spent on an observation's pictures.
 :func:`render_frames` takes the images :func:`chaingeo.envs.observation.render_state` encodes
-(drawn by :mod:`chaingeo.envs.fastview`, byte-equal to :mod:`chaingeo.envs.render`) as arrays;
-PNG is lossless, so they are pixel-equal to decoding the PNG (tested).
+(drawn by :mod:`chaingeo.envs.render.fastview`, byte-equal to :mod:`chaingeo.envs.render.scene`) as
+arrays; PNG is lossless, so they are pixel-equal to decoding the PNG (tested).
 PNG stays where bytes are wanted (the harness' logs and agents call ``render_state``);
 :func:`png_frames` keeps the round trip callable as the reference of ``chain bench env``.
 
@@ -25,6 +25,8 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
+from chaingeo.envs.machines.stacking import StackingState
+from chaingeo.envs.machines.state import BaseState
 from chaingeo.envs.observation import (
     VIEWS,
     PieceMap,
@@ -34,8 +36,6 @@ from chaingeo.envs.observation import (
     scene,
     state_images,
 )
-from chaingeo.envs.stacking import StackingState
-from chaingeo.envs.state import BaseState
 
 Frame = npt.NDArray[np.uint8]
 #: Bytes of pictures one :class:`FrameCache` keeps (about 40 positions at 256 px).
@@ -59,7 +59,7 @@ def _views(state: BaseState, size: int) -> dict[str, Frame]:
 
 
 def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
-    import chaingeo.envs.fastview as fastview
+    import chaingeo.envs.render.fastview as fastview
 
     return {v: _array(img) for v, img in fastview.render_images(pieces, box, VIEWS, size).items()}
 
@@ -84,8 +84,8 @@ def decode_png(data: bytes) -> Frame:
 
 
 def reference_frames(state: BaseState, size: int) -> dict[str, Frame]:
-    """:func:`render_frames` drawn by :mod:`chaingeo.envs.render` itself (the reference of
-    :mod:`chaingeo.envs.fastview`: the same pixels, slower), no PNG."""
+    """:func:`render_frames` drawn by :mod:`chaingeo.envs.render.scene` itself (the reference of
+    :mod:`chaingeo.envs.render.fastview`: the same pixels, slower), no PNG."""
     return {v: _array(img) for v, img in state_images(state, size, reference=True).items()}
 
 
@@ -146,8 +146,8 @@ class FrameCache:
 
     def clear(self) -> None:
         """Forget every picture (levels were replaced under the same ids), and the layouts
-        :mod:`chaingeo.envs.fastview` keeps in this process."""
-        import chaingeo.envs.fastview as fastview
+        :mod:`chaingeo.envs.render.fastview` keeps in this process."""
+        import chaingeo.envs.render.fastview as fastview
 
         self._store.clear()
         self._pictures = 0

@@ -2,7 +2,8 @@
 
 Importing this module registers both ids (``import chaingeo.envs.gym``, or
 ``gymnasium.make("chaingeo.envs.gym:chaingeo/Stacking-v0")``, which imports it). Each wraps the
-state machine of :mod:`chaingeo.envs.state`, so its steps are the agents' and the solvers' steps.
+state machine of :mod:`chaingeo.envs.machines.state`, so its steps are the agents' and the solvers'
+steps.
 
 * ``reset(seed=..., options={"level": id})`` starts a level: the one named, else one drawn
   with the environment's seeded generator from the levels it was given (default: the shipped
@@ -50,13 +51,13 @@ from gymnasium import spaces
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.limits import MAX_OBSERVATION_CHARS, MAX_STACKING_ACTIONS, LimitError
 from chaingeo.core.suite import shipped_levels
-from chaingeo.envs.actions import Action
+from chaingeo.envs.actions.text_space import ObservationText
+from chaingeo.envs.actions.types import Action
 from chaingeo.envs.frames import Frame, FrameCache, picture_names
 from chaingeo.envs.machines import new_state
+from chaingeo.envs.machines.state import BaseState
 from chaingeo.envs.observation import DEFAULT_HISTORY, VIEWS, observe
-from chaingeo.envs.render import MIN_SIZE
-from chaingeo.envs.state import BaseState
-from chaingeo.envs.text_space import ObservationText
+from chaingeo.envs.render.scene import MIN_SIZE
 
 #: Characters of text actions and observations: printable ASCII and newline.
 CHARSET: Final = frozenset(c for c in string.printable if c not in "\x0b\x0c\r")
@@ -126,7 +127,7 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
 
     # -- helpers ------------------------------------------------------------------------------
     def _start(self, level_id: str) -> BaseState:
-        from chaingeo.envs.stacking import StackingState
+        from chaingeo.envs.machines.stacking import StackingState
 
         if level_id not in self._templates:
             template = new_state(self.levels[level_id])
@@ -183,7 +184,7 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
         return out
 
     def _info(self, result: Any | None) -> dict[str, Any]:
-        from chaingeo.envs.stacking import StackingState
+        from chaingeo.envs.machines.stacking import StackingState
 
         state = self.state
         info: dict[str, Any] = {

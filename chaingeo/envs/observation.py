@@ -1,11 +1,11 @@
 """What an agent is shown each turn: the task, the pieces, recent turns, the budget, pictures.
 
-Text follows the agent convention: cells are 1-based (converted by :mod:`chaingeo.envs.actions`).
-The pictures come from :mod:`chaingeo.envs.render`, called from :func:`render_state` only. Stacking
-shows the box (placed pieces where they are) and the tray of unplaced pieces; a puzzle shows its
-largest part where it is and every other part laid out beside it along +x (parts apart never
-interact, so only their shapes matter), and its goal as ``target``: assembled (assembly) or
-every piece apart (disassembly).
+Text follows the agent convention: cells are 1-based (converted by
+:mod:`chaingeo.envs.actions.types`). The pictures come from :mod:`chaingeo.envs.render.scene`,
+called from :func:`render_state` only. Stacking shows the box (placed pieces where they are) and the
+tray of unplaced pieces; a puzzle shows its largest part where it is and every other part laid out
+beside it along +x (parts apart never interact, so only their shapes matter), and its goal as
+``target``: assembled (assembly) or every piece apart (disassembly).
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from typing import TYPE_CHECKING, Final
 
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.rules import PuzzleRules, StackingRules
-from chaingeo.envs import text_state
-from chaingeo.envs.actions import cells_text
-from chaingeo.envs.state import BaseState
+from chaingeo.envs.actions.types import cells_text
+from chaingeo.envs.machines import text_state
+from chaingeo.envs.machines.state import BaseState
 
 if TYPE_CHECKING:  # pictures are drawn only when asked for
     from PIL import Image
@@ -200,7 +200,7 @@ def state_text(state: BaseState) -> str:
 
 def ordered_parts(state: BaseState) -> list[frozenset[str]]:
     """A puzzle's parts, largest first (then by name)."""
-    from chaingeo.envs.puzzle import PuzzleState
+    from chaingeo.envs.machines.puzzle import PuzzleState
 
     assert isinstance(state, PuzzleState)
     return text_state.ordered_parts(state)
@@ -215,8 +215,8 @@ PieceMap = dict[str, tuple[Shape, str]]
 
 def scene(state: BaseState) -> tuple[PieceMap, tuple[int, int, int] | None, PieceMap]:
     """(pieces to draw where they are, the box or None, pieces for the tray)."""
-    from chaingeo.envs.puzzle import PuzzleState
-    from chaingeo.envs.stacking import StackingState
+    from chaingeo.envs.machines.puzzle import PuzzleState
+    from chaingeo.envs.machines.stacking import StackingState
 
     rgb = {p.name: p.rgb for p in state.level.pieces}
     if isinstance(state, StackingState):
@@ -243,7 +243,7 @@ def render_state(
     state: BaseState, size: int = DEFAULT_IMAGE_SIZE, reference: bool = False
 ) -> dict[str, bytes]:
     """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (puzzles)."""
-    from chaingeo.envs.raster import png_bytes
+    from chaingeo.envs.render.raster import png_bytes
 
     images = state_images(state, size, reference)
     return {name: png_bytes(img) for name, img in images.items()}
@@ -254,8 +254,8 @@ def state_images(
 ) -> dict[str, Image.Image]:
     """The pictures of an observation as images (:func:`render_state` encodes them; the
     Gymnasium environments take their pixels): the four views, then the extra picture.
-    ``reference`` draws them with :mod:`chaingeo.envs.render` itself, the slower reference
-    of :mod:`chaingeo.envs.fastview` (the same pixels)."""
+    ``reference`` draws them with :mod:`chaingeo.envs.render.scene` itself, the slower reference
+    of :mod:`chaingeo.envs.render.fastview` (the same pixels)."""
     pieces, box, _ = scene(state)
     images = dict(_drawer(reference).render_images(pieces, box, VIEWS, size))
     images[extra_picture(state)] = extra_image(state, size, reference)
@@ -264,10 +264,10 @@ def state_images(
 
 def _drawer(reference: bool) -> ModuleType:
     if reference:
-        import chaingeo.envs.render as render
+        import chaingeo.envs.render.scene as render
 
         return render
-    import chaingeo.envs.fastview as fastview
+    import chaingeo.envs.render.fastview as fastview
 
     return fastview
 

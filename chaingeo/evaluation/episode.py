@@ -49,9 +49,9 @@ from chaingeo.evaluation.agents.base import (
     Turn,
 )
 from chaingeo.evaluation.agents.registry import make_agent
-from chaingeo.evaluation.judges import make_judge
+from chaingeo.evaluation.judges.registry import make_judge
+from chaingeo.evaluation.judges.selection import Judge, verify
 from chaingeo.evaluation.logs import episode_key
-from chaingeo.evaluation.selection import Judge, verify
 from chaingeo.evaluation.usage import Usage
 
 ProtocolName = Literal["interactive", "oneshot"]

@@ -28,8 +28,8 @@ from typing import Any, Final, Literal
 from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.envs.machines import new_state
+from chaingeo.envs.machines.state import StepResult
 from chaingeo.envs.observation import observe
-from chaingeo.envs.state import StepResult
 from chaingeo.evaluation.agents.prompt import (
     ONESHOT_PROMPT,
     ONESHOT_TOOLS_PROMPT,

@@ -91,7 +91,7 @@ def _block_plans(
 def _boxes_touch(state: Assembly, *names: str) -> bool:
     """Do the bounding boxes of ``names`` and the rest of their part touch or overlap on every
     axis? (Played backwards, the removal is an insertion, which the assemble game allows only
-    then: :mod:`chaingeo.envs.puzzle`.)"""
+    then: :mod:`chaingeo.envs.machines.puzzle`.)"""
     mine = [c for n in names for c in state.cells_of(n)]
     others = sorted(state.part_of(names[0]) - set(names))
     rest = [c for n in others for c in state.cells_of(n)]

@@ -1,4 +1,5 @@
-"""A minimal stand-in for ``chaingeo.envs.state`` / ``chaingeo.envs.observation`` (a test double).
+"""A minimal stand-in for ``chaingeo.envs.machines.state`` / ``chaingeo.envs.observation`` (a test
+double).
 
 The game: take every piece once (``take NAME``), in any order. It follows the contract the
 harness relies on: ``step_text`` parses and applies, an unparseable or illegal action changes

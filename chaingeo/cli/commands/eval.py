@@ -174,7 +174,7 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.evaluation.agents.registry import BASELINES
     from chaingeo.evaluation.episode import ProtocolConfig
     from chaingeo.evaluation.logs import RunLog
-    from chaingeo.evaluation.report import Run, load_run, table1
+    from chaingeo.evaluation.report.tables import Run, load_run, table1
     from chaingeo.evaluation.runner import RunConfig, evaluate
     from chaingeo.evaluation.usage import PriceTable
 

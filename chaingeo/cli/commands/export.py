@@ -7,8 +7,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-#: The same as :data:`chaingeo.envs.mesh.FORMATS` (kept here so ``chain --help`` loads no mesh
-#: code).
+#: The same as :data:`chaingeo.envs.render.mesh.FORMATS` (kept here so ``chain --help`` loads no
+#: mesh code).
 FORMATS = ("glb", "stl", "obj")
 
 
@@ -22,7 +22,7 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.level import load_level
-    from chaingeo.envs.mesh import export_level
+    from chaingeo.envs.render.mesh import export_level
 
     level = load_level(args.level)
     target: Path = args.out or Path(f"{level.id}.{args.format}")

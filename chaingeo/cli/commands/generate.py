@@ -70,7 +70,7 @@ def add_curriculum_option(p: argparse.ArgumentParser, family: str) -> None:
 
 def run_job(args: argparse.Namespace, family: str, make: Any, config: Any) -> int:
     """Run one generation job from parsed options; print the summary as one JSON line."""
-    from chaingeo.envs.pictures import level_pictures
+    from chaingeo.envs.render.pictures import level_pictures
     from chaingeo.generator.batch import HELD_OUT, GenerationError, GenerationJob, run
     from chaingeo.generator.signature import shipped_signatures
 
@@ -167,7 +167,7 @@ def _register_suite(fam: Any) -> None:
 
 
 def _run_suite(args: argparse.Namespace) -> int:
-    from chaingeo.envs.pictures import level_pictures
+    from chaingeo.envs.render.pictures import level_pictures
     from chaingeo.generator.suite import build_suite
 
     try:

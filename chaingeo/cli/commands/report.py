@@ -33,7 +33,7 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.evaluation.report import find_runs, load_run, tables, write_report
+    from chaingeo.evaluation.report.tables import find_runs, load_run, tables, write_report
     from chaingeo.evaluation.usage import PriceTable
 
     runs = [load_run(p) for p in find_runs(args.runs)]
@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
     for path in write_report(runs, args.out):
         print(f"wrote {path}")
     if args.html is not None:
-        from chaingeo.evaluation.site import write_site
+        from chaingeo.evaluation.report.site import write_site
 
         site = write_site(runs, args.html, PriceTable.load(*args.prices))
         print(f"wrote {site / 'index.html'}")

@@ -26,7 +26,8 @@ from chaingeo.core.level import Level
 from chaingeo.evaluation.usage import Usage
 
 # ---------------------------------------------------------------------------------------------
-# The environment as the harness sees it (the contract with chaingeo.envs.state / observation).
+# The environment as the harness sees it (the contract with chaingeo.envs.machines.state /
+# observation).
 # ---------------------------------------------------------------------------------------------
 
 

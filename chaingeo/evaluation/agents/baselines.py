@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
-from chaingeo.envs.actions import (
+from chaingeo.envs.actions.types import (
     FinishAction,
     MoveAction,
     PickupAction,
@@ -35,7 +35,8 @@ from chaingeo.evaluation.agents.base import Agent, AgentError, Reply, StateLike,
 
 
 def oracle_plan(level: Level) -> list[str]:
-    """The stored optimal plan as agent action text (1-based cells, via chaingeo.envs.actions)."""
+    """The stored optimal plan as agent action text (1-based cells, via
+    chaingeo.envs.actions.types)."""
     sol = level.solution
     if isinstance(sol, StackingSolution):
         return [PlaceAction(n, tuple(sol.placements[n].cells)).to_text() for n in sol.order]

@@ -4,11 +4,11 @@ A model that speaks OpenAI tool calls is offered the functions its level's actio
 ``place {piece, cells}`` and ``pickup {piece}`` in stacking, ``move {pieces, direction,
 distance}`` in puzzles (plus ``into``/``offset`` in assembly), ``rotate {pieces, axis, angle}``
 only where the level's rules allow turns, and ``state {}``/``finish {}`` everywhere. Each call is
-translated into the canonical action text of :mod:`chaingeo.envs.actions` by plain string
+translated into the canonical action text of :mod:`chaingeo.envs.actions.types` by plain string
 building (``place red (1,1,1) (2,1,1)``, ``pickup red``, ``move red+blue -z inf``), so the
 environment's own parser judges it like any typed action. The arguments are read with
 ``json.loads`` only, within the agent-text limits of :mod:`chaingeo.core.limits` (length,
-nesting, digits: :func:`chaingeo.envs.chain_dialect.loads_agent_json`), and checked strictly
+nesting, digits: :func:`chaingeo.envs.actions.chain_dialect.loads_agent_json`), and checked strictly
 against the schema offered (types, allowed fields); a call that fails becomes an action text
 starting with ``!``, which no grammar accepts: the environment rejects it as unparseable and
 counts the step, and the agent is told why.
@@ -25,7 +25,7 @@ from typing import Any, Final
 from chaingeo.core import limits
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level
-from chaingeo.envs.chain_dialect import AgentJsonError, loads_agent_json
+from chaingeo.envs.actions.chain_dialect import AgentJsonError, loads_agent_json
 
 DIRECTIONS: Final = ("+x", "-x", "+y", "-y", "+z", "-z")
 AXES: Final = ("x", "y", "z")

@@ -1,0 +1,275 @@
+"""The renderer's pictures, byte for byte, drawn on arrays by kernels and partly kept.
+
+A view is the frame's background (walls, floor grid, back frame edges), the pieces' faces, the
+front frame edges, then titles, axis ticks, depth labels and the legend. Here every shape and
+every label is drawn by :mod:`chaingeo.envs.render.rasterjit` (Pillow's own algorithms as numba
+kernels) on a numpy array; only the legend still goes through Pillow. In a box (stacking) the
+frame stays put, so all but the faces, depth labels and legend are kept per layout (the
+background at drawing scale, and the picture without pieces): a step draws the faces on a copy
+of the background and takes only the rectangle they (and their labels) cover, redrawing the
+labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass
+(on a recent background, with recent label steps: a frame recurs within an episode).
+Every drawing call is the one :mod:`chaingeo.envs.render.scene` makes, in the same order, so the
+pictures are the same bytes (tested over the shipped levels); ``render`` stays the reference
+(and draws where the kernels do not apply: lines wide enough for round joints, or
+``CHAINGEO_JIT=python``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from collections.abc import Hashable, Sequence
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+from PIL import Image
+
+from chaingeo.core.jit import mode as jit_mode
+from chaingeo.envs.render import rasterjit
+from chaingeo.envs.render.labels import (
+    Step,
+    depth_label_steps,
+    overlaps,
+    paint_steps,
+    tick_steps,
+    title_steps,
+)
+from chaingeo.envs.render.legend import draw_legend, legend_layout
+from chaingeo.envs.render.raster import (
+    EDGE,
+    Box,
+    Camera,
+    Faces,
+    Flat,
+    FloatArray,
+    Projector,
+    scaled,
+    visible_faces,
+)
+from chaingeo.envs.render.scene import (
+    _BACKGROUND,
+    _FRAME,
+    _SUPERSAMPLE,
+    CAMERAS,
+    DEFAULT_SIZE,
+    TRAY_TITLE,
+    VIEWS,
+    PieceMap,
+    _check_size,
+    _check_views,
+    _frame_edges,
+    _Layout,
+    _Scene,
+    _scene,
+    _view_projector,
+    _view_titles,
+    _wall_shapes,
+    render_tray_image_with,
+)
+from chaingeo.envs.render.scene import (
+    _render_view as render_view,
+)
+
+#: Layouts kept per process (each about 1 MB at 256 px: the iso background is drawn at 2x).
+CAPACITY: Final = 48
+_EDGE: Final = np.array(EDGE, dtype=np.uint8)
+Pixels = npt.NDArray[np.uint8]
+
+
+@dataclass(frozen=True)
+class _Back:
+    """A view's frame drawn without pieces: at drawing scale ``k``, before the front edges."""
+
+    proj: Projector
+    k: int
+    big: Pixels
+    front: list[Flat]
+
+
+@dataclass(frozen=True)
+class _Static:
+    """What a view shows without pieces, for one frame, camera, size and legend height."""
+
+    back: _Back
+    plain: Pixels  # the finished picture without pieces, depth labels or legend
+    steps: tuple[Step, ...]  # titles and ticks, in drawing order
+
+
+_STORE: OrderedDict[Hashable, _Static] = OrderedDict()
+#: A frame that follows the pieces (a puzzle's): its background and label steps, kept only
+#: while recent (a frame recurs within an episode, seldom later; no finished picture is kept).
+_FOLLOW: OrderedDict[Hashable, tuple[_Back, tuple[Step, ...]]] = OrderedDict()
+FOLLOW_CAPACITY: Final = 16
+
+
+def clear() -> None:
+    """Forget every kept layout."""
+    _STORE.clear()
+    _FOLLOW.clear()
+
+
+def _layout_key(scene: _Scene, cam: Camera, size: int, title: str | None) -> Hashable:
+    legend_h = legend_layout(scene.legend, size)[1]
+    return (cam.name, size, scene.lo, scene.hi, title, legend_h, scene.has_box)
+
+
+def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
+    """The steps of ``render._render_view`` before the pieces, drawn by the kernels."""
+    lay = _Layout.of(size)
+    k = _SUPERSAMPLE if cam.depth_axis is None else 1
+    proj = _view_projector(scene, cam, lay)
+    big_proj = scaled(proj, k)
+    big = rasterjit.blank(size * k, _BACKGROUND).copy()
+    shapes = _wall_shapes(scene, cam, big_proj, k)
+    for p, q in _frame_edges(scene, cam, back=True):
+        shapes.append((1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k))
+    rasterjit.draw_flat(big, shapes)
+    edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
+    front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
+    return _Back(proj, k, big, front)
+
+
+def _finish(back: _Back, big: Pixels) -> Pixels:
+    rasterjit.draw_flat(big, back.front)
+    return rasterjit.reduce2(big) if back.k > 1 else big
+
+
+def _label_steps(
+    scene: _Scene, cam: Camera, size: int, proj: Projector, title: str | None
+) -> tuple[Step, ...]:
+    lay = _Layout.of(size)
+    titles = _view_titles(cam, scene)
+    lines = titles if title is None else [title, *titles[1:]]
+    return (
+        *title_steps(lines, size, lay.title_px),
+        *tick_steps(scene.lo, scene.hi, cam, proj, lay.tick_px),
+    )
+
+
+def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static | None:
+    """The layout's static parts when the frame is a box (it stays put); None for a frame that
+    follows the pieces (a puzzle's: its layouts seldom recur, so keeping them costs more than
+    it saves)."""
+    if not scene.has_box:
+        return None
+    key = _layout_key(scene, cam, size, title)
+    found = _STORE.get(key)
+    if found is not None:
+        _STORE.move_to_end(key)
+        return found
+    back = _back(scene, cam, size)
+    plain = _finish(back, back.big.copy())
+    steps = _label_steps(scene, cam, size, back.proj, title)
+    paint_steps(plain, steps)
+    plain.flags.writeable = False
+    made = _Static(back, plain, steps)
+    _STORE[key] = made
+    while len(_STORE) > CAPACITY:
+        _STORE.popitem(last=False)
+    return made
+
+
+def _union(a: Box, b: Box) -> Box:
+    return min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3])
+
+
+def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
+    """Final pixels the faces at drawing pixels ``pix`` may change (fill, edges, reduction)."""
+    lo = pix.reshape(-1, 2).min(axis=0) - margin
+    hi = pix.reshape(-1, 2).max(axis=0) + margin
+    x0, y0 = math.floor(lo[0]) // k, math.floor(lo[1]) // k
+    x1, y1 = math.ceil(hi[0]) // k + 1, math.ceil(hi[1]) // k + 1
+    return max(0, x0), max(0, y0), min(size, x1), min(size, y1)
+
+
+def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, FloatArray]:
+    """The picture with the faces drawn (before labels), and their drawing pixels."""
+    big = back.big.copy()
+    pix = scaled(back.proj, back.k).screen(faces.corners)
+    width = _Layout.of(size).edge_px(back.k)
+    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
+    return _finish(back, big), pix
+
+
+def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
+    image, pix = _pieces(st.back, faces, size)
+    proj, k = st.back.proj, st.back.k
+    labels = depth_label_steps(faces, cam, proj) if cam.depth_axis is not None else []
+    box = _touched(pix, _Layout.of(size).edge_px(k) + 2, k, size)
+    for step in labels:
+        box = _union(box, step.box)
+    x0, y0, x1, y1 = max(0, box[0]), max(0, box[1]), min(size, box[2]), min(size, box[3])
+    out = st.plain.copy()
+    if x0 >= x1 or y0 >= y1:
+        return out
+    paint_steps(image, [s for s in st.steps if overlaps(s.box, (x0, y0, x1, y1))])
+    paint_steps(image, labels)
+    out[y0:y1, x0:x1] = image[y0:y1, x0:x1]
+    return out
+
+
+def _recent(
+    scene: _Scene, cam: Camera, size: int, title: str | None
+) -> tuple[_Back, tuple[Step, ...]]:
+    """The background and label steps of a frame that follows the pieces (kept while recent)."""
+    key = _layout_key(scene, cam, size, title)
+    found = _FOLLOW.get(key)
+    if found is not None:
+        _FOLLOW.move_to_end(key)
+        return found
+    back = _back(scene, cam, size)
+    back.big.flags.writeable = False
+    made = back, tuple(_label_steps(scene, cam, size, back.proj, title))
+    _FOLLOW[key] = made
+    while len(_FOLLOW) > FOLLOW_CAPACITY:
+        _FOLLOW.popitem(last=False)
+    return made
+
+
+def _one_pass(scene: _Scene, cam: Camera, size: int, title: str | None, faces: Faces) -> Pixels:
+    back, steps = _recent(scene, cam, size, title)
+    image = _pieces(back, faces, size)[0] if len(faces.fills) else _finish(back, back.big.copy())
+    paint_steps(image, steps)
+    if cam.depth_axis is not None and len(faces.cells):
+        paint_steps(image, depth_label_steps(faces, cam, back.proj))
+    return image
+
+
+def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Image.Image:
+    if _Layout.of(size).edge_px(_SUPERSAMPLE) > 4 or jit_mode() != "numba":
+        return render_view(scene, cam, size, title=title, fast=True)  # round joints: Pillow
+    faces = visible_faces(scene.cells, scene.colors, cam)
+    st = _static(scene, cam, size, title)
+    if st is None:
+        pixels = _one_pass(scene, cam, size, title, faces)
+    elif len(faces.fills):
+        pixels = _with_faces(st, faces, cam, size)
+    else:
+        pixels = st.plain
+    image = Image.fromarray(pixels)
+    draw_legend(image, scene.legend)
+    return image
+
+
+def render_images(
+    pieces: PieceMap,
+    box: Sequence[int] | None = None,
+    views: Sequence[str] = VIEWS,
+    size: int = DEFAULT_SIZE,
+    title: str | None = None,
+) -> dict[str, Image.Image]:
+    """:func:`chaingeo.envs.render.scene.render_images`, the same pixels, faster."""
+    _check_size(size)
+    _check_views(views)
+    scene = _scene(pieces, box)
+    return {v: _render_view(scene, CAMERAS[v], size, title) for v in views}
+
+
+def render_tray_image(
+    pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE
+) -> Image.Image:
+    """:func:`chaingeo.envs.render.scene.render_tray_image`, the same pixels, faster."""
+    return render_tray_image_with(pieces, size, title, fast=True)

@@ -1,0 +1,167 @@
+"""The text and arrows of a view (titles, axis ticks, depth labels) as drawing steps that know
+the pixels they may touch.
+
+A step's ``box`` bounds every pixel it can change, so :mod:`chaingeo.envs.render.fastview` can keep
+a view's labels drawn once and redraw only the steps that overlap the part of the picture the
+pieces changed; drawing every step in order is exactly what the renderer always did.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+from PIL import Image, ImageDraw
+
+from chaingeo.envs.render import rasterjit
+from chaingeo.envs.render.raster import (
+    RGB,
+    Box,
+    Camera,
+    Faces,
+    FloatArray,
+    Projector,
+    arrow_shapes,
+    draw_flat,
+    put_text,
+    text_box,
+    text_color,
+    text_mask_array,
+)
+
+Pixels = npt.NDArray[np.uint8]
+TEXT: Final[RGB] = (20, 20, 20)
+AXIS_COLORS: Final[tuple[RGB, RGB, RGB]] = ((190, 30, 30), (20, 130, 40), (30, 60, 200))
+AXIS_NAMES: Final = "xyz"
+
+
+@dataclass(frozen=True)
+class Step:
+    """One drawing call and a box around every pixel it may change."""
+
+    box: Box
+    run: Callable[[Image.Image], None]
+    paint: Callable[[Pixels], None]  # the same on an (h, w, 3) array, by the kernels
+
+
+def overlaps(a: Box, b: Box) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def run_steps(image: Image.Image, steps: Sequence[Step]) -> None:
+    for step in steps:
+        step.run(image)
+
+
+def paint_steps(pixels: Pixels, steps: Sequence[Step]) -> None:
+    for step in steps:
+        step.paint(pixels)
+
+
+def text_step(
+    xy: Sequence[float] | FloatArray, text: str, px: int, fill: RGB, anchor: str = "mm"
+) -> Step:
+    at = (float(xy[0]), float(xy[1]))
+    box = text_box(at, text, px, anchor)
+    mask = text_mask_array(text, px, anchor)
+    ink = np.array(fill, dtype=np.uint8)
+    return Step(
+        box,
+        lambda im: put_text(im, at, text, px, fill, anchor),
+        lambda arr: rasterjit.paste_mask(arr, mask, box[0], box[1], ink),
+    )
+
+
+def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
+    reach = max(4.0, 3.2 * width) + width + 2
+    lo, hi = np.minimum(a, b) - reach, np.maximum(a, b) + reach
+    box = (math.floor(lo[0]), math.floor(lo[1]), math.ceil(hi[0]) + 1, math.ceil(hi[1]) + 1)
+    shapes = arrow_shapes(a, b, fill, width)
+    return Step(
+        box,
+        lambda im: draw_flat(ImageDraw.Draw(im), shapes),
+        lambda arr: rasterjit.draw_flat(arr, shapes),
+    )
+
+
+def tick_steps(
+    lo: Sequence[int], hi: Sequence[int], cam: Camera, proj: Projector, tick_px: int
+) -> list[Step]:
+    """1-based cell indices along one frame edge per displayed axis, then the axis name and an
+    arrow pointing the way the index grows."""
+    out: list[Step] = []
+    centre = proj(np.add(lo, hi) / 2.0)
+    for axis, spec in cam.tick_edges:
+        base = np.array(
+            [0.0 if s == "*" else float(lo[i] if s == "lo" else hi[i]) for i, s in enumerate(spec)]
+        )
+        start, end = base.copy(), base.copy()
+        start[axis], end[axis] = lo[axis], hi[axis]
+        a, b = proj(start), proj(end)
+        d = b - a
+        length = float(np.hypot(*d))
+        if length < 1e-6:
+            continue
+        d /= length
+        normal = np.array([-d[1], d[0]])
+        mid = (a + b) / 2
+        if float(np.dot(normal, mid - centre)) < 0:
+            normal = -normal
+        count = hi[axis] - lo[axis]
+        cell_px = length / count
+        px = int(min(tick_px, max(8, cell_px * 0.8)))
+        every = max(1, math.ceil(px * 1.4 / cell_px))
+        offset = normal * (px * 0.95 + 3)
+        for i, c in enumerate(range(lo[axis], hi[axis])):
+            if i % every and c != hi[axis] - 1:
+                continue
+            p = base.copy()
+            p[axis] = c + 0.5
+            out.append(text_step(proj(p) + offset, str(c + 1), px, TEXT))
+        # The arrow continues the row of numbers; the axis name sits just outside it.
+        color = AXIS_COLORS[axis]
+        tail = b + offset + d * (px * 0.5)
+        head = tail + d * (tick_px * 1.2)
+        out.append(arrow_step(tail, head, color, max(2, tick_px // 8)))
+        name_at = (tail + head) / 2 + normal * (tick_px * 0.9)
+        out.append(text_step(name_at, AXIS_NAMES[axis], tick_px + 3, color))
+    return out
+
+
+def depth_label_steps(faces: Faces, cam: Camera, proj: Projector) -> list[Step]:
+    """On each visible face of an axis view, the 1-based coordinate along the line of sight."""
+    depth = cam.depth_axis
+    assert depth is not None
+    nearest: dict[tuple[int, int], int] = {}
+    others = [i for i in range(3) if i != depth]
+    for i, cell in enumerate(faces.cells.tolist()):
+        nearest[(cell[others[0]], cell[others[1]])] = i  # far to near: the last one is in front
+    cell_px = proj.scale
+    px = int(min(22, max(9, cell_px * 0.24)))
+    if cell_px < 1.6 * px:
+        return []  # too small to print legibly
+    prefix = f"{AXIS_NAMES[depth]}=" if cell_px >= 3.2 * px else ""  # small cells: number only
+    shown = sorted(nearest.values())
+    centres = proj.screen(faces.corners[shown].mean(axis=1))
+    return [
+        text_step(
+            centres[j],
+            f"{prefix}{int(faces.cells[i][depth]) + 1}",
+            px,
+            text_color(faces.fills[i]),
+        )
+        for j, i in enumerate(shown)
+    ]
+
+
+def title_steps(lines: Sequence[str], size: int, title_px: int) -> list[Step]:
+    y = max(4, size // 100)
+    out = []
+    for text in lines:
+        out.append(text_step((max(4, size // 64), y), text, title_px, TEXT, anchor="la"))
+        y += int(title_px * 1.25)
+    return out
