@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 
 from chaingeo.cli.main import main
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 
 DATA = Path(__file__).parent / "data" / "burrtools"
 #: Small files whose whole analysis takes well under a second interpreted.
@@ -55,7 +55,7 @@ def test_many_files_one_line_each_and_a_bad_file_does_not_stop_the_batch(
     bad = tmp_path / "bad.xmpuzzle"
     bad.write_bytes(b"not a puzzle")
     level = "puzzle-easy-07-burr3"
-    by_file = shipped_levels("puzzle") / f"{level}.json"
+    by_file = suite_folder("puzzle") / f"{level}.json"
     status = main(["analyze", level, str(bad), str(by_file), "--no-optimal", "--jit", "numba"])
     assert status == 2
     captured = capsys.readouterr()
@@ -147,7 +147,7 @@ def test_counting_cut_short_keeps_the_known_assembly_s_figures() -> None:
     from chaingeo.solvers.deadline import Deadline
     from chaingeo.solvers.limits import SearchLimits
 
-    level = load_level(shipped_levels("puzzle") / "puzzle-mid-04-burr12.json")
+    level = load_level(suite_folder("puzzle") / "puzzle-mid-04-burr12.json")
     limits = SearchLimits(seconds=30.0)
     spent = Deadline(0.0)  # counting stops at once; the known assembly gets its own time
     out = level_figures(level, limits, True, True, deadline=spent)
