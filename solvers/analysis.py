@@ -382,9 +382,9 @@ def analyze(
     limits = DEFAULT_LIMITS if limits is None else limits
     deadline = Deadline(limits.seconds) if deadline is None else deadline
     start = time.perf_counter()
-    file = str(source) if isinstance(source, str | os.PathLike) else None
-    if file is not None and os.fspath(source).endswith(".xmpuzzle"):
-        source = read_xmpuzzle(os.fspath(source))
+    file = os.fspath(source) if isinstance(source, str | os.PathLike) else None
+    if file is not None and file.endswith(".xmpuzzle"):
+        source = read_xmpuzzle(file)
     several = False
     if isinstance(source, BTPuzzle):
         several = problem is None and len(source.problems) != 1
