@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # the real types for mypy and editors; at run time see _LAZY
     from chaingeo.core.geometry import Shape
     from chaingeo.core.level import Level
     from chaingeo.core.piecesets import PIECESETS
-    from chaingeo.core.suite import UnknownLevelError, load_level, shipped_levels
+    from chaingeo.core.suite import EXAMPLES, UnknownLevelError, load_level, shipped_levels
     from chaingeo.envs.machines import new_state
     from chaingeo.envs.observation import Observation, observe
     from chaingeo.solvers.analysis import analyze
@@ -39,6 +39,7 @@ if TYPE_CHECKING:  # the real types for mypy and editors; at run time see _LAZY
 _LAZY: Final = {
     "BTPuzzle": "chaingeo.core.formats.burrtools:BTPuzzle",
     "ChainGeoError": "chaingeo.core.errors:ChainGeoError",
+    "EXAMPLES": "chaingeo.core.suite:EXAMPLES",
     "Level": "chaingeo.core.level:Level",
     "Observation": "chaingeo.envs.observation:Observation",
     "PIECESETS": "chaingeo.core.piecesets:PIECESETS",
@@ -57,6 +58,7 @@ _LAZY: Final = {
 }
 
 __all__ = [
+    "EXAMPLES",
     "PIECESETS",
     "BTPuzzle",
     "ChainGeoError",

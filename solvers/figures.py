@@ -101,8 +101,9 @@ class PuzzleFigures:
             out["counts_complete"] = False
         if flags is not None:
             for cap, text in (("limit_cap", "limit"), ("optimal_limit_cap", "optimal_error")):
-                if cap in out:
-                    out[text] = with_flag(out[text], out.pop(cap), flags)
+                cap_field = out.pop(cap, None)
+                if text in out:
+                    out[text] = with_flag(out[text], cap_field, flags)
         return out
 
     def to_json(self, flags: Mapping[str, str] | None = None) -> str:

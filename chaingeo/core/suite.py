@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from chaingeo.core.level import Level
 
 __all__ = [
+    "EXAMPLES",
     "FAMILIES",
     "SUITE_PACKAGE",
     "UnknownLevelError",
@@ -32,6 +33,9 @@ __all__ = [
 #: The package the suite is installed as.
 SUITE_PACKAGE: Final = "chaingeo.levels"
 FAMILIES: Final = ("puzzle", "stacking")
+#: Example files shipped with the package (a BurrTools ``.xmpuzzle`` made by
+#: :mod:`chaingeo.generator.bt_examples`), for the quick start and the docs.
+EXAMPLES: Final = Path(__file__).resolve().parent.parent / "examples"
 
 
 class UnknownLevelError(ChainGeoError, LookupError):
