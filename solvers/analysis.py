@@ -22,6 +22,7 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Final
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
@@ -41,6 +42,7 @@ if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imp
 
 __all__ = [
     "DEFAULT_LIMITS",
+    "NotAPuzzleError",
     "PuzzleFigures",
     "analyze",
     "analyze_level",
@@ -48,6 +50,11 @@ __all__ = [
     "level_analysis_row",
     "problem_analysis_row",
 ]
+
+
+class NotAPuzzleError(ChainGeoError, ValueError):
+    """A stacking level given to the analysis, which takes puzzles only."""
+
 
 #: The key of a level's ``stats`` naming the blocks of a tower (piece names, one list per unit
 #: of a stack along z), written by the generator and read here.
@@ -123,7 +130,7 @@ def level_turns(level: Level) -> bool:
 def analyze_level(level: Level, limits: SearchLimits | None = None) -> Analysis:
     """:func:`analyze_puzzle` of a puzzle level, with the blocks it carries."""
     if level.family != "puzzle":
-        raise ValueError(f"{level.id}: a {level.family} level; only puzzles are analysed")
+        raise NotAPuzzleError(f"{level.id}: a {level.family} level; only puzzles are analysed")
     return analyze_puzzle(
         level.shapes,
         max_group=level_max_group(level),
@@ -205,7 +212,7 @@ def level_analysis_row(
     ``deadline`` (default: one of ``limits.seconds``); counts cut short by a cap are kept as
     lower bounds (see :func:`count_figures`)."""
     if level.family != "puzzle":
-        raise ValueError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
+        raise NotAPuzzleError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
     if deadline is None:
         deadline = Deadline(limits.seconds)
     max_group = level_max_group(level)

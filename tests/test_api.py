@@ -139,6 +139,12 @@ def test_analyze_takes_a_level_its_id_or_its_file_and_gives_the_old_figures() ->
         assert len(figures.plan) == figures.o_i
 
 
+def test_analyze_refuses_a_stacking_level_with_a_typed_error() -> None:
+    stacking = chaingeo.shipped_levels("stacking")[0]
+    with pytest.raises(chaingeo.ChainGeoError, match="analyze takes puzzle levels"):
+        chaingeo.analyze(stacking)
+
+
 def test_analyze_of_a_burrtools_file_gives_the_old_figures_and_the_command_s_line(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
