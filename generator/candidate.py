@@ -2,7 +2,8 @@
 
 Shared by the layout search (:mod:`chaingeo.generator.puzzle`) and the cube search
 (:mod:`chaingeo.generator.cubes`): a candidate is a list of pieces (assembled position) with the
-BurrTools-style analysis of :func:`chaingeo.solvers.motion.disassemble.analyze`, scored by (level,
+BurrTools-style analysis of :func:`chaingeo.solvers.motion.disassemble.analyze_assembly`, scored by
+(level,
 total moves).
 """
 
@@ -14,7 +15,7 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, analyze
+from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
 
 Score = tuple[int, int]
 
@@ -51,7 +52,7 @@ def evaluate(shapes: Sequence[Shape], config: PuzzleConfig) -> Analysis | None:
     if any(len(s) == 0 or not s.is_connected() for s in shapes):
         return None
     try:
-        result = analyze(
+        result = analyze_assembly(
             piece_names(shapes),
             max_group=config.max_group,
             limits=probe_limits(config),

@@ -17,7 +17,7 @@ from chaingeo.core.kinematics import Move, SearchLimitError
 from chaingeo.generator.candidate import Candidate, evaluate
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.maze import maze_search, runs, with_exit
-from chaingeo.solvers.motion.disassemble import analyze, translations
+from chaingeo.solvers.motion.disassemble import analyze_assembly, translations
 
 #: Towers of burr units; with single-piece moves (max_group=1) they are built unit by unit and
 #: their o_i is proven with the block bound (:mod:`chaingeo.solvers.optimal.blockbound`), one block
@@ -66,7 +66,7 @@ def tower_candidate(
                 continue
             named = {f"p{i}": s for i, s in enumerate(unit.shapes)}
             try:
-                plan = translations(analyze(named, max_group=1, optimal=True).plan)
+                plan = translations(analyze_assembly(named, max_group=1, optimal=True).plan)
             except SearchLimitError:
                 continue
             down = any(m.direction == "-z" for m in plan)

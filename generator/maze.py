@@ -12,7 +12,8 @@ pin comes free is the number of straight runs, the last one taking it out throug
 
 The path is a random self-avoiding induced walk on an ``n x n`` grid, biased to turn, cut at a
 border cell; the best of ``attempts`` walks is kept. The level claimed is the one the
-disassembly search measures (:func:`chaingeo.solvers.motion.disassemble.analyze`); the number of
+disassembly search measures (:func:`chaingeo.solvers.motion.disassemble.analyze_assembly`); the
+number of
 runs is what the construction predicts, and both are checked to agree.
 """
 

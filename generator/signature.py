@@ -17,7 +17,7 @@ from pathlib import Path
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, load_levels
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 
 #: Bump when the recipe changes (it is hashed in, so old and new never compare equal).
 SIGNATURE_VERSION = "split/1"
@@ -64,4 +64,4 @@ def suite_signatures(folder: str | Path) -> frozenset[str]:
 @cache
 def shipped_signatures() -> frozenset[str]:
     """The split signatures of the shipped suite: what a training split must avoid."""
-    return suite_signatures(shipped_levels())
+    return suite_signatures(suite_folder())

@@ -16,7 +16,8 @@ stay connected; that test runs on 32-bit masks (one bit per cell of the stick), 
 The search (:func:`standard_burr_search`) is simulated annealing on single cubes with restarts:
 each restart draws a random connected design that comes apart, then changes one cube at a time
 (give it to another stick, or empty it), scoring by (level, moves) from
-:func:`chaingeo.solvers.motion.disassemble.analyze` and accepting a worse design with a probability
+:func:`chaingeo.solvers.motion.disassemble.analyze_assembly` and accepting a worse design with a
+probability
 that falls to zero over the restart (a pure hill climb at the end). Designs that do not come apart
 completely are never accepted. With ``unique`` the kept design must also assemble in exactly
 one way (:func:`assembly_counts`). Only state caps bound the work, so a (seed, index) gives the
@@ -42,7 +43,7 @@ from chaingeo.solvers.assembly.assemble import iter_assemblies
 from chaingeo.solvers.cover.problem import PieceSpec
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, analyze
+from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
 from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable
 
 #: Stick length of Cutler's standard six-piece burr.
@@ -201,7 +202,7 @@ def assembly_counts(
     assemblies = solutions = 0
     for asm in iter_assemblies(specs, Shape(knot), optional=Shape(layout.shared)):
         assemblies += 1
-        if analyze(asm, max_group=max_group, limits=limits, optimal=False).disassemblable:
+        if analyze_assembly(asm, max_group=max_group, limits=limits, optimal=False).disassemblable:
             solutions += 1
             if stop_at is not None and solutions >= stop_at:
                 break

@@ -6,21 +6,23 @@ carries the structure a proven bound needs (``stats["blocks"]``: towers of burr 
 with it, everywhere: the block bound of :mod:`chaingeo.solvers.optimal.blockbound` for moves of one
 piece, the search under the class bound of :mod:`chaingeo.solvers.optimal.classsearch` for moves of
 several; every other puzzle with the plain optimal search of
-:mod:`chaingeo.solvers.motion.disassemble`.
+:func:`chaingeo.solvers.motion.disassemble.analyze_assembly`.
 
-*Time*: ``limits.seconds`` bounds one whole analysis. :func:`level_figures` and
-:func:`xmpuzzle_figures` (``chain analyze``) make one :class:`chaingeo.solvers.deadline.Deadline`
-and hand it to everything they run (the enumeration of assemblies, every disassembly, the optimal
-search), so the whole command stops with a :class:`SearchLimitError` naming ``seconds`` once
-it is spent (a spent optimal search alone is reported as ``optimal_error``).
+*Time*: ``limits.seconds`` bounds one whole analysis. :func:`analyze` (``chain analyze``,
+:func:`chaingeo.analyze`) makes one :class:`chaingeo.solvers.deadline.Deadline` and hands it to
+everything it runs (the enumeration of assemblies, every disassembly, the optimal search), so
+the whole command stops with a :class:`SearchLimitError` naming ``seconds`` once it is spent (a
+spent optimal search alone is reported as ``optimal_error``).
 """
 
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Final
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
@@ -30,12 +32,29 @@ from chaingeo.solvers.assembly.btcount import BTReport, count_bt
 from chaingeo.solvers.assembly.groups import PieceGroups, analyze_grouped
 from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.figures import PuzzleFigures
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, Rods, analyze
+from chaingeo.solvers.motion.disassemble import Analysis, Rods, analyze_assembly
 from chaingeo.solvers.motion.movement import MAX_PIECES
 
 if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imports
     from chaingeo.core.level import Level
+
+__all__ = [
+    "DEFAULT_LIMITS",
+    "NotAPuzzleError",
+    "PuzzleFigures",
+    "analyze",
+    "analyze_level",
+    "analyze_puzzle",
+    "level_analysis_row",
+    "problem_analysis_row",
+]
+
+
+class NotAPuzzleError(ChainGeoError, ValueError):
+    """A stacking level given to the analysis, which takes puzzles only."""
+
 
 #: The key of a level's ``stats`` naming the blocks of a tower (piece names, one list per unit
 #: of a stack along z), written by the generator and read here.
@@ -93,7 +112,7 @@ def analyze_puzzle(
         return analyze_by_blocks(
             shapes, blocks, limits=limits, stacked=True, search=False, deadline=deadline
         )
-    return analyze(
+    return analyze_assembly(
         shapes,
         max_group=max_group,
         limits=limits,
@@ -111,7 +130,7 @@ def level_turns(level: Level) -> bool:
 def analyze_level(level: Level, limits: SearchLimits | None = None) -> Analysis:
     """:func:`analyze_puzzle` of a puzzle level, with the blocks it carries."""
     if level.family != "puzzle":
-        raise ValueError(f"{level.id}: a {level.family} level; only puzzles are analysed")
+        raise NotAPuzzleError(f"{level.id}: a {level.family} level; only puzzles are analysed")
     return analyze_puzzle(
         level.shapes,
         max_group=level_max_group(level),
@@ -150,7 +169,7 @@ def disassembly_figures(
     if deadline is None:
         deadline = Deadline(limits.seconds)
     deadline.progress.stage = "taking the assembly apart"
-    first = analyze(
+    first = analyze_assembly(
         shapes,
         max_group=max_group,
         limits=limits,
@@ -163,7 +182,7 @@ def disassembly_figures(
     if optimal and first.disassemblable:
         deadline.progress.stage = "searching for the optimal plan"
         try:
-            out["optimal_steps"] = analyze_puzzle(
+            best = analyze_puzzle(
                 shapes,
                 max_group=max_group,
                 limits=limits,
@@ -171,13 +190,14 @@ def disassembly_figures(
                 turns=turns,
                 rods=rods,
                 deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
-            ).optimal_steps
+            )
+            out.update(optimal_steps=best.optimal_steps, plan=best.plan)
         except SearchLimitError as e:
             out.update(optimal_error_of(e))
     return out
 
 
-def level_figures(
+def level_analysis_row(
     level: Level,
     limits: SearchLimits,
     optimal: bool,
@@ -185,14 +205,14 @@ def level_figures(
     mirrors: Mirrors = "keep",
     deadline: Deadline | None = None,
 ) -> dict[str, Any]:
-    """What ``chain analyze`` prints for one of our puzzle levels: BurrTools' assemblies and
+    """The figures of one of our puzzle levels (a dict, with ``plan``): BurrTools' assemblies and
     solutions of the level written as a BurrTools file (:func:`level_puzzle`: each piece its
     own shape, so the counts are burrTxt's on that file; with the level's ``max_group``), then
     level, moves and o_i of the level's own assembly under its rules. All of it within
     ``deadline`` (default: one of ``limits.seconds``); counts cut short by a cap are kept as
     lower bounds (see :func:`count_figures`)."""
     if level.family != "puzzle":
-        raise ValueError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
+        raise NotAPuzzleError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
     if deadline is None:
         deadline = Deadline(limits.seconds)
     max_group = level_max_group(level)
@@ -277,7 +297,7 @@ def _stored_assembly(puzzle: BTPuzzle, index: int) -> tuple[dict[str, Shape], Pi
     return shapes, PieceGroups(shape_of, groups_of)
 
 
-def problem_figures(
+def problem_analysis_row(
     puzzle: BTPuzzle,
     index: int,
     limits: SearchLimits,
@@ -286,7 +306,7 @@ def problem_figures(
     mirrors: Mirrors = "keep",
     deadline: Deadline | None = None,
 ) -> dict[str, Any]:
-    """What ``chain analyze`` prints for one problem of a BurrTools puzzle: BurrTools'
+    """The figures of one problem of a BurrTools puzzle (a dict, with ``plan``): BurrTools'
     assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.assembly.btassemble`), then
     level, moves and o_i of the first solution (with ``assemble`` off: of the first stored
     assembly). With piece groups o_i is not searched (``optimal_error`` says so). Everything runs
@@ -328,37 +348,82 @@ def problem_figures(
         if optimal:
             deadline.progress.stage = f"problem {index}: searching for the optimal plan"
             try:
-                out["optimal_steps"] = analyze_puzzle(
+                best = analyze_puzzle(
                     shapes,
                     max_group=None,
                     limits=limits,
                     deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
-                ).optimal_steps
+                )
+                out.update(optimal_steps=best.optimal_steps, plan=best.plan)
             except SearchLimitError as e:
                 out.update(optimal_error_of(e))
     return out
 
 
-def xmpuzzle_figures(
-    path: str | os.PathLike[str],
+#: The caps :func:`analyze` uses by default: ``chain analyze``'s (120 s for the whole analysis,
+#: 10 s of it for o_i, 2,000,000 states per part).
+DEFAULT_LIMITS: Final = SearchLimits(optimal_seconds=10.0)
+
+
+def analyze(
+    source: Level | BTPuzzle | str | os.PathLike[str],
+    *,
+    limits: SearchLimits | None = None,
+    problem: int | None = None,
+    optimal: bool = True,
+    assemble: bool = True,
+    mirrors: Mirrors = "keep",
+    deadline: Deadline | None = None,
+) -> PuzzleFigures:
+    """Assemblies, solutions, level, moves and o_i of a puzzle, as ``chain analyze`` prints
+    them (:meth:`PuzzleFigures.to_json`).
+
+    ``source``: a :class:`~chaingeo.core.level.Level`, a level file or shipped level id, a
+    ``.xmpuzzle`` file or a read :class:`BTPuzzle`. ``problem``: the problem of a BurrTools
+    puzzle (default: its only one, or every one in ``problems``; ignored for levels).
+    ``optimal`` / ``assemble``: search o_i / count assemblies. ``mirrors``: see
+    :mod:`chaingeo.solvers.assembly.btassemble`. Everything runs within ``deadline`` (default:
+    one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`)."""
+    from chaingeo.core.jit import mode
+
+    limits = DEFAULT_LIMITS if limits is None else limits
+    deadline = Deadline(limits.seconds) if deadline is None else deadline
+    start = time.perf_counter()
+    file = os.fspath(source) if isinstance(source, str | os.PathLike) else None
+    if file is not None and file.endswith(".xmpuzzle"):
+        source = read_xmpuzzle(file)
+    several = False
+    if isinstance(source, BTPuzzle):
+        several = problem is None and len(source.problems) != 1
+        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline)
+    else:
+        from chaingeo.core.suite import load_level
+
+        level = load_level(source) if isinstance(source, str | os.PathLike) else source
+        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline)]
+    meta: dict[str, Any] = {"file": file, "kernels": mode()}
+    meta["seconds"] = round(time.perf_counter() - start, 3)
+    if several:
+        return PuzzleFigures.from_dict({"problems": rows, **meta})
+    return PuzzleFigures.from_dict({**rows[0], **meta})
+
+
+def _puzzle_rows(
+    puzzle: BTPuzzle,
     problem: int | None,
     limits: SearchLimits,
     optimal: bool,
     assemble: bool,
-    mirrors: Mirrors = "keep",
-    deadline: Deadline | None = None,
-) -> dict[str, Any]:
-    """What ``chain analyze`` prints for a BurrTools file: the figures of problem ``problem``,
-    or with None those of its only problem, or ``{"problems": [...]}`` listing every one; all
-    of it within ``deadline`` (default: one of ``limits.seconds``)."""
-    if deadline is None:
-        deadline = Deadline(limits.seconds)
-    puzzle = read_xmpuzzle(path)
+    mirrors: Mirrors,
+    deadline: Deadline,
+) -> list[dict[str, Any]]:
+    """The rows of problem ``problem``, or with None of the puzzle's only problem, or of every
+    one."""
     if problem is not None or len(puzzle.problems) == 1:
-        return problem_figures(puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline)
-    return {
-        "problems": [
-            problem_figures(puzzle, i, limits, optimal, assemble, mirrors, deadline)
-            for i in range(len(puzzle.problems))
+        return [
+            problem_analysis_row(puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline)
         ]
-    }
+    return [
+        problem_analysis_row(puzzle, i, limits, optimal, assemble, mirrors, deadline)
+        for i in range(len(puzzle.problems))
+    ]

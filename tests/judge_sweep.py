@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from chaingeo.core.level import Level, load_level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.worldmodel.judge_video import judge_video
 from chaingeo.envs.worldmodel.video import plan_video, write_gif
 
@@ -29,17 +29,17 @@ def cache_dir() -> Path:
 
 
 def puzzle_levels() -> list[str]:
-    return sorted(p.stem for p in shipped_levels("puzzle").glob("*.json"))
+    return sorted(p.stem for p in suite_folder("puzzle").glob("*.json"))
 
 
 def stacking_levels() -> list[str]:
     """Every 4th shipped stacking level: a spread of sizes at a quarter of the render time."""
-    return sorted(p.stem for p in shipped_levels("stacking").glob("*.json"))[::4]
+    return sorted(p.stem for p in suite_folder("stacking").glob("*.json"))[::4]
 
 
 def level(name: str) -> Level:
     family = "stacking" if name.startswith("stack") else "puzzle"
-    return load_level(shipped_levels(family) / f"{name}.json")
+    return load_level(suite_folder(family) / f"{name}.json")
 
 
 def rendered(name: str) -> Path:

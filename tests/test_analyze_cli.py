@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 
 from chaingeo.cli.main import main
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 
 DATA = Path(__file__).parent / "data" / "burrtools"
 #: Small files whose whole analysis takes well under a second interpreted.
@@ -55,7 +55,7 @@ def test_many_files_one_line_each_and_a_bad_file_does_not_stop_the_batch(
     bad = tmp_path / "bad.xmpuzzle"
     bad.write_bytes(b"not a puzzle")
     level = "puzzle-easy-07-burr3"
-    by_file = shipped_levels("puzzle") / f"{level}.json"
+    by_file = suite_folder("puzzle") / f"{level}.json"
     status = main(["analyze", level, str(bad), str(by_file), "--no-optimal", "--jit", "numba"])
     assert status == 2
     captured = capsys.readouterr()
@@ -143,22 +143,22 @@ def test_chain_version(capsys: pytest.CaptureFixture[str]) -> None:
 def test_counting_cut_short_keeps_the_known_assembly_s_figures() -> None:
     from chaingeo.core.formats.bt_level import level_puzzle
     from chaingeo.core.level import load_level
-    from chaingeo.solvers.analysis import level_figures, problem_figures
+    from chaingeo.solvers.analysis import level_analysis_row, problem_analysis_row
     from chaingeo.solvers.deadline import Deadline
     from chaingeo.solvers.limits import SearchLimits
 
-    level = load_level(shipped_levels("puzzle") / "puzzle-mid-04-burr12.json")
+    level = load_level(suite_folder("puzzle") / "puzzle-mid-04-burr12.json")
     limits = SearchLimits(seconds=30.0)
     spent = Deadline(0.0)  # counting stops at once; the known assembly gets its own time
-    out = level_figures(level, limits, True, True, deadline=spent)
+    out = level_analysis_row(level, limits, True, True, deadline=spent)
     assert out["counts_complete"] is False and out["limit_cap"] == "seconds"
     assert (out["assemblies"], out["solutions"]) == (0, 0)
     assert (out["level"], out["moves"]) == (level.stats["level"], level.stats["moves"])
     assert out["optimal_steps"] == level.optimal_steps
-    stored = problem_figures(level_puzzle(level), 0, limits, True, True, "drop", Deadline(0.0))
+    stored = problem_analysis_row(level_puzzle(level), 0, limits, True, True, "drop", Deadline(0.0))
     assert stored["counts_complete"] is False
     assert (stored["level"], stored["optimal_steps"]) == ("1.2.2", level.optimal_steps)
-    whole = problem_figures(level_puzzle(level), 0, limits, False, True, "drop")
+    whole = problem_analysis_row(level_puzzle(level), 0, limits, False, True, "drop")
     assert "counts_complete" not in whole
     assert (whole["assemblies"], whole["solutions"], whole["level"]) == (2, 1, "1.2.2")
 

@@ -17,7 +17,7 @@ from chaingeo.core.kinematics import (
     reference_optimal_disassembly,
     replay_disassembly,
 )
-from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze_assembly
 from chaingeo.solvers.optimal.astar import AStarLimits, Heuristic, astar_optimal
 from tests.puzzle_strategies import random_partition, small_scenes
 from tests.shared_files import BT, needs_files
@@ -32,7 +32,7 @@ def exact_distance(state: Assembly, max_group: int | None) -> int | None:
         if len(part) < 2:
             continue
         shapes = {n: state.shapes[n].translate(state.offsets[n]) for n in sorted(part)}
-        steps = analyze(shapes, max_group=max_group).optimal_steps
+        steps = analyze_assembly(shapes, max_group=max_group).optimal_steps
         if steps is None:
             return None
         total += steps
@@ -41,7 +41,7 @@ def exact_distance(state: Assembly, max_group: int | None) -> int | None:
 
 def check_plan(shapes: Mapping[str, Shape], max_group: int | None) -> None:
     found = astar_optimal(shapes, max_group=max_group)
-    expected = analyze(shapes, max_group=max_group).optimal_steps
+    expected = analyze_assembly(shapes, max_group=max_group).optimal_steps
     assert found.optimal_steps == expected
     assert found.reopened == 0  # a consistent heuristic never reopens a state
     if expected is not None:
@@ -93,7 +93,7 @@ def test_triples_family_when_small() -> None:
     pairs = astar_optimal(shapes)
     both = astar_optimal(shapes, triples=True, limits=AStarLimits(component_states=200_000))
     assert both.family[1] >= 1
-    assert both.optimal_steps == pairs.optimal_steps == analyze(shapes).optimal_steps
+    assert both.optimal_steps == pairs.optimal_steps == analyze_assembly(shapes).optimal_steps
     assert both.start_bound >= pairs.start_bound and both.reopened == 0
     with pytest.raises(SearchLimitError, match="sub-puzzle state cap"):
         astar_optimal(
@@ -120,7 +120,7 @@ def test_stuck_and_single_piece() -> None:
     ring = [(x, y, z) for x in range(3) for y in range(3) for z in (0, 1) if (x, y) != (1, 1)]
     post = [(1, 1, 0), (1, 1, 1), (1, 1, 2), (1, 1, -1), (1, 2, 2), (1, 2, -1)]
     locked = {"ring": Shape(ring), "post": Shape(post)}
-    assert analyze(locked).optimal_steps is None
+    assert analyze_assembly(locked).optimal_steps is None
     assert astar_optimal(locked).optimal_steps is None
 
 
@@ -150,7 +150,7 @@ def test_alpackino_needs_at_least_16_moves() -> None:
     assert BT is not None
     (asm,) = read_xmpuzzle(BT / "AlPackino.xmpuzzle").assemblies(0)
     shapes = {f"p{k:02d}": s for k, s in asm.items()}
-    assert analyze(shapes, optimal=False).moves == 17
+    assert analyze_assembly(shapes, optimal=False).moves == 17
     with pytest.raises(SearchLimitError, match="A\\* expansion cap") as err:
         astar_optimal(shapes, limits=AStarLimits(max_expansions=600_000, seconds=None))
     found = re.search(r"lower bound (\d+)", str(err.value))

@@ -15,7 +15,7 @@ from chaingeo.envs.machines import new_state
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.puzzle import make
 from chaingeo.generator.result import Rejection
-from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze_assembly
 from chaingeo.solvers.optimal.blockbound import analyze_by_blocks, block_lower_bound
 
 
@@ -39,7 +39,7 @@ def _partitions(names: list[str]) -> list[list[list[str]]]:
 
 def test_block_bound_is_below_the_plain_optimum_and_exact_when_met() -> None:
     for shapes in _small_puzzles():
-        plain = analyze(shapes, max_group=1, optimal=True)
+        plain = analyze_assembly(shapes, max_group=1, optimal=True)
         assert plain.optimal_steps is not None
         names = sorted(shapes)
         for blocks in _partitions(names):

@@ -13,9 +13,9 @@ from chaingeo.core.formats.bt_level import level_puzzle, rules_not_carried
 from chaingeo.core.formats.burrtools import read_xmpuzzle, write_xmpuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, StackingSolution, load_levels
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 
-LEVELS = load_levels(shipped_levels())
+LEVELS = load_levels(suite_folder())
 
 
 def _assembled(level: Level) -> dict[str, Shape]:
@@ -68,7 +68,7 @@ def test_convert_takes_a_level_id_or_file_and_writes_the_same_bytes(
     level = next(lv for lv in LEVELS if lv.id == "puzzle-mid-04-burr12")
     by_id, by_file = tmp_path / "a.xmpuzzle", tmp_path / "b.xmpuzzle"
     assert main(["convert", level.id, "--to", "xmpuzzle", "--out", str(by_id)]) == 0
-    source = shipped_levels("puzzle") / f"{level.id}.json"
+    source = suite_folder("puzzle") / f"{level.id}.json"
     assert main(["convert", str(source), str(by_file), "--to", "xmpuzzle"]) == 0
     assert by_id.read_bytes() == by_file.read_bytes()
     capsys.readouterr()

@@ -27,7 +27,7 @@ from chaingeo.solvers.assembly.btcount import StuckCheck, count_bt
 from chaingeo.solvers.assembly.groups import PieceGroups, assignable
 from chaingeo.solvers.cover.constrained import compile_packing
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Separation, Separations, _Solver, analyze
+from chaingeo.solvers.motion.disassemble import Separation, Separations, _Solver, analyze_assembly
 from tests import bt_reference as ref
 from tests.bt_instances import random_puzzle, reference_parts
 from tests.test_disassemble import _level_or_error
@@ -143,7 +143,7 @@ def test_linked_rings_need_not_come_apart_in_their_group() -> None:
         if len(named_assembly(packing, rows)) == 3
     )
     assert disassemble(packing, without_lid).disassemblable
-    assert not analyze(without_lid, optimal=False).disassemblable
+    assert not analyze_assembly(without_lid, optimal=False).disassemblable
 
 
 def test_group_counts_bound_stuck_parts() -> None:
@@ -169,7 +169,9 @@ def test_ring_maze_level_is_the_mazes_runs() -> None:
     assert report.first_packing is not None
     pin_and_ring = {n: s for n, s in report.first_packing.items() if len(s) < 20}
     assert len(pin_and_ring) == 2
-    assert not analyze(pin_and_ring, optimal=False).disassemblable  # the ring never comes off
+    assert not analyze_assembly(
+        pin_and_ring, optimal=False
+    ).disassemblable  # the ring never comes off
 
 
 def test_deep_maze_level_above_50() -> None:
@@ -221,7 +223,7 @@ def test_stuck_check_is_exactly_no_first_move() -> None:
     stuck = StuckCheck(packing)
     verdicts = []
     for rows in iter_classes(packing):
-        found = analyze(named_assembly(packing, rows), optimal=False, fallback=False)
+        found = analyze_assembly(named_assembly(packing, rows), optimal=False, fallback=False)
         verdicts.append((stuck(rows), not found.disassemblable and found.states == 1))
     assert all(s == one for s, one in verdicts)
     assert sum(s for s, _ in verdicts) == 745

@@ -19,7 +19,7 @@ from chaingeo.core.formats.burrtools import (
 )
 from chaingeo.core.geometry import ROTATIONS, Shape
 from chaingeo.core.piecesets.burrs import six_piece_family, solid_knot
-from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze_assembly
 from tests.shared_files import BT, needs_files
 
 
@@ -70,7 +70,7 @@ def test_alpackino_stored_solution_and_level() -> None:
     ]
     (asm,) = puzzle.assemblies(0)
     assert Shape([c for s in asm.values() for c in s]) == puzzle.shapes[prob.result].filled
-    result = analyze({f"p{k:02d}": s for k, s in asm.items()}, optimal=False)
+    result = analyze_assembly({f"p{k:02d}": s for k, s in asm.items()}, optimal=False)
     assert result.first_level == 1  # BurrTools: the first piece comes free in 1 move
     # BurrTools' own stored separation tree has these moves per separation (12 separations).
     assert result.level == "1.1.1.1.1.2.1.3.1.2.1.2" and result.moves == 17
@@ -87,7 +87,8 @@ def test_solid_burr_file_matches_our_family_and_knot() -> None:
     stored = puzzle.assemblies(0)
     assert len(stored) == 314 == puzzle.problems[0].recorded["solutions"]
     assert all(
-        analyze({f"p{k}": s for k, s in a.items()}, optimal=False).disassemblable for a in stored
+        analyze_assembly({f"p{k}": s for k, s in a.items()}, optimal=False).disassemblable
+        for a in stored
     )
 
 

@@ -150,9 +150,9 @@ def test_a_level_string_is_the_one_burrtxt_prints_for_its_assembly() -> None:
 
 
 def _own_level(level: Level) -> str | None:
-    from chaingeo.solvers.motion.disassemble import analyze
+    from chaingeo.solvers.motion.disassemble import analyze_assembly
 
-    return analyze(level.shapes, optimal=False).level
+    return analyze_assembly(level.shapes, optimal=False).level
 
 
 # -- (c) generator shapes --------------------------------------------------------------------

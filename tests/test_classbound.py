@@ -16,7 +16,7 @@ from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import Level, load_level
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.puzzle import make
-from chaingeo.solvers.motion.disassemble import analyze, translations
+from chaingeo.solvers.motion.disassemble import analyze_assembly, translations
 from chaingeo.solvers.optimal.blockbound import end_first_plan
 from chaingeo.solvers.optimal.classbound import (
     MAX_BUDGET,
@@ -76,7 +76,7 @@ def test_at_most_the_exact_optimum(
 ) -> None:
     names = sorted(shapes)
     blocks = random_blocks(names, data)
-    exact = analyze(shapes, max_group=max_group).optimal_steps
+    exact = analyze_assembly(shapes, max_group=max_group).optimal_steps
     assume(exact is not None)  # then every block comes apart alone too
     assert exact is not None
     for split in (blocks, [names]):
@@ -93,7 +93,7 @@ def test_generated_burrs_any_blocks() -> None:
     assert len(burrs) >= 2
     for shapes in burrs:
         names = sorted(shapes)
-        exact = analyze(shapes, max_group=None).optimal_steps
+        exact = analyze_assembly(shapes, max_group=None).optimal_steps
         assert exact is not None
         for blocks in ([names[:3], names[3:]], [names[::2], names[1::2]], [names]):
             assert 5 <= class_lower_bound(shapes, blocks).bound <= exact
@@ -121,7 +121,7 @@ def test_thirty_six_piece_towers_with_multi_piece_moves(name: str, bound: int, p
     assert sorted(map(sorted, blocks)) == sorted(band_blocks(level.shapes, 6))
     found = class_lower_bound(level.shapes, blocks)
     assert found.complete and found.removals == 35 and found.bound == bound
-    assert analyze(level.shapes, max_group=None, optimal=False).moves == plan >= bound
+    assert analyze_assembly(level.shapes, max_group=None, optimal=False).moves == plan >= bound
 
 
 def test_tower_taken_apart_unit_by_unit_is_within_three_of_the_bound() -> None:
@@ -130,7 +130,10 @@ def test_tower_taken_apart_unit_by_unit_is_within_three_of_the_bound() -> None:
     finds 38: tests/test_classsearch.py)."""
     shapes = dict(load_level(SUITE / "puzzle-hard-09-burr36.json").shapes)
     blocks = band_blocks(shapes, 6)
-    own = [translations(analyze({n: shapes[n] for n in b}, max_group=None).plan) for b in blocks]
+    own = [
+        translations(analyze_assembly({n: shapes[n] for n in b}, max_group=None).plan)
+        for b in blocks
+    ]
     plan = end_first_plan(shapes, blocks, own)
     assert plan is not None and len(plan) == 41
     assert replay_disassembly(shapes, plan).is_separated()

@@ -16,7 +16,7 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError, replay_disassembly
 from chaingeo.core.level import load_level
 from chaingeo.solvers.analysis import analyze_level
-from chaingeo.solvers.motion.disassemble import analyze, translations
+from chaingeo.solvers.motion.disassemble import analyze_assembly, translations
 from chaingeo.solvers.optimal.classbound import band_blocks, class_lower_bound
 from chaingeo.solvers.optimal.classsearch import ClassSearchLimits, class_search_optimal
 from tests.puzzle_strategies import random_blocks, small_scenes
@@ -31,7 +31,7 @@ def test_the_exact_optimum_on_random_scenes(
 ) -> None:
     names = sorted(shapes)
     blocks = random_blocks(names, data)
-    exact = analyze(shapes, max_group=max_group).optimal_steps
+    exact = analyze_assembly(shapes, max_group=max_group).optimal_steps
     limits = ClassSearchLimits(max_nodes=20_000)
     if exact is None:  # never comes apart: every round fails, the search ends at its cap
         with pytest.raises(SearchLimitError, match="proven lower bound"):
@@ -105,7 +105,9 @@ def test_chain_analyze_proves_a_multi_piece_tower(
     assert main(["analyze", str(path), "--no-assemble", "--seconds", "60"]) == 0
     out = json.loads(capsys.readouterr().out)
     level = load_level(path)
-    quick = analyze(level.shapes, max_group=None, optimal=False)  # BurrTools' level and moves
+    quick = analyze_assembly(
+        level.shapes, max_group=None, optimal=False
+    )  # BurrTools' level and moves
     assert out["optimal_steps"] == 38 and (out["level"], out["moves"]) == (quick.level, quick.moves)
     found = analyze_level(level)
     assert found.optimal_steps == len(found.plan) == 38 and quick.moves == 42

@@ -44,7 +44,7 @@ from chaingeo.solvers.cover.packings import (
 from chaingeo.solvers.cover.problem import CoverProblem
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze_assembly
 from tests.test_cover import instances
 from tests.test_cover_kernels import wide_instances
 
@@ -252,7 +252,7 @@ def test_one_deadline_covers_the_disassembler_too() -> None:
     with pytest.raises(SearchLimitError, match="seconds"):
         CoverSearch(small, deadline=spent).count()  # nothing runs past a spent deadline
     with pytest.raises(SearchLimitError, match="seconds"):
-        analyze({"a": Shape([(0, 0, 0)]), "b": Shape([(1, 0, 0)])}, deadline=spent)
+        analyze_assembly({"a": Shape([(0, 0, 0)]), "b": Shape([(1, 0, 0)])}, deadline=spent)
 
 
 def test_chain_analyze_stops_at_its_time_limit(

@@ -12,7 +12,7 @@ from PIL import Image
 
 from chaingeo.cli.main import main
 from chaingeo.core.level import Level, load_level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.dataset import DEMONSTRATIONS, LEVELS, export_dataset
 from chaingeo.envs.demos import demonstration, plan_texts
 
@@ -25,7 +25,7 @@ SIZE = 128
 
 def shipped(level_id: str) -> Level:
     family = level_id.split("-", 1)[0]
-    return load_level(shipped_levels() / family / f"{level_id}.json")
+    return load_level(suite_folder() / family / f"{level_id}.json")
 
 
 @pytest.fixture(scope="module")
@@ -192,7 +192,7 @@ def test_the_whole_shipped_suite_exports_and_loads(tmp_path: Path) -> None:
     from chaingeo.core.level import load_levels
     from chaingeo.generator.signature import level_signature
 
-    suite = load_levels(shipped_levels())
+    suite = load_levels(suite_folder())
     assert main(["export-dataset", "--out", str(tmp_path), "--image-size", "128"]) == 0
     got = datasets.load_dataset(str(tmp_path), LEVELS, cache_dir=str(tmp_path / "c"))["test"]
     assert got["id"] == sorted(lv.id for lv in suite)

@@ -32,12 +32,12 @@ def test_chain_demos_writes_the_same_lines_and_names_a_bad_level(
 ) -> None:
     from chaingeo.cli.main import main
     from chaingeo.core.level import load_level
-    from chaingeo.core.suite import shipped_levels
+    from chaingeo.core.suite import suite_folder
 
     path = tmp_path / "d.jsonl"
     level_id = "puzzle-easy-07-burr3"
     assert main(["demos", level_id, "--text-state", "--out", str(path)]) == 0
-    level = load_level(shipped_levels() / "puzzle" / f"{level_id}.json")
+    level = load_level(suite_folder() / "puzzle" / f"{level_id}.json")
     expected = list(demonstration_lines([level], text_state=True))
     assert path.read_text(encoding="ascii").splitlines() == expected
     assert "Current state:" in json.loads(expected[0])["observation"]

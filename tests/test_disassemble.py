@@ -26,7 +26,7 @@ from chaingeo.solvers.motion.disassemble import (
     Separation,
     Separations,
     _Solver,
-    analyze,
+    analyze_assembly,
     fast_legal_moves,
 )
 from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable
@@ -113,7 +113,7 @@ def test_successor_states_match_reference(shapes: dict[str, Shape], seed: int, s
 @given(small_scenes(max_pieces=4), st.sampled_from([None, 1]))
 def test_optimal_steps_match_reference_bfs(shapes: dict[str, Shape], max_group: int | None) -> None:
     ref = reference_optimal_disassembly(shapes, max_group)
-    got = analyze(shapes, max_group=max_group)
+    got = analyze_assembly(shapes, max_group=max_group)
     if ref is None:
         assert not got.disassemblable and got.optimal_steps is None
         return
@@ -186,9 +186,9 @@ def test_limits_raise_clear_errors() -> None:
         "blue": Shape([(0, 1, 0)]),
     }
     with pytest.raises(SearchLimitError, match="time limit"):
-        analyze(shapes, limits=SearchLimits(seconds=0.0))
+        analyze_assembly(shapes, limits=SearchLimits(seconds=0.0))
     with pytest.raises(SearchLimitError, match="state cap"):  # BurrTools' way needs 3 states
-        analyze(
+        analyze_assembly(
             SCENE | {"yellow": Shape([(5, 5, 5)])},
             limits=SearchLimits(max_states=4),
             separations="any",

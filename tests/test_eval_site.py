@@ -27,7 +27,7 @@ from PIL import Image
 
 from chaingeo.cli.main import main
 from chaingeo.core.level import Level, load_level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.agents.baselines import oracle_plan
 from chaingeo.evaluation.episode import ProtocolConfig
@@ -48,7 +48,7 @@ HOSTILE = '<script>alert("x")</script><img src=x onerror=alert(1)> & <b>bold</b>
 
 
 def _levels() -> list[Level]:
-    return [load_level(shipped_levels() / name) for name in LEVELS]
+    return [load_level(suite_folder() / name) for name in LEVELS]
 
 
 def _act(text: str) -> str:

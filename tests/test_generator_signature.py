@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from chaingeo.cli.main import main
 from chaingeo.core.geometry import IntArray, Shape
 from chaingeo.core.level import load_levels
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.generator.batch import HELD_OUT, GenerationJob, run
 from chaingeo.generator.config import stacking_config
 from chaingeo.generator.signature import (
@@ -69,7 +69,7 @@ def test_a_mirrored_piece_is_another_puzzle() -> None:
 
 
 def test_every_shipped_level_has_a_signature_and_only_goal_twins_share_one() -> None:
-    levels = load_levels(shipped_levels())
+    levels = load_levels(suite_folder())
     owners: dict[str, list[str]] = defaultdict(list)
     for level in levels:
         owners[level_signature(level)].append(level.id)

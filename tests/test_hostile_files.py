@@ -25,11 +25,11 @@ from chaingeo.cli.main import main
 from chaingeo.core.formats.burrtools import BurrToolsError, parse_xmpuzzle, read_xmpuzzle
 from chaingeo.core.geometry import Shape, puzzle_signature
 from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.solvers.motion.movement import MAX_PIECES
 from tests.env_levels import tiny_level
 
-BURR = shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"
+BURR = suite_folder("puzzle") / "puzzle-easy-04-burr6.json"
 
 # ---------------------------------------------------------------------------------------------
 # Item 9: level files

@@ -24,7 +24,7 @@ from chaingeo.cli.main import main
 from chaingeo.core import limits
 from chaingeo.core.kinematics import OPPOSITE
 from chaingeo.core.level import LevelError, load_level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.actions.types import MoveAction
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.machines.puzzle import PuzzleState
@@ -141,7 +141,7 @@ def test_far_offset_is_illegal_not_slow() -> None:
 
 def _base(family: str) -> dict[str, Any]:
     name = "puzzle-easy-04-burr6.json" if family == "puzzle" else ""
-    folder = shipped_levels(family)
+    folder = suite_folder(family)
     path = folder / name if name else sorted(folder.glob("*.json"))[0]
     data: dict[str, Any] = json.loads(path.read_text())
     return data
@@ -219,7 +219,7 @@ def test_json_depth_ignores_brackets_in_strings() -> None:
 
 def test_shipped_levels_are_within_the_limits() -> None:
     for family in ("stacking", "puzzle"):
-        for path in sorted(shipped_levels(family).glob("*.json")):
+        for path in sorted(suite_folder(family).glob("*.json")):
             load_level(path)
 
 
@@ -232,7 +232,7 @@ def test_validate_flags_a_stored_optimum_that_is_not(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     data = _base("puzzle")
-    state = new_state(load_level(shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"))
+    state = new_state(load_level(suite_folder("puzzle") / "puzzle-easy-04-burr6.json"))
     assert isinstance(state, PuzzleState) and data["optimal_steps"] == 7
     # a detour: one slide and back, then the stored optimal plan (still a valid plan)
     slide = next(
@@ -252,5 +252,5 @@ def test_validate_flags_a_stored_optimum_that_is_not(
     assert main(["validate", str(path)]) == 2
     row = json.loads(capsys.readouterr().out.splitlines()[0])
     assert "optimum is 7" in row["error"]
-    good = shipped_levels("puzzle") / "puzzle-easy-04-burr6.json"
+    good = suite_folder("puzzle") / "puzzle-easy-04-burr6.json"
     assert main(["validate", str(good)]) == 0

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from chaingeo.core import limits
 from chaingeo.core.level import Level, load_levels
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.evaluation.agents.baselines import oracle_plan
 from chaingeo.evaluation.agents.tools import skipped_result, translate
 from chaingeo.integrations.game import Game, Outcome, Protocol, efficiency_reward, recent
@@ -23,7 +23,7 @@ from tests.eval_support.plans import place_calls
 
 @cache
 def stacking() -> tuple[Level, ...]:
-    return tuple(load_levels(shipped_levels("stacking")))
+    return tuple(load_levels(suite_folder("stacking")))
 
 
 def play(game: Game, replies: list[str]) -> int:
@@ -116,7 +116,7 @@ def test_an_unknown_protocol_or_outcome_is_refused() -> None:
 
 
 def test_a_puzzle_is_played_the_same_way() -> None:
-    level = next(lv for lv in load_levels(shipped_levels("puzzle")) if lv.difficulty == "easy")
+    level = next(lv for lv in load_levels(suite_folder("puzzle")) if lv.difficulty == "easy")
     game = Game(level, images=False)
     game.opening()
     plan = oracle_plan(level)

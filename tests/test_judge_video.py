@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from chaingeo.cli.main import main
 from chaingeo.core.level import Level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.worldmodel.judge_segment import (
     U8,
     BoolArray,
@@ -45,7 +45,7 @@ Colors = list[tuple[str, tuple[int, int, int]]]
 def _level(name: str) -> Level:
     from chaingeo.core.level import load_level
 
-    return load_level(next(shipped_levels().rglob(f"{name}.json")))
+    return load_level(next(suite_folder().rglob(f"{name}.json")))
 
 
 def _colors(level: Level) -> Colors:
@@ -145,7 +145,7 @@ def test_a_piece_blanked_out_of_our_stacking_gif_is_still_lost(name: str) -> Non
 @pytest.mark.slow
 @pytest.mark.parametrize(
     "name",
-    sorted(p.stem for p in shipped_levels("puzzle").glob("*.json")) + stacking_levels(),
+    sorted(p.stem for p in suite_folder("puzzle").glob("*.json")) + stacking_levels(),
 )
 def test_our_gif_of_every_shipped_puzzle_passes_with_the_level(name: str) -> None:
     """Every shipped puzzle and every 4th shipped stacking level."""

@@ -59,7 +59,7 @@ def test_assemble_goal_plays_the_reversed_plan() -> None:
 @settings(max_examples=25, deadline=None)
 @given(n=st.integers(4, 7), seed=st.integers(0, 2**32 - 1))
 def test_runs_of_a_walk_are_the_solver_level(n: int, seed: int) -> None:
-    from chaingeo.solvers.motion.disassemble import analyze
+    from chaingeo.solvers.motion.disassemble import analyze_assembly
 
     path = random_walk(n, np.random.default_rng(seed))
     if not path:
@@ -67,7 +67,7 @@ def test_runs_of_a_walk_are_the_solver_level(n: int, seed: int) -> None:
     plate, pin = maze_pieces(path, n)
     if not plate.is_connected():
         return
-    result = analyze({"plate": plate, "pin": pin}, optimal=True)
+    result = analyze_assembly({"plate": plate, "pin": pin}, optimal=True)
     expected = runs(with_exit(path, n))
     assert result.first_level == expected == result.optimal_steps
 

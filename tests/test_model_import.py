@@ -23,7 +23,7 @@ from chaingeo.core.kinematics import replay_disassembly
 from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
 from chaingeo.solvers.cover.packings import first_packing
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, analyze
+from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
 from tests.shared_files import MODELS, needs_models
 
 #: What each model must give: kind and cells per part (in part order), or the refusal.
@@ -59,7 +59,7 @@ def imported() -> dict[str, ImportedModel | ModelImportError]:
 @pytest.fixture(scope="module")
 def analyses(imported: dict[str, ImportedModel | ModelImportError]) -> dict[str, Analysis]:
     return {
-        name: analyze(m.shapes, limits=LIMITS, optimal=True)
+        name: analyze_assembly(m.shapes, limits=LIMITS, optimal=True)
         for name, m in imported.items()
         if isinstance(m, ImportedModel) and m.kind == "puzzle"
     }

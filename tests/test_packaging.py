@@ -6,7 +6,7 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -31,6 +31,6 @@ def test_every_package_of_the_tree_goes_into_the_wheel() -> None:
 
 
 def test_the_shipped_suite_is_found_as_package_data() -> None:
-    assert shipped_levels().resolve() == (ROOT / "levels").resolve()
-    assert len(list(shipped_levels("puzzle").glob("*.json"))) == 32
-    assert len(list(shipped_levels("stacking").glob("*.json"))) == 77
+    assert suite_folder().resolve() == (ROOT / "levels").resolve()
+    assert len(list(suite_folder("puzzle").glob("*.json"))) == 32
+    assert len(list(suite_folder("stacking").glob("*.json"))) == 77

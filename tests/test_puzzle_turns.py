@@ -39,7 +39,7 @@ from chaingeo.envs.actions.types import (
 )
 from chaingeo.envs.machines.puzzle import PuzzleState
 from chaingeo.envs.machines.puzzle_actions import reference_actions
-from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze_assembly
 from tests.env_levels import puzzle_levels
 from tests.test_turn_search import luban3
 
@@ -47,7 +47,7 @@ from tests.test_turn_search import luban3
 @cache
 def luban_level(goal: str = "disassemble") -> Level:
     shapes, rods = luban3(6)
-    plan = list(analyze(shapes, turns=True, rods=rods).plan)
+    plan = list(analyze_assembly(shapes, turns=True, rods=rods).plan)
     moves = plan if goal == "disassemble" else [m.inverse() for m in reversed(plan)]
     colors = {"blue": "#1f5fbf", "forest": "#228b22", "rust": "#b7410e"}
     level = Level(

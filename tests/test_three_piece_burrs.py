@@ -28,7 +28,7 @@ from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.layouts import Layout, get_layout, three_crossing
 from chaingeo.generator.puzzle import difficulty_of, make
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import analyze
+from chaingeo.solvers.motion.disassemble import analyze_assembly
 
 #: (config, seed, index) of one quick item per layout that the generator accepts (found by the
 #: histograms in the README: burr3 item 8 of seed 1 is a level-4 burr, plate3 item 27 level 3).
@@ -89,7 +89,7 @@ def test_generated_item_is_verified_deterministic_and_interlocking(name: str) ->
     assert replay_disassembly(level.shapes, level.solution.moves).is_separated()  # type: ignore[union-attr]
     reference = reference_optimal_disassembly(level.shapes)
     assert reference is not None and len(reference) == level.optimal_steps
-    analysis = analyze(level.shapes)
+    analysis = analyze_assembly(level.shapes)
     assert analysis.optimal_steps == level.optimal_steps
     assert analysis.level == level.stats["level"]
     # interlocking: nothing leaves in the first move; the reference agrees on the level
@@ -141,7 +141,7 @@ def _level_census(layout: Layout) -> dict[object, int]:
             continue
         named = {f"p{i}": p for i, p in enumerate(pieces)}
         try:
-            result = analyze(named, optimal=False, limits=CENSUS_LIMITS)
+            result = analyze_assembly(named, optimal=False, limits=CENSUS_LIMITS)
         except SearchLimitError:
             census["over cap"] += 1
             continue

@@ -20,7 +20,7 @@ from chaingeo.core.kinematics import (
 )
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import analyze, fast_legal_moves
+from chaingeo.solvers.motion.disassemble import analyze_assembly, fast_legal_moves
 from chaingeo.solvers.motion.turnmoves import TurnTable
 from chaingeo.solvers.motion.turnsearch import TurnPartSearch, fast_legal_turns
 from tests.puzzle_strategies import small_scenes
@@ -112,14 +112,14 @@ def test_successor_states_match_reference(shapes: dict[str, Shape], seed: int, s
 @given(small_scenes(max_pieces=3))
 def test_optimal_with_turns_matches_reference_bfs(shapes: dict[str, Shape]) -> None:
     ref = reference_optimal_disassembly(shapes, turns=True, max_states=20_000)
-    a = analyze(shapes, turns=True, limits=SearchLimits(seconds=None))
+    a = analyze_assembly(shapes, turns=True, limits=SearchLimits(seconds=None))
     if ref is None:
         assert not a.disassemblable
         return
     assert a.optimal_steps == len(ref)
     assert a.first_level == reference_first_level(shapes, turns=True, max_states=20_000)
     assert replay_disassembly(shapes, a.plan).is_separated()
-    plain = analyze(shapes, limits=SearchLimits(seconds=None))
+    plain = analyze_assembly(shapes, limits=SearchLimits(seconds=None))
     if plain.optimal_steps is not None:  # turns only add ways
         assert a.optimal_steps is not None and a.optimal_steps <= plain.optimal_steps
 
@@ -147,9 +147,9 @@ def luban3(length: int = 10) -> tuple[dict[str, Shape], dict[str, dict[Cell, int
 
 def test_luban_lock_needs_its_rod_to_spin() -> None:
     shapes, rods = luban3(6)
-    assert not analyze(shapes).disassemblable  # translations alone: locked
-    assert not analyze(shapes, turns=True).disassemblable  # a square rod cannot spin
-    a = analyze(shapes, turns=True, rods=rods)
+    assert not analyze_assembly(shapes).disassemblable  # translations alone: locked
+    assert not analyze_assembly(shapes, turns=True).disassemblable  # a square rod cannot spin
+    a = analyze_assembly(shapes, turns=True, rods=rods)
     assert a.disassemblable and a.level == "2" and a.optimal_steps == 3
     assert replay_disassembly(shapes, a.plan, rods).is_separated()
     ref = reference_optimal_disassembly(shapes, turns=True, rods=rods)
@@ -167,7 +167,7 @@ def test_optimal_with_turns_matches_reference_bfs_four_pieces(shapes: dict[str, 
     except SearchLimitError:
         assume(False)
         return
-    a = analyze(shapes, turns=True, limits=SearchLimits(seconds=None))
+    a = analyze_assembly(shapes, turns=True, limits=SearchLimits(seconds=None))
     assert a.optimal_steps == (None if ref is None else len(ref))
     if ref is not None:
         assert replay_disassembly(shapes, a.plan).is_separated()
@@ -176,6 +176,6 @@ def test_optimal_with_turns_matches_reference_bfs_four_pieces(shapes: dict[str, 
 @pytest.mark.slow
 def test_full_size_luban_lock_matches_reference() -> None:
     shapes, rods = luban3(10)
-    a = analyze(shapes, turns=True, rods=rods)
+    a = analyze_assembly(shapes, turns=True, rods=rods)
     ref = reference_optimal_disassembly(shapes, turns=True, rods=rods)
     assert ref is not None and a.optimal_steps == len(ref) == 3 and a.level == "2"

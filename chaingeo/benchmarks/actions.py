@@ -23,7 +23,7 @@ import numpy as np
 
 from chaingeo.core.kinematics import Assembly
 from chaingeo.core.level import Level, load_levels
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.actions.types import action_of_move
 from chaingeo.envs.machines.puzzle import PuzzleState
 from chaingeo.envs.machines.puzzle_actions import reference_actions
@@ -62,7 +62,7 @@ def _ours(asm: Assembly, level: Level, picks: int) -> tuple[float, int]:
 
 
 def run(args: argparse.Namespace) -> int:
-    suite = shipped_levels("puzzle")
+    suite = suite_folder("puzzle")
     levels = [
         lv
         for lv in (load_levels(suite) if suite.is_dir() else [])

@@ -77,7 +77,7 @@ def _class_bound(name: str, shapes: Mapping[str, Shape]) -> dict[str, object]:
     """Class bound and plan length of a tower of burr units (six layers each)."""
     if not re.search(r"burr(12|18|24|36)\b", name):
         return {}
-    from chaingeo.solvers.motion.disassemble import analyze, translations
+    from chaingeo.solvers.motion.disassemble import analyze_assembly, translations
     from chaingeo.solvers.optimal.blockbound import end_first_plan
     from chaingeo.solvers.optimal.classbound import band_blocks, class_lower_bound
 
@@ -85,8 +85,11 @@ def _class_bound(name: str, shapes: Mapping[str, Shape]) -> dict[str, object]:
     blocks = band_blocks(shapes, 6)
     found = class_lower_bound(shapes, blocks)
     seconds = round(time.perf_counter() - t0, 3)
-    plan = analyze(shapes, max_group=None, optimal=False).moves
-    own = [translations(analyze({n: shapes[n] for n in b}, max_group=None).plan) for b in blocks]
+    plan = analyze_assembly(shapes, max_group=None, optimal=False).moves
+    own = [
+        translations(analyze_assembly({n: shapes[n] for n in b}, max_group=None).plan)
+        for b in blocks
+    ]
     stack = end_first_plan(shapes, blocks, own)  # units one by one from the ends, replayed
     classes = " ".join(f"{'xyz'[a]}{k}x{c}" for (a, k), c in found.classes)
     return {
@@ -153,11 +156,11 @@ def _astar(
 
 def _bfs(shapes: Mapping[str, Shape], max_group: int | None, seconds: float) -> dict[str, object]:
     from chaingeo.solvers.limits import SearchLimits
-    from chaingeo.solvers.motion.disassemble import analyze
+    from chaingeo.solvers.motion.disassemble import analyze_assembly
 
     t0 = time.perf_counter()
     try:
-        a = analyze(shapes, max_group=max_group, limits=SearchLimits(seconds=seconds))
+        a = analyze_assembly(shapes, max_group=max_group, limits=SearchLimits(seconds=seconds))
     except SearchLimitError as e:
         return {
             "bfs_o_i": None,

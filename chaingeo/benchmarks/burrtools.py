@@ -4,9 +4,9 @@ Instances: every example of :mod:`chaingeo.generator.bt_examples` (one per probl
 rules, piece groups with variable cells, ranges and several problems, mirror images, a level-51
 maze, the solid burr catalogue), plus BurrTools' own example files when present
 (``../shared/burrtools`` or ``CHAIN_BURRTOOLS_DIR``). For each problem, ``ours`` is what
-``chain analyze --no-optimal`` does (:func:`chaingeo.solvers.analysis.problem_figures`: BurrTools'
-assemblies and solutions, then level and moves of the first solution; o_i is left out, being
-no BurrTools figure and the same code in both engines) and ``previous`` the engine before
+``chain analyze --no-optimal`` does (:func:`chaingeo.solvers.analysis.problem_analysis_row`:
+BurrTools' assemblies and solutions, then level and moves of the first solution; o_i is left
+out, being no BurrTools figure and the same code in both engines) and ``previous`` the engine before
 BurrTools' semantics, timed in the same run:
 
 * on a problem with colour rules, ``previous`` counts without them and filters after: every
@@ -150,7 +150,7 @@ def previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) ->
     from chaingeo.solvers.cover.packings import iter_packings
     from chaingeo.solvers.cover.placements import target_symmetries
     from chaingeo.solvers.cover.problem import PieceSpec
-    from chaingeo.solvers.motion.disassemble import analyze
+    from chaingeo.solvers.motion.disassemble import analyze_assembly
 
     prob = puzzle.problem(index)
     res = puzzle.shapes[prob.result]
@@ -198,7 +198,7 @@ def previous_colours(puzzle: BTPuzzle, index: int, limits: Any, mirrors: str) ->
             f"p{i}": Shape(sorted(c for c, _ in p))
             for i, p in enumerate(sorted(assembly, key=sorted))
         }
-        if analyze(shapes, limits=limits, optimal=False).disassemblable:
+        if analyze_assembly(shapes, limits=limits, optimal=False).disassemblable:
             out["solutions"] += 1
             first = first or shapes
     if first is not None:
@@ -243,20 +243,20 @@ def _timed(fn: Callable[[], dict[str, Any]], repeat: int) -> tuple[float, dict[s
 def _warm_up() -> None:
     """Compile every kernel both engines use (bit-board, dancing links, movement)."""
     from chaingeo.generator.bt_examples import linked_rings
-    from chaingeo.solvers.analysis import problem_figures
+    from chaingeo.solvers.analysis import problem_analysis_row
     from chaingeo.solvers.assembly.btassemble import bt_packing_spec
     from chaingeo.solvers.cover.constrained import compile_packing
     from chaingeo.solvers.cover.search import CoverSearch
     from chaingeo.solvers.limits import SearchLimits
 
     puzzle = linked_rings()
-    problem_figures(puzzle, 0, SearchLimits(), True, True)
+    problem_analysis_row(puzzle, 0, SearchLimits(), True, True)
     previous_plain(puzzle, 0, SearchLimits(max_states=1000), "keep")
     CoverSearch(compile_packing(bt_packing_spec(puzzle, 0)).problem, engine="dlx").count()
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.solvers.analysis import problem_figures
+    from chaingeo.solvers.analysis import problem_analysis_row
     from chaingeo.solvers.assembly.btassemble import Mirrors
     from chaingeo.solvers.limits import SearchLimits
 
@@ -268,7 +268,7 @@ def run(args: argparse.Namespace) -> int:
     for name, puzzle, index, mirrors in _instances(args.quick):
         mode: Mirrors = "drop" if mirrors == "drop" else "keep"
         ours_s, ours = _timed(
-            partial(problem_figures, puzzle, index, limits, False, True, mode), args.repeat
+            partial(problem_analysis_row, puzzle, index, limits, False, True, mode), args.repeat
         )
         colours = bool(puzzle.colors and puzzle.problems[index].color_pairs)
         previous = previous_colours if colours else previous_plain

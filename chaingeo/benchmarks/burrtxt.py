@@ -131,7 +131,7 @@ def instances(folder: Path, quick: bool) -> list[Instance]:
     from chaingeo.core.formats.burrtools import read_xmpuzzle, write_xmpuzzle
     from chaingeo.core.level import load_levels
     from chaingeo.core.rules import PuzzleRules
-    from chaingeo.core.suite import shipped_levels
+    from chaingeo.core.suite import suite_folder
     from chaingeo.generator.bt_examples import EXAMPLES
 
     out: list[Instance] = []
@@ -144,7 +144,7 @@ def instances(folder: Path, quick: bool) -> list[Instance]:
         path = write_xmpuzzle(puzzle, folder / f"{name}.xmpuzzle")
         n = len(puzzle.problems)
         out.extend(Instance(f"{name}#{i}" if n > 1 else name, path, i) for i in range(n))
-    for level in load_levels(shipped_levels("puzzle")):
+    for level in load_levels(suite_folder("puzzle")):
         if isinstance(level.rules, PuzzleRules) and level.rules.turns:
             continue  # BurrTools has no turns
         path = write_xmpuzzle(level_puzzle(level), folder / f"{level.id}.xmpuzzle")

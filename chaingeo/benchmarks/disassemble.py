@@ -24,7 +24,7 @@ from collections.abc import Mapping
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, legal_moves, state_key
 from chaingeo.core.level import Level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 
 
 def reference_rate(
@@ -87,7 +87,7 @@ def _instances(quick: bool) -> list[Instance]:
     from chaingeo.generator.puzzle import make
 
     out: list[Instance] = []
-    suite = shipped_levels("puzzle")
+    suite = suite_folder("puzzle")
     levels = load_levels(suite) if suite.is_dir() else []
     for lv in levels[:3] if quick else levels:
         mg = lv.rules.max_group if isinstance(lv.rules, PuzzleRules) else None

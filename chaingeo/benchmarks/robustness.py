@@ -30,7 +30,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from chaingeo.core.level import Level, load_level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.machines.state import BaseState, StepResult
 from chaingeo.evaluation.agents.tools import tool_specs, translate
@@ -219,7 +219,7 @@ def fuzz_states() -> list[BaseState]:
     """Each fuzzed level at its start and halfway along its stored plan."""
     out: list[BaseState] = []
     for family, name in LEVEL_FILES:
-        level: Level = load_level(shipped_levels(family) / name)
+        level: Level = load_level(suite_folder(family) / name)
         state = new_state(level)
         out.append(state.clone())
         plan = _plan_texts(level)

@@ -22,7 +22,7 @@ from typing import Any
 from chaingeo.core.kinematics import Assembly, legal_turns
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.rules import PuzzleRules
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.machines.puzzle import PuzzleState
 from chaingeo.envs.machines.puzzle_actions import turn_actions
 from chaingeo.evaluation.agents.base import AgentSpec
@@ -61,7 +61,7 @@ def _span(asm: Assembly) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
-    suite = shipped_levels("puzzle")
+    suite = suite_folder("puzzle")
     levels = sorted(load_levels(suite) if suite.is_dir() else [], key=lambda lv: lv.id)
     turning = [lv for lv in levels if isinstance(lv.rules, PuzzleRules) and lv.rules.turns]
     if not turning:

@@ -21,11 +21,11 @@ def is_level_file(spec: str | Path) -> bool:
 def find_level(spec: str | Path, folder: Path | None = None) -> Level:
     """The level in file ``spec``, else the level whose id is ``spec`` under ``folder``."""
     from chaingeo.core.level import load_level, load_levels
-    from chaingeo.core.suite import shipped_levels
+    from chaingeo.core.suite import suite_folder
 
     if is_level_file(spec):
         return load_level(spec)
-    root = folder if folder is not None else shipped_levels()
+    root = folder if folder is not None else suite_folder()
     if not root.is_dir():
         raise CommandError(f"no level file or level id {str(spec)!r} ({root} is no folder)")
     for path in sorted(root.rglob(f"{Path(spec).name}.json")):  # files are named by id
@@ -49,8 +49,8 @@ def add_level_list(p: argparse.ArgumentParser) -> None:
 def levels_of(args: argparse.Namespace) -> list[Level]:
     """The levels named by :func:`add_level_list`'s arguments."""
     from chaingeo.core.level import load_levels
-    from chaingeo.core.suite import shipped_levels
+    from chaingeo.core.suite import suite_folder
 
     if args.levels:
         return [find_level(spec, args.folder) for spec in args.levels]
-    return load_levels(args.folder if args.folder is not None else shipped_levels())
+    return load_levels(args.folder if args.folder is not None else suite_folder())

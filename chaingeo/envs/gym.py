@@ -50,7 +50,7 @@ from gymnasium import spaces
 
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.limits import MAX_OBSERVATION_CHARS, MAX_STACKING_ACTIONS, LimitError
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.envs.actions.text_space import ObservationText
 from chaingeo.envs.actions.types import Action
 from chaingeo.envs.frames import Frame, FrameCache, picture_names
@@ -63,7 +63,7 @@ from chaingeo.envs.render.scene import MIN_SIZE
 CHARSET: Final = frozenset(c for c in string.printable if c not in "\x0b\x0c\r")
 ACTION_MAX_LENGTH: Final = 1024
 OBSERVATION_MAX_LENGTH: Final = MAX_OBSERVATION_CHARS
-DEFAULT_LEVELS: Final = shipped_levels()
+DEFAULT_LEVELS: Final = suite_folder()
 
 
 #: Every character outside :data:`CHARSET` (printable ASCII less \x0b \x0c \r), one at a time.

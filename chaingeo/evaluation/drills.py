@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any, Final
 
 from chaingeo.core.level import Level, load_level
-from chaingeo.core.suite import shipped_levels
+from chaingeo.core.suite import suite_folder
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import ProtocolConfig
 from chaingeo.evaluation.hostile_server import Served, serve
@@ -134,7 +134,7 @@ class _Outcome:
 
 
 def _levels() -> list[Level]:
-    return [load_level(shipped_levels(family) / name) for family, name in LEVELS]
+    return [load_level(suite_folder(family) / name) for family, name in LEVELS]
 
 
 def run_drill(drill: Drill, levels: Sequence[Level], work: Path) -> dict[str, Any]:

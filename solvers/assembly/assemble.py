@@ -20,7 +20,7 @@ from chaingeo.solvers.cover.packings import iter_packings
 from chaingeo.solvers.cover.problem import PieceSpec
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, analyze
+from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
 
 
 @dataclass(frozen=True)
@@ -93,7 +93,7 @@ def count_assemblies(
     )
     for asm in assemblies:
         n_asm += 1
-        result: Analysis = analyze(
+        result: Analysis = analyze_assembly(
             asm, max_group=max_group, limits=limits, optimal=False, deadline=deadline
         )
         if result.disassemblable:

@@ -13,7 +13,8 @@ The search is cut by symmetry first: an anchor (a piece used exactly once, else 
 and the rotations keeping it in place) keeps one placement per orbit, so every class is met at
 least once; canonical keys (:func:`chaingeo.solvers.cover.constrained.canonical_keys`) then keep
 each class once, the first met in the engine's fixed order. *Solutions* are the classes the
-disassembler takes apart (:func:`chaingeo.solvers.motion.disassemble.analyze`; with piece groups
+disassembler takes apart (:func:`chaingeo.solvers.motion.disassemble.analyze_assembly`; with piece
+groups
 :func:`chaingeo.solvers.assembly.groups.analyze_grouped`), under the same moves as everything else
 here.
 
@@ -48,7 +49,7 @@ from chaingeo.solvers.cover.search import CoverSearch
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion.btorient import BTImage
-from chaingeo.solvers.motion.disassemble import Analysis, Separations, analyze
+from chaingeo.solvers.motion.disassemble import Analysis, Separations, analyze_assembly
 
 Mirrors = Literal["keep", "drop"]
 
@@ -266,8 +267,10 @@ def disassemble(
 ) -> Analysis:
     """The disassembler's verdict on one assembly (level and moves), groups honoured
     (``groups``: :func:`piece_groups` of the packing, when the caller has it already;
-    ``deadline``: the analysis' shared one, else one of ``limits.seconds``;
-    ``separations``: see :func:`chaingeo.solvers.motion.disassemble.analyze`). Pieces are searched
+    ``deadline``: the analysis' shared one, else one of
+    ``limits.seconds``;
+    ``separations``: see :func:`chaingeo.solvers.motion.disassemble.analyze_assembly`). Pieces are
+    searched
     in the assembly's order (:func:`named_assembly`: BurrTools')."""
     groups = piece_groups(packing) if groups is None else groups
     order = list(assembly)
@@ -276,7 +279,7 @@ def disassemble(
             assembly, groups, max_group=max_group, limits=limits, deadline=deadline,
             separations=separations, order=order,
         )  # fmt: skip
-    return analyze(
+    return analyze_assembly(
         assembly, max_group=max_group, limits=limits, optimal=False, deadline=deadline,
         separations=separations, order=order, fallback=False,
     )  # fmt: skip

@@ -230,7 +230,8 @@ def count_bt(
     """BurrTools' assemblies and solutions of a packing, and the first solution. The search
     and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
     ``limits`` the enumeration has no time limit and each disassembly the default one).
-    ``separations``: see :func:`chaingeo.solvers.motion.disassemble.analyze`; ``levels``, when
+    ``separations``: see :func:`chaingeo.solvers.motion.disassemble.analyze_assembly`; ``levels``,
+    when
     given, gets every solution's level string in the order found. A cap reached raises its
     :class:`SearchLimitError`, or with ``partial`` ends the count: the report then holds what
     was counted (lower bounds) and the error. The running counts are kept in the deadline's

@@ -133,7 +133,7 @@ def analyze_grouped(
 ) -> Analysis:
     """Level and moves of an assembly under the group rule (``optimal_steps`` is None;
     ``deadline``, ``separations``, ``order``: as in
-    :func:`chaingeo.solvers.motion.disassemble.analyze`)."""
+    :func:`chaingeo.solvers.motion.disassemble.analyze_assembly`)."""
     solver = GroupedSolver(
         shapes, groups, max_group, limits or SearchLimits(), deadline, separations, order
     )

@@ -51,7 +51,7 @@ __all__ = [
     "SearchLimitError",
     "SearchLimits",
     "Separation",
-    "analyze",
+    "analyze_assembly",
     "fast_legal_moves",
     "move_rows",
 ]
@@ -504,7 +504,7 @@ def _decode(
     return build(root)
 
 
-def analyze(
+def analyze_assembly(
     shapes: Mapping[str, Shape],
     *,
     max_group: int | None = None,

@@ -1,6 +1,7 @@
 """A* over whole disassembly states: o_i, the fewest moves that take every piece apart.
 
-**The problem** (the quantity :func:`chaingeo.solvers.motion.disassemble.analyze` computes with
+**The problem** (the quantity :func:`chaingeo.solvers.motion.disassemble.analyze_assembly` computes
+with
 ``optimal=True``; rules of :mod:`chaingeo.core.kinematics`). A state is a partition of the pieces
 into *parts* plus, per part, its pieces' offsets relative to the part's first piece. A move
 translates a proper sub-group ``G`` of one part ``P`` along an axis by ``k >= 1`` (legal when

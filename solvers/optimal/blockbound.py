@@ -43,7 +43,7 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Assembly, Move, MoveError, SearchLimitError
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, analyze, translations
+from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly, translations
 
 
 def block_lower_bound(
@@ -81,7 +81,7 @@ def _block_plans(
             plans.append([])
             continue
         part = {n: shapes[n] for n in block}
-        result = analyze(part, max_group=1, limits=limits, optimal=True, deadline=deadline)
+        result = analyze_assembly(part, max_group=1, limits=limits, optimal=True, deadline=deadline)
         if result.optimal_steps is None:
             raise ValueError(f"block {sorted(block)} cannot be taken apart on its own")
         plans.append(translations(result.plan))
@@ -169,7 +169,8 @@ def analyze_by_blocks(
     search: bool = True,
     deadline: Deadline | None = None,
 ) -> Analysis:
-    """:func:`chaingeo.solvers.motion.disassemble.analyze` with single-piece moves and the block
+    """:func:`chaingeo.solvers.motion.disassemble.analyze_assembly` with single-piece moves and the
+    block
     bound: a plan whose length meets the bound is optimal. Tried in turn: the BurrTools-style plan,
     (when ``stacked``: the blocks form a stack along z, see :func:`end_first_plan`) the stack taken
     apart from its ends, and (when ``search``) the exact search, which stops once it meets
@@ -182,7 +183,7 @@ def analyze_by_blocks(
     if sorted(n for b in blocks for n in b) != names:
         raise ValueError("the blocks must split the pieces: every name in exactly one block")
     bound = len(names) - 1 + sum(len(p) - (len(b) - 1) for p, b in zip(plans, blocks, strict=True))
-    quick = analyze(shapes, max_group=1, limits=limits, optimal=False, deadline=deadline)
+    quick = analyze_assembly(shapes, max_group=1, limits=limits, optimal=False, deadline=deadline)
     if not quick.disassemblable:
         return quick
     if quick.moves == bound and (not stacked or removals_touch(shapes, translations(quick.plan))):
@@ -193,6 +194,6 @@ def analyze_by_blocks(
             return dataclasses.replace(quick, optimal_steps=bound, plan=tuple(plan))
     if not search:
         raise SearchLimitError(f"no quick plan meets the block bound {bound} (best {quick.moves})")
-    return analyze(
+    return analyze_assembly(
         shapes, max_group=1, limits=limits, optimal=True, lower_bound=bound, deadline=deadline
     )

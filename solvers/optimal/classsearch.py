@@ -48,7 +48,7 @@ from chaingeo.core.kinematics import Move, SearchLimitError
 from chaingeo.solvers.deadline import Deadline, deadline_of
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import movement as mv
-from chaingeo.solvers.motion.disassemble import Analysis, analyze
+from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable
 from chaingeo.solvers.optimal.classbound import MAX_BUDGET, ClassVectors, moved
 
@@ -318,14 +318,17 @@ def analyze_by_classes(
     limits: SearchLimits | None = None,
     deadline: Deadline | None = None,
 ) -> Analysis:
-    """:func:`chaingeo.solvers.motion.disassemble.analyze` of a puzzle made of ``blocks`` with moves
+    """:func:`chaingeo.solvers.motion.disassemble.analyze_assembly` of a puzzle made of ``blocks``
+    with moves
     of several pieces: level and moves from the BurrTools-style search, o_i and its plan from
     :func:`class_search_optimal` (``states`` counts both). Its caps come from ``limits``:
     ``max_total_states`` (default 1,000,000) expanded states, ``max_states`` class-vector
     states, one deadline of ``seconds`` for both searches."""
     lim = limits or SearchLimits()
     deadline = deadline_of(lim.seconds, deadline)
-    quick = analyze(shapes, max_group=max_group, limits=lim, optimal=False, deadline=deadline)
+    quick = analyze_assembly(
+        shapes, max_group=max_group, limits=lim, optimal=False, deadline=deadline
+    )
     if not quick.disassemblable:
         return quick
     caps = ClassSearchLimits(

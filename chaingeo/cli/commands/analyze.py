@@ -46,6 +46,7 @@ from chaingeo.cli.progress import ProgressLines
 
 if TYPE_CHECKING:
     from chaingeo.core.kinematics import SearchLimitError
+    from chaingeo.solvers.figures import PuzzleFigures
 
 #: Work an interpreted run may do before the command starts again with numba (seconds of the
 #: process' CPU time, so that a busy machine does not change the choice).
@@ -131,42 +132,38 @@ def _run_all(args: argparse.Namespace) -> int:
     status = 0
     for spec in args.files:
         try:
-            out = analyze_file(spec, args)
-            status = max(status, _cut_short(spec, out))
+            figures = analyze_file(spec, args)
+            status = max(status, _cut_short(spec, figures))
+            line = figures.to_json(LIMIT_FLAGS)
         except CommandError as e:
             if len(args.files) == 1:
                 raise
             print(f"chain analyze: {spec}: error: {e}", file=sys.stderr)
-            out, status = {"file": str(spec), "error": str(e)}, 2
-        print(json.dumps(out, sort_keys=True), flush=True)
+            line, status = json.dumps({"file": str(spec), "error": str(e)}, sort_keys=True), 2
+        print(line, flush=True)
     return status
 
 
-def _cut_short(spec: str, out: dict[str, Any]) -> int:
-    """Name the flag of every cap that cut counting short (``limit``) or the optimal search
-    (``optimal_error``), say so on stderr for counting, and
-    return the exit status: 1 when some count is a lower bound, else 0."""
-    status = 0
-    for row in [out, *out.get("problems", [])]:
-        if "optimal_limit_cap" in row:
-            row["optimal_error"] = with_flag(row["optimal_error"], row.pop("optimal_limit_cap"))
-        if "limit_cap" not in row:
-            continue
-        row["limit"] = with_flag(row["limit"], row.pop("limit_cap"))
+def _cut_short(spec: str, figures: PuzzleFigures) -> int:
+    """Say on stderr which cap cut counting short, naming its flag, and return the exit
+    status: 1 when some count is a lower bound, else 0."""
+    for row in figures.cut_short():
+        limit = with_flag(row.limit or "", row.limit_cap)
         print(
-            f"chain analyze: {spec}: counting stopped ({row['limit']}); the counts are lower "
+            f"chain analyze: {spec}: counting stopped ({limit}); the counts are lower "
             "bounds, the other figures are those of the known assembly",
             file=sys.stderr,
         )
-        status = 1
-    return status
+    return 1 if figures.cut_short() else 0
 
 
-def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
+def analyze_file(spec: str, args: argparse.Namespace) -> PuzzleFigures:
     """The figures of one file (``CommandError`` for any failure, with the reason)."""
+    from dataclasses import replace
+
     from chaingeo.core.errors import ChainGeoError
     from chaingeo.core.kinematics import SearchLimitError
-    from chaingeo.solvers.analysis import level_figures, xmpuzzle_figures
+    from chaingeo.solvers.analysis import analyze
     from chaingeo.solvers.deadline import Deadline
     from chaingeo.solvers.limits import SearchLimits
 
@@ -177,38 +174,23 @@ def analyze_file(spec: str, args: argparse.Namespace) -> dict[str, Any]:
     start = time.perf_counter()
     try:
         with ProgressLines(f"chain analyze: {spec}", deadline.progress):
-            if Path(spec).suffix == ".xmpuzzle":
-                out = xmpuzzle_figures(
-                    spec,
-                    args.problem,
-                    limits,
-                    not args.no_optimal,
-                    not args.no_assemble,
-                    args.mirrors,
-                    deadline,
-                )
-            else:
-                level = find_level(spec)
-                out = level_figures(
-                    level,
-                    limits,
-                    not args.no_optimal,
-                    not args.no_assemble,
-                    args.mirrors,
-                    deadline,
-                )
+            source = spec if Path(spec).suffix == ".xmpuzzle" else find_level(spec)
+            figures = analyze(
+                source,
+                limits=limits,
+                problem=args.problem,
+                optimal=not args.no_optimal,
+                assemble=not args.no_assemble,
+                mirrors=args.mirrors,
+                deadline=deadline,
+            )
     except SearchLimitError as e:
         raise CommandError(limit_message(e)) from None
     except (ChainGeoError, FileNotFoundError) as e:
         raise CommandError(str(e)) from None
     except (IndexError, RuntimeError, ValueError) as e:
         raise CommandError(str(e)) from None
-    from chaingeo.core.jit import mode
-
-    out["file"] = str(spec)
-    out["kernels"] = mode()
-    out["seconds"] = round(time.perf_counter() - start, 3)
-    return out
+    return replace(figures, file=str(spec), seconds=round(time.perf_counter() - start, 3))
 
 
 def limit_message(e: SearchLimitError) -> str:
@@ -218,8 +200,9 @@ def limit_message(e: SearchLimitError) -> str:
 
 def with_flag(reason: str, cap: str | None) -> str:
     """``reason`` and the flag that raises cap ``cap`` (a ``SearchLimits`` field), if any."""
-    flag = LIMIT_FLAGS.get(cap or "")
-    return f"{reason}; raise it with {flag}" if flag else reason
+    from chaingeo.solvers.figures import with_flag as with_option
+
+    return with_option(reason, cap, LIMIT_FLAGS)
 
 
 # -- interpreted kernels for one small file ---------------------------------------------------
@@ -284,14 +267,14 @@ def _run_interpreted(args: argparse.Namespace) -> int:
     previous = signal.signal(signal.SIGPROF, expire)
     signal.setitimer(signal.ITIMER_PROF, INTERPRETED_SECONDS)
     try:
-        out = analyze_file(args.files[0], args)
+        figures = analyze_file(args.files[0], args)
         signal.setitimer(signal.ITIMER_PROF, 0)
     except _TooLong:
         _restart_with_numba(args.command_line)
     finally:
         signal.signal(signal.SIGPROF, previous)
-    status = _cut_short(args.files[0], out)
-    print(json.dumps(out, sort_keys=True), flush=True)
+    status = _cut_short(args.files[0], figures)
+    print(figures.to_json(LIMIT_FLAGS), flush=True)
     return status
 
 

@@ -168,7 +168,7 @@ def _error_reasons(records: list[dict[str, Any]]) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.level import load_level, load_levels
-    from chaingeo.core.suite import shipped_levels
+    from chaingeo.core.suite import suite_folder
     from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
     from chaingeo.evaluation.agents.openai_chat import provider_fields
     from chaingeo.evaluation.agents.registry import BASELINES
@@ -178,7 +178,7 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.evaluation.runner import RunConfig, evaluate
     from chaingeo.evaluation.usage import PriceTable
 
-    source = args.levels or shipped_levels()
+    source = args.levels or suite_folder()
     if source.is_dir():
         levels = load_levels(source)
     elif source.exists():

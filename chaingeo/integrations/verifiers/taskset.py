@@ -19,7 +19,7 @@ import verifiers.v1 as vf
 from pydantic import Field
 
 from chaingeo.core.level import Level, LevelError, load_level
-from chaingeo.core.suite import FAMILIES, shipped_levels
+from chaingeo.core.suite import FAMILIES, suite_folder
 from chaingeo.integrations.game import (
     DEFAULT_WEIGHTS,
     Game,
@@ -119,7 +119,7 @@ def select_levels(config: ChainGeoConfig) -> list[tuple[Path, Level]]:
         folders = [Path(config.level_dir)]
     else:
         families = FAMILIES if config.family is None else (config.family,)
-        folders = [shipped_levels(f) for f in families]
+        folders = [suite_folder(f) for f in families]
     found = [(p, load_level(p)) for folder in folders for p in sorted(folder.rglob("*.json"))]
     ids = [lv.id for _, lv in found]
     if len(set(ids)) != len(ids):
