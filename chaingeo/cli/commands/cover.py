@@ -68,7 +68,7 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
         except KeyError as e:
             level = _shipped_level(source)
             if level is None:
-                raise CommandError(f"--pieces: no such file, and {e.args[0]}") from None
+                raise CommandError(f"--pieces: no such file or level id, and {e.args[0]}") from None
             return dict(level.shapes), level.box
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
