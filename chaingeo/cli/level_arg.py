@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 import itertools
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from chaingeo.cli.errors import CommandError
 
@@ -18,10 +18,10 @@ if TYPE_CHECKING:
 LEVEL_HELP = "a chain-level/1 file or the id of a shipped level"
 
 
-def add_level(p: argparse.ArgumentParser, name: str = "level", **kwargs: str) -> None:
+def add_level(p: argparse.ArgumentParser, name: str = "level", **kwargs: Any) -> None:
     """The positional LEVEL: a file or an id, resolved by :func:`find_level`."""
     kwargs.setdefault("help", LEVEL_HELP)
-    p.add_argument(name, **kwargs)  # type: ignore[arg-type]
+    p.add_argument(name, **kwargs)
 
 
 def find_level(spec: str | Path, folder: Path | None = None) -> Level:
