@@ -51,7 +51,7 @@ TAKES_A_LEVEL: dict[str, tuple[list[str], int]] = {
         ["export-dataset", "{stacking}", "--out", "{tmp}/ds", "--image-size", "128"],
         0,
     ),
-    "analyze": (["analyze", "{small}", "--jit", "python"], 0),
+    "analyze": (["analyze", "{small}"], 0),
 }
 
 
