@@ -158,3 +158,21 @@ def test_convert_positional_target_is_deprecated_but_works(
     ]
     assert main(["convert", PUZZLE, str(old), "--to", "xmpuzzle", "--out", str(new)]) == 2
     assert "give the file to write once" in capsys.readouterr().err
+
+
+def test_a_levels_folder_is_levels_everywhere_and_folder_still_works(
+    suite: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    stacking = str(suite / "stacking")
+    assert main(["demos", "--levels", stacking]) == 0
+    new = capsys.readouterr()
+    assert "warning" not in new.err and new.out.count("\n") == 2  # one level, two steps
+    assert main(["demos", "--folder", stacking]) == 0
+    old = capsys.readouterr()
+    assert old.out == new.out
+    assert old.err == (
+        "chain demos: warning: --folder is deprecated and goes in the next release; "
+        "write --levels\n" + new.err
+    )
+    assert main(["demos", "--levels", str(suite / "puzzle"), STACKING]) == 2
+    assert f"no level file or level id {STACKING!r}" in capsys.readouterr().err

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from chaingeo.cli.errors import CommandError
 
@@ -68,11 +70,44 @@ def _search(spec: str, root: Path) -> tuple[Path, Level] | None:
 
 
 def add_level_list(p: argparse.ArgumentParser) -> None:
-    """``[LEVELS...] --folder DIR``: level files or ids, by default every level of the folder."""
+    """``[LEVEL...] --levels DIR``: level files or ids, by default every level of the folder
+    (``--levels``, as in ``chain play`` and ``chain eval``; ``--folder`` is its old name)."""
     p.add_argument(
-        "levels", nargs="*", help="level files or ids (default: every level under --folder)"
+        "levels",
+        nargs="*",
+        metavar="LEVEL",
+        help="level files or ids (default: every level under --levels)",
     )
-    p.add_argument("--folder", type=Path, default=None, help="levels folder (default: shipped)")
+    p.add_argument(
+        "--levels",
+        dest="folder",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="folder of levels, where ids are looked up (default: the shipped suite)",
+    )
+    p.add_argument("--folder", dest="folder", type=Path, action=Renamed, help=argparse.SUPPRESS)
+
+
+class Renamed(argparse.Action):
+    """An option's old name: still taken for a release, with a warning naming the new one."""
+
+    NEW: ClassVar[dict[str, str]] = {"--folder": "--levels"}
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
+        new = self.NEW.get(option_string or "", "")
+        print(
+            f"{parser.prog}: warning: {option_string} is deprecated and goes in the next "
+            f"release; write {new}",
+            file=sys.stderr,
+        )
+        setattr(namespace, self.dest, values)
 
 
 def levels_of(args: argparse.Namespace) -> list[Level]:
