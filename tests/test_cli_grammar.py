@@ -52,6 +52,19 @@ TAKES_A_LEVEL: dict[str, tuple[list[str], int]] = {
         0,
     ),
     "analyze": (["analyze", "{small}"], 0),
+    "eval": (
+        [
+            "eval",
+            "--levels",
+            "{stacking}",
+            "--agent",
+            "oracle",
+            "--out",
+            "{tmp}/r",
+            "--no-progress",
+        ],
+        0,
+    ),
 }
 
 

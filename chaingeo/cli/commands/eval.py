@@ -44,7 +44,9 @@ def register(sub: Any) -> None:
         "--levels",
         type=Path,
         default=None,
-        help="level file or folder (default: the shipped suite)",
+        metavar="LEVELS",
+        help="a folder of levels, a chain-level/1 file or the id of a shipped level (default: "
+        "the shipped suite)",
     )
     p.add_argument(
         "--agent",
@@ -173,7 +175,8 @@ def _error_reasons(records: list[dict[str, Any]]) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.core.level import load_level, load_levels
+    from chaingeo.cli.level_arg import find_level
+    from chaingeo.core.level import load_levels
     from chaingeo.core.suite import shipped_levels
     from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
     from chaingeo.evaluation.agents.openai_chat import provider_fields
@@ -185,12 +188,8 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.evaluation.usage import PriceTable
 
     source = args.levels or shipped_levels()
-    if source.is_dir():
-        levels = load_levels(source)
-    elif source.exists():
-        levels = [load_level(source)]
-    else:
-        raise CommandError(f"{source}: no such level file or folder")
+    # a folder of levels, else one level: a file or the id of a shipped level
+    levels = load_levels(source) if source.is_dir() else [find_level(source)]
     if args.family:
         levels = [lv for lv in levels if lv.family == args.family]
     if args.difficulty:
