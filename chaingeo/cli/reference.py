@@ -10,7 +10,7 @@ import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from chaingeo.cli.help_format import HelpFormatter, is_required, shown_default
+from chaingeo.cli.help_format import HelpFormatter, shown_default
 from chaingeo.cli.main import build_parser
 
 #: Where the reference lives, relative to the repository root.
@@ -67,9 +67,12 @@ def _row(parser: argparse.ArgumentParser, action: argparse.Action) -> str:
     params = {**vars(action), "prog": parser.prog}
     text = (action.help or "") % params
     default = shown_default(action)
+    one_of = any(
+        g.required and action in g._group_actions for g in parser._mutually_exclusive_groups
+    )
     cells = [
         f"`{invocation}`",
-        "yes" if is_required(action) else "",
+        "yes" if action.required else "one of" if one_of else "",
         "" if default is None else f"`{default}`",
         _cell(text),
     ]
