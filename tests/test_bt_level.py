@@ -69,7 +69,7 @@ def test_convert_takes_a_level_id_or_file_and_writes_the_same_bytes(
     by_id, by_file = tmp_path / "a.xmpuzzle", tmp_path / "b.xmpuzzle"
     assert main(["convert", level.id, "--to", "xmpuzzle", "--out", str(by_id)]) == 0
     source = suite_folder("puzzle") / f"{level.id}.json"
-    assert main(["convert", str(source), str(by_file), "--to", "xmpuzzle"]) == 0
+    assert main(["convert", str(source), "--out", str(by_file), "--to", "xmpuzzle"]) == 0
     assert by_id.read_bytes() == by_file.read_bytes()
     capsys.readouterr()
     turned = tmp_path / "c.xmpuzzle"

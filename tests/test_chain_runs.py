@@ -91,7 +91,10 @@ def test_our_default_profile_refuses_the_floating_pickup_chain_allows() -> None:
 def test_tray_file_becomes_a_verified_level(tmp_path: Path) -> None:
     target = tmp_path / "level.json"
     source = DATA / "tray_2x2x3_easy_001.json"
-    assert main(["convert", "--from", "chain", str(source), str(target), "--rules", "chain"]) == 0
+    assert (
+        main(["convert", "--from", "chain", str(source), "--out", str(target), "--rules", "chain"])
+        == 0
+    )
     level = load_level(target)  # validated in full on load
     assert level.id == "tray_2x2x3_easy_001" and level.difficulty == "easy"
     assert level.rules == StackingRules(profile="chain") and level.optimal_steps == 3
@@ -124,7 +127,16 @@ def test_packed_file_still_converts_and_keeps_its_packing(
 def test_old_flag_reads_tray_files_too(tmp_path: Path) -> None:
     target = tmp_path / "t.json"
     source = DATA / "tray_2x2x3_easy_001.json"
-    args = ["convert", str(source), str(target), "--to", "chain-level", "--difficulty", "hard"]
+    args = [
+        "convert",
+        str(source),
+        "--out",
+        str(target),
+        "--to",
+        "chain-level",
+        "--difficulty",
+        "hard",
+    ]
     assert main(args) == 0
     assert load_level(target).difficulty == "hard"
 
@@ -152,7 +164,7 @@ def test_bad_chain_files_give_one_line_errors(
 ) -> None:
     path = tmp_path / "bad.json"
     path.write_text(json.dumps(data))
-    assert main(["convert", "--from", "chain", str(path), str(tmp_path / "out.json")]) != 0
+    assert main(["convert", "--from", "chain", str(path), "--out", str(tmp_path / "out.json")]) != 0
     err = capsys.readouterr().err
     assert why in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "out.json").exists()

@@ -60,7 +60,7 @@ def test_validate_and_convert(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     lines = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert lines[0]["id"] == "bedlam-known" and lines[-1]["levels"] == 1
     orig = tmp_path / "orig.json"
-    assert main(["convert", str(path), str(orig), "--to", "chain-json"]) == 0
+    assert main(["convert", str(path), "--out", str(orig), "--to", "chain-json"]) == 0
     assert json.loads(orig.read_text()) == export_chain_stacking(level)
     back = tmp_path / "back.json"
     assert (
@@ -68,6 +68,7 @@ def test_validate_and_convert(tmp_path: Path, capsys: pytest.CaptureFixture[str]
             [
                 "convert",
                 str(orig),
+                "--out",
                 str(back),
                 "--to",
                 "chain-level",

@@ -72,7 +72,7 @@ def test_every_command_refuses_a_non_finite_level_by_name(
     out = str(tmp_path / "out.json")
     for argv in (
         ["validate", str(path)],
-        ["convert", str(path), out, "--to", "chain-json"],
+        ["convert", str(path), "--out", out, "--to", "chain-json"],
         ["play", str(path), "--no-images"],
     ):
         assert main(argv) == 2, argv

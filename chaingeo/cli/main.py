@@ -14,10 +14,10 @@ import importlib
 import pkgutil
 import sys
 from collections.abc import Sequence
-from typing import Any
 
 import chaingeo.cli.commands
 from chaingeo import __version__
+from chaingeo.cli.help_format import CommandParser, HelpFormatter
 from chaingeo.core.errors import ChainGeoError
 
 # At exit, the interpreter's last collections walk every object numba and numpy created (about
@@ -31,35 +31,18 @@ COMMANDS: tuple[str, ...] = tuple(
 )
 
 
-class _HelpFormatter(argparse.RawDescriptionHelpFormatter):
-    """Every option's default in its help (none for flags and options without one);
-    descriptions kept as written."""
-
-    def _get_help_string(self, action: argparse.Action) -> str | None:
-        text = action.help or ""
-        default = action.default
-        hidden = text == argparse.SUPPRESS or default in (None, False, argparse.SUPPRESS)
-        if "%(default)" in text or hidden or default == [] or not text:
-            return action.help
-        if action.option_strings or action.nargs in ("?", "*"):
-            return f"{text} (default: %(default)s)"
-        return action.help
-
-
-class CommandParser(argparse.ArgumentParser):
-    """A subcommand's parser: its ``--help`` shows every default."""
-
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        kwargs.setdefault("formatter_class", _HelpFormatter)
-        super().__init__(*args, **kwargs)
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="chain",
         description="CHAIN-geo: exact discrete-geometry levels, solvers and agent evaluation.",
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--version", action="version", version=f"chain {__version__}")
+    parser.add_argument(
+        "--version",
+        action="version",
+        version=f"chain {__version__}",
+        help="print chaingeo's version",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=CommandParser)
     for name in COMMANDS:
         importlib.import_module(name).register(sub)

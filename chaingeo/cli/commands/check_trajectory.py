@@ -8,6 +8,8 @@ import argparse
 import json
 from typing import Any
 
+from chaingeo.cli.level_arg import add_level
+
 
 def register(sub: Any) -> None:
     p = sub.add_parser(
@@ -20,7 +22,7 @@ def register(sub: Any) -> None:
         '{"valid", "violations": [{"kind", "frame", "piece", "reason"}], "undecided", "plan", '
         '"goal"}.',
     )
-    p.add_argument("level", help="a chain-level/1 file or the id of a shipped level")
+    add_level(p)
     p.add_argument("trajectory", help="a chain-trajectory/1 JSON file")
     p.add_argument(
         "--max-jump",

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 from chaingeo.cli.errors import CommandError
 from chaingeo.cli.level_arg import find_level
+from chaingeo.cli.out_arg import add_out
 
 if TYPE_CHECKING:  # the command imports its work lazily, so `chain --help` stays fast
     from chaingeo.core.formats.chain_json import ChainStacking
@@ -31,6 +32,11 @@ if TYPE_CHECKING:  # the command imports its work lazily, so `chain --help` stay
 
 #: Exact-cover nodes allowed when packing a tray file (CHAIN's hardest levels need thousands).
 PACK_NODE_LIMIT = 50_000_000
+#: Said on standard error when the file to write comes positionally (the old grammar).
+DEPRECATED_TARGET = (
+    "chain convert: warning: a positional TARGET is deprecated and goes in the next release; "
+    "write --out {target}"
+)
 _DIFFICULTY_RE = re.compile(r"(?:^|[_\-.])(easy|mid|hard)(?:$|[_\-.])")
 
 
@@ -39,15 +45,16 @@ def register(sub: Any) -> None:
         "convert",
         help="import/export CHAIN's stacking JSON; export any level as a BurrTools .xmpuzzle",
     )
-    p.add_argument("source", help="the file to read (for an export: a level file or level id)")
     p.add_argument(
-        "target",
-        type=Path,
-        nargs="?",
-        help="the file to write (default: the level on standard output); same as --out",
+        "source",
+        help="the file to read: on import CHAIN's level file; on export a chain-level/1 file "
+        "or the id of a shipped level",
     )
-    p.add_argument("--out", type=Path, default=None, help="the file to write")
-    direction = p.add_mutually_exclusive_group(required=True)
+    # Deprecated (one release): the file to write, as --out; hidden from the help.
+    p.add_argument("target", type=Path, nargs="?", help=argparse.SUPPRESS)
+    add_out(p, "file", "the level (import; default: standard output) or the exported file")
+    required = p.add_argument_group("direction (required: one of)")
+    direction = required.add_mutually_exclusive_group(required=True)
     direction.add_argument(
         "--to",
         choices=("chain-level", "chain-json", "xmpuzzle"),
@@ -76,16 +83,18 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.out is not None:
-        if args.target is not None and args.target != args.out:
+    if args.target is not None:
+        if args.out is not None and args.target != args.out:
             raise CommandError("give the file to write once: as TARGET or as --out")
+        print(DEPRECATED_TARGET.format(target=args.target), file=sys.stderr)
+    else:
         args.target = args.out
     from chaingeo.core.formats.chain_json import write_chain_stacking
     from chaingeo.core.level import level_bytes, save_level
 
     if args.to in ("chain-json", "xmpuzzle"):
         if args.target is None:
-            raise CommandError(f"--to {args.to} needs a target file")
+            raise CommandError(f"--to {args.to} needs a target file (--out FILE)")
         level = find_level(args.source)
         if args.to == "xmpuzzle":
             export_xmpuzzle(level, args.target)

@@ -13,9 +13,12 @@ import argparse
 import json
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from chaingeo.cli.errors import CommandError
+
+if TYPE_CHECKING:
+    from chaingeo.core.level import Level
 
 
 def register(sub: Any) -> None:
@@ -23,11 +26,14 @@ def register(sub: Any) -> None:
     p.add_argument(
         "--pieces",
         required=True,
-        help="a built-in piece set (soma, pentominoes, bedlam), a level file, or a JSON file "
-        "holding a list (or a name -> voxels mapping) of voxel lists",
+        help="a built-in piece set (soma, pentominoes, bedlam), a level file or the id of a "
+        "shipped level, or a JSON file holding a list (or a name -> voxels mapping) of voxel "
+        "lists",
     )
     p.add_argument("--box", help="box size AxBxC (default: the level file's box)")
-    p.add_argument("--engine", choices=("auto", "dlx", "bitboard"), default="auto")
+    p.add_argument(
+        "--engine", choices=("auto", "dlx", "bitboard"), default="auto", help="exact-cover engine"
+    )
     p.add_argument(
         "--rotations-only", action="store_true", help="count distinct up to rotations only"
     )
@@ -60,7 +66,10 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
         try:
             return dict(get_pieceset(source).pieces), None
         except KeyError as e:
-            raise CommandError(f"--pieces: no such file, and {e.args[0]}") from None
+            level = _shipped_level(source)
+            if level is None:
+                raise CommandError(f"--pieces: no such file or level id, and {e.args[0]}") from None
+            return dict(level.shapes), level.box
     try:
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
@@ -83,6 +92,16 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
     if not pieces:
         raise CommandError(f"--pieces: {source} holds no pieces")
     return pieces, None
+
+
+def _shipped_level(spec: str) -> Level | None:
+    """The shipped level of id ``spec``, if any (an unknown name is the piece-set error)."""
+    from chaingeo.cli.level_arg import find_level
+
+    try:
+        return find_level(spec)
+    except CommandError:
+        return None
 
 
 def run(args: argparse.Namespace) -> int:

@@ -14,15 +14,17 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from chaingeo.cli.out_arg import add_out
+
 
 def register(sub: Any) -> None:
     from chaingeo.cli.level_arg import add_level_list
 
     p = sub.add_parser("demos", help="write demonstrations (optimal plans replayed) as JSONL")
     add_level_list(p)
-    p.add_argument("--out", default="-", help="JSONL file to write (default -, standard output)")
+    add_out(p, "file", "the JSONL demonstrations; - for standard output", default="-", type=str)
     p.add_argument("--text-state", action="store_true", help="show every piece's cells too")
-    p.add_argument("--history", type=int, default=5, help="recent turns shown (default 5)")
+    p.add_argument("--history", type=int, default=5, help="recent turns shown")
     p.set_defaults(func=run)
 
 

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from chaingeo.cli.errors import CommandError
+from chaingeo.cli.out_arg import add_out
 
 
 def register(sub: Any) -> None:
@@ -43,7 +44,9 @@ def register(sub: Any) -> None:
         "--levels",
         type=Path,
         default=None,
-        help="level file or folder (default: the shipped suite)",
+        metavar="LEVELS",
+        help="a folder of levels, a chain-level/1 file or the id of a shipped level (default: "
+        "the shipped suite)",
     )
     p.add_argument(
         "--agent",
@@ -79,7 +82,12 @@ def register(sub: Any) -> None:
         help="request body field for the model server (VALUE read as JSON when it parses), e.g."
         " reasoning_effort=high or extra_body='{\"top_k\": 20}', repeatable",
     )
-    p.add_argument("--protocol", choices=("interactive", "oneshot", "both"), default="interactive")
+    p.add_argument(
+        "--protocol",
+        choices=("interactive", "oneshot", "both"),
+        default="interactive",
+        help="turn by turn with feedback, or the whole plan at once",
+    )
     p.add_argument("--samples", type=int, default=1, help="episodes per level (Pass@k, Avg@k)")
     p.add_argument("--candidates", type=int, default=1, help="candidates per turn (verifier)")
     p.add_argument(
@@ -94,19 +102,19 @@ def register(sub: Any) -> None:
         metavar="KEY=VALUE",
         help="judge option, e.g. model=NAME base_url=URL (for --judge model), repeatable",
     )
-    p.add_argument("--history-window", type=int, default=5)
+    p.add_argument("--history-window", type=int, default=5, help="recent turns shown")
     p.add_argument("--text-state", action="store_true", help="add every piece's cells as text")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of the agents' randomness")
     p.add_argument("--jobs", type=int, default=1, help="episodes in parallel (processes)")
     p.add_argument("--dask", metavar="ADDRESS", help="run episodes on a Dask scheduler")
     p.add_argument("--family", choices=("stacking", "puzzle"), help="only this family")
     p.add_argument("--difficulty", choices=("easy", "mid", "hard"), help="only this tier")
     p.add_argument("--limit", type=int, help="only the first N levels (by id)")
-    p.add_argument("--out", type=Path, help="folder for the run directories (runs/<time>)")
+    add_out(p, "folder", "the run directories (default: runs/<time>)")
     p.add_argument("--resume", action="store_true", help="continue the runs in --out")
     p.add_argument("--retry-errors", action="store_true", help="with --resume: rerun errors")
     p.add_argument("--prices", action="append", default=[], help="extra price table (JSON)")
-    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument(
         "--allow-errors",
         action="store_true",
@@ -167,7 +175,8 @@ def _error_reasons(records: list[dict[str, Any]]) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.core.level import load_level, load_levels
+    from chaingeo.cli.level_arg import find_level
+    from chaingeo.core.level import load_levels
     from chaingeo.core.suite import suite_folder
     from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
     from chaingeo.evaluation.agents.openai_chat import provider_fields
@@ -179,12 +188,8 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.evaluation.usage import PriceTable
 
     source = args.levels or suite_folder()
-    if source.is_dir():
-        levels = load_levels(source)
-    elif source.exists():
-        levels = [load_level(source)]
-    else:
-        raise CommandError(f"{source}: no such level file or folder")
+    # a folder of levels, else one level: a file or the id of a shipped level
+    levels = load_levels(source) if source.is_dir() else [find_level(source)]
     if args.family:
         levels = [lv for lv in levels if lv.family == args.family]
     if args.difficulty:

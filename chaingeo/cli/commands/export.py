@@ -7,6 +7,9 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from chaingeo.cli.level_arg import add_level
+from chaingeo.cli.out_arg import add_out
+
 #: The same as :data:`chaingeo.envs.render.mesh.FORMATS` (kept here so ``chain --help`` loads no
 #: mesh code).
 FORMATS = ("glb", "stl", "obj")
@@ -14,17 +17,17 @@ FORMATS = ("glb", "stl", "obj")
 
 def register(sub: Any) -> None:
     p = sub.add_parser("export", help="write a level's pieces (solved) as a GLB, STL or OBJ mesh")
-    p.add_argument("level", type=Path, help="a chain-level/1 file")
-    p.add_argument("--format", choices=FORMATS, default="glb", help="mesh format (default glb)")
-    p.add_argument("--out", type=Path, help="output file (default: LEVEL_ID.FORMAT here)")
+    add_level(p)
+    p.add_argument("--format", choices=FORMATS, default="glb", help="mesh format")
+    add_out(p, "file", "the mesh (default: LEVEL_ID.FORMAT here)")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.core.level import load_level
+    from chaingeo.cli.level_arg import find_level
     from chaingeo.envs.render.mesh import export_level
 
-    level = load_level(args.level)
+    level = find_level(args.level)
     target: Path = args.out or Path(f"{level.id}.{args.format}")
     data = export_level(level, args.format)
     target.parent.mkdir(parents=True, exist_ok=True)

@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 from typing import Any
+
+from chaingeo.cli.out_arg import add_out
 
 
 def register(sub: Any) -> None:
@@ -22,7 +23,7 @@ def register(sub: Any) -> None:
         "export-dataset", help="write levels and demonstrations as a Hugging Face dataset folder"
     )
     add_level_list(p)
-    p.add_argument("--out", type=Path, required=True, help="dataset folder to write")
+    add_out(p, "folder", "the dataset (data files and README.md card)", required=True)
     p.add_argument(
         "--split",
         default="test",

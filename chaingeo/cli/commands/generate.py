@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from chaingeo.cli.errors import CommandError
+from chaingeo.cli.out_arg import add_out
 
 
 def register(sub: Any) -> None:
@@ -31,16 +32,16 @@ def register(sub: Any) -> None:
 def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
     """Options every family shares: how many, which seed, where, on what."""
     if count:
-        p.add_argument("--count", type=int, default=10, help="levels to accept (default 10)")
+        p.add_argument("--count", type=int, default=10, help="levels to accept")
         p.add_argument("--seed", type=int, default=0, help="item i uses SeedSequence([seed, i])")
-        p.add_argument("--out", type=Path, required=True, help="output folder")
+        add_out(p, "folder", "the levels (and their pictures)", required=True)
         p.add_argument(
             "--max-items",
             type=int,
             default=None,
             help="most items to try (default: 10 x count, at least 100)",
         )
-        p.add_argument("--first-index", type=int, default=0, help="first item index (default 0)")
+        p.add_argument("--first-index", type=int, default=0, help="first item index")
         p.add_argument("--no-pictures", action="store_true", help="skip the PNG pictures")
         p.add_argument(
             "--split",
@@ -54,7 +55,7 @@ def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
-def add_curriculum_option(p: argparse.ArgumentParser, family: str) -> None:
+def add_curriculum_option(p: argparse._ActionsContainer, family: str) -> None:
     """``--curriculum K``: step K of the family's easy-to-hard list
     (chaingeo.generator.curriculum)."""
     from chaingeo.generator.curriculum import CURRICULA
@@ -102,9 +103,13 @@ def run_job(args: argparse.Namespace, family: str, make: Any, config: Any) -> in
 
 def _register_stacking(fam: Any) -> None:
     p = fam.add_parser("stacking", help="pack-the-box levels (easy / mid / hard)")
-    p.add_argument("--box", help="box size AxBxC, e.g. 3x3x4")
-    p.add_argument("--mode", choices=("easy", "mid", "hard"), help="difficulty mode")
-    p.add_argument("--config", help="a registered config name instead of --box/--mode")
+    what = p.add_argument_group(
+        "what to generate (required: --box and --mode, or --config, or --curriculum)"
+    )
+    what.add_argument("--box", help="box size AxBxC, e.g. 3x3x4")
+    what.add_argument("--mode", choices=("easy", "mid", "hard"), help="difficulty mode")
+    what.add_argument("--config", help="a registered config name instead of --box/--mode")
+    add_curriculum_option(what, "stacking")
     p.add_argument("--min-nodes", type=int, help="least exact-cover nodes to a first packing")
     p.add_argument("--max-pieces", type=int, help="most pieces")
     p.add_argument("--min-piece", type=int, help="smallest piece (first stage)")
@@ -113,7 +118,6 @@ def _register_stacking(fam: Any) -> None:
     p.add_argument(
         "--no-linear-assembly", action="store_true", help="do not require a linear assembly"
     )
-    add_curriculum_option(p, "stacking")
     add_run_options(p)
     p.set_defaults(func=_run_stacking)
 
@@ -160,7 +164,7 @@ def _run_stacking(args: argparse.Namespace) -> int:
 
 def _register_suite(fam: Any) -> None:
     p = fam.add_parser("suite", help="rebuild the shipped 77-level stacking suite, byte for byte")
-    p.add_argument("--out", type=Path, default=Path("levels") / "stacking", help="target folder")
+    add_out(p, "folder", "the suite's levels", default=Path("levels") / "stacking")
     p.add_argument("--pictures", type=Path, help="also write the pictures into this folder")
     add_run_options(p, count=False)
     p.set_defaults(func=_run_suite)
@@ -197,18 +201,23 @@ def _register_puzzle(fam: Any) -> None:
         help=(
             "burr3, plate3, burr6, burr6x8 / burr6x8u (Cutler's standard six-piece burr; u: "
             "unique assembly), burr12, burr18, burr24, burr36 (towers; with --max-group 1 "
-            "built and proven unit by unit), cubeN or mazeN (maze burr: level grows with N); "
-            "default burr6"
+            "built and proven unit by unit), cubeN or mazeN (maze burr: level grows with N) "
+            "(default: burr6)"
         ),
     )
-    p.add_argument("--min-level", type=int, help="least moves to free the first part (default 1)")
+    p.add_argument("--min-level", type=int, help="least moves to free the first part (default: 1)")
     p.add_argument("--pieces", type=int, default=0, help="pieces of a cubeN partition")
     p.add_argument("--hole-rate", type=float, help="chance a shared cell starts empty")
     p.add_argument("--hill-steps", type=int, help="single-voxel improvement steps")
-    p.add_argument("--goal", choices=("disassemble", "assemble"), default="disassemble")
+    p.add_argument(
+        "--goal",
+        choices=("disassemble", "assemble"),
+        default="disassemble",
+        help="what the levels ask",
+    )
     p.add_argument("--max-group", type=int, help="most pieces one move may carry")
     p.add_argument("--seconds", type=float, help="time limit of the optimal-plan search")
-    p.add_argument("--restarts", type=int, help="annealing runs (burr6x8; default 2)")
+    p.add_argument("--restarts", type=int, help="annealing runs (burr6x8; default: 2)")
     p.add_argument(
         "--unique", action="store_true", help="only designs that assemble in one way (burr6x8)"
     )
@@ -235,7 +244,7 @@ def _run_puzzle(args: argparse.Namespace) -> int:
 
 def _register_puzzle_suite(fam: Any) -> None:
     p = fam.add_parser("puzzle-suite", help="rebuild the shipped 32-level puzzle suite")
-    p.add_argument("--out", type=Path, default=Path("levels") / "puzzle", help="target folder")
+    add_out(p, "folder", "the suite's levels", default=Path("levels") / "puzzle")
     p.add_argument("--models", type=Path, required=True,
                    help="CHAIN's puzzle models (e.g. ../shared/chain-models)")  # fmt: skip
     p.add_argument("--jobs", type=int, default=1, help="suite entries built in parallel")

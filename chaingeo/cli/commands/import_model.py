@@ -32,14 +32,29 @@ def register(sub: Any) -> None:
     p = sub.add_parser("import", help="import a CHAIN URDF/OBJ puzzle model as a level")
     p.add_argument("model", type=Path, help="a model folder (PART/urdf/*.urdf), or with "
                    "--report a folder of model folders")  # fmt: skip
-    p.add_argument("--out", type=Path, help="level file or folder (default: print the level)")
-    p.add_argument("--goal", choices=("disassemble", "assemble"), default="disassemble")
-    p.add_argument("--kind", choices=("auto", "puzzle", "stacking"), default="auto")
+    p.add_argument(
+        "--out",
+        type=Path,
+        metavar="FILE.json|DIR",
+        help="file: the level, when the name ends in .json; else folder (created when missing) "
+        "that gets LEVEL_ID.json (default: print the level)",
+    )
+    p.add_argument(
+        "--goal",
+        choices=("disassemble", "assemble"),
+        default="disassemble",
+        help="what the level asks",
+    )
+    p.add_argument(
+        "--kind", choices=("auto", "puzzle", "stacking"), default="auto", help="what the model is"
+    )
     p.add_argument("--max-group", type=int, default=None, help="most pieces one move may carry")
     p.add_argument("--turns", action="store_true", help="allow 90-degree turns of groups "
                    "(rules turns=true; the model's round rods spin in place)")  # fmt: skip
     p.add_argument("--max-states", type=int, default=500_000, help="state cap per part search")
-    p.add_argument("--max-total-states", type=int, default=3_000_000)
+    p.add_argument(
+        "--max-total-states", type=int, default=3_000_000, help="state cap of all part searches"
+    )
     p.add_argument("--seconds", type=float, default=120.0, help="time cap of each analysis")
     p.add_argument("--report", action="store_true", help="table of every model under MODEL")
     p.add_argument("--json", action="store_true", help="with --report: JSON lines, not markdown")
@@ -160,6 +175,16 @@ def _markdown(rows: list[dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def import_target(out: Path, level_id: str) -> Path:
+    """``--out``'s file: ``out`` itself when it names a ``.json`` file, else ``out/ID.json`` in
+    the folder ``out`` (made when missing; a new folder's name is never taken as a file's)."""
+    from chaingeo.cli.out_arg import out_folder
+
+    if out.suffix.lower() == ".json" and not out.is_dir():
+        return out
+    return out_folder(out) / f"{level_id}.json"
+
+
 def run(args: argparse.Namespace) -> int:
     from chaingeo.core.formats.models import import_model
     from chaingeo.core.kinematics import SearchLimitError
@@ -178,6 +203,5 @@ def run(args: argparse.Namespace) -> int:
     if args.out is None:
         print(level_bytes(level).decode("utf-8"), end="")
         return 0
-    target = args.out / f"{level.id}.json" if args.out.is_dir() else args.out
-    print(save_level(level, target))
+    print(save_level(level, import_target(args.out, level.id)))
     return 0

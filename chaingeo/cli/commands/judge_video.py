@@ -20,10 +20,18 @@ def register(sub: Any) -> None:
     p.add_argument(
         "--level",
         default=None,
-        help="the level shown (file or shipped id): its piece colours, and for a video drawn by "
-        "'chain video' the kinematic check of every move (default: colours from the first frame)",
+        metavar="LEVEL",
+        help="the level shown (a chain-level/1 file or the id of a shipped level): its piece "
+        "colours, and for a video drawn by 'chain video' the kinematic check of every move "
+        "(default: colours from the first frame)",
     )
-    p.add_argument("--evidence", type=Path, default=None, help="folder for one PNG a violation")
+    p.add_argument(
+        "--evidence",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="folder (created when missing): one PNG a violation",
+    )
     p.set_defaults(func=run)
 
 

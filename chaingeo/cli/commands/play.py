@@ -17,19 +17,26 @@ import tempfile
 from pathlib import Path
 from typing import Any, TextIO
 
-from chaingeo.cli.level_arg import find_level
+from chaingeo.cli.level_arg import add_level, find_level
 
 
 def register(sub: Any) -> None:
     p = sub.add_parser("play", help="play a level in the terminal (same actions as an agent)")
-    p.add_argument("level", help="a level file, or the id of a level under --levels")
+    add_level(p, help="a chain-level/1 file or the id of a level under --levels")
     p.add_argument(
         "--levels",
         type=Path,
         default=None,
+        metavar="DIR",
         help="folder to look ids up in (default: the shipped suite)",
     )
-    p.add_argument("--views", type=Path, default=None, help="folder for the rendered views")
+    p.add_argument(
+        "--views",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="folder (created when missing): the rendered views (default: a temporary one)",
+    )
     p.add_argument("--no-images", action="store_true", help="do not render views")
     p.add_argument("--size", type=int, default=512, help="image size in pixels")
     p.set_defaults(func=run)

@@ -7,12 +7,15 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from chaingeo.cli.level_arg import add_level
+from chaingeo.cli.out_arg import add_out
+
 
 def register(sub: Any) -> None:
     p = sub.add_parser("render", help="write PNG pictures of a level, solved, and of its pieces")
-    p.add_argument("level", help="a chain-level/1 file or the id of a shipped level")
-    p.add_argument("--out", type=Path, default=Path("."), help="folder for the PNGs (default .)")
-    p.add_argument("--size", type=int, default=512, help="picture size in pixels (default 512)")
+    add_level(p)
+    add_out(p, "folder", "the PNGs, LEVEL_ID-VIEW.png", default=Path("."))
+    p.add_argument("--size", type=int, default=512, help="picture size in pixels")
     p.add_argument(
         "--exploded",
         action="store_true",
@@ -24,6 +27,7 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.level_arg import find_level
+    from chaingeo.cli.out_arg import out_folder
     from chaingeo.envs.render.pictures import render_exploded
     from chaingeo.envs.render.scene import render_level_tray, render_solution_views
 
@@ -32,7 +36,7 @@ def run(args: argparse.Namespace) -> int:
     pictures["pieces"] = render_level_tray(level, args.size)
     if args.exploded:
         pictures["exploded"] = render_exploded(level, args.size)
-    args.out.mkdir(parents=True, exist_ok=True)
+    out_folder(args.out)
     for view, data in pictures.items():
         target = args.out / f"{level.id}-{view}.png"
         target.write_bytes(data)

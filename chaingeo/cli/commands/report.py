@@ -7,6 +7,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from chaingeo.cli.out_arg import add_out
+
 
 def register(sub: Any) -> None:
     p = sub.add_parser(
@@ -15,7 +17,7 @@ def register(sub: Any) -> None:
         "and optionally an HTML run viewer",
     )
     p.add_argument("runs", nargs="+", type=Path, help="run directories, or folders of them")
-    p.add_argument("--out", type=Path, default=Path("report"), help="where to write files")
+    add_out(p, "folder", "the tables (markdown + CSV) and the plot", default=Path("report"))
     p.add_argument(
         "--html",
         type=Path,

@@ -27,7 +27,12 @@ if TYPE_CHECKING:  # the level reader is imported when a command runs, not to li
 
 def register(sub: Any) -> None:
     p = sub.add_parser("validate", help="verify level files (format, geometry, stored solutions)")
-    p.add_argument("paths", nargs="+", type=Path, help="level files or folders of them")
+    p.add_argument(
+        "paths",
+        nargs="+",
+        metavar="LEVEL",
+        help="level files, folders of them, or ids of shipped levels",
+    )
     p.add_argument(
         "--no-recheck", action="store_true", help="skip re-deriving optimal_steps by search"
     )
@@ -100,11 +105,13 @@ def _recheck_row(level: Level, f: Path) -> tuple[dict[str, Any], bool]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from chaingeo.cli.level_arg import level_file
     from chaingeo.core.level import content_hash, level_set_hash, load_level
 
     files: list[Path] = []
-    for path in args.paths:
-        files.extend(sorted(path.rglob("*.json")) if path.is_dir() else [path])
+    for spec in args.paths:
+        path = Path(spec)
+        files.extend(sorted(path.rglob("*.json")) if path.is_dir() else [level_file(spec)])
     levels = []
     status = 0
     for f in files:

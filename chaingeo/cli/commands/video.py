@@ -8,22 +8,26 @@ import time
 from pathlib import Path
 from typing import Any
 
+from chaingeo.cli.level_arg import add_level
+from chaingeo.cli.out_arg import add_out
+
 
 def register(sub: Any) -> None:
     p = sub.add_parser("video", help="render a level's plan as an MP4 or GIF video")
-    p.add_argument("level", help="a chain-level/1 file or the id of a shipped level")
+    add_level(p)
     p.add_argument(
         "--plan",
         default="optimal",
-        help="'optimal' (the level's own plan, default) or a text file of actions, one a line, "
+        help="'optimal' (the level's own plan) or a text file of actions, one a line, "
         "as an agent would type them",
     )
-    p.add_argument("--out", type=Path, required=True, help="FILE.mp4 or FILE.gif")
+    add_out(p, "file", "the video, FILE.mp4 or FILE.gif", required=True)
     p.add_argument("--size", type=int, default=384, help="frame size in pixels")
     p.add_argument(
         "--trajectory-out",
         type=Path,
         default=None,
+        metavar="FILE",
         help="also write the plan's pose trajectory (chain-trajectory/1 JSON; chain "
         "check-trajectory reads it)",
     )

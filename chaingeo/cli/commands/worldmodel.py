@@ -5,8 +5,10 @@ image and prompt) and the ground-truth video of its optimal plan (see
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
+
+from chaingeo.cli.level_arg import add_level
+from chaingeo.cli.out_arg import add_out
 
 
 def register(sub: Any) -> None:
@@ -14,15 +16,15 @@ def register(sub: Any) -> None:
         "worldmodel",
         help="write a level's reference image, video-model prompt and ground-truth video",
     )
-    p.add_argument("level", help="a chain-level/1 file or the id of a shipped level")
-    p.add_argument("--out", type=Path, required=True, help="folder for the files")
+    add_level(p)
+    add_out(p, "folder", "the reference image, the prompt and the video", required=True)
     p.add_argument(
         "--format",
         choices=("mp4", "gif"),
         default=None,
-        help="ground-truth video format (default mp4 with the extra 'video', else gif)",
+        help="ground-truth video format (default: mp4 with the extra 'video', else gif)",
     )
-    p.add_argument("--size", type=int, default=384, help="frame size in pixels (default 384)")
+    p.add_argument("--size", type=int, default=384, help="frame size in pixels")
     p.set_defaults(func=run)
 
 
