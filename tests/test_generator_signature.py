@@ -129,3 +129,10 @@ def test_curriculum_steps_run_easy_to_hard_and_bad_steps_are_one_line(
     assert main(["generate", "puzzle", "--curriculum", "99", *base]) == 2
     assert "runs from 0 (easiest) to 6" in capsys.readouterr().err
     assert main(["generate", "stacking", "--curriculum", "0", "--box", "2x2x2", *base]) == 2
+
+
+def test_the_command_line_knows_each_curriculum_s_length_without_importing_it() -> None:
+    from chaingeo.cli.commands.generate import CURRICULUM_STEPS
+    from chaingeo.generator.curriculum import CURRICULA
+
+    assert CURRICULUM_STEPS == CURRICULA

@@ -12,7 +12,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Final
 
 from chaingeo.cli.errors import CommandError
 from chaingeo.cli.out_arg import add_out
@@ -55,17 +55,20 @@ def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
+#: Steps of each family's curriculum (chaingeo.generator.curriculum.CURRICULA, which a test
+#: compares): importing the generator to build ``--help`` would load numpy for every command.
+CURRICULUM_STEPS: Final = {"stacking": 8, "puzzle": 7}
+
+
 def add_curriculum_option(p: argparse._ActionsContainer, family: str) -> None:
     """``--curriculum K``: step K of the family's easy-to-hard list
     (chaingeo.generator.curriculum)."""
-    from chaingeo.generator.curriculum import CURRICULA
-
     p.add_argument(
         "--curriculum",
         type=int,
         metavar="K",
-        help=f"difficulty step 0 (easiest) .. {CURRICULA[family] - 1} (hardest) instead of the "
-        "shape options; explicit options still override it",
+        help=f"difficulty step 0 (easiest) .. {CURRICULUM_STEPS[family] - 1} (hardest) instead "
+        "of the shape options; explicit options still override it",
     )
 
 
