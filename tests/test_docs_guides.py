@@ -20,8 +20,25 @@ PAGES = sorted((ROOT / "docs").rglob("*.md"))
 SNIPPET = re.compile(r'^--8<-- "([^"]+)"$', flags=re.M)
 
 
-def _blocks(path: Path, lang: str) -> list[str]:
-    return re.findall(rf"```{lang}\n(.*?)\n```", path.read_text(encoding="utf-8"), flags=re.S)
+def _fenced(text: str) -> list[tuple[str, str]]:
+    """(language, body) of each fenced block, fences paired in order (a closing fence never
+    opens a block)."""
+    found: list[tuple[str, str]] = []
+    lang: str | None = None
+    body: list[str] = []
+    for line in text.splitlines():
+        if lang is None and line.startswith("```"):
+            lang, body = line[3:].strip(), []
+        elif lang is not None and line.strip() == "```":
+            found.append((lang, "\n".join(body)))
+            lang = None
+        elif lang is not None:
+            body.append(line)
+    return found
+
+
+def _blocks(path: Path, *langs: str) -> list[str]:
+    return [body for lang, body in _fenced(path.read_text(encoding="utf-8")) if lang in langs]
 
 
 def _expand(block: str) -> str:
@@ -40,6 +57,11 @@ def test_guides_and_getting_started_have_runnable_examples() -> None:
     assert {"guides/training", "getting-started"} <= names
 
 
+def test_fences_pair_in_order() -> None:
+    text = "```python\nx = 1\n```\nchain prose\n```bash\nchain play --help\n```\n"
+    assert _fenced(text) == [("python", "x = 1"), ("bash", "chain play --help")]
+
+
 def test_snippets_expand() -> None:
     block = '--8<-- "docs/examples/quickstart.py"'
     assert _expand(block) == (ROOT / "docs" / "examples" / "quickstart.py").read_text()
@@ -55,7 +77,7 @@ def test_python_blocks_run(page: Path) -> None:
 def test_chain_commands_exist(page: Path) -> None:
     sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
     known = set(sub.choices)
-    for block in _blocks(page, "(?:bash)?"):
+    for block in _blocks(page, "bash", ""):
         for line in block.splitlines():
             words = line.split()
             if "chain" in words[:3] and not line.startswith("#"):
