@@ -31,7 +31,7 @@ def _model(level: Level) -> str | None:
     return design.removeprefix("chain/") if design.startswith("chain/") else None
 
 
-#: CHAIN's published models that import exactly (README, 'CHAIN's own models'); the other
+#: CHAIN's published models that import exactly (docs/guides/importing.md); the other
 #: three are refused (two not on a lattice) or are a stacking model.
 IMPORTABLE = {
     "interlocking-cube-puzzle",

@@ -57,5 +57,5 @@ def test_regenerating_a_suite_item_reproduces_its_bytes(name: str) -> None:
     assert level_bytes(again) == path.read_bytes()
 
 
-def test_readme_documents_the_suite_command() -> None:
-    assert "chain generate suite" in (ROOT / "README.md").read_text()
+def test_docs_document_the_suite_command() -> None:
+    assert "chain generate suite" in (ROOT / "docs" / "guides" / "generating.md").read_text()

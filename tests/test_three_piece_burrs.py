@@ -31,7 +31,8 @@ from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion.disassemble import analyze_assembly
 
 #: (config, seed, index) of one quick item per layout that the generator accepts (found by the
-#: histograms in the README: burr3 item 8 of seed 1 is a level-4 burr, plate3 item 27 level 3).
+#: histograms in docs/benchmarks/generation.md: burr3 item 8 of seed 1 is a level-4 burr,
+#: plate3 item 27 level 3).
 ITEMS = {
     "burr3": (PuzzleConfig(shape="burr3", hole_rate=0.5, hill_steps=100, min_level=2), 1, 8),
     "plate3": (PuzzleConfig(shape="plate3", hole_rate=0.4, hill_steps=100, min_level=2), 1, 27),
@@ -153,7 +154,7 @@ def _level_census(layout: Layout) -> dict[object, int]:
 @pytest.mark.parametrize(
     ("layout", "expected"),
     [
-        # the README's figures: plate3 never goes beyond level 3 ...
+        # the figures of docs/benchmarks/generation.md: plate3 never goes beyond level 3 ...
         (
             get_layout("plate3"),
             {"broken": 53120, "locked": 24613, "over cap": 180, 2: 795, 3: 24},
