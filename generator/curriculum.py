@@ -7,7 +7,7 @@ search effort) and the box sizes; small boxes in easy mode are left out, as thei
 puzzles are all in the shipped suite (a train split would refuse every one). Puzzles walk up
 the level of the first removal (three-piece burrs, then maze burrs whose level is the number of
 straight runs of a path). Each step costs about a second per item or less; the tier mix
-measured per step is in the README.
+measured per step is in docs/benchmarks/generation.md.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ STACKING_STEPS: Final[tuple[tuple[tuple[int, int, int], str], ...]] = (
     ((4, 4, 4), "hard"),
 )
 
-#: The three-piece burr's settings (README: 1 s per item, levels 1 to 4).
+#: The three-piece burr's settings (docs/guides/generating.md: 1 s per item, levels 1 to 4).
 _BURR3: Final[dict[str, object]] = {"shape": "burr3", "hole_rate": 0.8, "hill_steps": 100}
 
 #: Puzzle steps: PuzzleConfig fields, easy to hard (first-removal level grows with K).

@@ -115,7 +115,8 @@ def three_crossing(
 
 def burr3() -> Layout:
     """Three-piece burr: three 3x3x7 sticks; each pair overlaps two units deep (38 shared cells;
-    random designs with holes plus hill climbing reach levels 2 to 5, see the README)."""
+    random designs with holes plus hill climbing reach levels 2 to 5, see
+    docs/guides/generating.md)."""
     return three_crossing(
         "burr3",
         7,

@@ -99,11 +99,11 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> Candidate 
 
 
 def difficulty_of(first_level: int, optimal_steps: int, pieces: int) -> Difficulty:
-    """The suite's tiers (README, 'The puzzle suite'), in the paper's sense: *easy* is few
-    pieces and weak interlocking (at most 6 pieces, the first part free within 2 moves, a plan
-    of at most 8); *hard* is strong interlocking (5 or more moves before any part comes free),
-    a long plan (20 or more moves), or many pieces that interlock (12 or more pieces and a
-    first part needing 3 or more moves); *mid* is everything else, such as many loosely held
+    """The suite's tiers (docs/guides/generating.md, 'The puzzle suite'), in the paper's sense:
+    *easy* is few pieces and weak interlocking (at most 6 pieces, the first part free within 2
+    moves, a plan of at most 8); *hard* is strong interlocking (5 or more moves before any part
+    comes free), a long plan (20 or more moves), or many pieces that interlock (12 or more pieces
+    and a first part needing 3 or more moves); *mid* is everything else, such as many loosely held
     pieces."""
     if first_level >= 5 or optimal_steps >= 20 or (pieces >= 12 and first_level >= 3):
         return "hard"

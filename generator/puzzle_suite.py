@@ -87,7 +87,7 @@ A: Goal = "assemble"
 #: give; the generators fill the rest: six-piece burrs (Cutler's standard 2x2x8 burrs of level
 #: 7 and up in the hard tier), three-piece and three-plate burrs, interlocking cubes, a
 #: 12-piece tower and two 36-piece towers. Both goals in every tier; most generated levels ask
-#: for assembly, which neither baseline manages (README, 'The puzzle suite').
+#: for assembly, which neither baseline manages (docs/benchmarks/baselines.md, 'The puzzle suite').
 SUITE: tuple[SuiteEntry | ModelEntry, ...] = (
     ModelEntry("easy", "luban-3-piece", (D,), turns=True),
     ModelEntry("easy", "luban-6-piece", (D, A)),

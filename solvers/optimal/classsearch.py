@@ -4,8 +4,8 @@ Towers of burr units played with moves that may carry any group of pieces have s
 beyond breadth-first search, and A* with pair databases (:mod:`chaingeo.solvers.optimal.astar`)
 proves only 36 on the suite's 36-piece towers. The class bound of
 :mod:`chaingeo.solvers.optimal.classbound` is much closer; as the heuristic of a depth-first
-iterative deepening search it closes them (figures: README, "Class search", and ``chain bench
-astar``).
+iterative deepening search it closes them (figures: docs/benchmarks/search.md, "Class search", and
+``chain bench astar``).
 
 **Problem** as in :mod:`chaingeo.solvers.optimal.astar`: a state is a partition of the pieces into
 parts with offsets; a move carries a proper group of one part one or more steps along an axis, or
