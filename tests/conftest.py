@@ -36,7 +36,7 @@ def pytest_testnodedown(node: Any, error: Any) -> None:
 
 
 def pytest_terminal_summary(terminalreporter: Any) -> None:
-    """The burrTxt differential tests' counts (tests/conformance/test_burrtxt_diff.py), when they ran."""
+    """The burrTxt differential tests' counts (conformance/test_burrtxt_diff.py), when they ran."""
     outcomes = _local_outcomes()
     if _FROM_WORKERS:
         from tests.support.burrtxt import Outcome

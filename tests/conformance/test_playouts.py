@@ -1,8 +1,10 @@
 """Random playouts over every shipped level, OpenSpiel style: from the start, seeded random
-legal actions, and at every state the contracts an agent and a search rely on: every listed
-action is accepted, a clone has the same key and stays independent, push / pop restores the
-key, an action's canonical text (what an agent types) does exactly what the action does, and
-``step_text`` never raises, whatever the text."""
+legal actions, and at every state the contracts an agent and a search rely on: listed actions
+are accepted (the one played and a seeded sample of the others), a clone has the same key and
+stays independent, push / pop restores the key, the same actions from a fresh start reach the
+same key (keys are stable, not tied to one object's history), an action's canonical text (what
+an agent types) does exactly what the action does, and ``step_text`` never raises, whatever
+the text."""
 
 from __future__ import annotations
 
@@ -21,22 +23,29 @@ from tests.support.paths import LEVELS
 SHIPPED: list[Level] = load_levels(LEVELS) if LEVELS.is_dir() else []
 #: Steps of one playout, and the texts no state may raise on (odd, empty, hostile).
 STEPS = 8
+#: Listed actions checked for acceptance at each state besides the one played.
+SAMPLED = 4
 JUNK = ("", "   ", "place", "move ??? +x 1", "\x00\udcff", "move red +q 99999999999", "{" * 300)
 
 
 def _playout(level: Level, seed: int) -> None:
     rng = np.random.default_rng(np.random.SeedSequence([seed, len(level.id)]))
     state = new_state(level)
+    played: list[Action] = []
     for _ in range(STEPS):
         legal = state.legal_actions()
         if state.finished or len(legal) == 0:
             break
+        for i in rng.choice(len(legal), size=min(SAMPLED, len(legal)), replace=False):
+            assert state.problem(legal[int(i)]) is None, state.describe(legal[int(i)])
         action = legal[int(rng.integers(len(legal)))]
         assert state.problem(action) is None, state.describe(action)
         _check_clone_and_undo(state, action)
         _check_text_does_what_the_action_does(state, action)
         _check_junk_text(state, rng)
         state.apply(action)
+        played.append(action)
+    _check_stable_key(level, played, state)
 
 
 def _check_clone_and_undo(state: BaseState, action: Action) -> None:
@@ -47,6 +56,13 @@ def _check_clone_and_undo(state: BaseState, action: Action) -> None:
     assert state.key() == before  # the clone is independent
     twin.pop()
     assert twin.key() == before
+
+
+def _check_stable_key(level: Level, played: list[Action], state: BaseState) -> None:
+    again = new_state(level)
+    for action in played:
+        again.apply(action)
+    assert again.key() == state.key() and hash(again.key()) == hash(state.key())
 
 
 def _check_text_does_what_the_action_does(state: BaseState, action: Action) -> None:
