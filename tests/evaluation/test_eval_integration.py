@@ -77,9 +77,28 @@ def _shipped() -> list[Level]:
     return load_levels(folder) if any(folder.rglob("*.json")) else []
 
 
-@pytest.mark.parametrize("protocol", ["interactive", "oneshot"])
-def test_oracle_solves_every_level_in_exactly_optimal_steps(protocol: str) -> None:
-    for level in _suite() + _shipped():
+def _oracle_cases() -> list[object]:
+    """Both protocols over the test levels and every eighth shipped level; every shipped level
+    under ``slow`` (each one's plan is replayed as agent text by default in
+    tests/conformance/test_conformance.py; the harness runs the same code for all)."""
+    shipped = _shipped()
+    some = _suite() + shipped[::8]
+    rest = [lv for i, lv in enumerate(shipped) if i % 8]
+    return [
+        case
+        for protocol in ("interactive", "oneshot")
+        for case in (
+            pytest.param(protocol, some, id=f"{protocol}-some"),
+            pytest.param(protocol, rest, id=f"{protocol}-rest", marks=pytest.mark.slow),
+        )
+    ]
+
+
+@pytest.mark.parametrize(("protocol", "levels"), _oracle_cases())
+def test_oracle_solves_every_level_in_exactly_optimal_steps(
+    protocol: str, levels: list[Level]
+) -> None:
+    for level in levels:
         task = EpisodeTask(level, 0, 0, AgentSpec("oracle"), ProtocolConfig(name=protocol))  # type: ignore[arg-type]
         rec = run_episode(task).record
         assert rec["success"], level.id

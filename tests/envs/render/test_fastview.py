@@ -94,6 +94,7 @@ def _assert_same(state: BaseState, size: int) -> None:
     )  # drawn again on the kept layout (box) or recent frame (puzzle)
 
 
+@pytest.mark.slow  # by default the next test compares the same drawing on 8 levels
 def test_every_shipped_level_starts_with_the_reference_pictures() -> None:
     fastview.clear()
     for level in _shipped():

@@ -66,6 +66,7 @@ def test_pentomino_packings(box: tuple[int, int, int], engine: Engine) -> None:
     assert (r.solutions, r.distinct) == _known(box)
 
 
+@pytest.mark.slow  # the 2x5x6 box above runs the same 3D search by default
 def test_solid_pentominoes_3x4x5() -> None:
     r = count_packings(PENTOMINOES.pieces, (3, 4, 5))
     assert (r.solutions, r.distinct) == _known((3, 4, 5))
