@@ -18,7 +18,7 @@ _FROM_WORKERS: list[dict[str, str]] = []
 
 
 def _local_outcomes() -> list[Any]:
-    module = sys.modules.get("tests.burrtxt")
+    module = sys.modules.get("tests.support.burrtxt")
     return list(module.OUTCOMES) if module is not None else []
 
 
@@ -36,15 +36,15 @@ def pytest_testnodedown(node: Any, error: Any) -> None:
 
 
 def pytest_terminal_summary(terminalreporter: Any) -> None:
-    """The burrTxt differential tests' counts (tests/test_burrtxt_diff.py), when they ran."""
+    """The burrTxt differential tests' counts (conformance/test_burrtxt_diff.py), when they ran."""
     outcomes = _local_outcomes()
     if _FROM_WORKERS:
-        from tests.burrtxt import Outcome
+        from tests.support.burrtxt import Outcome
 
         outcomes += [Outcome(**o) for o in _FROM_WORKERS]
     if not outcomes:
         return
-    from tests.burrtxt import summary_lines
+    from tests.support.burrtxt import summary_lines
 
     terminalreporter.write_sep("-", "BurrTools (burrTxt) differential")
     for line in summary_lines(outcomes):

@@ -1,7 +1,8 @@
 """``python -m chaingeo.cli.reference [PATH]``: the command reference (docs/reference/commands.md)
 written from the ``chain`` parser itself, so it cannot drift from the command line: every
 command and sub-command, its usage, and each argument with its default and whether it is
-required. ``--check`` exits 1 when PATH is not what it would write (tests/test_cli_reference.py)."""
+required. ``--check`` exits 1 when PATH is not what it would write
+(tests/cli/test_cli_reference.py)."""
 
 from __future__ import annotations
 

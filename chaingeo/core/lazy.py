@@ -3,7 +3,7 @@ stays cheap: ``import chaingeo`` loads neither numpy nor numba.
 
 A package lists ``{public name: "module:attribute"}`` and binds what :func:`lazy_exports`
 returns to its ``__getattr__`` and ``__dir__`` outside ``TYPE_CHECKING`` (its real imports sit
-inside, for mypy and editors; ``tests/test_api.py`` checks that both agree).
+inside, for mypy and editors; ``tests/conformance/test_api.py`` checks that both agree).
 """
 
 from __future__ import annotations

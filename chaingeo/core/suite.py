@@ -3,7 +3,7 @@ and a level by id or by path.
 
 The repository keeps the suite in ``levels/``; the wheel carries the same files as the package
 data of ``chaingeo.levels`` (``pyproject.toml`` maps the folder), so code never looks for it
-relative to the source tree. Files are named by level id (``tests/test_api.py`` checks).
+relative to the source tree. Files are named by level id (``tests/conformance/test_api.py`` checks).
 """
 
 from __future__ import annotations

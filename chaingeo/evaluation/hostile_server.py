@@ -2,7 +2,7 @@
 
 For ``chain bench robustness`` (:func:`serve`; it lives here because every module of
 :mod:`chaingeo.benchmarks` is a benchmark name) and the tests' validating fake server
-(``tests/eval_support/fake_openai.py``, which answers through :func:`chat_answer` and
+(``tests/support/fake_openai.py``, which answers through :func:`chat_answer` and
 :func:`play`). An entry is a dict: a reply (``reply`` text, ``tool_calls`` as ``(name,
 arguments)`` pairs, ``usage`` as ``(prompt, completion)`` or ``raw_usage``, any JSON value, sent
 as is) or a fault (``fault``): ``trickle`` (a whole answer, one byte every ``interval`` seconds
