@@ -64,7 +64,5 @@ def test_every_folder_of_the_tests_is_a_package() -> None:
 def test_tests_in_folders_find_their_files_through_the_support_paths() -> None:
     nested = [p for p in SOURCES if p.parent != TESTS and p.name != "paths.py"]
     nested.remove(Path(__file__).resolve())
-    own_file = re.compile(
-        r"(?<![\w.])__file__"
-    )  # a module's own ``__file__``, not ``mod.__file__``
+    own_file = re.compile(r"(?<![\w.])__file__")  # a module's own, not ``mod.__file__``
     assert not [p.name for p in nested if own_file.search(p.read_text(encoding="utf-8"))]
