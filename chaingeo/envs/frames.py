@@ -61,7 +61,7 @@ def _views(state: BaseState, size: int) -> dict[str, Frame]:
 def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
     import chaingeo.envs.render.fastview as fastview
 
-    return {v: _array(img) for v, img in fastview.render_images(pieces, box, VIEWS, size).items()}
+    return fastview.render_arrays(pieces, box, VIEWS, size)
 
 
 def _extra(state: BaseState, size: int) -> Frame:

@@ -37,7 +37,7 @@ from chaingeo.envs.render.labels import (
     tick_steps,
     title_steps,
 )
-from chaingeo.envs.render.legend import draw_legend, legend_layout
+from chaingeo.envs.render.legend import clear_memo, legend_layout, paint_legend
 from chaingeo.envs.render.raster import (
     EDGE,
     Box,
@@ -109,6 +109,7 @@ def clear() -> None:
     """Forget every kept layout."""
     _STORE.clear()
     _FOLLOW.clear()
+    clear_memo()
 
 
 def _layout_key(scene: _Scene, cam: Camera, size: int, title: str | None) -> Hashable:
@@ -238,9 +239,11 @@ def _one_pass(scene: _Scene, cam: Camera, size: int, title: str | None, faces: F
     return image
 
 
-def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Image.Image:
+def _view_pixels(scene: _Scene, cam: Camera, size: int, title: str | None) -> Pixels:
+    """One finished view as a writable ``(size, size, 3)`` array."""
     if _Layout.of(size).edge_px(_SUPERSAMPLE) > 4 or jit_mode() != "numba":
-        return render_view(scene, cam, size, title=title, fast=True)  # round joints: Pillow
+        image = render_view(scene, cam, size, title=title, fast=True)  # round joints: Pillow
+        return np.array(image, dtype=np.uint8)
     faces = visible_faces(scene.cells, scene.colors, cam)
     st = _static(scene, cam, size, title)
     if st is None:
@@ -248,10 +251,23 @@ def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Im
     elif len(faces.fills):
         pixels = _with_faces(st, faces, cam, size)
     else:
-        pixels = st.plain
-    image = Image.fromarray(pixels)
-    draw_legend(image, scene.legend)
-    return image
+        pixels = st.plain.copy()
+    paint_legend(pixels, scene.legend)
+    return pixels
+
+
+def render_arrays(
+    pieces: PieceMap,
+    box: Sequence[int] | None = None,
+    views: Sequence[str] = VIEWS,
+    size: int = DEFAULT_SIZE,
+    title: str | None = None,
+) -> dict[str, Pixels]:
+    """:func:`render_images` as writable ``(size, size, 3)`` arrays (no image in between)."""
+    _check_size(size)
+    _check_views(views)
+    scene = _scene(pieces, box)
+    return {v: _view_pixels(scene, CAMERAS[v], size, title) for v in views}
 
 
 def render_images(
@@ -262,10 +278,8 @@ def render_images(
     title: str | None = None,
 ) -> dict[str, Image.Image]:
     """:func:`chaingeo.envs.render.scene.render_images`, the same pixels, faster."""
-    _check_size(size)
-    _check_views(views)
-    scene = _scene(pieces, box)
-    return {v: _render_view(scene, CAMERAS[v], size, title) for v in views}
+    arrays = render_arrays(pieces, box, views, size, title)
+    return {v: Image.fromarray(a) for v, a in arrays.items()}
 
 
 def render_tray_image(
