@@ -1,13 +1,18 @@
-"""What the fast path keeps between pictures (drawn legends) gives the bytes drawing gives."""
+"""The fast path's newer parts (kept legends, swatches, the tray on arrays) give the bytes the
+reference renderer gives, on random input."""
 
 from __future__ import annotations
 
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from PIL import Image
+from PIL import Image, ImageDraw
 
+from chaingeo.core.geometry import Shape
+from chaingeo.envs.render import rasterjit
 from chaingeo.envs.render.legend import clear_memo, draw_legend, paint_legend
+from chaingeo.envs.render.scene import render_tray_image
+from chaingeo.envs.render.sheet import tray_pixels
 
 names = st.text("abcdefghijklmnopqrstuvwxyz", min_size=1, max_size=9)
 rgb = st.tuples(st.integers(0, 255), st.integers(0, 255), st.integers(0, 255))
@@ -33,3 +38,36 @@ def test_kept_legends_are_the_drawn_ones(
             got = under.copy()
             paint_legend(got, legend)
             assert np.array_equal(got, np.asarray(image))
+
+
+box_coord = st.floats(-6.0, 70.0, allow_nan=False).map(lambda v: round(v * 8) / 8)
+
+
+@settings(max_examples=200, deadline=None)
+@given(box_coord, box_coord, st.floats(0.0, 30.0), st.floats(0.0, 30.0), rgb, st.booleans())
+def test_rectangle_kernel_is_pillows_rectangle(
+    x: float, y: float, w: float, h: float, fill: tuple[int, int, int], black: bool
+) -> None:
+    image = Image.new("RGB", (64, 64), (255, 255, 255))
+    arr = np.full((64, 64, 3), 255, np.uint8)
+    fill = (0, 0, 0) if black else fill  # the outline is left out when it is the fill
+    ImageDraw.Draw(image).rectangle([x, y, x + w, y + h], fill=fill, outline=(0, 0, 0))
+    box = np.array([x, y, x + w, y + h])
+    rasterjit.rectangle(
+        arr, box, np.array(fill, np.uint8), np.zeros(3, np.uint8), fill != (0, 0, 0)
+    )
+    assert np.array_equal(np.asarray(image), arr)
+
+
+cell = st.tuples(st.integers(0, 3), st.integers(0, 2), st.integers(0, 2))
+piece = st.tuples(st.sets(cell, min_size=1, max_size=7), rgb | st.just((0, 0, 0)))
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.dictionaries(names, piece, min_size=0, max_size=7), st.sampled_from([128, 256]))
+def test_tray_on_arrays_is_the_reference_tray(
+    pieces: dict[str, tuple[set[tuple[int, int, int]], tuple[int, int, int]]], size: int
+) -> None:
+    scene_pieces = {n: (Shape(cells), color) for n, (cells, color) in pieces.items()}
+    expected = np.asarray(render_tray_image(scene_pieces, size))
+    assert np.array_equal(tray_pixels(scene_pieces, size), expected)

@@ -66,6 +66,10 @@ def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -
 
 def _extra(state: BaseState, size: int) -> Frame:
     """The tray (stacking) or the target (puzzles), as :func:`render_state` draws it."""
+    if isinstance(state, StackingState):
+        from chaingeo.envs.render.sheet import tray_pixels
+
+        return tray_pixels(scene(state)[2], size)
     return _array(extra_image(state, size))
 
 

@@ -67,11 +67,11 @@ from chaingeo.envs.render.scene import (
     _view_projector,
     _view_titles,
     _wall_shapes,
-    render_tray_image_with,
 )
 from chaingeo.envs.render.scene import (
     _render_view as render_view,
 )
+from chaingeo.envs.render.sheet import tray_pixels
 
 #: Layouts kept per process (each about 1 MB at 256 px: the iso background is drawn at 2x).
 CAPACITY: Final = 48
@@ -286,4 +286,4 @@ def render_tray_image(
     pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE
 ) -> Image.Image:
     """:func:`chaingeo.envs.render.scene.render_tray_image`, the same pixels, faster."""
-    return render_tray_image_with(pieces, size, title, fast=True)
+    return Image.fromarray(tray_pixels(pieces, size, title))

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from typing import Final
+from functools import lru_cache
+from typing import Final, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -39,9 +39,9 @@ AXIS_COLORS: Final[tuple[RGB, RGB, RGB]] = ((190, 30, 30), (20, 130, 40), (30, 6
 AXIS_NAMES: Final = "xyz"
 
 
-@dataclass(frozen=True)
-class Step:
-    """One drawing call and a box around every pixel it may change."""
+class Step(NamedTuple):
+    """One drawing call and a box around every pixel it may change (a tuple: views make
+    dozens per picture)."""
 
     box: Box
     run: Callable[[Image.Image], None]
@@ -62,17 +62,25 @@ def paint_steps(pixels: Pixels, steps: Sequence[Step]) -> None:
         step.paint(pixels)
 
 
+@lru_cache(maxsize=256)
+def ink(fill: RGB) -> Pixels:
+    """A colour as a read-only ``uint8`` array (the kernels' ink), made once."""
+    out = np.array(fill, dtype=np.uint8)
+    out.flags.writeable = False
+    return out
+
+
 def text_step(
     xy: Sequence[float] | FloatArray, text: str, px: int, fill: RGB, anchor: str = "mm"
 ) -> Step:
     at = (float(xy[0]), float(xy[1]))
     box = text_box(at, text, px, anchor)
     mask = text_mask_array(text, px, anchor)
-    ink = np.array(fill, dtype=np.uint8)
+    color = ink(fill)
     return Step(
         box,
         lambda im: put_text(im, at, text, px, fill, anchor),
-        lambda arr: rasterjit.paste_mask(arr, mask, box[0], box[1], ink),
+        lambda arr: rasterjit.paste_mask(arr, mask, box[0], box[1], color),
     )
 
 

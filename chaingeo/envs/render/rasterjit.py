@@ -364,6 +364,24 @@ def draw_faces(img: U8, corners: npt.NDArray[np.float64], fills: U8, edge: U8, w
 
 
 @njit(cache=True)
+def rectangle(img: U8, box: npt.NDArray[np.float64], fill: U8, outline: U8, edged: bool) -> None:
+    """``ImageDraw.rectangle(box, fill=fill, outline=outline)`` (width 1): corners truncated
+    to ints, the rows filled end inclusive, then (``edged``: the two colours differ) the
+    outline's rows and the columns between them (``ImagingDrawRectangle``)."""
+    x0, y0, x1, y1 = int(box[0]), int(box[1]), int(box[2]), int(box[3])
+    if y0 > y1:
+        y0, y1 = y1, y0
+    top, bottom = max(y0, 0), min(y1, img.shape[0])
+    for y in range(top, bottom + 1):
+        _hline(img, x0, y, x1, fill)
+    if edged:
+        _hline(img, x0, y0, x1, outline)
+        _hline(img, x0, y1, x1, outline)
+        _line(img, x1, y0 + 1, x1, y1, outline)
+        _line(img, x0, y0 + 1, x0, y1, outline)
+
+
+@njit(cache=True)
 def reduce2(img: U8) -> U8:
     """``Image.reduce(2)`` of an even-sized picture: each 2x2 block's mean, rounded half up."""
     h, w = img.shape[0] // 2, img.shape[1] // 2
