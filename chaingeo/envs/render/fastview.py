@@ -103,6 +103,7 @@ _STORE: OrderedDict[Hashable, _Static] = OrderedDict()
 #: while recent (a frame recurs within an episode, seldom later; no finished picture is kept).
 _FOLLOW: OrderedDict[Hashable, tuple[_Back, tuple[Step, ...]]] = OrderedDict()
 FOLLOW_CAPACITY: Final = 16
+_SCRATCH: dict[tuple[int, int], Pixels] = {}
 
 
 def clear() -> None:
@@ -188,25 +189,50 @@ def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
 
 def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, FloatArray]:
     """The picture with the faces drawn (before labels), and their drawing pixels."""
-    big = back.big.copy()
+    if back.k > 1:  # drawn on a kept work picture: only the reduction is handed out
+        big = _scratch(size * back.k, 0)
+        np.copyto(big, back.big)
+    else:
+        big = back.big.copy()
     pix = scaled(back.proj, back.k).screen(faces.corners)
     width = _Layout.of(size).edge_px(back.k)
     rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
     return _finish(back, big), pix
 
 
+def _scratch(side: int, slot: int) -> Pixels:
+    """A work picture kept for reuse (its pixels are whatever its last user left)."""
+    key = (side, slot)
+    if key not in _SCRATCH:
+        _SCRATCH[key] = np.empty((side, side, 3), dtype=np.uint8)
+    return _SCRATCH[key]
+
+
 def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
-    image, pix = _pieces(st.back, faces, size)
-    proj, k = st.back.proj, st.back.k
-    labels = depth_label_steps(faces, cam, proj) if cam.depth_axis is not None else []
-    box = _touched(pix, _Layout.of(size).edge_px(k) + 2, k, size)
+    """The picture without pieces, and inside the rectangle the faces and their labels cover:
+    the faces on the background, the front edges, the reduction (of that rectangle only),
+    then every label that overlaps it."""
+    back, k = st.back, st.back.k
+    big = _scratch(size * k, 0)
+    np.copyto(big, back.big)
+    pix = scaled(back.proj, k).screen(faces.corners)
+    width = _Layout.of(size).edge_px(k)
+    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
+    rasterjit.draw_flat(big, back.front)
+    labels = depth_label_steps(faces, cam, back.proj) if cam.depth_axis is not None else []
+    box = _touched(pix, width + 2, k, size)
     for step in labels:
         box = _union(box, step.box)
     x0, y0, x1, y1 = max(0, box[0]), max(0, box[1]), min(size, box[2]), min(size, box[3])
     out = st.plain.copy()
     if x0 >= x1 or y0 >= y1:
         return out
-    paint_steps(image, [s for s in st.steps if overlaps(s.box, (x0, y0, x1, y1))])
+    image = big
+    if k > 1:
+        image = _scratch(size, 1)
+        rasterjit.reduce2_into(big, image, x0, y0, x1, y1)
+    rect = (x0, y0, x1, y1)
+    paint_steps(image, [s for s in st.steps if overlaps(s.box, rect)])
     paint_steps(image, labels)
     out[y0:y1, x0:x1] = image[y0:y1, x0:x1]
     return out

@@ -344,9 +344,36 @@ def fit_centre(
     points: FloatArray, cam: Camera, box: tuple[float, float, float, float], scale: float
 ) -> tuple[float, float]:
     """Origin that centres ``points`` in ``box`` at a given scale."""
+    return centre_at(extreme_sums(points, cam), box, scale)
+
+
+def extreme_sums(points: FloatArray, cam: Camera) -> tuple[float, float]:
+    """Along screen right and up: the largest plus the smallest coordinate of ``points``."""
     sx, sy = points @ np.array(cam.right), points @ np.array(cam.up)
-    cx = (box[0] + box[2]) / 2 - float(sx.max() + sx.min()) / 2 * scale
-    cy = (box[1] + box[3]) / 2 + float(sy.max() + sy.min()) / 2 * scale
+    return float(sx.max() + sx.min()), float(sy.max() + sy.min())
+
+
+@lru_cache(maxsize=512)
+def box_spans(extent: tuple[int, int, int], cams: tuple[Camera, ...]) -> tuple[float, float]:
+    """The widest screen extents of the box ``extent`` (from the origin) over ``cams``."""
+    corners = frame_corners((0, 0, 0), extent)
+    r = [float(np.ptp(corners @ np.array(c.right))) for c in cams]
+    u = [float(np.ptp(corners @ np.array(c.up))) for c in cams]
+    return max(r), max(u)
+
+
+@lru_cache(maxsize=1024)
+def box_sums(extent: tuple[int, int, int], cam: Camera) -> tuple[float, float]:
+    """:func:`extreme_sums` of the box ``extent`` (from the origin): pieces recur."""
+    return extreme_sums(frame_corners((0, 0, 0), extent), cam)
+
+
+def centre_at(
+    sums: tuple[float, float], box: tuple[float, float, float, float], scale: float
+) -> tuple[float, float]:
+    """:func:`fit_centre` from :func:`extreme_sums` (kept where the points recur)."""
+    cx = (box[0] + box[2]) / 2 - sums[0] / 2 * scale
+    cy = (box[1] + box[3]) / 2 + sums[1] / 2 * scale
     return cx, cy
 
 

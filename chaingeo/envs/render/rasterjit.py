@@ -401,6 +401,23 @@ def reduce2(img: U8) -> U8:
 
 
 @njit(cache=True)
+def reduce2_into(img: U8, out: U8, x0: int, y0: int, x1: int, y1: int) -> None:
+    """:func:`reduce2` of the output rectangle ``[x0, x1) x [y0, y1)`` only, into ``out``."""
+    for y in range(y0, y1):
+        top, bottom = img[2 * y], img[2 * y + 1]
+        for x in range(x0, x1):
+            for ch in range(3):
+                s = (
+                    np.int64(top[2 * x, ch])
+                    + np.int64(top[2 * x + 1, ch])
+                    + np.int64(bottom[2 * x, ch])
+                    + np.int64(bottom[2 * x + 1, ch])
+                    + 2
+                )
+                out[y, x, ch] = s >> 2
+
+
+@njit(cache=True)
 def paste_mask(img: U8, mask: U8, x0: int, y0: int, c: U8) -> None:
     """``Image.paste(c, (x0, y0), mask)`` of an 8-bit mask (Pillow's ``fill_mask_L``: each
     channel blended as ``(out * (255 - m) + c * m) / 255``, rounded its way), clipped."""

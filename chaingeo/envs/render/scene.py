@@ -46,11 +46,13 @@ from chaingeo.envs.render.raster import (
     FloatArray,
     Posed,
     Projector,
+    box_spans,
+    box_sums,
+    centre_at,
     draw_faces,
     draw_faces_fast,
     draw_flat,
     fit,
-    fit_centre,
     frame_corners,
     line,
     oblique_camera,
@@ -361,6 +363,9 @@ PIECES_TITLE: Final = "PIECES: the puzzle's parts"
 _SHEET_NOTE: Final = "each from front-right-above (left) and back-left-below (right)"
 
 
+_AXES: Final = tuple((np.array(c.right), np.array(c.up)) for c in SHEET_CAMERAS)
+
+
 @lru_cache(maxsize=512)
 def _sheet_faces(cells: tuple[tuple[int, int, int], ...], rgb: RGB, cam: int) -> Faces:
     """One piece's faces on the sheet (they depend only on its shape, colour and camera)."""
@@ -409,10 +414,7 @@ def _sheet_layout(pieces: PieceMap, size: int, fast: bool) -> _Sheet | None:
     shapes = {n: pieces[n][0].normalized() for n in names}
     spans = np.array([1e-9, 1e-9])
     for n in names:
-        corners = frame_corners((0, 0, 0), shapes[n].extent)
-        for cam in SHEET_CAMERAS:
-            r, u = np.array(cam.right), np.array(cam.up)
-            spans = np.maximum(spans, (np.ptp(corners @ r), np.ptp(corners @ u)))
+        spans = np.maximum(spans, box_spans(shapes[n].extent, SHEET_CAMERAS))
     cols = sheet_grid(len(names), size, title_h, label_h, spans)
     rows = math.ceil(len(names) / cols)
     cell_w, cell_h = size / cols, (size - title_h) / rows
@@ -423,16 +425,14 @@ def _sheet_layout(pieces: PieceMap, size: int, fast: bool) -> _Sheet | None:
         col, row = i % cols, i // cols
         x0, y0 = col * cell_w, title_h + row * cell_h
         rgb = parse_color(pieces[n][1])
-        colors = np.tile(np.array(rgb, dtype=np.float64), (len(shapes[n]), 1))
-        corners = frame_corners((0, 0, 0), shapes[n].extent)
         for j, cam in enumerate(SHEET_CAMERAS):
             box = (x0 + j * cell_w / 2, y0, x0 + (j + 1) * cell_w / 2, y0 + cell_h - label_h)
-            proj = Projector(
-                np.array(cam.right), np.array(cam.up), scale, fit_centre(corners, cam, box, scale)
-            )
+            sums = box_sums(shapes[n].extent, cam)
+            proj = Projector(_AXES[j][0], _AXES[j][1], scale, centre_at(sums, box, scale))
             if fast:
                 faces = _sheet_faces(shapes[n].cells, rgb, j)
             else:
+                colors = np.tile(np.array(rgb, dtype=np.float64), (len(shapes[n]), 1))
                 faces = visible_faces(shapes[n].voxels, colors, cam)
             drawn.append((faces, scaled(proj, k)))
         cubes = len(shapes[n])
