@@ -3,13 +3,21 @@ reference renderer gives, on random input."""
 
 from __future__ import annotations
 
+import random
+from functools import cache
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image, ImageDraw
 
 from chaingeo.core.geometry import Shape
-from chaingeo.envs.render import rasterjit
+from chaingeo.core.level import Level
+from chaingeo.envs.frames import render_frames
+from chaingeo.envs.gym import StackingEnv
+from chaingeo.envs.machines import new_state
+from chaingeo.envs.observation import state_images
+from chaingeo.envs.render import fastview, rasterjit
 from chaingeo.envs.render.legend import clear_memo, draw_legend, paint_legend
 from chaingeo.envs.render.scene import render_tray_image
 from chaingeo.envs.render.sheet import tray_pixels
@@ -71,3 +79,42 @@ def test_tray_on_arrays_is_the_reference_tray(
     scene_pieces = {n: (Shape(cells), color) for n, (cells, color) in pieces.items()}
     expected = np.asarray(render_tray_image(scene_pieces, size))
     assert np.array_equal(tray_pixels(scene_pieces, size), expected)
+
+
+@cache
+def _stacking_levels() -> tuple[Level, ...]:
+    return tuple(StackingEnv(images=False).levels.values())
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_frames_along_random_placements_and_pickups_are_the_references(seed: int) -> None:
+    """Views reuse kept layouts, work pictures and legends across steps and sizes; every
+    picture must still be the reference's, and the one drawn from scratch."""
+    rng = random.Random(seed)
+    state = new_state(rng.choice(_stacking_levels()))
+    for _ in range(5):
+        moves = [a for a in state.legal_actions() if a.to_text() not in ("finish", "state")]
+        if not moves:
+            break
+        state.step_text(rng.choice(moves).to_text())
+        size = rng.choice([128, 256])
+        got = render_frames(state, size)
+        want = {n: np.asarray(im) for n, im in state_images(state, size, reference=True).items()}
+        assert list(got) == list(want)
+        assert all(np.array_equal(got[n], want[n]) for n in want)
+        fastview.clear()
+        fresh = render_frames(state, size)
+        assert all(np.array_equal(fresh[n], want[n]) for n in want)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 32), st.integers(0, 32), st.integers(0, 32), st.integers(0, 32))
+def test_reducing_a_rectangle_is_that_part_of_the_reduction(a: int, b: int, c: int, d: int) -> None:
+    big = np.random.default_rng(a * 33 + b).integers(0, 256, (64, 64, 3)).astype(np.uint8)
+    x0, x1, y0, y1 = min(a, c), max(a, c), min(b, d), max(b, d)
+    out = np.zeros((32, 32, 3), np.uint8)
+    rasterjit.reduce2_into(big, out, x0, y0, x1, y1)
+    want = np.zeros_like(out)
+    want[y0:y1, x0:x1] = rasterjit.reduce2(big)[y0:y1, x0:x1]
+    assert np.array_equal(out, want)
