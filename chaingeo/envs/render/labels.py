@@ -124,12 +124,7 @@ def tick_steps(
         px = int(min(tick_px, max(8, cell_px * 0.8)))
         every = max(1, math.ceil(px * 1.4 / cell_px))
         offset = normal * (px * 0.95 + 3)
-        for i, c in enumerate(range(lo[axis], hi[axis])):
-            if i % every and c != hi[axis] - 1:
-                continue
-            p = base.copy()
-            p[axis] = c + 0.5
-            out.append(text_step(proj(p) + offset, str(c + 1), px, TEXT))
+        out.extend(_ticks(base, axis, range(lo[axis], hi[axis]), every, proj, offset, px))
         # The arrow continues the row of numbers; the axis name sits just outside it.
         color = AXIS_COLORS[axis]
         tail = b + offset + d * (px * 0.5)
@@ -137,6 +132,32 @@ def tick_steps(
         out.append(arrow_step(tail, head, color, max(2, tick_px // 8)))
         name_at = (tail + head) / 2 + normal * (tick_px * 0.9)
         out.append(text_step(name_at, AXIS_NAMES[axis], tick_px + 3, color))
+    return out
+
+
+def _ticks(
+    base: FloatArray,
+    axis: int,
+    cells: range,
+    every: int,
+    proj: Projector,
+    offset: FloatArray,
+    px: int,
+) -> list[Step]:
+    """The numbers along one edge: ``proj(p) + offset`` per shown cell, on scalars (the same
+    arithmetic as :meth:`Projector.__call__` on one point, without its arrays)."""
+    p = base.copy()
+    right, up, scale = proj.right, proj.up, proj.scale
+    ox, oy = proj.origin
+    dx, dy = float(offset[0]), float(offset[1])
+    out = []
+    for i, c in enumerate(cells):
+        if i % every and c != cells[-1]:
+            continue
+        p[axis] = c + 0.5
+        x = float(p @ right) * scale + ox + dx
+        y = -float(p @ up) * scale + oy + dy
+        out.append(text_step((x, y), str(c + 1), px, TEXT))
     return out
 
 
