@@ -61,11 +61,16 @@ def _views(state: BaseState, size: int) -> dict[str, Frame]:
 def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
     import chaingeo.envs.render.fastview as fastview
 
-    return {v: _array(img) for v, img in fastview.render_images(pieces, box, VIEWS, size).items()}
+    return fastview.render_arrays(pieces, box, VIEWS, size)
 
 
-def _extra(state: BaseState, size: int) -> Frame:
-    """The tray (stacking) or the target (puzzles), as :func:`render_state` draws it."""
+def _extra(state: BaseState, size: int, tray: PieceMap | None = None) -> Frame:
+    """The tray (stacking: ``tray``, else the state's) or the target (puzzles), as
+    :func:`render_state` draws it."""
+    if isinstance(state, StackingState):
+        from chaingeo.envs.render.sheet import tray_pixels
+
+        return tray_pixels(scene(state)[2] if tray is None else tray, size)
     return _array(extra_image(state, size))
 
 
@@ -128,7 +133,7 @@ class FrameCache:
     def frames(self, state: BaseState) -> dict[str, Frame]:
         """Every picture of ``state`` (as :func:`render_frames` draws them), copied."""
         level = state.level.id
-        pieces, box, _ = scene(state)
+        pieces, box, tray = scene(state)
         # Keyed by what is drawn, not by state.key(): a puzzle's key holds each part up to
         # translation, while the views draw (and label) where the largest part really is.
         drawn = tuple(sorted((n, shape.cells, str(color)) for n, (shape, color) in pieces.items()))
@@ -140,7 +145,7 @@ class FrameCache:
             extra_key: Hashable = ("tray", level, tuple(sorted(state.tray)))
         else:
             extra_key = ("target", level)
-        (extra,) = self._get(extra_key, lambda: (_extra(state, self.size),))
+        (extra,) = self._get(extra_key, lambda: (_extra(state, self.size, tray),))
         names = picture_names(state.level.family)
         return {n: f.copy() for n, f in zip(names, (*views, extra), strict=True)}
 

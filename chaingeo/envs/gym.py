@@ -109,6 +109,9 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
             raise ValueError(f"image_size must be at least {MIN_SIZE} pixels, got {image_size}")
         self._templates: dict[str, BaseState] = {}
         self._catalogues: dict[str, tuple[list[str], dict[Action, int]]] = {}
+        #: Per level: catalogue index by object identity (a state's legal placements are the
+        #: very objects of its level's table: looking them up skips hashing each one).
+        self._by_id: dict[str, dict[int, int]] = {}
         self._frames = FrameCache(image_size)
         self._state: BaseState | None = None
         self.action_space = spaces.Text(ACTION_MAX_LENGTH, min_length=0, charset=CHARSET)
@@ -140,6 +143,7 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
                     )
                 index = {a: i for i, a in enumerate(actions)}
                 self._catalogues[level_id] = ([a.to_text() for a in actions], index)
+                self._by_id[level_id] = {id(a): i for a, i in index.items()}
             self._templates[level_id] = template
         return self._templates[level_id].clone()
 
@@ -199,8 +203,9 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
         }
         if isinstance(state, StackingState):
             _, index = self._catalogues[state.level.id]
+            by_id = self._by_id[state.level.id]
             mask = np.zeros(MAX_STACKING_ACTIONS, dtype=np.int8)
-            mask[[index[a] for a in state.legal_actions()]] = 1
+            mask[[by_id.get(id(a)) or index[a] for a in state.legal_actions()]] = 1
             info["action_mask"] = mask
         elif self.list_legal_actions:
             info["legal_actions"] = [a.to_text() for a in state.legal_actions()]

@@ -3,11 +3,12 @@
 A view is the frame's background (walls, floor grid, back frame edges), the pieces' faces, the
 front frame edges, then titles, axis ticks, depth labels and the legend. Here every shape and
 every label is drawn by :mod:`chaingeo.envs.render.rasterjit` (Pillow's own algorithms as numba
-kernels) on a numpy array; only the legend still goes through Pillow. In a box (stacking) the
-frame stays put, so all but the faces, depth labels and legend are kept per layout (the
-background at drawing scale, and the picture without pieces): a step draws the faces on a copy
-of the background and takes only the rectangle they (and their labels) cover, redrawing the
-labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass
+kernels) on a numpy array; the legend is drawn by Pillow once per strip under it and then kept
+(:func:`chaingeo.envs.render.legend.paint_legend`). In a box (stacking) the frame stays put, so
+all but the faces, depth labels and legend are kept per layout (the background at drawing
+scale, and the picture without pieces): a step draws the faces on a work copy of the
+background and reduces and takes only the rectangle they (and their labels) cover, redrawing
+the labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass
 (on a recent background, with recent label steps: a frame recurs within an episode).
 Every drawing call is the one :mod:`chaingeo.envs.render.scene` makes, in the same order, so the
 pictures are the same bytes (tested over the shipped levels); ``render`` stays the reference
@@ -37,7 +38,7 @@ from chaingeo.envs.render.labels import (
     tick_steps,
     title_steps,
 )
-from chaingeo.envs.render.legend import draw_legend, legend_layout
+from chaingeo.envs.render.legend import clear_memo, legend_layout, paint_legend
 from chaingeo.envs.render.raster import (
     EDGE,
     Box,
@@ -67,11 +68,11 @@ from chaingeo.envs.render.scene import (
     _view_projector,
     _view_titles,
     _wall_shapes,
-    render_tray_image_with,
 )
 from chaingeo.envs.render.scene import (
     _render_view as render_view,
 )
+from chaingeo.envs.render.sheet import tray_pixels
 
 #: Layouts kept per process (each about 1 MB at 256 px: the iso background is drawn at 2x).
 CAPACITY: Final = 48
@@ -103,12 +104,14 @@ _STORE: OrderedDict[Hashable, _Static] = OrderedDict()
 #: while recent (a frame recurs within an episode, seldom later; no finished picture is kept).
 _FOLLOW: OrderedDict[Hashable, tuple[_Back, tuple[Step, ...]]] = OrderedDict()
 FOLLOW_CAPACITY: Final = 16
+_SCRATCH: dict[tuple[int, int], Pixels] = {}
 
 
 def clear() -> None:
     """Forget every kept layout."""
     _STORE.clear()
     _FOLLOW.clear()
+    clear_memo()
 
 
 def _layout_key(scene: _Scene, cam: Camera, size: int, title: str | None) -> Hashable:
@@ -187,25 +190,50 @@ def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
 
 def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, FloatArray]:
     """The picture with the faces drawn (before labels), and their drawing pixels."""
-    big = back.big.copy()
+    if back.k > 1:  # drawn on a kept work picture: only the reduction is handed out
+        big = _scratch(size * back.k, 0)
+        np.copyto(big, back.big)
+    else:
+        big = back.big.copy()
     pix = scaled(back.proj, back.k).screen(faces.corners)
     width = _Layout.of(size).edge_px(back.k)
     rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
     return _finish(back, big), pix
 
 
+def _scratch(side: int, slot: int) -> Pixels:
+    """A work picture kept for reuse (its pixels are whatever its last user left)."""
+    key = (side, slot)
+    if key not in _SCRATCH:
+        _SCRATCH[key] = np.empty((side, side, 3), dtype=np.uint8)
+    return _SCRATCH[key]
+
+
 def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
-    image, pix = _pieces(st.back, faces, size)
-    proj, k = st.back.proj, st.back.k
-    labels = depth_label_steps(faces, cam, proj) if cam.depth_axis is not None else []
-    box = _touched(pix, _Layout.of(size).edge_px(k) + 2, k, size)
+    """The picture without pieces, and inside the rectangle the faces and their labels cover:
+    the faces on the background, the front edges, the reduction (of that rectangle only),
+    then every label that overlaps it."""
+    back, k = st.back, st.back.k
+    big = _scratch(size * k, 0)
+    np.copyto(big, back.big)
+    pix = scaled(back.proj, k).screen(faces.corners)
+    width = _Layout.of(size).edge_px(k)
+    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
+    rasterjit.draw_flat(big, back.front)
+    labels = depth_label_steps(faces, cam, back.proj) if cam.depth_axis is not None else []
+    box = _touched(pix, width + 2, k, size)
     for step in labels:
         box = _union(box, step.box)
     x0, y0, x1, y1 = max(0, box[0]), max(0, box[1]), min(size, box[2]), min(size, box[3])
     out = st.plain.copy()
     if x0 >= x1 or y0 >= y1:
         return out
-    paint_steps(image, [s for s in st.steps if overlaps(s.box, (x0, y0, x1, y1))])
+    image = big
+    if k > 1:
+        image = _scratch(size, 1)
+        rasterjit.reduce2_into(big, image, x0, y0, x1, y1)
+    rect = (x0, y0, x1, y1)
+    paint_steps(image, [s for s in st.steps if overlaps(s.box, rect)])
     paint_steps(image, labels)
     out[y0:y1, x0:x1] = image[y0:y1, x0:x1]
     return out
@@ -238,9 +266,11 @@ def _one_pass(scene: _Scene, cam: Camera, size: int, title: str | None, faces: F
     return image
 
 
-def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Image.Image:
+def _view_pixels(scene: _Scene, cam: Camera, size: int, title: str | None) -> Pixels:
+    """One finished view as a writable ``(size, size, 3)`` array."""
     if _Layout.of(size).edge_px(_SUPERSAMPLE) > 4 or jit_mode() != "numba":
-        return render_view(scene, cam, size, title=title, fast=True)  # round joints: Pillow
+        image = render_view(scene, cam, size, title=title, fast=True)  # round joints: Pillow
+        return np.array(image, dtype=np.uint8)
     faces = visible_faces(scene.cells, scene.colors, cam)
     st = _static(scene, cam, size, title)
     if st is None:
@@ -248,10 +278,23 @@ def _render_view(scene: _Scene, cam: Camera, size: int, title: str | None) -> Im
     elif len(faces.fills):
         pixels = _with_faces(st, faces, cam, size)
     else:
-        pixels = st.plain
-    image = Image.fromarray(pixels)
-    draw_legend(image, scene.legend)
-    return image
+        pixels = st.plain.copy()
+    paint_legend(pixels, scene.legend)
+    return pixels
+
+
+def render_arrays(
+    pieces: PieceMap,
+    box: Sequence[int] | None = None,
+    views: Sequence[str] = VIEWS,
+    size: int = DEFAULT_SIZE,
+    title: str | None = None,
+) -> dict[str, Pixels]:
+    """:func:`render_images` as writable ``(size, size, 3)`` arrays (no image in between)."""
+    _check_size(size)
+    _check_views(views)
+    scene = _scene(pieces, box)
+    return {v: _view_pixels(scene, CAMERAS[v], size, title) for v in views}
 
 
 def render_images(
@@ -262,14 +305,12 @@ def render_images(
     title: str | None = None,
 ) -> dict[str, Image.Image]:
     """:func:`chaingeo.envs.render.scene.render_images`, the same pixels, faster."""
-    _check_size(size)
-    _check_views(views)
-    scene = _scene(pieces, box)
-    return {v: _render_view(scene, CAMERAS[v], size, title) for v in views}
+    arrays = render_arrays(pieces, box, views, size, title)
+    return {v: Image.fromarray(a) for v, a in arrays.items()}
 
 
 def render_tray_image(
     pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE
 ) -> Image.Image:
     """:func:`chaingeo.envs.render.scene.render_tray_image`, the same pixels, faster."""
-    return render_tray_image_with(pieces, size, title, fast=True)
+    return Image.fromarray(tray_pixels(pieces, size, title))

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
-from typing import Final
+from functools import lru_cache
+from typing import Final, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -39,9 +39,9 @@ AXIS_COLORS: Final[tuple[RGB, RGB, RGB]] = ((190, 30, 30), (20, 130, 40), (30, 6
 AXIS_NAMES: Final = "xyz"
 
 
-@dataclass(frozen=True)
-class Step:
-    """One drawing call and a box around every pixel it may change."""
+class Step(NamedTuple):
+    """One drawing call and a box around every pixel it may change (a tuple: views make
+    dozens per picture)."""
 
     box: Box
     run: Callable[[Image.Image], None]
@@ -62,17 +62,25 @@ def paint_steps(pixels: Pixels, steps: Sequence[Step]) -> None:
         step.paint(pixels)
 
 
+@lru_cache(maxsize=256)
+def ink(fill: RGB) -> Pixels:
+    """A colour as a read-only ``uint8`` array (the kernels' ink), made once."""
+    out = np.array(fill, dtype=np.uint8)
+    out.flags.writeable = False
+    return out
+
+
 def text_step(
     xy: Sequence[float] | FloatArray, text: str, px: int, fill: RGB, anchor: str = "mm"
 ) -> Step:
     at = (float(xy[0]), float(xy[1]))
     box = text_box(at, text, px, anchor)
     mask = text_mask_array(text, px, anchor)
-    ink = np.array(fill, dtype=np.uint8)
+    color = ink(fill)
     return Step(
         box,
         lambda im: put_text(im, at, text, px, fill, anchor),
-        lambda arr: rasterjit.paste_mask(arr, mask, box[0], box[1], ink),
+        lambda arr: rasterjit.paste_mask(arr, mask, box[0], box[1], color),
     )
 
 
@@ -116,12 +124,7 @@ def tick_steps(
         px = int(min(tick_px, max(8, cell_px * 0.8)))
         every = max(1, math.ceil(px * 1.4 / cell_px))
         offset = normal * (px * 0.95 + 3)
-        for i, c in enumerate(range(lo[axis], hi[axis])):
-            if i % every and c != hi[axis] - 1:
-                continue
-            p = base.copy()
-            p[axis] = c + 0.5
-            out.append(text_step(proj(p) + offset, str(c + 1), px, TEXT))
+        out.extend(_ticks(base, axis, range(lo[axis], hi[axis]), every, proj, offset, px))
         # The arrow continues the row of numbers; the axis name sits just outside it.
         color = AXIS_COLORS[axis]
         tail = b + offset + d * (px * 0.5)
@@ -129,6 +132,32 @@ def tick_steps(
         out.append(arrow_step(tail, head, color, max(2, tick_px // 8)))
         name_at = (tail + head) / 2 + normal * (tick_px * 0.9)
         out.append(text_step(name_at, AXIS_NAMES[axis], tick_px + 3, color))
+    return out
+
+
+def _ticks(
+    base: FloatArray,
+    axis: int,
+    cells: range,
+    every: int,
+    proj: Projector,
+    offset: FloatArray,
+    px: int,
+) -> list[Step]:
+    """The numbers along one edge: ``proj(p) + offset`` per shown cell, on scalars (the same
+    arithmetic as :meth:`Projector.__call__` on one point, without its arrays)."""
+    p = base.copy()
+    right, up, scale = proj.right, proj.up, proj.scale
+    ox, oy = proj.origin
+    dx, dy = float(offset[0]), float(offset[1])
+    out = []
+    for i, c in enumerate(cells):
+        if i % every and c != cells[-1]:
+            continue
+        p[axis] = c + 0.5
+        x = float(p @ right) * scale + ox + dx
+        y = -float(p @ up) * scale + oy + dy
+        out.append(text_step((x, y), str(c + 1), px, TEXT))
     return out
 
 

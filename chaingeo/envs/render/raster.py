@@ -228,6 +228,10 @@ class Projector:
 
     def __call__(self, p: npt.ArrayLike) -> FloatArray:
         q = np.asarray(p, dtype=np.float64)
+        if q.ndim == 1:  # one point (labels): the same arithmetic on scalars, 5x faster
+            x1 = float(q @ self.right) * self.scale + self.origin[0]
+            y1 = -float(q @ self.up) * self.scale + self.origin[1]
+            return np.array([x1, y1])
         x = q @ self.right * self.scale + self.origin[0]
         y = -(q @ self.up) * self.scale + self.origin[1]
         return np.stack([x, y], axis=-1)
@@ -340,9 +344,36 @@ def fit_centre(
     points: FloatArray, cam: Camera, box: tuple[float, float, float, float], scale: float
 ) -> tuple[float, float]:
     """Origin that centres ``points`` in ``box`` at a given scale."""
+    return centre_at(extreme_sums(points, cam), box, scale)
+
+
+def extreme_sums(points: FloatArray, cam: Camera) -> tuple[float, float]:
+    """Along screen right and up: the largest plus the smallest coordinate of ``points``."""
     sx, sy = points @ np.array(cam.right), points @ np.array(cam.up)
-    cx = (box[0] + box[2]) / 2 - float(sx.max() + sx.min()) / 2 * scale
-    cy = (box[1] + box[3]) / 2 + float(sy.max() + sy.min()) / 2 * scale
+    return float(sx.max() + sx.min()), float(sy.max() + sy.min())
+
+
+@lru_cache(maxsize=512)
+def box_spans(extent: tuple[int, int, int], cams: tuple[Camera, ...]) -> tuple[float, float]:
+    """The widest screen extents of the box ``extent`` (from the origin) over ``cams``."""
+    corners = frame_corners((0, 0, 0), extent)
+    r = [float(np.ptp(corners @ np.array(c.right))) for c in cams]
+    u = [float(np.ptp(corners @ np.array(c.up))) for c in cams]
+    return max(r), max(u)
+
+
+@lru_cache(maxsize=1024)
+def box_sums(extent: tuple[int, int, int], cam: Camera) -> tuple[float, float]:
+    """:func:`extreme_sums` of the box ``extent`` (from the origin): pieces recur."""
+    return extreme_sums(frame_corners((0, 0, 0), extent), cam)
+
+
+def centre_at(
+    sums: tuple[float, float], box: tuple[float, float, float, float], scale: float
+) -> tuple[float, float]:
+    """:func:`fit_centre` from :func:`extreme_sums` (kept where the points recur)."""
+    cx = (box[0] + box[2]) / 2 - sums[0] / 2 * scale
+    cy = (box[1] + box[3]) / 2 + sums[1] / 2 * scale
     return cx, cy
 
 
@@ -373,6 +404,18 @@ def png_bytes(image: Image.Image) -> bytes:
             _png_chunk(b"IEND", b""),
         )
     )
+
+
+def sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: FloatArray) -> int:
+    """Columns of the piece grid that draw the pieces largest (fewest columns on a tie)."""
+    best, best_scale = 1, -1.0
+    for cols in range(1, n + 1):
+        rows = math.ceil(n / cols)
+        cell_w, cell_h = size / cols, (size - title_h) / rows
+        scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
+        if scale > best_scale + 1e-9:
+            best, best_scale = cols, scale
+    return best
 
 
 @dataclass(frozen=True)

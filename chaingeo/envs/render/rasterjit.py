@@ -364,6 +364,24 @@ def draw_faces(img: U8, corners: npt.NDArray[np.float64], fills: U8, edge: U8, w
 
 
 @njit(cache=True)
+def rectangle(img: U8, box: npt.NDArray[np.float64], fill: U8, outline: U8, edged: bool) -> None:
+    """``ImageDraw.rectangle(box, fill=fill, outline=outline)`` (width 1): corners truncated
+    to ints, the rows filled end inclusive, then (``edged``: the two colours differ) the
+    outline's rows and the columns between them (``ImagingDrawRectangle``)."""
+    x0, y0, x1, y1 = int(box[0]), int(box[1]), int(box[2]), int(box[3])
+    if y0 > y1:
+        y0, y1 = y1, y0
+    top, bottom = max(y0, 0), min(y1, img.shape[0])
+    for y in range(top, bottom + 1):
+        _hline(img, x0, y, x1, fill)
+    if edged:
+        _hline(img, x0, y0, x1, outline)
+        _hline(img, x0, y1, x1, outline)
+        _line(img, x1, y0 + 1, x1, y1, outline)
+        _line(img, x0, y0 + 1, x0, y1, outline)
+
+
+@njit(cache=True)
 def reduce2(img: U8) -> U8:
     """``Image.reduce(2)`` of an even-sized picture: each 2x2 block's mean, rounded half up."""
     h, w = img.shape[0] // 2, img.shape[1] // 2
@@ -380,6 +398,23 @@ def reduce2(img: U8) -> U8:
                 s = acc[6 * x + ch] + acc[6 * x + 3 + ch] + 2
                 dst[y, 3 * x + ch] = s >> 2
     return out
+
+
+@njit(cache=True)
+def reduce2_into(img: U8, out: U8, x0: int, y0: int, x1: int, y1: int) -> None:
+    """:func:`reduce2` of the output rectangle ``[x0, x1) x [y0, y1)`` only, into ``out``."""
+    for y in range(y0, y1):
+        top, bottom = img[2 * y], img[2 * y + 1]
+        for x in range(x0, x1):
+            for ch in range(3):
+                s = (
+                    np.int64(top[2 * x, ch])
+                    + np.int64(top[2 * x + 1, ch])
+                    + np.int64(bottom[2 * x, ch])
+                    + np.int64(bottom[2 * x + 1, ch])
+                    + 2
+                )
+                out[y, x, ch] = s >> 2
 
 
 @njit(cache=True)

@@ -27,8 +27,6 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from chaingeo.core.geometry import Shape
-from chaingeo.core.jit import mode as jit_mode
-from chaingeo.envs.render import rasterjit
 from chaingeo.envs.render.labels import (
     AXIS_NAMES,
     TEXT,
@@ -48,11 +46,13 @@ from chaingeo.envs.render.raster import (
     FloatArray,
     Posed,
     Projector,
+    box_spans,
+    box_sums,
+    centre_at,
     draw_faces,
     draw_faces_fast,
     draw_flat,
     fit,
-    fit_centre,
     frame_corners,
     line,
     oblique_camera,
@@ -61,6 +61,7 @@ from chaingeo.envs.render.raster import (
     posed_faces,
     put_text,
     scaled,
+    sheet_grid,
     text_length,
     visible_faces,
 )
@@ -362,16 +363,7 @@ PIECES_TITLE: Final = "PIECES: the puzzle's parts"
 _SHEET_NOTE: Final = "each from front-right-above (left) and back-left-below (right)"
 
 
-def _sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: FloatArray) -> int:
-    """Columns of the piece grid that draw the pieces largest (fewest columns on a tie)."""
-    best, best_scale = 1, -1.0
-    for cols in range(1, n + 1):
-        rows = math.ceil(n / cols)
-        cell_w, cell_h = size / cols, (size - title_h) / rows
-        scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
-        if scale > best_scale + 1e-9:
-            best, best_scale = cols, scale
-    return best
+_AXES: Final = tuple((np.array(c.right), np.array(c.up)) for c in SHEET_CAMERAS)
 
 
 @lru_cache(maxsize=512)
@@ -385,16 +377,9 @@ def _sheet_faces(cells: tuple[tuple[int, int, int], ...], rgb: RGB, cam: int) ->
 def _sheet_pieces(
     drawn: Sequence[tuple[Faces, Projector]], size: int, width: int, fast: bool
 ) -> Image.Image:
-    """The sheet's pieces drawn at twice the size and reduced: by Pillow, or (``fast``) all at
-    once by :mod:`chaingeo.envs.render.rasterjit` (the same pixels; Pillow when lines get round
-    joints)."""
+    """The sheet's pieces drawn at twice the size and reduced (``fast``: by
+    :func:`draw_faces_fast`; :mod:`chaingeo.envs.render.sheet` draws them by the kernels)."""
     k = _SUPERSAMPLE
-    if fast and width <= 4 and jit_mode() == "numba":
-        big = rasterjit.blank(size * k, _BACKGROUND).copy()
-        corners = np.concatenate([p.screen(f.corners) for f, p in drawn])
-        fills = np.concatenate([f.fills for f, _ in drawn])
-        rasterjit.draw_faces(big, corners, fills, np.array(EDGE, dtype=np.uint8), width)
-        return Image.fromarray(rasterjit.reduce2(big))
     image = Image.new("RGB", (size * k, size * k), _BACKGROUND)
     draw = ImageDraw.Draw(image)
     for faces, proj in drawn:
@@ -402,28 +387,35 @@ def _sheet_pieces(
     return image.reduce(k)
 
 
-def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) -> Image.Image:
-    """Every piece in its own cell, drawn twice (see :data:`SHEET_CAMERAS`) at one common
-    scale, labelled with a colour swatch, its name and its number of cubes."""
+@dataclass(frozen=True)
+class _Sheet:
+    """The piece sheet's faces and projectors (drawing scale), labels and grid of cells."""
+
+    drawn: list[tuple[Faces, Projector]]
+    slots: list[tuple[str, RGB, float, float]]
+    cols: int
+    rows: int
+    cell_w: float
+    cell_h: float
+    title_h: float
+    label_px: int
+
+
+def _sheet_layout(pieces: PieceMap, size: int, fast: bool) -> _Sheet | None:
+    """The layout of :func:`_render_tray` (None without pieces)."""
     lay = _Layout.of(size)
     k = _SUPERSAMPLE
     names = sorted(pieces)
     title_h = lay.title_px * 2.85 + 6
     if not names:
-        image = Image.new("RGB", (size, size), _BACKGROUND)
-        _title(image, [title], lay)
-        put_text(image, (size / 2, size / 2), "(no pieces)", lay.tick_px, _TEXT)
-        return image
+        return None
     label_px = max(9, min(lay.tick_px, size // 40))
     label_h = label_px * 1.7
     shapes = {n: pieces[n][0].normalized() for n in names}
     spans = np.array([1e-9, 1e-9])
     for n in names:
-        corners = frame_corners((0, 0, 0), shapes[n].extent)
-        for cam in SHEET_CAMERAS:
-            r, u = np.array(cam.right), np.array(cam.up)
-            spans = np.maximum(spans, (np.ptp(corners @ r), np.ptp(corners @ u)))
-    cols = _sheet_grid(len(names), size, title_h, label_h, spans)
+        spans = np.maximum(spans, box_spans(shapes[n].extent, SHEET_CAMERAS))
+    cols = sheet_grid(len(names), size, title_h, label_h, spans)
     rows = math.ceil(len(names) / cols)
     cell_w, cell_h = size / cols, (size - title_h) / rows
     scale = min(cell_w / 2 * 0.84 / spans[0], (cell_h - label_h) * 0.84 / spans[1])
@@ -433,35 +425,47 @@ def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) ->
         col, row = i % cols, i // cols
         x0, y0 = col * cell_w, title_h + row * cell_h
         rgb = parse_color(pieces[n][1])
-        colors = np.tile(np.array(rgb, dtype=np.float64), (len(shapes[n]), 1))
-        corners = frame_corners((0, 0, 0), shapes[n].extent)
         for j, cam in enumerate(SHEET_CAMERAS):
             box = (x0 + j * cell_w / 2, y0, x0 + (j + 1) * cell_w / 2, y0 + cell_h - label_h)
-            proj = Projector(
-                np.array(cam.right), np.array(cam.up), scale, fit_centre(corners, cam, box, scale)
-            )
+            sums = box_sums(shapes[n].extent, cam)
+            proj = Projector(_AXES[j][0], _AXES[j][1], scale, centre_at(sums, box, scale))
             if fast:
                 faces = _sheet_faces(shapes[n].cells, rgb, j)
             else:
+                colors = np.tile(np.array(rgb, dtype=np.float64), (len(shapes[n]), 1))
                 faces = visible_faces(shapes[n].voxels, colors, cam)
             drawn.append((faces, scaled(proj, k)))
         cubes = len(shapes[n])
         label = f"{n} ({cubes} cube{'s' if cubes != 1 else ''})"
         slots.append((label, rgb, x0 + cell_w / 2, y0 + cell_h - label_h / 2))
-    image = _sheet_pieces(drawn, size, lay.edge_px(k), fast)
+    return _Sheet(drawn, slots, cols, rows, cell_w, cell_h, title_h, label_px)
+
+
+def _render_tray(pieces: PieceMap, size: int, title: str, fast: bool = False) -> Image.Image:
+    """Every piece in its own cell, drawn twice (see :data:`SHEET_CAMERAS`) at one common
+    scale, labelled with a colour swatch, its name and its number of cubes."""
+    lay = _Layout.of(size)
+    sheet = _sheet_layout(pieces, size, fast)
+    if sheet is None:
+        image = Image.new("RGB", (size, size), _BACKGROUND)
+        _title(image, [title], lay)
+        put_text(image, (size / 2, size / 2), "(no pieces)", lay.tick_px, _TEXT)
+        return image
+    label_px, title_h, cell_w = sheet.label_px, sheet.title_h, sheet.cell_w
+    image = _sheet_pieces(sheet.drawn, size, lay.edge_px(_SUPERSAMPLE), fast)
     small = ImageDraw.Draw(image)
     _title(image, [title, _SHEET_NOTE], lay)
-    for text, rgb, x, y in slots:
+    for text, rgb, x, y in sheet.slots:
         width = text_length(text, label_px)
         left = x - (width + label_px * 1.4) / 2
         small.rectangle(
             [left, y - label_px / 2, left + label_px, y + label_px / 2], fill=rgb, outline=EDGE
         )
         put_text(image, (left + label_px * 1.4, y), text, label_px, _TEXT, anchor="lm")
-    for c in range(1, cols):
+    for c in range(1, sheet.cols):
         small.line([(c * cell_w, title_h), (c * cell_w, size)], fill=_GRID, width=1)
-    for rr in range(1, rows):
-        y = title_h + rr * cell_h
+    for rr in range(1, sheet.rows):
+        y = title_h + rr * sheet.cell_h
         small.line([(0, y), (size, y)], fill=_GRID, width=1)
     return image
 
@@ -545,12 +549,16 @@ def render_tray_image(
 def render_tray_image_with(pieces: PieceMap, size: int, title: str, fast: bool) -> Image.Image:
     """:func:`render_tray_image`; ``fast`` keeps each piece's faces and skips Pillow's per-call
     checks (the same pixels; :mod:`chaingeo.envs.render.fastview`)."""
+    _check_tray(pieces, size)
+    return _render_tray(pieces, size, title, fast)
+
+
+def _check_tray(pieces: PieceMap, size: int) -> None:
     _check_size(size)
     for shape, color in pieces.values():
         parse_color(color)
         if len(shape) == 0:
             raise ValueError("a piece needs at least one cell")
-    return _render_tray(pieces, size, title, fast)
 
 
 def render_tray(pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE) -> bytes:
