@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.core.jit import mode, njit
 from chaingeo.solvers.cover.problem import CoverProblem
 
 I64 = npt.NDArray[np.int64]
@@ -23,6 +23,8 @@ Int32Array = npt.NDArray[np.int32]
 
 #: Passes over the rows at most (each after the first only when some row died).
 MAX_PASSES = 16
+#: Interpreted kernels: rows x rows x columns up to this go through :func:`_dead_rows_dense`.
+DENSE_WORK = 60_000_000
 
 
 @njit(cache=True)
@@ -90,14 +92,25 @@ def live_rows(problem: CoverProblem, rows: Int32Array | None = None) -> Int32Arr
     Columns: every cell (required unless optional) and, for a piece used at most once, the
     piece (required when it must be used); pieces that may be used several times add no
     column (their rows stay compatible with each other), which only keeps more rows."""
+    if problem.n_rows == 0:
+        return np.zeros(0, dtype=np.int32)
+    row_ptr, cols, col_ptr, col_rows, required, alive = columns(problem, rows)
+    dense = mode() == "python" and problem.n_rows**2 * len(required) <= DENSE_WORK
+    if not (dense and _dead_rows_dense(row_ptr, cols, required, alive, MAX_PASSES)):
+        _dead_rows(row_ptr, cols, col_ptr, col_rows, required, alive, MAX_PASSES)
+    return np.flatnonzero(alive).astype(np.int32)
+
+
+def columns(
+    problem: CoverProblem, rows: Int32Array | None = None
+) -> tuple[I64, I64, I64, I64, B1, B1]:
+    """The arrays :func:`_dead_rows` takes: rows' columns, columns' rows, required, alive."""
     n_rows, n_cells = problem.n_rows, problem.n_cells
     alive = np.zeros(n_rows, dtype=np.bool_)
     if rows is None:
         alive[:] = True
     else:
         alive[np.asarray(rows, dtype=np.int64)] = True
-    if n_rows == 0:
-        return np.zeros(0, dtype=np.int32)
     single = np.array([t.hi == 1 for t in problem.types], dtype=np.bool_)
     must = np.array([t.lo == 1 for t in problem.types], dtype=np.bool_)
     row_type = problem.row_type.astype(np.int64)
@@ -118,5 +131,33 @@ def live_rows(problem: CoverProblem, rows: Int32Array | None = None) -> Int32Arr
     col_rows = np.repeat(np.arange(n_rows), sizes)[order]
     col_ptr = np.zeros(len(required) + 1, dtype=np.int64)
     np.cumsum(np.bincount(cols, minlength=len(required)), out=col_ptr[1:])
-    _dead_rows(row_ptr, cols, col_ptr, col_rows, required, alive, MAX_PASSES)
-    return np.flatnonzero(alive).astype(np.int32)
+    return row_ptr, cols, col_ptr, col_rows, required, alive
+
+
+def _dead_rows_dense(row_ptr: I64, cols: I64, required: B1, alive: B1, max_passes: int) -> bool:
+    """:func:`_dead_rows` in numpy for interpreted runs (the loop there costs 0.2-0.5 s of a
+    small puzzle): every alive row tested at once per round, rows x rows conflicts as a matrix
+    product. Returns False, ``alive`` untouched, where the result could differ from the
+    kernel's one row at a time: more than ``max_passes`` rounds, or a required column left
+    with no row (then which rows the kernel keeps depends on its order). Elsewhere both reach
+    the same greatest set of rows none of which is dead: deadness only grows as rows go."""
+    n_rows, n_cols = len(row_ptr) - 1, len(required)
+    cover = np.zeros((n_rows, n_cols), dtype=np.float32)
+    cover[np.repeat(np.arange(n_rows), np.diff(row_ptr)), cols] = 1.0
+    free = required[None, :] & (cover == 0)
+    live = alive.copy()
+    for _ in range(max_passes + 1):
+        held = cover * live[:, None]
+        count = held.sum(axis=0)
+        clash = (cover @ held.T > 0).astype(np.float32)  # [r, r2]: alive r2 shares a column
+        left = clash @ cover  # [r, c]: alive rows covering c that placing r removes
+        dead = live & ((left > 0) & (left == count[None, :]) & free).any(axis=1)
+        if not dead.any():
+            break
+        live &= ~dead
+    else:
+        return False
+    if np.any(required & ((cover * live[:, None]).sum(axis=0) == 0)):
+        return False
+    alive[:] = live
+    return True
