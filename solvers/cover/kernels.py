@@ -8,9 +8,10 @@ where it stopped.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.jit import njit
 
@@ -31,6 +32,34 @@ N_REGS = 5
 
 def new_regs() -> np.ndarray:
     return np.zeros(N_REGS, dtype=np.int64)
+
+
+class Control(NamedTuple):
+    """What one call of any engine's kernel runs under and writes to (numba sees a tuple):
+    the registers it resumes from, the shuffle's PRNG state, and where the solutions go."""
+
+    regs: npt.NDArray[np.int64]
+    rng: npt.NDArray[np.uint64]
+    shuffle: bool
+    out: npt.NDArray[np.int32]
+    max_store: int
+    stop_after: int
+    node_limit: int
+
+
+@njit(cache=True)
+def stored_enough(ctl: Control, n_out: int, found: int) -> bool:
+    """Whether the batch is full or the caller's solution count is reached."""
+    return (ctl.max_store > 0 and n_out == ctl.max_store) or found == ctl.stop_after
+
+
+@njit(cache=True)
+def save_registers(regs: np.ndarray, k: int, nodes: int, updates: int, found: int) -> None:
+    """Leave the counters where the next call resumes."""
+    regs[REG_DEPTH] = k
+    regs[REG_NODES] = nodes
+    regs[REG_UPDATES] = updates
+    regs[REG_SOLUTIONS] += found
 
 
 @njit(cache=True)

@@ -400,6 +400,25 @@ def node_moves(
 
 
 @njit(cache=True)
+def shift_child(
+    row: I16, child: I16, base: int, pieces: I64, m: int, mask: int, d: int, k: int
+) -> None:  # fmt: skip
+    """``child`` = ``row`` with the group ``mask`` (bits of the piece indices ``pieces[:m]``,
+    offsets at ``base + 3 piece``) moved ``k`` units along direction ``d``. The first piece
+    never moves: when it belongs to the group, the others move the opposite way instead."""
+    child[:] = row
+    a = base + d // 2
+    step = k if d % 2 == 0 else -k
+    if (mask >> pieces[0]) & 1:
+        step = -step
+        mask = ~mask
+    for p in range(m):
+        q = pieces[p]
+        if (mask >> q) & 1:
+            child[a + 3 * q] += step
+
+
+@njit(cache=True)
 def hash_row(row: I16) -> np.uint64:
     h = np.uint64(14695981039346656037)
     for v in row:
@@ -530,6 +549,7 @@ def expand(
     gaps = np.empty((3, n, n), dtype=np.int64)
     off = np.empty((n, 3), dtype=np.int64)
     child = np.empty(w, dtype=np.int16)
+    everyone = np.arange(n, dtype=np.int64)
     while n_seps > 0 and seps[n_seps - 1, 0] >= node:
         n_seps -= 1
     done = 0
@@ -564,21 +584,10 @@ def expand(
                     seps[n_seps, 1] = np.int64(mask)
                     seps[n_seps, 2] = dr
                     n_seps += 1
-                a = dr // 2
-                sign = 1 if dr % 2 == 0 else -1
-                anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
                 for k in range(1, kmax + 1):
                     if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
                         return NEED_STATES, node, n_states, n_seps, n_layers
-                    for t in range(w):
-                        child[t] = states[node, t]
-                    for p in range(n):
-                        inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
-                        if anchor_moves:  # keep piece 0 still: move everyone else back instead
-                            if not inside:
-                                child[3 * p + a] -= sign * k
-                        elif inside:
-                            child[3 * p + a] += sign * k
+                    shift_child(states[node], child, 0, everyone, n, moves_buf[r, 0], dr, k)
                     got = find_or_insert(states, n_states, table, child)
                     if got < 0:
                         parent[n_states] = node
