@@ -124,20 +124,6 @@ class MRVStack(NamedTuple):
     chosen: I32
 
 
-@njit(cache=True, inline="always")
-def _count_row(m: Any, b0: Any, b1: Any, b2: Any, b3: Any, sat: Any) -> Any:
-    """Add the mask ``m`` to the bit-sliced counters; returns them."""
-    c0 = b0 & m
-    b0 ^= m
-    c1 = b1 & c0
-    b1 ^= c0
-    c2 = b2 & c1
-    b2 ^= c1
-    sat |= b3 & c2
-    b3 ^= c2
-    return b0, b1, b2, b3, sat
-
-
 @njit(cache=True)
 def _short_or_best(rows: MRVRows, cnt: Any, tcount: Any) -> tuple[int, int]:
     """``(-2, 0)`` when a counted type has too few rows left, else the unused exact-once piece
@@ -200,7 +186,14 @@ def _expand(
         n += keep
         run += keep
         m &= _NONE - np.uint64(keep)
-        b0, b1, b2, b3, sat = _count_row(m, b0, b1, b2, b3, sat)
+        c0 = b0 & m
+        b0 ^= m
+        c1 = b1 & c0
+        b1 ^= c0
+        c2 = b2 & c1
+        b2 ^= c1
+        sat |= b3 & c2
+        b3 ^= c2
     tcount[cur] += run
     empty = rows.primary[0] & ~occ
     if empty & ~(b0 | b1 | b2 | b3 | sat):
@@ -309,7 +302,7 @@ def _exact_min_wide(
     return cell, best
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _expand_any(
     rows: MRVRows, st: MRVStack, src: Any, a: int, b: int, w: int, occ: Any, br: Any
 ) -> tuple[int, int]:
@@ -319,7 +312,7 @@ def _expand_any(
     return _expand_wide(rows, st, src, a, b, w, occ, br)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _place(rows: MRVRows, occ: Any, r: int, here: Any) -> bool:
     """``here = occ | masks[r]``; whether it covers every mandatory cell."""
     if rows.masks.shape[1] == 1:
