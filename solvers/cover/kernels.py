@@ -47,6 +47,19 @@ class Control(NamedTuple):
     node_limit: int
 
 
+class Levels(NamedTuple):
+    """Per-level search state of the DLX and first-cell kernels: type counts, the branch lists
+    (``buf``), each level's end and position in them, an engine's own per-level value
+    (``aux``: the column, or the candidate base) and the row chosen."""
+
+    cnt: npt.NDArray[np.int32]
+    buf: npt.NDArray[np.int32]
+    nbuf: npt.NDArray[np.int64]
+    pos: npt.NDArray[np.int64]
+    aux: npt.NDArray[np.int64]
+    chosen: npt.NDArray[np.int32]
+
+
 @njit(cache=True)
 def stored_enough(ctl: Control, n_out: int, found: int) -> bool:
     """Whether the batch is full or the caller's solution count is reached."""

@@ -223,27 +223,19 @@ class CoverSearch:
         """One call of the search's kernel up to ``node_limit`` nodes in total; solutions go to
         ``out`` (see :func:`chaingeo.solvers.cover.dlx.dlx_run`)."""
         a = self._arr
-        if isinstance(a, DLXArrays):
-            HL, HR, U, D, TOP, RW, S = self._links
-            return dlx_run(
-                HL, HR, U, D, TOP, RW, S, a.kind, a.lo, a.hi, self._cnt, a.counters,
-                self._buf, self._nbuf, self._pos, self._aux, self._chosen,
-                self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, node_limit,
-            )  # fmt: skip
-        if isinstance(a, BitboardArrays):
-            return bitboard_run(
-                a.mask, a.rtype, a.rid, a.cand_ptr, a.cand, a.skip,
-                a.type_ptr, a.exact1, a.mrv_depth, a.primary,
-                a.lo, a.hi, self._cnt, a.counters, a.table,
-                a.nb, a.region_gcd, a.region_min,
-                self._occ, self._perm, self._nbuf, self._pos, self._aux, self._chosen,
-                self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, node_limit,
-            )  # fmt: skip
         ctl = kernels.Control(
             self._regs, self._rng, self._shuffle, out, max_store, stop_after, node_limit
         )
+        if isinstance(a, DLXArrays):
+            lv = kernels.Levels(
+                self._cnt, self._buf, self._nbuf, self._pos, self._aux, self._chosen
+            )
+            return dlx_run(self._links, a.columns, lv, ctl)
+        if isinstance(a, BitboardArrays):
+            lv = kernels.Levels(
+                self._cnt, self._perm, self._nbuf, self._pos, self._aux, self._chosen
+            )
+            return bitboard_run(a.rows, self._occ, lv, ctl)
         return mrv_run(a.rows, self._stack, ctl)
 
     def _call(self, max_store: int, stop_after: int) -> Int32Array:
