@@ -125,14 +125,14 @@ class MRVStack(NamedTuple):
 
 
 @njit(cache=True)
-def _short_or_best(rows: MRVRows, cnt: Any, tcount: Any) -> tuple[int, int]:
+def _short_or_best(counters: Any, pieces: Any, lo: Any, cnt: Any, tcount: Any) -> tuple[int, int]:
     """``(-2, 0)`` when a counted type has too few rows left, else the unused exact-once piece
     with the fewest alive rows ``(type, rows)`` (``(-1, 2^30)`` when there is none)."""
-    for q in rows.counters:
-        if cnt[q] + tcount[q] < rows.lo[q]:
+    for q in counters:
+        if cnt[q] + tcount[q] < lo[q]:
             return -2, 0
     best_t, best_n = -1, 1 << 30
-    for t in rows.pieces:
+    for t in pieces:
         if cnt[t] == 0 and tcount[t] < best_n:
             best_t, best_n = t, tcount[t]
     return best_t, best_n
@@ -162,13 +162,18 @@ def _branches(
 
 @njit(cache=True)
 def _expand(
-    rows: MRVRows, st: MRVStack, src: Any, a: int, b: int, w: int, occ: Any, br: Any
-) -> tuple[int, int]:
-    """Filter ``src[a:b]`` to the rows alive under ``occ`` (one word; written from
-    ``live[w]``), pick the branching cell or piece and write its rows to ``br``; returns ``(end
-    of the alive list, number of branches)`` with 0 branches for a dead end."""
-    mask, rtype, cnt, hi, tcount, live = rows.mask, rows.rtype, st.cnt, rows.hi, st.tcount, st.live
-    b0 = b1 = b2 = b3 = sat = _NONE
+    src: Any, a: int, b: int, live: Any, w: int, occ: Any, primary: Any,
+    mask: Any, rtype: Any, lo: Any, hi: Any, cnt: Any, tcount: Any, counters: Any,
+    pieces: Any, table: Any, tally: Any, br: Any,
+) -> tuple[int, int]:  # fmt: skip
+    """Filter ``src[a:b]`` to the rows alive under ``occ`` (written from ``live[w]``), pick the
+    branching cell or piece and write its rows to ``br``; returns ``(end of the alive list,
+    number of branches)`` with 0 branches for a dead end."""
+    b0 = _NONE
+    b1 = _NONE
+    b2 = _NONE
+    b3 = _NONE
+    sat = _NONE
     tcount[:] = 0
     n = w
     cur = 0  # rows come grouped by type: count each type's run in a register
@@ -195,20 +200,20 @@ def _expand(
         sat |= b3 & c2
         b3 ^= c2
     tcount[cur] += run
-    empty = rows.primary[0] & ~occ
+    empty = primary & ~occ
     if empty & ~(b0 | b1 | b2 | b3 | sat):
         return n, 0  # an empty cell no row can fill
-    best_t, best_n = _short_or_best(rows, cnt, tcount)
+    best_t, best_n = _short_or_best(counters, pieces, lo, cnt, tcount)
     if best_t == -2:
         return n, 0  # not enough rows left for a piece still needed
     cell = -1
     for v in range(1, min(best_n, SATURATED)):  # cells strictly below the best piece
         x = empty & _with_count(v, b0, b1, b2, b3, sat)
         if x != _NONE:
-            cell, best_n = _low(x, rows.table), v
+            cell, best_n = _low(x, table), v
             break
     if cell < 0 and best_n > SATURATED:
-        c, cn = _exact_min(live, w, n, mask, empty, rows.table, st.tally)
+        c, cn = _exact_min(live, w, n, mask, empty, table, tally)
         if cn < best_n:
             cell, best_n = c, cn
     bit = _ONE << np.uint64(cell) if cell >= 0 else _NONE
@@ -217,18 +222,11 @@ def _expand(
 
 @njit(cache=True)
 def _expand_wide(
-    rows: MRVRows, st: MRVStack, src: Any, a: int, b: int, w0: int, occ: Any, br: Any
-) -> tuple[int, int]:
-    """:func:`_expand` on masks of ``W`` words (``st.planes``: (5, W) scratch counters)."""
-    masks, rtype, cnt, hi, tcount, live = (
-        rows.masks,
-        rows.rtype,
-        st.cnt,
-        rows.hi,
-        st.tcount,
-        st.live,
-    )
-    planes, empty, table = st.planes, st.scratch[1], rows.table
+    src: Any, a: int, b: int, live: Any, w0: int, occ: Any, primary: Any,
+    masks: Any, rtype: Any, lo: Any, hi: Any, cnt: Any, tcount: Any, counters: Any,
+    pieces: Any, table: Any, tally: Any, planes: Any, empty: Any, br: Any,
+) -> tuple[int, int]:  # fmt: skip
+    """:func:`_expand` on masks of ``W`` words (``planes``: (5, W) scratch counters)."""
     W = masks.shape[1]
     planes[:] = _NONE
     tcount[:] = 0
@@ -252,11 +250,11 @@ def _expand_wide(
                 c = nxt
             planes[4, w] |= c
     for w in range(W):
-        empty[w] = rows.primary[w] & ~occ[w]
+        empty[w] = primary[w] & ~occ[w]
         seen = planes[0, w] | planes[1, w] | planes[2, w] | planes[3, w] | planes[4, w]
         if empty[w] & ~seen:
             return n, 0
-    best_t, best_n = _short_or_best(rows, cnt, tcount)
+    best_t, best_n = _short_or_best(counters, pieces, lo, cnt, tcount)
     if best_t == -2:
         return n, 0
     cell = -1
@@ -272,9 +270,9 @@ def _expand_wide(
             best_n = v
             break
     if cell < 0 and best_n > SATURATED:
-        cell, best_n = _exact_min_wide(live, w0, n, masks, empty, table, st.tally, cell, best_n)
+        cell, best_n = _exact_min_wide(live, w0, n, masks, empty, table, tally, cell, best_n)
     if cell < 0:
-        return n, _branches(live, w0, n, rows.mask, _NONE, rtype, best_t, br)
+        return n, _branches(live, w0, n, masks[:, 0], _NONE, rtype, best_t, br)
     word, bit = cell // 64, _ONE << np.uint64(cell % 64)
     return n, _branches(live, w0, n, masks[:, word], bit, rtype, best_t, br)
 
@@ -303,120 +301,119 @@ def _exact_min_wide(
 
 
 @njit(cache=True)
-def _expand_any(
-    rows: MRVRows, st: MRVStack, src: Any, a: int, b: int, w: int, occ: Any, br: Any
-) -> tuple[int, int]:
-    """:func:`_expand` on one-word targets, :func:`_expand_wide` on the others."""
-    if rows.masks.shape[1] == 1:
-        return _expand(rows, st, src, a, b, w, occ[0], br)
-    return _expand_wide(rows, st, src, a, b, w, occ, br)
-
-
-@njit(cache=True)
-def _place(rows: MRVRows, occ: Any, r: int, here: Any) -> bool:
-    """``here = occ | masks[r]``; whether it covers every mandatory cell."""
-    if rows.masks.shape[1] == 1:
-        h = occ[0] | rows.mask[r]
-        here[0] = h
-        return bool((h & rows.primary[0]) == rows.primary[0])
+def _place_wide(occ: Any, add: Any, primary: Any, here: Any) -> bool:
+    """``here = occ | add`` (``W`` words); whether it covers every mandatory cell."""
     full = True
-    for w in range(rows.masks.shape[1]):
-        here[w] = occ[w] | rows.masks[r, w]
-        if (here[w] & rows.primary[w]) != rows.primary[w]:
+    for w in range(occ.shape[0]):
+        here[w] = occ[w] | add[w]
+        if (here[w] & primary[w]) != primary[w]:
             full = False
     return full
 
 
 @njit(cache=True)
-def _counts_ok(rows: MRVRows, cnt: Any) -> bool:
-    """Every counted type has at least its ``lo`` rows."""
-    for q in rows.counters:  # noqa: SIM110 (numba compiles no generator into all())
-        if cnt[q] < rows.lo[q]:
-            return False
-    return True
-
-
-@njit(cache=True)
 def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control) -> int:
     """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`
-    (:class:`MRVStack` describes the levels)."""
-    regs, cnt, occ, br, nbr, pos, chosen = (
-        ctl.regs,
-        st.cnt,
-        st.occ,
-        st.br,
-        st.nbr,
-        st.pos,
-        st.chosen,
-    )
+    (:class:`MRVStack` describes the levels). One-word targets keep the occupancy in a
+    register and call :func:`_expand`, wider ones :func:`_expand_wide`."""
+    mask, masks, rtype, rid, allrows, primary, lo, hi, counters, pieces, table = rows[:11]
+    nb, region_gcd, region_min = rows[11:]
+    cnt, live, lstart, occ, tcount, tally, planes, scratch, br, nbr, pos, chosen = st
+    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
     status = regs[kn.REG_STATUS]
     if status == kn.DONE:
         return 0
+    wide = masks.shape[1] > 1
+    p0 = primary[0]
     nodes = regs[kn.REG_NODES]
     updates = regs[kn.REG_UPDATES]
     found = 0
     n_out = 0
-    here = st.scratch[0]
+    here = scratch[0]
     if status == kn.FRESH:
         k = 0
         occ[0, :] = _NONE
-        st.lstart[0] = 0
-        end, n_br = _expand_any(rows, st, rows.allrows, 0, len(rows.allrows), 0, occ[0], br[0])
-        updates += len(rows.allrows)
-        st.lstart[1] = end
+        lstart[0] = 0
+        if wide:
+            end, n_br = _expand_wide(
+                allrows, 0, len(allrows), live, 0, occ[0], primary, masks, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, planes, scratch[1], br[0],
+            )  # fmt: skip
+        else:
+            end, n_br = _expand(
+                allrows, 0, len(allrows), live, 0, _NONE, p0, mask, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, br[0],
+            )  # fmt: skip
+        updates += len(allrows)
+        lstart[1] = end
         nbr[0] = n_br
         pos[0] = 0
-        if ctl.shuffle:
-            kn.shuffle_prefix(br[0], n_br, ctl.rng)
+        if shuffle:
+            kn.shuffle_prefix(br[0], n_br, rng)
     else:
         k = regs[kn.REG_DEPTH]
     regs[kn.REG_STATUS] = kn.RUNNING
     while True:
         if pos[k] < nbr[k]:
-            if nodes >= ctl.node_limit:
+            if nodes >= node_limit:
                 regs[kn.REG_STATUS] = kn.LIMIT
                 break
             r = br[k, pos[k]]
             pos[k] += 1
             nodes += 1
             chosen[k] = r
-            full = _place(rows, occ[k], r, here)
-            t = rows.rtype[r]
+            h0 = occ[k, 0] | mask[r]
+            full = _place_wide(occ[k], masks[r], primary, here) if wide else (h0 & p0) == p0
+            t = rtype[r]
             cnt[t] += 1
             if full:  # every mandatory cell covered
-                ok = _counts_ok(rows, cnt)
+                ok = True
+                for q in counters:
+                    if cnt[q] < lo[q]:
+                        ok = False
+                        break
                 cnt[t] -= 1
                 if ok:
                     found += 1
-                    if ctl.max_store > 0:
-                        n_out = kn.store_solution(ctl.out, n_out, chosen, rows.rid, k)
-                    if kn.stored_enough(ctl, n_out, found):
+                    if max_store > 0:
+                        n_out = kn.store_solution(out, n_out, chosen, rid, k)
+                    if (max_store > 0 and n_out == max_store) or found == stop_after:
                         break
                 continue
-            if rows.region_min > 0 and not regions_ok(
-                rows.mask[r], rows.primary[0] & ~here[0], rows.nb, rows.region_gcd, rows.region_min
-            ):
+            if region_min > 0 and not regions_ok(mask[r], p0 & ~h0, nb, region_gcd, region_min):
                 cnt[t] -= 1  # cuts off a region no set of pieces can fill
                 continue
-            a, b = st.lstart[k], st.lstart[k + 1]
+            a, b = lstart[k], lstart[k + 1]
             updates += b - a
-            end, n_br = _expand_any(rows, st, st.live, a, b, b, here, br[k + 1])
+            if wide:
+                end, n_br = _expand_wide(
+                    live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
+                    tcount, counters, pieces, table, tally, planes, scratch[1], br[k + 1],
+                )  # fmt: skip
+            else:
+                end, n_br = _expand(
+                    live, a, b, live, b, h0, p0, mask, rtype, lo, hi, cnt,
+                    tcount, counters, pieces, table, tally, br[k + 1],
+                )  # fmt: skip
             if n_br == 0:
                 cnt[t] -= 1
                 continue
             k += 1
-            occ[k, :] = here
-            st.lstart[k + 1] = end
+            if wide:
+                occ[k, :] = here
+            else:
+                occ[k, 0] = h0
+            lstart[k + 1] = end
             nbr[k] = n_br
             pos[k] = 0
-            if ctl.shuffle:
-                kn.shuffle_prefix(br[k], n_br, ctl.rng)
+            if shuffle:
+                kn.shuffle_prefix(br[k], n_br, rng)
         else:
             if k == 0:
                 regs[kn.REG_STATUS] = kn.DONE
                 break
             k -= 1
-            cnt[rows.rtype[chosen[k]]] -= 1
+            cnt[rtype[chosen[k]]] -= 1
     kn.save_registers(regs, k, nodes, updates, found)
     return n_out
 

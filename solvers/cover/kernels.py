@@ -61,12 +61,6 @@ class Levels(NamedTuple):
 
 
 @njit(cache=True)
-def stored_enough(ctl: Control, n_out: int, found: int) -> bool:
-    """Whether the batch is full or the caller's solution count is reached."""
-    return (ctl.max_store > 0 and n_out == ctl.max_store) or found == ctl.stop_after
-
-
-@njit(cache=True)
 def save_registers(regs: np.ndarray, k: int, nodes: int, updates: int, found: int) -> None:
     """Leave the counters where the next call resumes."""
     regs[REG_DEPTH] = k

@@ -399,14 +399,15 @@ def node_moves(
     return rows
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def shift_child(
     row: I16, child: I16, base: int, pieces: I64, m: int, mask: int, d: int, k: int
 ) -> None:  # fmt: skip
     """``child`` = ``row`` with the group ``mask`` (bits of the piece indices ``pieces[:m]``,
     offsets at ``base + 3 piece``) moved ``k`` units along direction ``d``. The first piece
     never moves: when it belongs to the group, the others move the opposite way instead."""
-    child[:] = row
+    for t in range(child.shape[0]):  # a loop: slice assignment is slow on short rows
+        child[t] = row[t]
     a = base + d // 2
     step = k if d % 2 == 0 else -k
     if (mask >> pieces[0]) & 1:

@@ -122,12 +122,12 @@ def part_h(row: I16, n: int, label: int, size: int, pdb: PDBView) -> int:
     subset can never come apart."""
     if size < 2:
         return 0
-    key = pdb.key
+    fam, n_fam, keys, vals, table, key, miss = pdb  # locals: a tuple field read costs a refcount
     h = size - 1
-    for f in range(pdb.n_fam):
-        a = pdb.fam[f, 0]
-        b = pdb.fam[f, 1]
-        c = pdb.fam[f, 2]
+    for f in range(n_fam):
+        a = fam[f, 0]
+        b = fam[f, 1]
+        c = fam[f, 2]
         if row[a] != label or row[b] != label:
             continue
         m = 2
@@ -139,12 +139,12 @@ def part_h(row: I16, n: int, label: int, size: int, pdb: PDBView) -> int:
         for t in range(3):
             key[1 + t] = row[n + 3 * b + t] - row[n + 3 * a + t]
             key[4 + t] = row[n + 3 * c + t] - row[n + 3 * a + t] if m == 3 else 0
-        idx = lookup(pdb.keys, pdb.hash, key)
+        idx = lookup(keys, table, key)
         if idx < 0:
             for t in range(KEY_WIDTH):
-                pdb.miss[t] = key[t]
+                miss[t] = key[t]
             return -1
-        g = pdb.vals[idx]
+        g = vals[idx]
         if g >= DEAD:
             return DEAD
         v = g + size - m
@@ -345,30 +345,31 @@ def _store(
     """Store ``child`` of ``cur`` (``hgf``: its ``h``, active ``h``, ``g``, ``f``; ``move``:
     mask, direction, ``k``) unless known at a ``g`` as small; -1, or the buffer to grow."""
     h, hc, g1, fc = hgf
+    rows, gv, hv, hact, fv, parent, mmask, mdir, mk, closed, table = nodes
     n_states = regs[R_STATES]
-    if n_states >= nodes.rows.shape[0] or 2 * (n_states + 1) > nodes.table.shape[0]:
+    if n_states >= rows.shape[0] or 2 * (n_states + 1) > table.shape[0]:
         return NEED_STATES
     if regs[R_HEAP] + 1 >= heap.key.shape[0]:
         return NEED_HEAP
-    got = mv.find_or_insert(nodes.rows, n_states, nodes.table, child)
+    got = mv.find_or_insert(rows, n_states, table, child)
     if got < 0:
         got = -1 - got
         regs[R_STATES] = n_states + 1
-        nodes.hv[got] = h
-        nodes.hact[got] = hc
-        nodes.closed[got] = 0
-    elif g1 >= nodes.gv[got]:
+        hv[got] = h
+        hact[got] = hc
+        closed[got] = 0
+    elif g1 >= gv[got]:
         return -1
-    elif nodes.closed[got]:
-        nodes.closed[got] = 0
+    elif closed[got]:
+        closed[got] = 0
         regs[R_REOPENED] += 1
-    nodes.gv[got] = g1
-    nodes.fv[got] = fc
-    nodes.parent[got] = cur
-    nodes.mmask[got] = move[0]
-    nodes.mdir[got] = move[1]
-    nodes.mk[got] = move[2]
-    regs[R_HEAP] = _push(heap.key, heap.node, regs[R_HEAP], _heap_key(g1, nodes.hv[got]), got)
+    gv[got] = g1
+    fv[got] = fc
+    parent[got] = cur
+    mmask[got] = move[0]
+    mdir[got] = move[1]
+    mk[got] = move[2]
+    regs[R_HEAP] = _push(heap.key, heap.node, regs[R_HEAP], _heap_key(g1, hv[got]), got)
     return -1
 
 
@@ -390,20 +391,21 @@ def _expand(
         return GROUPS
     if nrows == -1:
         return NEED_MOVES
+    moves = pieces.moves
     g1 = nodes.gv[cur] + 1
     hbase = nodes.hv[cur] - nodes.hact[cur]
     big_f = nodes.fv[cur]  # this (partial) expansion stores the children with f == big_f
     first = big_f == nodes.gv[cur] + nodes.hv[cur]
     nxt = DEAD
     for r in range(nrows):
-        lmask = pieces.moves[r, 0]
-        d = pieces.moves[r, 1]
-        kmax = pieces.moves[r, 2]
+        lmask = moves[r, 0]
+        d = moves[r, 1]
+        kmax = moves[r, 2]
         gmask = 0
         for p in range(m):
             if (lmask >> p) & 1:
                 gmask |= 1 << members[p]
-        last = kmax + 1 if pieces.moves[r, 3] else kmax  # k = kmax + 1 stands for the removal
+        last = kmax + 1 if moves[r, 3] else kmax  # k = kmax + 1 stands for the removal
         for k in range(1, last + 1):
             if k <= kmax:
                 mv.shift_child(row, child, n, members, m, gmask, d, k)
@@ -415,7 +417,8 @@ def _expand(
                 h = hbase + hc
                 kk = k
             else:  # the removal: two parts, re-anchored at their smallest pieces
-                child[:] = row
+                for t in range(child.shape[0]):
+                    child[t] = row[t]
                 la, lb, sa = _split(row, child, n, members, m, gmask)
                 hab, hc = _split_h(child, n, cnt, act, la, lb, sa, m - sa, pdb)
                 if hab < 0:
