@@ -124,7 +124,7 @@ class MRVStack(NamedTuple):
     chosen: I32
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _short_or_best(counters: Any, pieces: Any, lo: Any, cnt: Any, tcount: Any) -> tuple[int, int]:
     """``(-2, 0)`` when a counted type has too few rows left, else the unused exact-once piece
     with the fewest alive rows ``(type, rows)`` (``(-1, 2^30)`` when there is none)."""
@@ -138,7 +138,7 @@ def _short_or_best(counters: Any, pieces: Any, lo: Any, cnt: Any, tcount: Any) -
     return best_t, best_n
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _branches(
     live: Any, w: int, n: int, col: Any, bit: Any, rtype: Any, best_t: int, br: Any
 ) -> int:

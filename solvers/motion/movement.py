@@ -401,20 +401,22 @@ def node_moves(
 
 @njit(cache=True, inline="always")
 def shift_child(
-    row: I16, child: I16, base: int, pieces: I64, m: int, mask: int, d: int, k: int
+    row: I16, child: I16, base: int, pieces: I64 | None, m: int, mask: int, d: int, k: int
 ) -> None:  # fmt: skip
     """``child`` = ``row`` with the group ``mask`` (bits of the piece indices ``pieces[:m]``,
-    offsets at ``base + 3 piece``) moved ``k`` units along direction ``d``. The first piece
-    never moves: when it belongs to the group, the others move the opposite way instead."""
+    or ``0..m-1`` when ``pieces`` is None; offsets at ``base + 3 piece``) moved ``k`` units
+    along direction ``d``. The first piece never moves: when it belongs to the group, the
+    others move the opposite way instead."""
     for t in range(child.shape[0]):  # a loop: slice assignment is slow on short rows
         child[t] = row[t]
     a = base + d // 2
     step = k if d % 2 == 0 else -k
-    if (mask >> pieces[0]) & 1:
+    first = 0 if pieces is None else pieces[0]
+    if (mask >> first) & 1:
         step = -step
         mask = ~mask
     for p in range(m):
-        q = pieces[p]
+        q = p if pieces is None else pieces[p]
         if (mask >> q) & 1:
             child[a + 3 * q] += step
 
@@ -550,7 +552,6 @@ def expand(
     gaps = np.empty((3, n, n), dtype=np.int64)
     off = np.empty((n, 3), dtype=np.int64)
     child = np.empty(w, dtype=np.int16)
-    everyone = np.arange(n, dtype=np.int64)
     while n_seps > 0 and seps[n_seps - 1, 0] >= node:
         n_seps -= 1
     done = 0
@@ -588,7 +589,7 @@ def expand(
                 for k in range(1, kmax + 1):
                     if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
                         return NEED_STATES, node, n_states, n_seps, n_layers
-                    shift_child(states[node], child, 0, everyone, n, moves_buf[r, 0], dr, k)
+                    shift_child(states[node], child, 0, None, n, moves_buf[r, 0], dr, k)
                     got = find_or_insert(states, n_states, table, child)
                     if got < 0:
                         parent[n_states] = node

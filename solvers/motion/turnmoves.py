@@ -428,7 +428,6 @@ def expand_turns(
     off = np.empty((n, 3), dtype=np.int64)
     rot = np.empty(n, dtype=np.int64)
     child = np.empty(w, dtype=np.int16)
-    everyone = np.arange(n, dtype=np.int64)
     c = np.empty(3, dtype=np.int64)
     new_off = np.empty(3, dtype=np.int64)
     while n_seps > 0 and seps[n_seps - 1, 0] >= node_start:
@@ -470,7 +469,7 @@ def expand_turns(
             for k in range(1, kmax + 1):
                 if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
                     return mv.NEED_STATES, node, n_states, n_seps, 0
-                mv.shift_child(states[node], child, 0, everyone, n, moves_buf[r, 0], d, k)
+                mv.shift_child(states[node], child, 0, None, n, moves_buf[r, 0], d, k)
                 got = mv.find_or_insert(states, n_states, table, child)
                 if got < 0:
                     parent[n_states] = node

@@ -89,7 +89,6 @@ def sub_component(
     gaps = np.empty((3, m, m), dtype=np.int64)
     off = np.empty((m, 3), dtype=np.int64)
     child = np.empty(w, dtype=np.int16)
-    everyone = np.arange(m, dtype=np.int64)
     key = np.empty(KEY_WIDTH, dtype=np.int16)
     while node < n_states:
         if known[node] >= 0:
@@ -122,7 +121,7 @@ def sub_component(
                     return SUB_NEED_STATES, node, n_states, e0, r0
                 if n_edges >= edges.shape[0]:
                     return SUB_NEED_EDGES, node, n_states, e0, r0
-                mv.shift_child(states[node], child, 0, everyone, m, moves_buf[r, 0], d, k)
+                mv.shift_child(states[node], child, 0, None, m, moves_buf[r, 0], d, k)
                 got = mv.find_or_insert(states, n_states, table, child)
                 if got < 0:
                     got = -1 - got
