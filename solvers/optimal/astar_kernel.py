@@ -589,16 +589,23 @@ class Run:
             return -1
         pdb = self.pdb
         max_exp = -1 if self.limits.max_expansions is None else self.limits.max_expansions
+        bundles: tuple[Nodes, Heap, Pieces] | None = None
+        view: PDBView | None = None
         while True:
             self.deadline.check()
-            status = run_astar(
-                self.regs, self._nodes(), Heap(self.hkey, self.hnode), self._pieces(),
-                pdb_view(pdb, self.miss), max_exp, 20000,
-            )  # fmt: skip
+            if bundles is None:  # the arrays were replaced (grown)
+                bundles = (self._nodes(), Heap(self.hkey, self.hnode), self._pieces())
+            if view is None or view.keys is not pdb.keys or view.hash is not pdb.hash:
+                view = pdb_view(pdb, self.miss)
+            elif view.vals is not pdb.vals:
+                view = view._replace(vals=pdb.vals)
+            status = run_astar(self.regs, *bundles, view, max_exp, 20000)
             if status == FOUND:
                 return int(self.regs[R_GOAL])
             if status == EXHAUSTED:
                 return -1
+            if status in (NEED_STATES, NEED_HEAP, NEED_MOVES):
+                bundles = None
             if status == NEED_STATES:
                 self._grow_states()
             elif status == NEED_HEAP:
