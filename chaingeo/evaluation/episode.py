@@ -234,171 +234,220 @@ def run_episode(task: EpisodeTask) -> EpisodeResult:
     """Play one episode. Whatever an agent or the environment raises becomes an errored record
     (class and message, never a traceback), except :class:`AuthenticationError`, which no
     other episode would survive either: it propagates so the run stops at once."""
-    level, proto = task.level, task.protocol
-    seed = episode_seed(task.seed, level, task.sample)
-    started = time.monotonic()
-    images = _Images()
-    steps: list[dict[str, Any]] = []
-    usage = Usage()
-    record = _header(task, seed)
-    record["model"] = None
-    state: StateLike | None = None
-    agent: Agent | None = None
-    finished = False
-    judge: Judge | None = None
-    status, error, error_type = "done", None, None
-    try:
-        make_state, observe_state = _environment(proto.env)
-        state = make_state(level)
-        agent = make_agent(task.agent)
-        record["model"] = agent.model
-        agent.start(level, seed)
+    return _Episode(task).run()
 
-        def see(window: int) -> ObservationLike:
-            obs: ObservationLike = observe_state(
-                state, history_window=window, text_state=proto.text_state, images=agent.uses_images
-            )
-            return obs
 
-        if proto.name == "interactive":
-            judge = make_judge(proto.judge, proto.judge_options)
-            judge.start(seed)
-            note: str | None = None
-            previous: Reply | None = None
-            results: tuple[StepResultLike, ...] = ()
-            turn = 0
-            while not (state.is_success() or state.is_truncated()):
-                if turn >= state.max_steps:
-                    raise RuntimeError(f"{level.id}: the environment stopped counting steps")
-                obs = see(proto.history_window)
-                shown = images.names(obs)
-                replies = [
-                    agent.act(
-                        Turn(
-                            level,
-                            obs,
-                            state.clone() if agent.needs_state else None,
-                            turn,
-                            task.sample,
-                            c,
-                            note,
-                            previous,
-                            results,
-                        )
+class _Episode:
+    """One episode's play: the state, the agent, what has been recorded so far."""
+
+    def __init__(self, task: EpisodeTask) -> None:
+        self.task = task
+        self.seed = episode_seed(task.seed, task.level, task.sample)
+        self.started = time.monotonic()
+        self.images = _Images()
+        self.steps: list[dict[str, Any]] = []
+        self.usage = Usage()
+        self.record = _header(task, self.seed)
+        self.record["model"] = None
+        self.state: StateLike | None = None
+        self.agent: Agent | None = None
+        self.judge: Judge | None = None
+        self.finished = False
+        self.status: str = "done"
+        self.error: str | None = None
+        self.error_type: str | None = None
+
+    def _fail(self, e: BaseException) -> None:
+        """Record the first error only: later ones are consequences."""
+        if self.status == "done":
+            self.status, self.error, self.error_type = "error", describe_error(e), type(e).__name__
+
+    def run(self) -> EpisodeResult:
+        proto = self.task.protocol
+        try:
+            make_state, observe_state = _environment(proto.env)
+            state = self.state = make_state(self.task.level)
+            agent = self.agent = make_agent(self.task.agent)
+            self.record["model"] = agent.model
+            agent.start(self.task.level, self.seed)
+
+            def see(window: int) -> ObservationLike:
+                obs: ObservationLike = observe_state(
+                    state, history_window=window, text_state=proto.text_state,
+                    images=agent.uses_images,
+                )  # fmt: skip
+                return obs
+
+            if proto.name == "interactive":
+                self._interactive(state, agent, see)
+            else:
+                self._oneshot(state, agent, see(0))
+        except AuthenticationError:
+            raise
+        except Exception as e:  # one bad episode must never stop a run
+            self._fail(e)
+        finally:
+            self._close_agent()
+        return self._result()
+
+    def _close_agent(self) -> None:
+        if self.agent is None:
+            return
+        try:
+            notes = self.agent.notes()
+            if notes:
+                self.record["agent_notes"] = notes
+            self.agent.close()
+        except Exception as e:
+            self._fail(e)
+
+    def _interactive(
+        self, state: StateLike, agent: Agent, see: Callable[[int], ObservationLike]
+    ) -> None:
+        """Turn after turn until success, truncation or the agent finishes."""
+        task, proto = self.task, self.task.protocol
+        judge = self.judge = make_judge(proto.judge, proto.judge_options)
+        judge.start(self.seed)
+        note: str | None = None
+        previous: Reply | None = None
+        results: tuple[StepResultLike, ...] = ()
+        turn = 0
+        while not (state.is_success() or state.is_truncated()):
+            if turn >= state.max_steps:
+                raise RuntimeError(f"{task.level.id}: the environment stopped counting steps")
+            obs = see(proto.history_window)
+            shown = self.images.names(obs)
+            replies = [
+                agent.act(
+                    Turn(
+                        task.level,
+                        obs,
+                        state.clone() if agent.needs_state else None,
+                        turn,
+                        task.sample,
+                        c,
+                        note,
+                        previous,
+                        results,
                     )
-                    for c in range(proto.candidates)
-                ]
-                for r in replies:
-                    usage = usage + r.usage
-                cands: list[dict[str, Any]] = []
-                chosen = replies[0]
-                if len(replies) > 1:
-                    checked = verify(state, replies)
-                    spent = judge.usage
-                    best = judge.rank(state, checked, obs)[0]
-                    chosen = replies[best]
-                    cands = [
-                        {
-                            "reply": c.reply.text,
-                            "action": c.reply.action,
-                            **({"actions": list(c.reply.actions)} if c.reply.actions else {}),
-                            "legal": c.legal,
-                            "error": c.result.error if c.result else None,
-                            "usage": c.reply.usage.to_json(),
-                            "chosen": c.index == best,
-                        }
-                        for c in checked
-                    ]
-                todo = chosen.actions or (chosen.action if chosen.action is not None else "",)
-                done: list[StepResultLike] = []
-                for i, sent in enumerate(todo):
-                    if i and (state.finished or state.is_success() or state.is_truncated()):
-                        break
-                    result = state.step_text(sent)
-                    done.append(result)
-                    rec = _step_record(turn, chosen, sent, result, i)
-                    if i == 0:
-                        rec["images"] = shown
-                        if cands:
-                            rec["candidates"] = cands
-                            rec["usage"] = sum((r.usage for r in replies), Usage()).to_json()
-                            if judge.usage != spent:
-                                rec["judge_usage"] = _spent(judge.usage, spent).to_json()
-                    steps.append(rec)
-                    if not result.legal:
-                        break  # the actions after a rejected one are not taken
-                note = chosen.note if chosen.action is None else None
-                previous, results = chosen, tuple(done)
-                turn += 1
-                if state.finished:
-                    finished = True
-                    break
-        else:
-            obs = see(0)
-            keep = (proto.oneshot_view, *AUXILIARY_VIEWS)
-            view = {k: v for k, v in obs.images.items() if k in keep}
-            obs = _with_images(obs, view)
-            shown = images.names(obs)
-            plan = agent.plan(
-                Turn(level, obs, state.clone() if agent.needs_state else None, 0, task.sample)
-            )
-            usage = usage + plan.usage
-            record["plan"] = {
-                "reply": plan.text,
-                "actions": list(plan.actions),
-                "note": plan.note,
-                "usage": plan.usage.to_json(),
-                "images": shown,
+                )
+                for c in range(proto.candidates)
+            ]
+            for r in replies:
+                self.usage = self.usage + r.usage
+            chosen, extra = self._choose(state, judge, replies, obs)
+            done = self._take(state, turn, chosen, {"images": shown, **extra})
+            note = chosen.note if chosen.action is None else None
+            previous, results = chosen, tuple(done)
+            turn += 1
+            if state.finished:
+                self.finished = True
+                return
+
+    def _choose(
+        self, state: StateLike, judge: Judge, replies: list[Reply], obs: ObservationLike
+    ) -> tuple[Reply, dict[str, Any]]:
+        """The reply to play (the judge ranks several candidates) and what the turn's first
+        step record gets besides (the candidates, their usage, the judge's)."""
+        if len(replies) <= 1:
+            return replies[0], {}
+        checked = verify(state, replies)
+        spent = judge.usage
+        best = judge.rank(state, checked, obs)[0]
+        cands = [
+            {
+                "reply": c.reply.text,
+                "action": c.reply.action,
+                **({"actions": list(c.reply.actions)} if c.reply.actions else {}),
+                "legal": c.legal,
+                "error": c.result.error if c.result else None,
+                "usage": c.reply.usage.to_json(),
+                "chosen": c.index == best,
             }
-            if plan.calls:
-                record["plan"]["calls"] = [c.to_json() for c in plan.calls]
-            for i, text in enumerate(plan.actions):
-                if state.is_success() or state.is_truncated():
-                    break
-                result = state.step_text(text)
-                steps.append(_step_record(i, Reply(text, text), text, result))
-                if state.finished:
-                    finished = True
-                    break
-    except AuthenticationError:
-        raise
-    except Exception as e:  # one bad episode must never stop a run
-        status, error, error_type = "error", describe_error(e), type(e).__name__
-    finally:
-        if agent is not None:
-            try:
-                notes = agent.notes()
-                if notes:
-                    record["agent_notes"] = notes
-                agent.close()
-            except Exception as e:
-                if status == "done":
-                    status, error, error_type = "error", describe_error(e), type(e).__name__
-    if judge is not None and judge.usage.calls:
-        record["judge"] = {"model": judge.model, "usage": judge.usage.to_json()}
-    try:
-        ended = _ending(state)
-    except Exception as e:  # a state that cannot report its end
-        ended = _ending(None)
-        if status == "done":
-            status, error, error_type = "error", describe_error(e), type(e).__name__
-    record.update(status=status, error=error)
-    if error_type is not None:
-        record["error_type"] = error_type
-    record.update(
-        success=ended["success"],
-        steps_used=ended["steps_used"],
-        invalid=sum(1 for s in steps if not s["legal"]),
-        unparseable=sum(1 for s in steps if s["error"] == "unparseable"),
-        illegal=sum(1 for s in steps if s["error"] == "illegal"),
-        ambiguous=sum(1 for s in steps if s["error"] == "ambiguous"),
-        finished=finished,
-        truncated=ended["truncated"],
-        usage=usage.to_json(),
-        wall_seconds=round(time.monotonic() - started, 3),
-        steps=steps,
-    )
-    return EpisodeResult(record, images.files)
+            for c in checked
+        ]
+        extra: dict[str, Any] = {
+            "candidates": cands,
+            "usage": sum((r.usage for r in replies), Usage()).to_json(),
+        }
+        if judge.usage != spent:
+            extra["judge_usage"] = _spent(judge.usage, spent).to_json()
+        return replies[best], extra
+
+    def _take(
+        self, state: StateLike, turn: int, chosen: Reply, first: dict[str, Any]
+    ) -> list[StepResultLike]:
+        """Play the chosen reply's actions, one step record each; stop at a rejected one."""
+        todo = chosen.actions or (chosen.action if chosen.action is not None else "",)
+        done: list[StepResultLike] = []
+        for i, sent in enumerate(todo):
+            if i and (state.finished or state.is_success() or state.is_truncated()):
+                break
+            result = state.step_text(sent)
+            done.append(result)
+            rec = _step_record(turn, chosen, sent, result, i)
+            if i == 0:
+                rec.update(first)
+            self.steps.append(rec)
+            if not result.legal:
+                break  # the actions after a rejected one are not taken
+        return done
+
+    def _oneshot(self, state: StateLike, agent: Agent, obs: ObservationLike) -> None:
+        """One plan from the first observation, its actions played in order."""
+        task, proto = self.task, self.task.protocol
+        keep = (proto.oneshot_view, *AUXILIARY_VIEWS)
+        view = {k: v for k, v in obs.images.items() if k in keep}
+        obs = _with_images(obs, view)
+        shown = self.images.names(obs)
+        plan = agent.plan(
+            Turn(task.level, obs, state.clone() if agent.needs_state else None, 0, task.sample)
+        )
+        self.usage = self.usage + plan.usage
+        self.record["plan"] = {
+            "reply": plan.text,
+            "actions": list(plan.actions),
+            "note": plan.note,
+            "usage": plan.usage.to_json(),
+            "images": shown,
+        }
+        if plan.calls:
+            self.record["plan"]["calls"] = [c.to_json() for c in plan.calls]
+        for i, text in enumerate(plan.actions):
+            if state.is_success() or state.is_truncated():
+                break
+            result = state.step_text(text)
+            self.steps.append(_step_record(i, Reply(text, text), text, result))
+            if state.finished:
+                self.finished = True
+                break
+
+    def _result(self) -> EpisodeResult:
+        record, steps, judge = self.record, self.steps, self.judge
+        if judge is not None and judge.usage.calls:
+            record["judge"] = {"model": judge.model, "usage": judge.usage.to_json()}
+        try:
+            ended = _ending(self.state)
+        except Exception as e:  # a state that cannot report its end
+            ended = _ending(None)
+            self._fail(e)
+        record.update(status=self.status, error=self.error)
+        if self.error_type is not None:
+            record["error_type"] = self.error_type
+        record.update(
+            success=ended["success"],
+            steps_used=ended["steps_used"],
+            invalid=sum(1 for s in steps if not s["legal"]),
+            unparseable=sum(1 for s in steps if s["error"] == "unparseable"),
+            illegal=sum(1 for s in steps if s["error"] == "illegal"),
+            ambiguous=sum(1 for s in steps if s["error"] == "ambiguous"),
+            finished=self.finished,
+            truncated=ended["truncated"],
+            usage=self.usage.to_json(),
+            wall_seconds=round(time.monotonic() - self.started, 3),
+            steps=steps,
+        )
+        return EpisodeResult(record, self.images.files)
 
 
 def _ending(state: StateLike | None) -> dict[str, Any]:

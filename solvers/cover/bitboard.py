@@ -16,26 +16,19 @@ way down, against ``lo`` at a full cover).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.jit import njit
-from chaingeo.solvers.cover.kernels import (
-    DONE,
-    FRESH,
-    LIMIT,
-    REG_DEPTH,
-    REG_NODES,
-    REG_SOLUTIONS,
-    REG_STATUS,
-    REG_UPDATES,
-    RUNNING,
-    shuffle_prefix,
-    store_solution,
-)
+from chaingeo.solvers.cover import kernels as kn
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
+
+I32 = npt.NDArray[np.int32]
+I64 = npt.NDArray[np.int64]
+U64 = npt.NDArray[np.uint64]
 
 MAX_CELLS = 64
 #: Levels (from the root) at which the search branches on whichever of the first empty cell and
@@ -111,7 +104,7 @@ def _enter(k: int, lst_start: int, lst_len: int, cand: Any, perm: Any, width: in
         off = k * width
         for i in range(lst_len):
             perm[off + i] = cand[lst_start + i]
-        shuffle_prefix(perm[off : off + lst_len], lst_len, rng)
+        kn.shuffle_prefix(perm[off : off + lst_len], lst_len, rng)
         base[k] = off
     else:
         base[k] = lst_start
@@ -156,30 +149,50 @@ def _fewest_fits(
     return a, n, best, work
 
 
+class BitboardRows(NamedTuple):
+    """The problem side of a first-cell search (read only): row masks and types, candidate
+    lists per cell and per type (``skip``: the end of each type's run), the exact-once pieces
+    and how deep to branch on them, the mandatory cells, count ranges, region pruning."""
+
+    mask: U64
+    rtype: I32
+    rid: I32
+    cand_ptr: I64
+    cand: I32
+    skip: I64
+    type_ptr: I64
+    exact1: I32
+    mrv_depth: int
+    primary: np.uint64
+    lo: I32
+    hi: I32
+    counters: I32
+    table: I32
+    nb: U64
+    region_gcd: int
+    region_min: int
+
+
 @njit(cache=True)
-def bitboard_run(
-    mask: Any, rtype: Any, rid: Any, cand_ptr: Any, cand: Any, skip: Any,
-    type_ptr: Any, exact1: Any, mrv_depth: int, primary: np.uint64,
-    lo: Any, hi: Any, cnt: Any, counters: Any, table: Any,
-    nb: Any, region_gcd: int, region_min: int,
-    occ: Any, perm: Any, end: Any, pos: Any, base: Any, chosen: Any,
-    regs: Any, rng: Any, shuffle: bool,
-    out: Any, max_store: int, stop_after: int, node_limit: int,
-) -> int:  # fmt: skip
+def bitboard_run(rows: BitboardRows, occ: U64, lv: kn.Levels, ctl: kn.Control) -> int:
     """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`.
 
     ``pos[k]``/``end[k]`` index ``cand`` (fixed order) or level ``k``'s slice of ``perm``
-    (random order, ``width`` entries per level).
+    (random order, ``width`` entries per level); ``occ[k]``: level ``k``'s occupancy.
     """
-    status = regs[REG_STATUS]
-    if status == DONE:
+    mask, rtype, rid, cand_ptr, cand, skip, type_ptr, exact1, mrv_depth, primary = rows[:10]
+    lo, hi, counters, table, nb, region_gcd, region_min = rows[10:]
+    cnt, perm, end, pos, base, chosen = lv
+    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
+    status = regs[kn.REG_STATUS]
+    if status == kn.DONE:
         return 0
     width = len(perm) // len(pos)
-    nodes = regs[REG_NODES]
-    updates = regs[REG_UPDATES]
+    nodes = regs[kn.REG_NODES]
+    updates = regs[kn.REG_UPDATES]
     found = 0
     n_out = 0
-    if status == FRESH:
+    if status == kn.FRESH:
         k = 0
         occ[0] = np.uint64(0)
         c = _lowest_bit(primary, table)
@@ -192,8 +205,8 @@ def bitboard_run(
             updates += work
         _enter(0, a, n, cand, perm, width, base, pos, end, shuffle, rng)
     else:
-        k = regs[REG_DEPTH]
-    regs[REG_STATUS] = RUNNING
+        k = regs[kn.REG_DEPTH]
+    regs[kn.REG_STATUS] = kn.RUNNING
     src = perm if shuffle else cand
     stop = False
     while not stop:
@@ -222,12 +235,12 @@ def bitboard_run(
         if row >= 0 and nodes >= node_limit:
             pos[k] = p - 1
             updates -= 1  # the row is tried again on resumption
-            regs[REG_STATUS] = LIMIT
+            regs[kn.REG_STATUS] = kn.LIMIT
             break
         pos[k] = p
         if row < 0:  # level exhausted: backtrack
             if k == 0:
-                regs[REG_STATUS] = DONE
+                regs[kn.REG_STATUS] = kn.DONE
                 break
             k -= 1
             cnt[rtype[chosen[k]]] -= 1
@@ -244,7 +257,7 @@ def bitboard_run(
             if ok:
                 found += 1
                 if max_store > 0:
-                    n_out = store_solution(out, n_out, chosen, rid, k)
+                    n_out = kn.store_solution(out, n_out, chosen, rid, k)
                 if (max_store > 0 and n_out == max_store) or found == stop_after:
                     stop = True
             continue
@@ -262,10 +275,7 @@ def bitboard_run(
             if fits == 0:
                 n = 0
         _enter(k, a, n, cand, perm, width, base, pos, end, shuffle, rng)
-    regs[REG_DEPTH] = k
-    regs[REG_NODES] = nodes
-    regs[REG_UPDATES] = updates
-    regs[REG_SOLUTIONS] += found
+    kn.save_registers(regs, k, nodes, updates, found)
     return n_out
 
 
@@ -344,8 +354,12 @@ class BitboardArrays:
         n_primary = problem.n_cells - len(problem.optional)
         self.max_depth = min(n_primary, int(self.hi.sum()))
         self.max_col = max(int(counts.max()), int(np.diff(self.type_ptr).max(initial=0)))
-        self.table = DEBRUIJN_TABLE
-        self.nb, self.region_gcd, self.region_min = region_pruning(problem)
+        nb, gcd, smallest = region_pruning(problem)
+        self.rows = BitboardRows(
+            self.mask, self.rtype, self.rid, self.cand_ptr, self.cand, self.skip, self.type_ptr,
+            self.exact1, self.mrv_depth, primary, self.lo, self.hi, self.counters,
+            DEBRUIJN_TABLE, nb, int(gcd), int(smallest),
+        )  # fmt: skip
 
 
 def region_pruning(problem: CoverProblem) -> tuple[np.ndarray, int, int]:

@@ -14,8 +14,9 @@ ends the branch at once; so does, in box targets of one word, a placement that c
 region no set of pieces can fill (:func:`chaingeo.solvers.cover.bitboard.regions_ok`, same scan
 order).
 
-Targets over 64 cells use ``W = ceil(cells / 64)`` words per mask (:func:`mrv_wide_run`); the
-one-word kernel :func:`mrv_run` is the same algorithm on scalars. Piece types carry count ranges
+Targets over 64 cells use ``W = ceil(cells / 64)`` words per mask (:func:`_expand_wide`); on
+one-word targets :func:`_expand` is the same algorithm on scalars; one driver :func:`mrv_run`
+serves both. Piece types carry count ranges
 exactly as in :mod:`chaingeo.solvers.cover.dlx`. ``nodes`` counts rows placed (as in the DLX kernel:
 a row that completes a cover or ends in a dead end counts too); ``updates`` counts rows tested by
 the filter (the unit of work here).
@@ -23,27 +24,20 @@ the filter (the unit of work here).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.jit import njit
+from chaingeo.solvers.cover import kernels as kn
 from chaingeo.solvers.cover.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
-from chaingeo.solvers.cover.kernels import (
-    DONE,
-    FRESH,
-    LIMIT,
-    REG_DEPTH,
-    REG_NODES,
-    REG_SOLUTIONS,
-    REG_STATUS,
-    REG_UPDATES,
-    RUNNING,
-    shuffle_prefix,
-    store_solution,
-)
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
+
+I32 = npt.NDArray[np.int32]
+I64 = npt.NDArray[np.int64]
+U64 = npt.NDArray[np.uint64]
 
 _ONE = np.uint64(1)
 _NONE = np.uint64(0)
@@ -91,6 +85,81 @@ def _exact_min(live: Any, a: int, b: int, mask: Any, empty: Any, table: Any, tal
     return best, best_n
 
 
+class MRVRows(NamedTuple):
+    """The problem side of a search (read only): row masks (``mask``: the first word of
+    ``masks``, what one-word targets use), types and their count ranges, region pruning."""
+
+    mask: U64
+    masks: U64
+    rtype: I32
+    rid: I32
+    allrows: I32
+    primary: U64
+    lo: I32
+    hi: I32
+    counters: I32
+    pieces: I32
+    table: I32
+    nb: U64
+    region_gcd: int
+    region_min: int
+
+
+class MRVStack(NamedTuple):
+    """The search side, resumable: level ``k`` has the alive rows ``live[lstart[k] :
+    lstart[k + 1]]``, occupancy ``occ[k]`` (``W`` words) and branches ``br[k, :nbr[k]]``
+    (tried up to ``pos[k]``); the rest is scratch."""
+
+    cnt: I32
+    live: I32
+    lstart: I64
+    occ: U64
+    tcount: I32
+    tally: I32
+    planes: U64
+    scratch: U64
+    br: I32
+    nbr: I64
+    pos: I64
+    chosen: I32
+
+
+@njit(cache=True, inline="always")
+def _short_or_best(counters: Any, pieces: Any, lo: Any, cnt: Any, tcount: Any) -> tuple[int, int]:
+    """``(-2, 0)`` when a counted type has too few rows left, else the unused exact-once piece
+    with the fewest alive rows ``(type, rows)`` (``(-1, 2^30)`` when there is none)."""
+    for q in counters:
+        if cnt[q] + tcount[q] < lo[q]:
+            return -2, 0
+    best_t, best_n = -1, 1 << 30
+    for t in pieces:
+        if cnt[t] == 0 and tcount[t] < best_n:
+            best_t, best_n = t, tcount[t]
+    return best_t, best_n
+
+
+@njit(cache=True, inline="always")
+def _branches(
+    live: Any, w: int, n: int, col: Any, bit: Any, rtype: Any, best_t: int, br: Any
+) -> int:
+    """Write to ``br`` the alive rows ``live[w:n]`` through the cell ``bit`` of the mask column
+    ``col`` (``bit`` non-zero), else those of the piece type ``best_t``; returns how many."""
+    k = 0
+    if bit != _NONE:
+        for i in range(w, n):
+            j = live[i]
+            if col[j] & bit:
+                br[k] = j
+                k += 1
+    else:
+        for i in range(w, n):
+            j = live[i]
+            if rtype[j] == best_t:
+                br[k] = j
+                k += 1
+    return k
+
+
 @njit(cache=True)
 def _expand(
     src: Any, a: int, b: int, live: Any, w: int, occ: Any, primary: Any,
@@ -134,13 +203,9 @@ def _expand(
     empty = primary & ~occ
     if empty & ~(b0 | b1 | b2 | b3 | sat):
         return n, 0  # an empty cell no row can fill
-    for q in counters:
-        if cnt[q] + tcount[q] < lo[q]:
-            return n, 0  # not enough rows left for a piece still needed
-    best_t, best_n = -1, 1 << 30
-    for t in pieces:
-        if cnt[t] == 0 and tcount[t] < best_n:
-            best_t, best_n = t, tcount[t]
+    best_t, best_n = _short_or_best(counters, pieces, lo, cnt, tcount)
+    if best_t == -2:
+        return n, 0  # not enough rows left for a piece still needed
     cell = -1
     for v in range(1, min(best_n, SATURATED)):  # cells strictly below the best piece
         x = empty & _with_count(v, b0, b1, b2, b3, sat)
@@ -151,120 +216,8 @@ def _expand(
         c, cn = _exact_min(live, w, n, mask, empty, table, tally)
         if cn < best_n:
             cell, best_n = c, cn
-    k = 0
-    if cell >= 0:
-        bit = _ONE << np.uint64(cell)
-        for i in range(w, n):
-            j = live[i]
-            if mask[j] & bit:
-                br[k] = j
-                k += 1
-    else:
-        for i in range(w, n):
-            j = live[i]
-            if rtype[j] == best_t:
-                br[k] = j
-                k += 1
-    return n, k
-
-
-@njit(cache=True)
-def mrv_run(
-    mask: Any, rtype: Any, rid: Any, allrows: Any, primary: Any,
-    lo: Any, hi: Any, cnt: Any, counters: Any, pieces: Any, table: Any,
-    nb: Any, region_gcd: int, region_min: int,
-    live: Any, lstart: Any, occ: Any, tcount: Any, tally: Any,
-    br: Any, nbr: Any, pos: Any, chosen: Any,
-    regs: Any, rng: Any, shuffle: bool,
-    out: Any, max_store: int, stop_after: int, node_limit: int,
-) -> int:  # fmt: skip
-    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`.
-
-    Level ``k`` has the alive rows ``live[lstart[k] : lstart[k + 1]]``, occupancy ``occ[k]``
-    and branches ``br[k, :nbr[k]]`` (tried up to ``pos[k]``).
-    """
-    status = regs[REG_STATUS]
-    if status == DONE:
-        return 0
-    nodes = regs[REG_NODES]
-    updates = regs[REG_UPDATES]
-    found = 0
-    n_out = 0
-    if status == FRESH:
-        k = 0
-        occ[0] = _NONE
-        lstart[0] = 0
-        end, n_br = _expand(
-            allrows, 0, len(allrows), live, 0, _NONE, primary, mask, rtype, lo, hi, cnt,
-            tcount, counters, pieces, table, tally, br[0],
-        )  # fmt: skip
-        updates += len(allrows)
-        lstart[1] = end
-        nbr[0] = n_br
-        pos[0] = 0
-        if shuffle:
-            shuffle_prefix(br[0], n_br, rng)
-    else:
-        k = regs[REG_DEPTH]
-    regs[REG_STATUS] = RUNNING
-    while True:
-        if pos[k] < nbr[k]:
-            if nodes >= node_limit:
-                regs[REG_STATUS] = LIMIT
-                break
-            r = br[k, pos[k]]
-            pos[k] += 1
-            nodes += 1
-            chosen[k] = r
-            here = occ[k] | mask[r]
-            t = rtype[r]
-            cnt[t] += 1
-            if (here & primary) == primary:  # every mandatory cell covered
-                ok = True
-                for q in counters:
-                    if cnt[q] < lo[q]:
-                        ok = False
-                        break
-                cnt[t] -= 1
-                if ok:
-                    found += 1
-                    if max_store > 0:
-                        n_out = store_solution(out, n_out, chosen, rid, k)
-                    if (max_store > 0 and n_out == max_store) or found == stop_after:
-                        break
-                continue
-            if region_min > 0 and not regions_ok(
-                mask[r], primary & ~here, nb, region_gcd, region_min
-            ):
-                cnt[t] -= 1  # cuts off a region no set of pieces can fill
-                continue
-            a, b = lstart[k], lstart[k + 1]
-            updates += b - a
-            end, n_br = _expand(
-                live, a, b, live, b, here, primary, mask, rtype, lo, hi, cnt,
-                tcount, counters, pieces, table, tally, br[k + 1],
-            )  # fmt: skip
-            if n_br == 0:
-                cnt[t] -= 1
-                continue
-            k += 1
-            occ[k] = here
-            lstart[k + 1] = end
-            nbr[k] = n_br
-            pos[k] = 0
-            if shuffle:
-                shuffle_prefix(br[k], n_br, rng)
-        else:
-            if k == 0:
-                regs[REG_STATUS] = DONE
-                break
-            k -= 1
-            cnt[rtype[chosen[k]]] -= 1
-    regs[REG_DEPTH] = k
-    regs[REG_NODES] = nodes
-    regs[REG_UPDATES] = updates
-    regs[REG_SOLUTIONS] += found
-    return n_out
+    bit = _ONE << np.uint64(cell) if cell >= 0 else _NONE
+    return n, _branches(live, w, n, mask, bit, rtype, best_t, br)
 
 
 @njit(cache=True)
@@ -301,13 +254,9 @@ def _expand_wide(
         seen = planes[0, w] | planes[1, w] | planes[2, w] | planes[3, w] | planes[4, w]
         if empty[w] & ~seen:
             return n, 0
-    for q in counters:
-        if cnt[q] + tcount[q] < lo[q]:
-            return n, 0
-    best_t, best_n = -1, 1 << 30
-    for t in pieces:
-        if cnt[t] == 0 and tcount[t] < best_n:
-            best_t, best_n = t, tcount[t]
+    best_t, best_n = _short_or_best(counters, pieces, lo, cnt, tcount)
+    if best_t == -2:
+        return n, 0
     cell = -1
     for v in range(1, min(best_n, SATURATED)):  # cells strictly below the best piece
         for w in range(W):
@@ -321,90 +270,103 @@ def _expand_wide(
             best_n = v
             break
     if cell < 0 and best_n > SATURATED:
-        tally[:] = 0
-        for i in range(w0, n):
-            for w in range(W):
-                m = masks[live[i], w] & empty[w]
-                while m != _NONE:
-                    tally[64 * w + _low(m, table)] += 1
-                    m &= m - _ONE
-        for w in range(W):
-            e = empty[w]
-            while e != _NONE:
-                c = 64 * w + _low(e, table)
-                if tally[c] < best_n:
-                    cell, best_n = c, tally[c]
-                e &= e - _ONE
-    k = 0
-    if cell >= 0:
-        word, bit = cell // 64, _ONE << np.uint64(cell % 64)
-        for i in range(w0, n):
-            j = live[i]
-            if masks[j, word] & bit:
-                br[k] = j
-                k += 1
-    else:
-        for i in range(w0, n):
-            j = live[i]
-            if rtype[j] == best_t:
-                br[k] = j
-                k += 1
-    return n, k
+        cell, best_n = _exact_min_wide(live, w0, n, masks, empty, table, tally, cell, best_n)
+    if cell < 0:
+        return n, _branches(live, w0, n, masks[:, 0], _NONE, rtype, best_t, br)
+    word, bit = cell // 64, _ONE << np.uint64(cell % 64)
+    return n, _branches(live, w0, n, masks[:, word], bit, rtype, best_t, br)
 
 
 @njit(cache=True)
-def mrv_wide_run(
-    masks: Any, rtype: Any, rid: Any, allrows: Any, primary: Any,
-    lo: Any, hi: Any, cnt: Any, counters: Any, pieces: Any, table: Any,
-    live: Any, lstart: Any, occ: Any, tcount: Any, tally: Any, planes: Any, scratch: Any,
-    br: Any, nbr: Any, pos: Any, chosen: Any,
-    regs: Any, rng: Any, shuffle: bool,
-    out: Any, max_store: int, stop_after: int, node_limit: int,
-) -> int:  # fmt: skip
-    """:func:`mrv_run` on masks of ``W`` words: ``occ`` is (depth, W), ``scratch`` (2, W)."""
-    status = regs[REG_STATUS]
-    if status == DONE:
-        return 0
+def _exact_min_wide(
+    live: Any, a: int, b: int, masks: Any, empty: Any, table: Any, tally: Any, cell: int, best: int
+) -> tuple[int, int]:
+    """:func:`_exact_min` on ``W`` words, keeping ``(cell, best)`` unless a cell has fewer."""
     W = masks.shape[1]
-    nodes = regs[REG_NODES]
-    updates = regs[REG_UPDATES]
+    tally[:] = 0
+    for i in range(a, b):
+        for w in range(W):
+            m = masks[live[i], w] & empty[w]
+            while m != _NONE:
+                tally[64 * w + _low(m, table)] += 1
+                m &= m - _ONE
+    for w in range(W):
+        e = empty[w]
+        while e != _NONE:
+            c = 64 * w + _low(e, table)
+            if tally[c] < best:
+                cell, best = c, tally[c]
+            e &= e - _ONE
+    return cell, best
+
+
+@njit(cache=True)
+def _place_wide(occ: Any, add: Any, primary: Any, here: Any) -> bool:
+    """``here = occ | add`` (``W`` words); whether it covers every mandatory cell."""
+    full = True
+    for w in range(occ.shape[0]):
+        here[w] = occ[w] | add[w]
+        if (here[w] & primary[w]) != primary[w]:
+            full = False
+    return full
+
+
+@njit(cache=True)
+def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control) -> int:
+    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`
+    (:class:`MRVStack` describes the levels). One-word targets keep the occupancy in a
+    register and call :func:`_expand`, wider ones :func:`_expand_wide`."""
+    mask, masks, rtype, rid, allrows, primary, lo, hi, counters, pieces, table = rows[:11]
+    nb, region_gcd, region_min = rows[11:]
+    cnt, live, lstart, occ, tcount, tally, planes, scratch, br, nbr, pos, chosen = st
+    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
+    status = regs[kn.REG_STATUS]
+    if status == kn.DONE:
+        return 0
+    wide = masks.shape[1] > 1
+    p0 = primary[0]
+    nodes = regs[kn.REG_NODES]
+    updates = regs[kn.REG_UPDATES]
     found = 0
     n_out = 0
     here = scratch[0]
-    if status == FRESH:
+    if status == kn.FRESH:
         k = 0
         occ[0, :] = _NONE
         lstart[0] = 0
-        end, nb = _expand_wide(
-            allrows, 0, len(allrows), live, 0, occ[0], primary, masks, rtype, lo, hi, cnt,
-            tcount, counters, pieces, table, tally, planes, scratch[1], br[0],
-        )  # fmt: skip
+        if wide:
+            end, n_br = _expand_wide(
+                allrows, 0, len(allrows), live, 0, occ[0], primary, masks, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, planes, scratch[1], br[0],
+            )  # fmt: skip
+        else:
+            end, n_br = _expand(
+                allrows, 0, len(allrows), live, 0, _NONE, p0, mask, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, br[0],
+            )  # fmt: skip
         updates += len(allrows)
         lstart[1] = end
-        nbr[0] = nb
+        nbr[0] = n_br
         pos[0] = 0
         if shuffle:
-            shuffle_prefix(br[0], nb, rng)
+            kn.shuffle_prefix(br[0], n_br, rng)
     else:
-        k = regs[REG_DEPTH]
-    regs[REG_STATUS] = RUNNING
+        k = regs[kn.REG_DEPTH]
+    regs[kn.REG_STATUS] = kn.RUNNING
     while True:
         if pos[k] < nbr[k]:
             if nodes >= node_limit:
-                regs[REG_STATUS] = LIMIT
+                regs[kn.REG_STATUS] = kn.LIMIT
                 break
             r = br[k, pos[k]]
             pos[k] += 1
             nodes += 1
             chosen[k] = r
-            full = True
-            for w in range(W):
-                here[w] = occ[k, w] | masks[r, w]
-                if (here[w] & primary[w]) != primary[w]:
-                    full = False
+            h0 = occ[k, 0] | mask[r]
+            full = _place_wide(occ[k], masks[r], primary, here) if wide else (h0 & p0) == p0
             t = rtype[r]
             cnt[t] += 1
-            if full:
+            if full:  # every mandatory cell covered
                 ok = True
                 for q in counters:
                     if cnt[q] < lo[q]:
@@ -414,36 +376,45 @@ def mrv_wide_run(
                 if ok:
                     found += 1
                     if max_store > 0:
-                        n_out = store_solution(out, n_out, chosen, rid, k)
+                        n_out = kn.store_solution(out, n_out, chosen, rid, k)
                     if (max_store > 0 and n_out == max_store) or found == stop_after:
                         break
                 continue
+            if region_min > 0 and not regions_ok(mask[r], p0 & ~h0, nb, region_gcd, region_min):
+                cnt[t] -= 1  # cuts off a region no set of pieces can fill
+                continue
             a, b = lstart[k], lstart[k + 1]
             updates += b - a
-            end, nb = _expand_wide(
-                live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
-                tcount, counters, pieces, table, tally, planes, scratch[1], br[k + 1],
-            )  # fmt: skip
-            if nb == 0:
+            if wide:
+                end, n_br = _expand_wide(
+                    live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
+                    tcount, counters, pieces, table, tally, planes, scratch[1], br[k + 1],
+                )  # fmt: skip
+            else:
+                end, n_br = _expand(
+                    live, a, b, live, b, h0, p0, mask, rtype, lo, hi, cnt,
+                    tcount, counters, pieces, table, tally, br[k + 1],
+                )  # fmt: skip
+            if n_br == 0:
                 cnt[t] -= 1
                 continue
             k += 1
-            occ[k, :] = here
+            if wide:
+                occ[k, :] = here
+            else:
+                occ[k, 0] = h0
             lstart[k + 1] = end
-            nbr[k] = nb
+            nbr[k] = n_br
             pos[k] = 0
             if shuffle:
-                shuffle_prefix(br[k], nb, rng)
+                kn.shuffle_prefix(br[k], n_br, rng)
         else:
             if k == 0:
-                regs[REG_STATUS] = DONE
+                regs[kn.REG_STATUS] = kn.DONE
                 break
             k -= 1
             cnt[rtype[chosen[k]]] -= 1
-    regs[REG_DEPTH] = k
-    regs[REG_NODES] = nodes
-    regs[REG_UPDATES] = updates
-    regs[REG_SOLUTIONS] += found
+    kn.save_registers(regs, k, nodes, updates, found)
     return n_out
 
 
@@ -488,11 +459,32 @@ class MRVArrays:
         self.max_depth = min(n_primary, int(self.hi.sum()))
         per_type = np.bincount(self.rtype, minlength=T) if T else np.zeros(1, np.int64)
         self.max_col = max(int(per_cell.max(initial=0)), int(per_type.max(initial=0)), 1)
-        self.table = DEBRUIJN_TABLE
         if W == 1:
-            self.nb, self.region_gcd, self.region_min = region_pruning(problem)
+            nb, gcd, smallest = region_pruning(problem)
         else:
-            self.nb, self.region_gcd, self.region_min = np.zeros(8, np.uint64), 1, 0
+            nb, gcd, smallest = np.zeros(8, np.uint64), 1, 0
+        self.rows = MRVRows(
+            self.mask, masks, self.rtype, self.rid, self.allrows, primary, self.lo, self.hi,
+            self.counters, self.pieces, DEBRUIJN_TABLE, nb, int(gcd), int(smallest),
+        )  # fmt: skip
+
+    def stack(self, depth: int, n_types: int) -> MRVStack:
+        """Fresh search-side arrays for ``depth`` levels."""
+        W = self.words
+        return MRVStack(
+            cnt=np.zeros(n_types, dtype=np.int32),
+            live=np.zeros((depth + 1) * max(len(self.rid), 1), dtype=np.int32),
+            lstart=np.zeros(depth + 2, dtype=np.int64),
+            occ=np.zeros((depth + 1, W), dtype=np.uint64),
+            tcount=np.zeros(max(n_types, 1), dtype=np.int32),
+            tally=np.zeros(64 * W, dtype=np.int32),
+            planes=np.zeros((5, W), dtype=np.uint64),
+            scratch=np.zeros((2, W), dtype=np.uint64),
+            br=np.zeros((depth, self.max_col), dtype=np.int32),
+            nbr=np.zeros(depth, dtype=np.int64),
+            pos=np.zeros(depth, dtype=np.int64),
+            chosen=np.zeros(depth, dtype=np.int32),
+        )
 
 
 def _row_cells(problem: CoverProblem, rows: Int32Array) -> tuple[Int32Array, Int32Array]:

@@ -17,26 +17,19 @@ branching on mandatory cells).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.jit import njit
-from chaingeo.solvers.cover.kernels import (
-    DONE,
-    FRESH,
-    LIMIT,
-    REG_DEPTH,
-    REG_NODES,
-    REG_SOLUTIONS,
-    REG_STATUS,
-    REG_UPDATES,
-    RUNNING,
-    shuffle_prefix,
-    store_solution,
-)
+from chaingeo.solvers.cover import kernels as kn
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
+
+I32 = npt.NDArray[np.int32]
+I64 = npt.NDArray[np.int64]
+U64 = npt.NDArray[np.uint64]
 
 PRIMARY, SECONDARY, COUNTER = 0, 1, 2
 
@@ -148,28 +141,49 @@ def _choose(HR: Any, S: Any) -> int:
     return best
 
 
+class Links(NamedTuple):
+    """The linked-list matrix (node layout above); ``HL``, ``HR``, ``U``, ``D``, ``S`` change
+    during a search (:meth:`DLXArrays.fresh` copies them)."""
+
+    HL: I32
+    HR: I32
+    U: I32
+    D: I32
+    TOP: I32
+    RW: I32
+    S: I32
+
+
+class Columns(NamedTuple):
+    """Per column: its kind (primary, secondary, counter) and count range; the counters
+    that have a lower bound."""
+
+    kind: I32
+    lo: I32
+    hi: I32
+    counters: I32
+
+
 @njit(cache=True, boundscheck=False)
-def dlx_run(
-    HL: Any, HR: Any, U: Any, D: Any, TOP: Any, RW: Any, S: Any,
-    kind: Any, lo: Any, hi: Any, cnt: Any, counters: Any,
-    buf: Any, nbuf: Any, pos: Any, lcol: Any, chosen: Any,
-    regs: Any, rng: Any, shuffle: bool,
-    out: Any, max_store: int, stop_after: int, node_limit: int,
-) -> int:  # fmt: skip
+def dlx_run(links: Links, cols: Columns, lv: kn.Levels, ctl: kn.Control) -> int:
     """Run (or resume) the search; returns how many solutions were written to ``out``.
 
     Stops when ``max_store`` solutions are stored (if > 0), ``stop_after`` solutions were found
     in this call (if > 0), the tree is exhausted (status DONE) or ``node_limit`` total nodes were
     spent (status LIMIT). ``out[i, :depth]`` holds the chosen row ids, -1 padded.
     """
-    status = regs[REG_STATUS]
-    if status == DONE:
+    HL, HR, U, D, TOP, RW, S = links
+    kind, lo, hi, counters = cols
+    cnt, buf, nbuf, pos, lcol, chosen = lv
+    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
+    status = regs[kn.REG_STATUS]
+    if status == kn.DONE:
         return 0
-    nodes = regs[REG_NODES]
-    updates = regs[REG_UPDATES]
+    nodes = regs[kn.REG_NODES]
+    updates = regs[kn.REG_UPDATES]
     found = 0
     n_out = 0
-    if status == FRESH:
+    if status == kn.FRESH:
         c = _choose(HR, S)
         updates += _cover(c, HL, HR, U, D, TOP, S)
         k = 0
@@ -180,17 +194,17 @@ def dlx_run(
             n += 1
             i = D[i]
         if shuffle:
-            shuffle_prefix(buf[0], n, rng)
+            kn.shuffle_prefix(buf[0], n, rng)
         nbuf[0] = n
         pos[0] = 0
         lcol[0] = c
     else:
-        k = regs[REG_DEPTH]
-    regs[REG_STATUS] = RUNNING
+        k = regs[kn.REG_DEPTH]
+    regs[kn.REG_STATUS] = kn.RUNNING
     while True:
         if pos[k] < nbuf[k]:
             if nodes >= node_limit:
-                regs[REG_STATUS] = LIMIT
+                regs[kn.REG_STATUS] = kn.LIMIT
                 break
             r = buf[k, pos[k]]
             pos[k] += 1
@@ -207,7 +221,7 @@ def dlx_run(
                 if ok:
                     found += 1
                     if max_store > 0:
-                        n_out = store_solution(out, n_out, chosen, RW, k)
+                        n_out = kn.store_solution(out, n_out, chosen, RW, k)
                 _unselect(r, HL, HR, U, D, TOP, S, kind, hi, cnt)
                 if ok and ((max_store > 0 and n_out == max_store) or found == stop_after):
                     break
@@ -224,21 +238,18 @@ def dlx_run(
                 n += 1
                 i = D[i]
             if shuffle:
-                shuffle_prefix(buf[k], n, rng)
+                kn.shuffle_prefix(buf[k], n, rng)
             nbuf[k] = n
             pos[k] = 0
             lcol[k] = c
         else:
             _uncover(lcol[k], HL, HR, U, D, TOP, S)
             if k == 0:
-                regs[REG_STATUS] = DONE
+                regs[kn.REG_STATUS] = kn.DONE
                 break
             k -= 1
             _unselect(chosen[k], HL, HR, U, D, TOP, S, kind, hi, cnt)
-    regs[REG_DEPTH] = k
-    regs[REG_NODES] = nodes
-    regs[REG_UPDATES] = updates
-    regs[REG_SOLUTIONS] += found
+    kn.save_registers(regs, k, nodes, updates, found)
     return n_out
 
 
@@ -310,16 +321,17 @@ class DLXArrays:
         pa = np.asarray(prim, dtype=np.int32)
         HR[pa] = np.roll(pa, -1)
         HL[pa] = np.roll(pa, 1)
-        self.arrays = (HL, HR, U, D, TOP, RW, S)
+        self.arrays = Links(HL, HR, U, D, TOP, RW, S)
         self.kind, self.lo, self.hi = kind, lo, hi
         self.counters = np.asarray(
             [h for h in range(1, n_cols + 1) if kind[h] == COUNTER and lo[h] > 0], dtype=np.int32
         )
+        self.columns = Columns(kind, lo, hi, self.counters)
         self.max_depth = min(int(np.count_nonzero(kind == PRIMARY)), int(hi[1 : T + 1].sum()))
         self.max_col = int(S[1:].max()) if n_cols else 0
         self.has_primary = len(prim) > 1
 
-    def fresh(self) -> tuple[np.ndarray, ...]:
+    def fresh(self) -> Links:
         """Copies of the mutable arrays for one independent search."""
         HL, HR, U, D, TOP, RW, S = self.arrays
-        return (HL.copy(), HR.copy(), U.copy(), D.copy(), TOP, RW, S.copy())
+        return Links(HL.copy(), HR.copy(), U.copy(), D.copy(), TOP, RW, S.copy())

@@ -8,9 +8,10 @@ where it stopped.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.jit import njit
 
@@ -31,6 +32,41 @@ N_REGS = 5
 
 def new_regs() -> np.ndarray:
     return np.zeros(N_REGS, dtype=np.int64)
+
+
+class Control(NamedTuple):
+    """What one call of any engine's kernel runs under and writes to (numba sees a tuple):
+    the registers it resumes from, the shuffle's PRNG state, and where the solutions go."""
+
+    regs: npt.NDArray[np.int64]
+    rng: npt.NDArray[np.uint64]
+    shuffle: bool
+    out: npt.NDArray[np.int32]
+    max_store: int
+    stop_after: int
+    node_limit: int
+
+
+class Levels(NamedTuple):
+    """Per-level search state of the DLX and first-cell kernels: type counts, the branch lists
+    (``buf``), each level's end and position in them, an engine's own per-level value
+    (``aux``: the column, or the candidate base) and the row chosen."""
+
+    cnt: npt.NDArray[np.int32]
+    buf: npt.NDArray[np.int32]
+    nbuf: npt.NDArray[np.int64]
+    pos: npt.NDArray[np.int64]
+    aux: npt.NDArray[np.int64]
+    chosen: npt.NDArray[np.int32]
+
+
+@njit(cache=True)
+def save_registers(regs: np.ndarray, k: int, nodes: int, updates: int, found: int) -> None:
+    """Leave the counters where the next call resumes."""
+    regs[REG_DEPTH] = k
+    regs[REG_NODES] = nodes
+    regs[REG_UPDATES] = updates
+    regs[REG_SOLUTIONS] += found
 
 
 @njit(cache=True)

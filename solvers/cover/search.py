@@ -27,7 +27,7 @@ import numpy as np
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.cover import kernels
 from chaingeo.solvers.cover.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
-from chaingeo.solvers.cover.bitmrv import MRVArrays, mrv_run, mrv_wide_run
+from chaingeo.solvers.cover.bitmrv import MRVArrays, mrv_run
 from chaingeo.solvers.cover.dlx import DLXArrays, dlx_run
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverError, CoverProblem
@@ -197,15 +197,7 @@ class CoverSearch:
             self._occ = np.zeros(depth + 1, dtype=np.uint64)
             self._cnt = np.zeros(len(problem.types), dtype=np.int32)
         else:
-            n_types = len(problem.types)
-            self._cnt = np.zeros(n_types, dtype=np.int32)
-            self._live = np.zeros((depth + 1) * max(len(a.rid), 1), dtype=np.int32)
-            self._lstart = np.zeros(depth + 2, dtype=np.int64)
-            self._occ = np.zeros((depth + 1, a.words), dtype=np.uint64)
-            self._tcount = np.zeros(max(n_types, 1), dtype=np.int32)
-            self._tally = np.zeros(64 * a.words, dtype=np.int32)
-            self._planes = np.zeros((5, a.words), dtype=np.uint64)
-            self._scratch = np.zeros((2, a.words), dtype=np.uint64)
+            self._stack = a.stack(depth, len(problem.types))
 
     @property
     def stats(self) -> CoverStats:
@@ -231,43 +223,20 @@ class CoverSearch:
         """One call of the search's kernel up to ``node_limit`` nodes in total; solutions go to
         ``out`` (see :func:`chaingeo.solvers.cover.dlx.dlx_run`)."""
         a = self._arr
+        ctl = kernels.Control(
+            self._regs, self._rng, self._shuffle, out, max_store, stop_after, node_limit
+        )
         if isinstance(a, DLXArrays):
-            HL, HR, U, D, TOP, RW, S = self._links
-            return dlx_run(
-                HL, HR, U, D, TOP, RW, S, a.kind, a.lo, a.hi, self._cnt, a.counters,
-                self._buf, self._nbuf, self._pos, self._aux, self._chosen,
-                self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, node_limit,
-            )  # fmt: skip
+            lv = kernels.Levels(
+                self._cnt, self._buf, self._nbuf, self._pos, self._aux, self._chosen
+            )
+            return dlx_run(self._links, a.columns, lv, ctl)
         if isinstance(a, BitboardArrays):
-            return bitboard_run(
-                a.mask, a.rtype, a.rid, a.cand_ptr, a.cand, a.skip,
-                a.type_ptr, a.exact1, a.mrv_depth, a.primary,
-                a.lo, a.hi, self._cnt, a.counters, a.table,
-                a.nb, a.region_gcd, a.region_min,
-                self._occ, self._perm, self._nbuf, self._pos, self._aux, self._chosen,
-                self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, node_limit,
-            )  # fmt: skip
-        if a.words == 1:
-            return mrv_run(
-                a.mask, a.rtype, a.rid, a.allrows, a.primary[0],
-                a.lo, a.hi, self._cnt, a.counters, a.pieces, a.table,
-                a.nb, a.region_gcd, a.region_min,
-                self._live, self._lstart, self._occ[:, 0], self._tcount, self._tally,
-                self._buf, self._nbuf, self._pos, self._chosen,
-                self._regs, self._rng, self._shuffle,
-                out, max_store, stop_after, node_limit,
-            )  # fmt: skip
-        return mrv_wide_run(
-            a.masks, a.rtype, a.rid, a.allrows, a.primary,
-            a.lo, a.hi, self._cnt, a.counters, a.pieces, a.table,
-            self._live, self._lstart, self._occ, self._tcount, self._tally,
-            self._planes, self._scratch,
-            self._buf, self._nbuf, self._pos, self._chosen,
-            self._regs, self._rng, self._shuffle,
-            out, max_store, stop_after, node_limit,
-        )  # fmt: skip
+            lv = kernels.Levels(
+                self._cnt, self._perm, self._nbuf, self._pos, self._aux, self._chosen
+            )
+            return bitboard_run(a.rows, self._occ, lv, ctl)
+        return mrv_run(a.rows, self._stack, ctl)
 
     def _call(self, max_store: int, stop_after: int) -> Int32Array:
         out = np.zeros((max(max_store, 1), self._depth), dtype=np.int32)

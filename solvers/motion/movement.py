@@ -399,6 +399,28 @@ def node_moves(
     return rows
 
 
+@njit(cache=True, inline="always")
+def shift_child(
+    row: I16, child: I16, base: int, pieces: I64 | None, m: int, mask: int, d: int, k: int
+) -> None:  # fmt: skip
+    """``child`` = ``row`` with the group ``mask`` (bits of the piece indices ``pieces[:m]``,
+    or ``0..m-1`` when ``pieces`` is None; offsets at ``base + 3 piece``) moved ``k`` units
+    along direction ``d``. The first piece never moves: when it belongs to the group, the
+    others move the opposite way instead."""
+    for t in range(child.shape[0]):  # a loop: slice assignment is slow on short rows
+        child[t] = row[t]
+    a = base + d // 2
+    step = k if d % 2 == 0 else -k
+    first = 0 if pieces is None else pieces[0]
+    if (mask >> first) & 1:
+        step = -step
+        mask = ~mask
+    for p in range(m):
+        q = p if pieces is None else pieces[p]
+        if (mask >> q) & 1:
+            child[a + 3 * q] += step
+
+
 @njit(cache=True)
 def hash_row(row: I16) -> np.uint64:
     h = np.uint64(14695981039346656037)
@@ -564,21 +586,10 @@ def expand(
                     seps[n_seps, 1] = np.int64(mask)
                     seps[n_seps, 2] = dr
                     n_seps += 1
-                a = dr // 2
-                sign = 1 if dr % 2 == 0 else -1
-                anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
                 for k in range(1, kmax + 1):
                     if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
                         return NEED_STATES, node, n_states, n_seps, n_layers
-                    for t in range(w):
-                        child[t] = states[node, t]
-                    for p in range(n):
-                        inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
-                        if anchor_moves:  # keep piece 0 still: move everyone else back instead
-                            if not inside:
-                                child[3 * p + a] -= sign * k
-                        elif inside:
-                            child[3 * p + a] += sign * k
+                    shift_child(states[node], child, 0, None, n, moves_buf[r, 0], dr, k)
                     got = find_or_insert(states, n_states, table, child)
                     if got < 0:
                         parent[n_states] = node

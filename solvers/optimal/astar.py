@@ -181,17 +181,13 @@ class Heuristic:
         """``h(state)``, or None when some subset can never come apart (nor can the puzzle)."""
         row = self.row(state)
         n = len(self.table.names)
-        key = np.zeros(KEY_WIDTH, dtype=np.int16)
         miss = np.zeros(KEY_WIDTH, dtype=np.int16)
         total = 0
         pdb = self.pdb
         for part in state.parts:
             label = min(self.table.index(p) for p in part)
             while True:
-                h = ak.part_h(
-                    row, n, label, len(part), pdb.fam, pdb.n_family,
-                    pdb.keys, pdb.vals, pdb.hash, key, miss,
-                )  # fmt: skip
+                h = ak.part_h(row, n, label, len(part), ak.pdb_view(pdb, miss))
                 if h >= 0:
                     break
                 pdb.ensure(miss.tolist())

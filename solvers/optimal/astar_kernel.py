@@ -13,7 +13,7 @@ again with the same ``g`` and change nothing).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -57,16 +57,72 @@ N_REGS = 7
 _GBITS = 20  # heap key: f << 20 | (2^20 - 1 - g): smaller f first, then larger g
 
 
+class PDBView(NamedTuple):
+    """A pattern database as the kernel reads it (:class:`PatternDB`'s arrays of the moment),
+    with the key scratch and where a missing entry's key is written."""
+
+    fam: I64
+    n_fam: int
+    keys: I16
+    vals: I32
+    hash: I64
+    key: I16
+    miss: I16
+
+
+def pdb_view(pdb: PatternDB, miss: I16) -> PDBView:
+    """The view of ``pdb`` now (its arrays are replaced as it grows)."""
+    key = np.zeros(KEY_WIDTH, dtype=np.int16)
+    return PDBView(pdb.fam, pdb.n_family, pdb.keys, pdb.vals, pdb.hash, key, miss)
+
+
+class Nodes(NamedTuple):
+    """The stored states (:class:`Run`'s arrays): ``rows`` and their hash ``table``; per node
+    ``g``, ``h``, the active part's ``h``, ``f``, the parent and the move from it (group mask,
+    direction, ``k``; 0 for a removal), and whether it is closed."""
+
+    rows: I16
+    gv: I32
+    hv: I32
+    hact: I32
+    fv: I32
+    parent: I64
+    mmask: I64
+    mdir: I64
+    mk: I64
+    closed: U8
+    table: I64
+
+
+class Heap(NamedTuple):
+    """The open list: a binary heap of keys (:func:`_heap_key`) and their nodes."""
+
+    key: I64
+    node: I64
+
+
+class Pieces(NamedTuple):
+    """The pieces' voxels and boxes (:meth:`PieceTable.part_arrays`), the group caps, and the
+    buffers :func:`chaingeo.solvers.motion.movement.node_moves` writes."""
+
+    vox: I64
+    starts: I64
+    lo: I64
+    hi: I64
+    max_group: int
+    group_limit: int
+    moves: I64
+    groups: U64
+
+
 @njit(cache=True)
-def part_h(
-    row: I16, n: int, label: int, size: int, fam: I64, n_fam: int,
-    pkeys: I16, pvals: I32, ptable: I64, key: I16, miss: I16,
-) -> int:  # fmt: skip
+def part_h(row: I16, n: int, label: int, size: int, pdb: PDBView) -> int:
     """The term of one part (module docstring of :mod:`chaingeo.solvers.optimal.astar`); -1 when a
-    pattern database entry is missing (its key is written to ``miss``), ``DEAD`` when some subset
-    can never come apart."""
+    pattern database entry is missing (its key is written to ``pdb.miss``), ``DEAD`` when some
+    subset can never come apart."""
     if size < 2:
         return 0
+    fam, n_fam, keys, vals, table, key, miss = pdb  # locals: a tuple field read costs a refcount
     h = size - 1
     for f in range(n_fam):
         a = fam[f, 0]
@@ -83,12 +139,12 @@ def part_h(
         for t in range(3):
             key[1 + t] = row[n + 3 * b + t] - row[n + 3 * a + t]
             key[4 + t] = row[n + 3 * c + t] - row[n + 3 * a + t] if m == 3 else 0
-        idx = lookup(pkeys, ptable, key)
+        idx = lookup(keys, table, key)
         if idx < 0:
             for t in range(KEY_WIDTH):
                 miss[t] = key[t]
             return -1
-        g = pvals[idx]
+        g = vals[idx]
         if g >= DEAD:
             return DEAD
         v = g + size - m
@@ -140,219 +196,281 @@ def _heap_key(g: int, h: int) -> int:
 
 
 @njit(cache=True)
+def _next_node(regs: I64, nodes: Nodes, heap: Heap, max_expansions: int) -> int:
+    """Pop the open list until a current entry: ``R_CUR`` set and -1, or a status (the goal,
+    an empty list, the expansion cap)."""
+    while True:
+        if regs[R_HEAP] == 0:
+            return EXHAUSTED
+        hk = heap.key[0]
+        node = heap.node[0]
+        regs[R_HEAP] = _pop(heap.key, heap.node, regs[R_HEAP])
+        g = (1 << _GBITS) - 1 - (hk & ((1 << _GBITS) - 1))
+        f = hk >> _GBITS
+        if g != nodes.gv[node] or f != nodes.fv[node]:
+            continue  # stale heap entry
+        if f > regs[R_BOUND]:
+            regs[R_BOUND] = f
+        if nodes.hv[node] == 0:
+            regs[R_GOAL] = node
+            return FOUND
+        if max_expansions >= 0 and regs[R_EXPANDED] >= max_expansions:
+            regs[R_HEAP] = _push(heap.key, heap.node, regs[R_HEAP], hk, node)
+            return LIMIT
+        regs[R_CUR] = node
+        return -1
+
+
+@njit(cache=True)
+def _active_part(row: I16, n: int, cnt: I64, members: I64) -> tuple[int, int]:
+    """``(label, size)`` of the first part of two or more pieces, its pieces in ``members``;
+    ``cnt``: every part's size."""
+    cnt[:] = 0
+    for i in range(n):
+        cnt[row[i]] += 1
+    act = -1
+    for i in range(n):
+        if cnt[i] >= 2:
+            act = i
+            break
+    m = 0
+    for i in range(n):
+        if row[i] == act:
+            members[m] = i
+            m += 1
+    return act, m
+
+
+@njit(cache=True)
+def _part_moves(row: I16, n: int, members: I64, m: int, pieces: Pieces) -> int:
+    """:func:`chaingeo.solvers.motion.movement.node_moves` of the part ``members[:m]`` at its
+    offsets in ``row``: the number of moves written to ``pieces.moves`` (or its -1, -2)."""
+    nvox = 0
+    for p in range(m):
+        q = members[p]
+        nvox += pieces.starts[q + 1] - pieces.starts[q]
+    vox = np.empty((3, nvox, 3), dtype=np.int64)
+    starts = np.empty(m + 1, dtype=np.int64)
+    lo = np.empty((m, 3), dtype=np.int64)
+    hi = np.empty((m, 3), dtype=np.int64)
+    off = np.empty((m, 3), dtype=np.int64)
+    gaps = np.empty((3, m, m), dtype=np.int64)
+    pos = 0
+    for p in range(m):
+        q = members[p]
+        starts[p] = pos
+        for v in range(pieces.starts[q], pieces.starts[q + 1]):
+            for a in range(3):
+                for t in range(3):
+                    vox[a, pos, t] = pieces.vox[a, v, t]
+            pos += 1
+        for t in range(3):
+            lo[p, t] = pieces.lo[q, t]
+            hi[p, t] = pieces.hi[q, t]
+            off[p, t] = row[n + 3 * q + t]
+    starts[m] = pos
+    return mv.node_moves(
+        vox, starts, lo, hi, off, pieces.max_group, pieces.group_limit, False, gaps,
+        pieces.groups, pieces.moves,
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _split(row: I16, child: I16, n: int, members: I64, m: int, gmask: int) -> tuple[int, int, int]:
+    """Write to ``child`` the removal of ``gmask`` from the part ``members[:m]`` of ``row``: two
+    parts re-anchored at their smallest pieces; returns ``(label a, label b, size of a)``."""
+    la = -1
+    lb = -1
+    for p in range(m):
+        q = members[p]
+        if (gmask >> q) & 1:
+            if la < 0:
+                la = q
+        elif lb < 0:
+            lb = q
+    sa = 0
+    for p in range(m):
+        q = members[p]
+        lab = la if (gmask >> q) & 1 else lb
+        sa += 1 if lab == la else 0
+        child[q] = lab
+        for t in range(3):
+            child[n + 3 * q + t] = row[n + 3 * q + t] - row[n + 3 * lab + t]
+    return la, lb, sa
+
+
+@njit(cache=True)
+def _split_h(
+    child: I16, n: int, cnt: I64, act: int, la: int, lb: int, sa: int, sb: int, pdb: PDBView
+) -> tuple[int, int]:
+    """``(h of both new parts, h of the child's active part)`` after :func:`_split` of the part
+    ``act``; ``(-1, 0)`` on a missing entry, ``(DEAD, 0)`` when a part never comes apart."""
+    ha = part_h(child, n, la, sa, pdb)
+    if ha < 0:
+        return -1, 0
+    hb = part_h(child, n, lb, sb, pdb)
+    if hb < 0:
+        return -1, 0
+    if ha >= DEAD or hb >= DEAD:
+        return DEAD, 0
+    nact = -1
+    for i in range(n):
+        c = cnt[i]
+        if i == act:
+            c = 0
+        if i == la:
+            c = sa
+        if i == lb:
+            c = sb
+        if c >= 2:
+            nact = i
+            break
+    if nact < 0:
+        return ha + hb, 0
+    if nact == la:
+        return ha + hb, ha
+    if nact == lb:
+        return ha + hb, hb
+    hc = part_h(child, n, nact, cnt[nact], pdb)
+    if hc < 0:
+        return -1, 0
+    return ha + hb, hc
+
+
+@njit(cache=True)
+def _store(
+    regs: I64, nodes: Nodes, heap: Heap, child: I16, cur: int, hgf: tuple[int, int, int, int],
+    move: tuple[int, int, int],
+) -> int:  # fmt: skip
+    """Store ``child`` of ``cur`` (``hgf``: its ``h``, active ``h``, ``g``, ``f``; ``move``:
+    mask, direction, ``k``) unless known at a ``g`` as small; -1, or the buffer to grow."""
+    h, hc, g1, fc = hgf
+    rows, gv, hv, hact, fv, parent, mmask, mdir, mk, closed, table = nodes
+    n_states = regs[R_STATES]
+    if n_states >= rows.shape[0] or 2 * (n_states + 1) > table.shape[0]:
+        return NEED_STATES
+    if regs[R_HEAP] + 1 >= heap.key.shape[0]:
+        return NEED_HEAP
+    got = mv.find_or_insert(rows, n_states, table, child)
+    if got < 0:
+        got = -1 - got
+        regs[R_STATES] = n_states + 1
+        hv[got] = h
+        hact[got] = hc
+        closed[got] = 0
+    elif g1 >= gv[got]:
+        return -1
+    elif closed[got]:
+        closed[got] = 0
+        regs[R_REOPENED] += 1
+    gv[got] = g1
+    fv[got] = fc
+    parent[got] = cur
+    mmask[got] = move[0]
+    mdir[got] = move[1]
+    mk[got] = move[2]
+    regs[R_HEAP] = _push(heap.key, heap.node, regs[R_HEAP], _heap_key(g1, hv[got]), got)
+    return -1
+
+
+@njit(cache=True)
+def _expand(
+    regs: I64, nodes: Nodes, heap: Heap, pieces: Pieces, pdb: PDBView,
+    work: tuple[I16, I64, I64],
+) -> int:  # fmt: skip
+    """Expand ``R_CUR``, its active part only, storing the children with ``f`` equal to its
+    ``fv`` (a partial expansion): -1 when done, else a status. ``work``: scratch (a child row,
+    part sizes, the active part's pieces)."""
+    child, cnt, members = work
+    cur = regs[R_CUR]
+    row = nodes.rows[cur]
+    n = pieces.lo.shape[0]
+    act, m = _active_part(row, n, cnt, members)
+    nrows = _part_moves(row, n, members, m, pieces)
+    if nrows == -2:
+        return GROUPS
+    if nrows == -1:
+        return NEED_MOVES
+    moves = pieces.moves
+    g1 = nodes.gv[cur] + 1
+    hbase = nodes.hv[cur] - nodes.hact[cur]
+    big_f = nodes.fv[cur]  # this (partial) expansion stores the children with f == big_f
+    first = big_f == nodes.gv[cur] + nodes.hv[cur]
+    nxt = DEAD
+    for r in range(nrows):
+        lmask = moves[r, 0]
+        d = moves[r, 1]
+        kmax = moves[r, 2]
+        gmask = 0
+        for p in range(m):
+            if (lmask >> p) & 1:
+                gmask |= 1 << members[p]
+        last = kmax + 1 if moves[r, 3] else kmax  # k = kmax + 1 stands for the removal
+        for k in range(1, last + 1):
+            if k <= kmax:
+                mv.shift_child(row, child, n, members, m, gmask, d, k)
+                hc = part_h(child, n, act, m, pdb)
+                if hc < 0:
+                    return NEED_PDB
+                if hc >= DEAD:
+                    continue
+                h = hbase + hc
+                kk = k
+            else:  # the removal: two parts, re-anchored at their smallest pieces
+                for t in range(child.shape[0]):
+                    child[t] = row[t]
+                la, lb, sa = _split(row, child, n, members, m, gmask)
+                hab, hc = _split_h(child, n, cnt, act, la, lb, sa, m - sa, pdb)
+                if hab < 0:
+                    return NEED_PDB
+                if hab >= DEAD:
+                    continue
+                h = hbase + hab
+                kk = 0
+            fc = g1 + h
+            if fc > big_f:  # left for a later expansion of cur
+                nxt = min(nxt, fc)
+                continue
+            if fc < big_f and not first:
+                continue  # stored by an earlier expansion of cur
+            status = _store(regs, nodes, heap, child, cur, (h, hc, g1, fc), (gmask, d, kk))
+            if status >= 0:
+                return status
+    if nxt < DEAD:  # children with a larger f remain: come back at the next f
+        if regs[R_HEAP] + 1 >= heap.key.shape[0]:
+            return NEED_HEAP
+        nodes.fv[cur] = nxt
+        key = _heap_key(nodes.gv[cur], nxt - nodes.gv[cur])
+        regs[R_HEAP] = _push(heap.key, heap.node, regs[R_HEAP], key, cur)
+    else:
+        nodes.fv[cur] = -1
+    return -1
+
+
+@njit(cache=True)
 def run_astar(
-    regs: I64, rows: I16, gv: I32, hv: I32, hact: I32, fv: I32, parent: I64, mmask: I64, mdir: I64,
-    mk: I64, closed: U8, table: I64, hkey: I64, hnode: I64,
-    gvox: I64, gstarts: I64, glo: I64, ghi: I64, max_group: int, group_limit: int,
-    fam: I64, n_fam: int, pkeys: I16, pvals: I32, ptable: I64, miss: I16,
-    moves_buf: I64, groups_buf: U64, max_expansions: int, batch: int,
+    regs: I64, nodes: Nodes, heap: Heap, pieces: Pieces, pdb: PDBView, max_expansions: int,
+    batch: int,
 ) -> int:  # fmt: skip
     """A* from the stored states until a status (module docstring); see :class:`Run`."""
-    n = glo.shape[0]
-    w = rows.shape[1]
-    child = np.empty(w, dtype=np.int16)
-    key = np.empty(KEY_WIDTH, dtype=np.int16)
-    cnt = np.zeros(n, dtype=np.int64)
-    members = np.empty(n, dtype=np.int64)
+    n = pieces.lo.shape[0]
+    work = (
+        np.empty(nodes.rows.shape[1], dtype=np.int16),
+        np.zeros(n, dtype=np.int64),
+        np.empty(n, dtype=np.int64),
+    )
     done = 0
     while True:
-        cur = regs[R_CUR]
-        if cur < 0:
+        if regs[R_CUR] < 0:
             if done >= batch:
                 return YIELD
-            if regs[R_HEAP] == 0:
-                return EXHAUSTED
-            hk = hkey[0]
-            node = hnode[0]
-            regs[R_HEAP] = _pop(hkey, hnode, regs[R_HEAP])
-            g = (1 << _GBITS) - 1 - (hk & ((1 << _GBITS) - 1))
-            f = hk >> _GBITS
-            if g != gv[node] or f != fv[node]:
-                continue  # stale heap entry
-            if f > regs[R_BOUND]:
-                regs[R_BOUND] = f
-            if hv[node] == 0:
-                regs[R_GOAL] = node
-                return FOUND
-            if max_expansions >= 0 and regs[R_EXPANDED] >= max_expansions:
-                regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], hk, node)
-                return LIMIT
-            regs[R_CUR] = node
-            cur = node
-        # ---- expand cur: the active part only ---------------------------------------------
-        for i in range(n):
-            cnt[i] = 0
-        for i in range(n):
-            cnt[rows[cur, i]] += 1
-        act = -1
-        for i in range(n):
-            if cnt[i] >= 2:
-                act = i
-                break
-        m = 0
-        nvox = 0
-        for i in range(n):
-            if rows[cur, i] == act:
-                members[m] = i
-                m += 1
-                nvox += gstarts[i + 1] - gstarts[i]
-        vox = np.empty((3, nvox, 3), dtype=np.int64)
-        starts = np.empty(m + 1, dtype=np.int64)
-        lo = np.empty((m, 3), dtype=np.int64)
-        hi = np.empty((m, 3), dtype=np.int64)
-        off = np.empty((m, 3), dtype=np.int64)
-        gaps = np.empty((3, m, m), dtype=np.int64)
-        pos = 0
-        for p in range(m):
-            q = members[p]
-            starts[p] = pos
-            for v in range(gstarts[q], gstarts[q + 1]):
-                for a in range(3):
-                    for t in range(3):
-                        vox[a, pos, t] = gvox[a, v, t]
-                pos += 1
-            for t in range(3):
-                lo[p, t] = glo[q, t]
-                hi[p, t] = ghi[q, t]
-                off[p, t] = rows[cur, n + 3 * q + t]
-        starts[m] = pos
-        nrows = mv.node_moves(
-            vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
-        )
-        if nrows == -2:
-            return GROUPS
-        if nrows == -1:
-            return NEED_MOVES
-        g1 = gv[cur] + 1
-        hbase = hv[cur] - hact[cur]
-        big_f = fv[cur]  # this (partial) expansion stores the children with f == big_f
-        first = big_f == gv[cur] + hv[cur]
-        nxt = DEAD
-        for r in range(nrows):
-            lmask = np.uint64(moves_buf[r, 0])
-            d = moves_buf[r, 1]
-            kmax = moves_buf[r, 2]
-            gmask = np.int64(0)
-            for p in range(m):
-                if lmask & (np.uint64(1) << np.uint64(p)):
-                    gmask |= np.int64(1) << np.int64(members[p])
-            ax = d // 2
-            sign = 1 if d % 2 == 0 else -1
-            anchor_moves = (lmask & np.uint64(1)) != np.uint64(0)
-            last = kmax + 1 if moves_buf[r, 3] else kmax  # k = kmax + 1 stands for the removal
-            for k in range(1, last + 1):
-                for t in range(w):
-                    child[t] = rows[cur, t]
-                if k <= kmax:
-                    for p in range(m):
-                        q = members[p]
-                        inside = (gmask >> q) & 1
-                        if anchor_moves:
-                            if not inside:
-                                child[n + 3 * q + ax] -= sign * k
-                        elif inside:
-                            child[n + 3 * q + ax] += sign * k
-                    hp = part_h(child, n, act, m, fam, n_fam, pkeys, pvals, ptable, key, miss)
-                    if hp < 0:
-                        return NEED_PDB
-                    if hp >= DEAD:
-                        continue
-                    h = hbase + hp
-                    hc = hp
-                    kk = k
-                else:  # the removal: two parts, re-anchored at their smallest pieces
-                    la = -1
-                    lb = -1
-                    for p in range(m):
-                        q = members[p]
-                        if (gmask >> q) & 1:
-                            if la < 0:
-                                la = q
-                        elif lb < 0:
-                            lb = q
-                    sa = 0
-                    for p in range(m):
-                        q = members[p]
-                        lab = la if (gmask >> q) & 1 else lb
-                        sa += 1 if lab == la else 0
-                        child[q] = lab
-                        for t in range(3):
-                            child[n + 3 * q + t] = (
-                                rows[cur, n + 3 * q + t] - rows[cur, n + 3 * lab + t]
-                            )
-                    sb = m - sa
-                    ha = part_h(child, n, la, sa, fam, n_fam, pkeys, pvals, ptable, key, miss)
-                    if ha < 0:
-                        return NEED_PDB
-                    hb = part_h(child, n, lb, sb, fam, n_fam, pkeys, pvals, ptable, key, miss)
-                    if hb < 0:
-                        return NEED_PDB
-                    if ha >= DEAD or hb >= DEAD:
-                        continue
-                    h = hbase + ha + hb
-                    nact = -1
-                    for i in range(n):
-                        c = cnt[i]
-                        if i == act:
-                            c = 0
-                        if i == la:
-                            c = sa
-                        if i == lb:
-                            c = sb
-                        if c >= 2:
-                            nact = i
-                            break
-                    if nact < 0:
-                        hc = 0
-                    elif nact == la:
-                        hc = ha
-                    elif nact == lb:
-                        hc = hb
-                    else:
-                        hc = part_h(
-                            child, n, nact, cnt[nact], fam, n_fam, pkeys, pvals, ptable, key, miss
-                        )
-                        if hc < 0:
-                            return NEED_PDB
-                    kk = 0
-                fc = g1 + h
-                if fc > big_f:  # left for a later expansion of cur
-                    nxt = min(nxt, fc)
-                    continue
-                if fc < big_f and not first:
-                    continue  # stored by an earlier expansion of cur
-                n_states = regs[R_STATES]
-                if n_states >= rows.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                    return NEED_STATES
-                if regs[R_HEAP] + 1 >= hkey.shape[0]:
-                    return NEED_HEAP
-                got = mv.find_or_insert(rows, n_states, table, child)
-                if got < 0:
-                    got = -1 - got
-                    regs[R_STATES] = n_states + 1
-                    hv[got] = h
-                    hact[got] = hc
-                    closed[got] = 0
-                elif g1 >= gv[got]:
-                    continue
-                elif closed[got]:
-                    closed[got] = 0
-                    regs[R_REOPENED] += 1
-                gv[got] = g1
-                fv[got] = fc
-                parent[got] = cur
-                mmask[got] = gmask
-                mdir[got] = d
-                mk[got] = kk
-                regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(g1, hv[got]), got)
-        if nxt < DEAD:  # children with a larger f remain: come back at the next f
-            if regs[R_HEAP] + 1 >= hkey.shape[0]:
-                return NEED_HEAP
-            fv[cur] = nxt
-            regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(gv[cur], nxt - gv[cur]), cur)
-        else:
-            fv[cur] = -1
-        closed[cur] = 1
+            status = _next_node(regs, nodes, heap, max_expansions)
+            if status >= 0:
+                return status
+        status = _expand(regs, nodes, heap, pieces, pdb, work)
+        if status >= 0:
+            return status
+        nodes.closed[regs[R_CUR]] = 1
         regs[R_EXPANDED] += 1
         regs[R_CUR] = -1
         done += 1
@@ -417,16 +535,11 @@ class Run:
     def _start(self) -> bool:
         """Store the start state with its ``h``; False when it can never come apart."""
         mv.find_or_insert(self.rows, 0, self.table, self.rows[0].copy())
-        key = np.zeros(KEY_WIDTH, dtype=np.int16)
-        pdb = self.pdb
         while True:
-            h = part_h(
-                self.rows[0], self.n, 0, self.n, pdb.fam, pdb.n_family,
-                pdb.keys, pdb.vals, pdb.hash, key, self.miss,
-            )  # fmt: skip
+            h = part_h(self.rows[0], self.n, 0, self.n, pdb_view(self.pdb, self.miss))
             if h >= 0:
                 break
-            pdb.ensure(self.miss.tolist())
+            self.pdb.ensure(self.miss.tolist())
         if h >= DEAD:
             return False
         self.hv[0] = self.hact[0] = self.fv[0] = self.start_h = h
@@ -458,25 +571,41 @@ class Run:
             self.table = np.full(size, -1, dtype=np.int64)
             mv.rebuild_table(self.rows, self.n_states, self.table)
 
+    def _nodes(self) -> Nodes:
+        return Nodes(
+            self.rows, self.gv, self.hv, self.hact, self.fv, self.parent, self.mmask, self.mdir,
+            self.mk, self.closed, self.table,
+        )  # fmt: skip
+
+    def _pieces(self) -> Pieces:
+        return Pieces(
+            self.gvox, self.gstarts, self.glo, self.ghi, self.max_group,
+            self.limits.group_limit, self.moves_buf, self.groups_buf,
+        )  # fmt: skip
+
     def search(self) -> int:
         """Run to the end: the goal node, or -1 when the puzzle never comes apart."""
         if not self._start():
             return -1
         pdb = self.pdb
         max_exp = -1 if self.limits.max_expansions is None else self.limits.max_expansions
+        bundles: tuple[Nodes, Heap, Pieces] | None = None
+        view: PDBView | None = None
         while True:
             self.deadline.check()
-            status = run_astar(
-                self.regs, self.rows, self.gv, self.hv, self.hact, self.fv, self.parent, self.mmask,
-                self.mdir, self.mk, self.closed, self.table, self.hkey, self.hnode,
-                self.gvox, self.gstarts, self.glo, self.ghi, self.max_group,
-                self.limits.group_limit, pdb.fam, pdb.n_family, pdb.keys, pdb.vals, pdb.hash,
-                self.miss, self.moves_buf, self.groups_buf, max_exp, 20000,
-            )  # fmt: skip
+            if bundles is None:  # the arrays were replaced (grown)
+                bundles = (self._nodes(), Heap(self.hkey, self.hnode), self._pieces())
+            if view is None or view.keys is not pdb.keys or view.hash is not pdb.hash:
+                view = pdb_view(pdb, self.miss)
+            elif view.vals is not pdb.vals:
+                view = view._replace(vals=pdb.vals)
+            status = run_astar(self.regs, *bundles, view, max_exp, 20000)
             if status == FOUND:
                 return int(self.regs[R_GOAL])
             if status == EXHAUSTED:
                 return -1
+            if status in (NEED_STATES, NEED_HEAP, NEED_MOVES):
+                bundles = None
             if status == NEED_STATES:
                 self._grow_states()
             elif status == NEED_HEAP:

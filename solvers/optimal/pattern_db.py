@@ -116,23 +116,12 @@ def sub_component(
                 rems[n_rems, 0] = node
                 rems[n_rems, 1] = np.int64(mask)
                 n_rems += 1
-            a = d // 2
-            sign = 1 if d % 2 == 0 else -1
-            anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
             for k in range(1, kmax + 1):
                 if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
                     return SUB_NEED_STATES, node, n_states, e0, r0
                 if n_edges >= edges.shape[0]:
                     return SUB_NEED_EDGES, node, n_states, e0, r0
-                for t in range(w):
-                    child[t] = states[node, t]
-                for p in range(m):
-                    inside = (mask & (np.uint64(1) << np.uint64(p))) != np.uint64(0)
-                    if anchor_moves:
-                        if not inside:
-                            child[3 * p + a] -= sign * k
-                    elif inside:
-                        child[3 * p + a] += sign * k
+                mv.shift_child(states[node], child, 0, None, m, moves_buf[r, 0], d, k)
                 got = mv.find_or_insert(states, n_states, table, child)
                 if got < 0:
                     got = -1 - got
