@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from chaingeo.cli.main import main
@@ -218,3 +219,23 @@ def test_a_bad_optimal_time_limit_is_refused(
     assert main(["analyze", "puzzle-mid-04-burr12", "--optimal-seconds", value]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and "--optimal-seconds: expected a positive number" in captured.err
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_the_interpreted_try_counts_the_assemblers_placements(seed: int) -> None:
+    """``--jit auto`` tries a BurrTools file interpreted by its placements: the count it
+    stops at is exactly the assembler's rows for the pieces (no colours in these puzzles),
+    on seeded random boxes cut into pieces, with holes and congruent bars."""
+    from chaingeo.cli.commands.analyze import placements_within
+    from chaingeo.solvers.assembly.btassemble import bt_packing_spec
+    from chaingeo.solvers.cover.constrained import compile_packing
+    from tests.support.burrtxt import random_puzzle
+
+    puzzle = random_puzzle(np.random.default_rng(seed))
+    packing = compile_packing(bt_packing_spec(puzzle, 0))
+    starts = packing.problem.row_start
+    rows = sum(
+        int(starts[t + 1] - starts[t]) for t in range(len(packing.types)) if t != packing.hole_type
+    )
+    assert placements_within(puzzle, puzzle.problems, rows)
+    assert not placements_within(puzzle, puzzle.problems, rows - 1)

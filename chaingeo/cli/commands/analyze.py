@@ -30,12 +30,14 @@ some file failed (its line carries ``error``; the message is also on standard er
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import os
 import signal
 import sys
 import time
+from collections.abc import Sequence
 from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING, Any, Final
@@ -45,6 +47,7 @@ from chaingeo.cli.level_arg import find_level
 from chaingeo.cli.progress import ProgressLines
 
 if TYPE_CHECKING:
+    from chaingeo.core.formats.burrtools import BTProblem, BTPuzzle
     from chaingeo.core.kinematics import SearchLimitError
     from chaingeo.solvers.figures import PuzzleFigures
 
@@ -54,6 +57,13 @@ INTERPRETED_SECONDS: Final = 0.15
 #: A file is tried interpreted only up to these sizes (pieces, voxels of all pieces).
 SMALL_PIECES: Final = 12
 SMALL_VOXELS: Final = 160
+#: A BurrTools file is tried interpreted up to this many placements of its pieces in its
+#: result (:func:`placements_within`): the work grows with them, not with the voxels (Soma in a
+#: 3x3x3 box, 27 voxels, has 688; the soma file's 12-piece problem 188 and a 376-voxel maze
+#: 278 both overran the interpreted budget and paid a restart; 4 rings on a pin, 56, did not).
+SMALL_ROWS: Final = 150
+#: ... and up to this many result voxels (bounding the look itself).
+SMALL_RESULT_VOXELS: Final = 1000
 
 
 #: The flags that set the fields of ``SearchLimits`` a search may reach.
@@ -245,6 +255,11 @@ def _small(spec: str, problem: int | None) -> bool:
             )
             pieces = sum(p.max for prob in problems for p in prob.parts)
             voxels = sum(len(puzzle.shapes[prob.result].cells) for prob in problems)
+            return (
+                0 < pieces <= SMALL_PIECES
+                and voxels <= SMALL_RESULT_VOXELS
+                and placements_within(puzzle, problems, SMALL_ROWS)
+            )
         else:
             level = find_level(spec)
             pieces = len(level.pieces)
@@ -252,6 +267,26 @@ def _small(spec: str, problem: int | None) -> bool:
     except Exception:  # a look only: the analysis itself reports what is wrong
         return False
     return 0 < pieces <= SMALL_PIECES and voxels <= SMALL_VOXELS
+
+
+def placements_within(puzzle: BTPuzzle, problems: Sequence[BTProblem], limit: int) -> bool:
+    """Whether the problems' parts have at most ``limit`` placements in their results (every
+    orientation and offset that lies in the result's voxels; colours not checked, so this is
+    an upper bound on the assembler's rows). Stops counting past ``limit``."""
+    count = 0
+    for prob in problems:
+        result = puzzle.shapes[prob.result].cells
+        inside, lo, hi = result.cell_set, result.min_corner, result.max_corner
+        for part in prob.parts:
+            for shape in puzzle.shapes[part.shape].cells.orientations():
+                cells, ext = shape.normalized().cells, shape.extent
+                for x, y, z in itertools.product(
+                    *(range(int(lo[a]), int(hi[a]) - ext[a] + 2) for a in range(3))
+                ):
+                    count += all((a + x, b + y, c + z) in inside for a, b, c in cells)
+                    if count > limit:
+                        return False
+    return True
 
 
 def _run_interpreted(args: argparse.Namespace) -> int:
