@@ -30,7 +30,6 @@ some file failed (its line carries ``error``; the message is also on standard er
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
 import math
 import os
@@ -272,20 +271,17 @@ def _small(spec: str, problem: int | None) -> bool:
 def placements_within(puzzle: BTPuzzle, problems: Sequence[BTProblem], limit: int) -> bool:
     """Whether the problems' parts have at most ``limit`` placements in their results (every
     orientation and offset that lies in the result's voxels; colours not checked, so this is
-    an upper bound on the assembler's rows). Stops counting past ``limit``."""
+    an upper bound on the assembler's rows). Plain numpy: no kernel is loaded before the
+    interpreted mode is chosen."""
+    from chaingeo.solvers.cover.placements import placements
+
     count = 0
     for prob in problems:
         result = puzzle.shapes[prob.result].cells
-        inside, lo, hi = result.cell_set, result.min_corner, result.max_corner
         for part in prob.parts:
-            for shape in puzzle.shapes[part.shape].cells.orientations():
-                cells, ext = shape.normalized().cells, shape.extent
-                for x, y, z in itertools.product(
-                    *(range(int(lo[a]), int(hi[a]) - ext[a] + 2) for a in range(3))
-                ):
-                    count += all((a + x, b + y, c + z) in inside for a, b, c in cells)
-                    if count > limit:
-                        return False
+            count += len(placements(puzzle.shapes[part.shape].cells, result).cells)
+            if count > limit:
+                return False
     return True
 
 
