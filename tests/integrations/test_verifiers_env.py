@@ -28,6 +28,16 @@ KEY_VAR = "CHAINGEO_TEST_KEY"
 EASY: dict[str, Any] = {"family": "stacking", "difficulty": "easy"}
 
 
+def needs_plugin() -> None:
+    """Skip unless verifiers' plugin module is installed: verifiers finds the taskset id
+    ``chaingeo-env`` only through it, a distribution of its own (.ci/run installs it)."""
+    pytest.importorskip(
+        "chaingeo_env",
+        reason="the plugin chaingeo-env is not installed "
+        "(pip install ./chaingeo/integrations/verifiers/plugin)",
+    )
+
+
 def plans(limit: int, **taskset: Any) -> list[list[str]]:
     """The optimal plans of the first ``limit`` tasks, in the order the eval runs them."""
     env = load_environment(**taskset)
@@ -48,6 +58,7 @@ def evaluate(
     from verifiers.v1.cli.eval.runner import run_eval
     from verifiers.v1.configs.cli.eval import EvalConfig
 
+    needs_plugin()
     monkeypatch.setenv(KEY_VAR, "sk-test")
     env: dict[str, Any] = {"taskset": {"id": TASKSET_ID, **taskset}}
     if agent is not None:
@@ -111,6 +122,19 @@ def test_nonsense_scores_zero(
     assert [p["type"] for p in last] == ["text"]
     if protocol == "interactive":
         assert "Recent turns:" in last[0]["text"] and "Steps left: 1" in last[0]["text"]
+
+
+def test_the_taskset_id_names_our_classes() -> None:
+    """verifiers' own loaders, given the id, find exactly our taskset, environment and harness
+    (through the plugin module, which is nothing but a re-export)."""
+    needs_plugin()
+    from verifiers.v1.utils import loaders
+
+    import chaingeo.integrations.verifiers as ours
+
+    assert loaders.taskset_class(TASKSET_ID) is ours.ChainGeoTaskset
+    assert loaders.environment_class(TASKSET_ID) is ours.ChainGeoEnv
+    assert loaders.harness_class(TASKSET_ID) is ours.ChainGeoHarness
 
 
 def test_the_whole_conversation_on_request(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -200,6 +224,7 @@ def test_a_folder_of_levels_and_an_empty_selection(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_the_vf_eval_command(tmp_path: Path) -> None:
     """``vf-eval chaingeo-env ...``: verifiers' command line finds the taskset by its id."""
+    needs_plugin()
     script = Script(entries=[reply("<action>finish</action>")], chat_history=True)
     vf_eval = Path(sys.executable).with_name("vf-eval")
     with fake_openai(script) as url:

@@ -2,11 +2,12 @@
 ``vf-eval`` and training with prime-rl.
 
 ``load_environment(family=..., difficulty=..., split=..., images=True, protocol=..., reward=...)``
-returns the environment; the installed module ``chaingeo_env`` exports the same taskset,
-environment and harness under the taskset id ``chaingeo-env``, which is how verifiers' command
-line finds them (``vf-eval chaingeo-env --env.taskset.family puzzle``). Rewards, summing to 1 for
-an optimal, well-formed episode: ``success`` (0.5), ``efficiency`` (0.4; ``1 - NormDist`` when
-solved) and ``format`` (0.1; the share of readable actions).
+returns the environment. verifiers' command line finds a taskset by the top-level module its id
+names: the plugin module ``chaingeo_env`` (a distribution of its own, ``plugin/`` beside this
+file, so chaingeo's wheel stays one package) exports the same taskset, environment and harness
+under the id ``chaingeo-env`` (``vf-eval chaingeo-env --env.taskset.family puzzle``).
+Rewards, summing to 1 for an optimal, well-formed episode: ``success`` (0.5), ``efficiency``
+(0.4; ``1 - NormDist`` when solved) and ``format`` (0.1; the share of readable actions).
 """
 
 from __future__ import annotations
