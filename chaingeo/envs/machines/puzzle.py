@@ -68,8 +68,8 @@ from chaingeo.envs.actions.types import (
     cell_text,
     vector_text,
 )
+from chaingeo.envs.machines.move_table import GroupMoves
 from chaingeo.envs.machines.puzzle_actions import (
-    MoveRange,
     assembly_actions,
     disassembly_actions,
     oriented_table,
@@ -84,10 +84,9 @@ from chaingeo.envs.machines.puzzle_tables import normal_key as normal_key
 from chaingeo.envs.machines.puzzle_turns import PartKey, describe_turn, resolve_turn, turn_problem
 from chaingeo.envs.machines.state import BaseState
 
-_ByGroup = dict[tuple[tuple[str, ...], str], MoveRange]
 #: a position (kept alive so its id stays its own), its moves by (group, direction), its turns,
 #: its actions
-_Listed = tuple[Assembly, _ByGroup, list[TurnAction], ActionList]
+_Listed = tuple[Assembly, GroupMoves, list[TurnAction], ActionList]
 _CACHED_POSITIONS = 8
 
 
@@ -169,7 +168,7 @@ class PuzzleState(BaseState):
     def _legal_moves(self) -> Sequence[Action]:
         return self._actions()[2]
 
-    def _actions(self) -> tuple[_ByGroup, list[TurnAction], ActionList]:
+    def _actions(self) -> tuple[GroupMoves, list[TurnAction], ActionList]:
         """(the moves of groups within a part by (group, direction), the legal turns, every
         legal action) of this position, computed once per position. Disassembling, the first
         are every move."""
@@ -180,13 +179,14 @@ class PuzzleState(BaseState):
         table = oriented_table(self._asm, self.tables.piece_table, self.tables.oriented)
         tt = self.tables.turn_table
         turns = [] if tt is None else turn_actions(self._asm, mg, tt)
+        by_group: GroupMoves
         if self.mode == "disassemble":
-            ranges = disassembly_actions(self._asm, mg, table)
-            actions = ActionList([*ranges, turns])
+            by_group = disassembly_actions(self._asm, mg, table)
+            actions = ActionList([by_group, turns])
         else:
             ranges, listed = assembly_actions(self._asm, mg, table)
             actions = ActionList([listed, turns])
-        by_group = {(r.pieces, r.direction): r for r in ranges}
+            by_group = {(r.pieces, r.direction): r for r in ranges}
         if len(self._legal_cache) >= _CACHED_POSITIONS:
             del self._legal_cache[next(iter(self._legal_cache))]
         self._legal_cache[id(self._asm)] = (self._asm, by_group, turns, actions)

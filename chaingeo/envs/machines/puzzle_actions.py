@@ -5,10 +5,11 @@ every part coming in anywhere next to another): building them all costs seconds 
 an agent looks at a few. So they come in sorted lazy blocks inside an
 :class:`~chaingeo.envs.actions.lists.ActionList`:
 
-* :class:`MoveRange`: one group along one direction, distances ``1..kmax`` (then ``inf`` when
-  it can leave), from the numba movement analysis
+* :class:`~chaingeo.envs.machines.move_table.MoveTable`: every group along every direction,
+  distances ``1..kmax`` (then ``inf`` when it can leave), from the numba movement analysis
   (:func:`chaingeo.solvers.motion.disassemble.move_rows`, tested equal to the reference
-  :func:`chaingeo.core.kinematics.legal_moves`);
+  :func:`chaingeo.core.kinematics.legal_moves`), as arrays; assembling, the slides as one
+  :class:`~chaingeo.envs.machines.move_table.MoveRange` per group and direction;
 * :class:`InsertionBlock`: one part coming in along one direction into another part, every
   landing place, from a numba kernel equal to the reference
   :func:`chaingeo.core.kinematics.insertion_shifts`;
@@ -22,8 +23,7 @@ translation kernels see each piece as it stands now).
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping, Sequence
-from typing import overload
+from collections.abc import Mapping
 
 import numpy as np
 
@@ -43,6 +43,7 @@ from chaingeo.core.kinematics import (
 from chaingeo.core.turns import AXES, TurnMove
 from chaingeo.envs.actions.lists import ActionList
 from chaingeo.envs.actions.types import Action, FinishAction, MoveAction, TurnAction
+from chaingeo.envs.machines.move_table import LazyBlock, MoveRange, MoveTable
 from chaingeo.solvers.motion.disassemble import move_rows
 from chaingeo.solvers.motion.partsearch import PieceTable
 from chaingeo.solvers.motion.turnmoves import TurnTable
@@ -159,63 +160,7 @@ def turn_actions(asm: Assembly, max_group: int | None, table: TurnTable) -> list
     return out
 
 
-class _Lazy(Sequence[MoveAction]):
-    """A sorted block of actions that builds its ``i``-th member only when asked."""
-
-    __slots__ = ()
-
-    def _build(self, i: int) -> MoveAction:
-        raise NotImplementedError
-
-    @overload
-    def __getitem__(self, index: int) -> MoveAction: ...
-    @overload
-    def __getitem__(self, index: slice) -> list[MoveAction]: ...
-    def __getitem__(self, index: int | slice) -> MoveAction | list[MoveAction]:
-        if isinstance(index, slice):
-            return [self[i] for i in range(*index.indices(len(self)))]
-        i = index + len(self) if index < 0 else index
-        if not 0 <= i < len(self):
-            raise IndexError(f"action index {index} out of range for {len(self)}")
-        return self._build(i)
-
-    def __iter__(self) -> Iterator[MoveAction]:
-        return (self._build(i) for i in range(len(self)))
-
-
-class MoveRange(_Lazy):
-    """The moves of ``pieces`` along ``direction``: distances ``1..kmax``, then ``inf`` when
-    ``removable``, in the order of the actions' sort keys."""
-
-    __slots__ = ("direction", "key", "kmax", "pieces", "removable")
-
-    def __init__(self, pieces: tuple[str, ...], direction: str, kmax: int, removable: bool):
-        self.pieces = pieces
-        self.direction = direction
-        self.kmax = kmax
-        self.removable = removable
-        self.key: tuple[object, ...] = (pieces, direction, False, ())
-
-    def __len__(self) -> int:
-        return self.kmax + (1 if self.removable else 0)
-
-    def _build(self, i: int) -> MoveAction:
-        return MoveAction(Move(self.pieces, self.direction, i + 1 if i < self.kmax else None))
-
-    def __contains__(self, value: object) -> bool:
-        if not (
-            isinstance(value, MoveAction)
-            and value.into is None
-            and value.offset is None
-            and value.move.pieces == self.pieces
-            and value.move.direction == self.direction
-        ):
-            return False
-        k = value.move.distance
-        return self.removable if k is None else 1 <= k <= self.kmax
-
-
-class InsertionBlock(_Lazy):
+class InsertionBlock(LazyBlock):
     """The insertions of ``part`` along ``direction`` into ``into``, sorted by offset.
 
     ``delta`` turns a shift into the agent's offset (the shift of ``part``'s first piece
@@ -308,13 +253,19 @@ def _groups(names: tuple[str, ...], masks: np.ndarray) -> dict[int, tuple[str, .
     }
 
 
-def disassembly_actions(asm: Assembly, max_group: int | None, table: PieceTable) -> list[MoveRange]:
-    """The moves of :func:`chaingeo.core.kinematics.legal_moves`, sorted, as lazy ranges."""
+def disassembly_actions(asm: Assembly, max_group: int | None, table: PieceTable) -> MoveTable:
+    """The moves of :func:`chaingeo.core.kinematics.legal_moves`, sorted, as one lazy table."""
+    return MoveTable(_ranges(asm, max_group, table))
+
+
+def disassembly_ranges(asm: Assembly, max_group: int | None, table: PieceTable) -> list[MoveRange]:
+    """The same moves as one lazy block per (group, direction): one Python object per pair,
+    the way :class:`MoveTable` is checked (tests) and timed against (``chain bench actions``)."""
     chunks: list[MoveRange] = []
     for names, rows in _ranges(asm, max_group, table):
         groups = _groups(names, rows[:, 0])
         chunks.extend(MoveRange(groups[m], _DIRS[d], k, bool(r)) for m, d, k, r in rows.tolist())
-    return sorted(chunks, key=lambda c: c.key)
+    return sorted((c for c in chunks if len(c)), key=lambda c: c.key)
 
 
 def _slide_rows(rows: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
