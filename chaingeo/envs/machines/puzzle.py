@@ -162,7 +162,8 @@ class PuzzleState(BaseState):
     def is_success(self) -> bool:
         if self.mode == "disassemble":
             return self._asm.is_separated()
-        return normal_key(self._asm) == self.tables.target_key
+        target = self.tables.target_key  # one entry per part: a count that differs decides
+        return len(self._asm.parts) == len(target) and normal_key(self._asm) == target
 
     # -- legal actions ------------------------------------------------------------------------
     def _legal_moves(self) -> Sequence[Action]:

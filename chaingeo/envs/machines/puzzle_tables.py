@@ -20,12 +20,11 @@ def part_key(asm: Assembly, part: frozenset[str]) -> PartKey:
     """One part as (name, offset relative to the part's first piece); where turns left pieces
     turned, see :func:`chaingeo.envs.machines.puzzle_turns.turned_part_key`."""
     names = sorted(part)
-    if any(asm.rotation_of(n) for n in names):
+    if asm.rotations and any(asm.rotation_of(n) for n in names):  # most states turn nothing
         return turned_part_key(asm, names)
-    bx, by, bz = asm.offsets[names[0]]
-    return tuple(
-        (n, (asm.offsets[n][0] - bx, asm.offsets[n][1] - by, asm.offsets[n][2] - bz)) for n in names
-    )
+    offsets = asm.offsets
+    bx, by, bz = offsets[names[0]]
+    return tuple((n, (x - bx, y - by, z - bz)) for n in names for x, y, z in (offsets[n],))
 
 
 def normal_key(asm: Assembly) -> PositionKey:
