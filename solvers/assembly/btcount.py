@@ -151,12 +151,10 @@ class RowVerdicts:
         the shape's origin lands (cached a type)."""
         hit = self._orient_keys.get(t)
         if hit is None:
-            name = self.type_slot[t]
-            keys = [
-                self.image.placement_key(name, o.voxels)
-                for o in self.packing.problem.table[t].orientations
-            ]
-            arr = np.array(keys, dtype=np.int64).reshape(-1, 4)
+            orients = self.packing.problem.table[t].orientations
+            arr = self.image.placement_keys(
+                self.type_slot[t], np.stack([o.voxels for o in orients])
+            )
             hit = self._orient_keys[t] = (arr[:, 0], arr[:, 1:])
         return hit
 

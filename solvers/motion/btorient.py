@@ -189,6 +189,15 @@ class BTImage:
                 image[n] = Shape(v)
         return image, np.asarray(m, dtype=np.int64)
 
+    def placement_keys(self, name: str, stack: np.ndarray) -> np.ndarray:
+        """:meth:`placement_key` of each voxel set of a stack ``(n, k, 3)``, as rows
+        ``(t, x, y, z)`` (one sort for all: a type's orientations)."""
+        found = self.find[name]
+        hits = [found[key] for key in _normals(stack)]
+        low = np.array([h[1] for h in hits], dtype=np.int64).reshape(-1, 3)
+        rot = np.array([h[0] for h in hits], dtype=np.int64).reshape(-1, 1)
+        return np.hstack([rot, stack.min(axis=1) - low])
+
     def placement_key(self, name: str, vox: np.ndarray) -> Key:
         """BurrTools' placement of a piece: its first rotation giving the voxels, and where the
         shape's origin lands."""
