@@ -236,10 +236,16 @@ class Packing:
 
     def row_maps(self, reflections: bool) -> Int32Array:
         """``maps[g, r]``: the row that symmetry ``g`` of :meth:`group` makes of row ``r``
-        (-1: its image is a piece the problem does not have)."""
+        (-1: its image is a piece the problem does not have). A symmetry's row is its own
+        business, so with the rotations' maps known only the reflections are looked up."""
         hit = self._maps.get(reflections)
         if hit is None:
-            hit = self._row_maps([self.symmetries[g] for g in self.group(reflections)])
+            rot = self._maps.get(False) if reflections else None
+            if rot is None or self.group(False) != list(range(len(rot))):
+                hit = self._row_maps([self.symmetries[g] for g in self.group(reflections)])
+            else:  # rotations come first and are known: map rows by the reflections only
+                flips = [s for s in self.symmetries if not s.proper]
+                hit = np.concatenate([rot, self._row_maps(flips)]) if flips else rot
             self._maps[reflections] = hit
         return hit
 

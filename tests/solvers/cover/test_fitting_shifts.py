@@ -153,3 +153,15 @@ def test_row_keys_are_each_rows_placement_key(seed: int) -> None:
         name = verdicts.type_slot[int(verdicts.row_type[r])]
         t, x, y, z = verdicts.image.placement_key(name, packing.placed(r).voxels)
         assert key == (((t << 16 | x + bias) << 16 | y + bias) << 16) | z + bias
+
+
+@pytest.mark.parametrize("seed", range(15))
+def test_reflection_maps_extend_the_rotation_maps(seed: int) -> None:
+    """All symmetries' row maps built on the rotations' (known first) are the maps built in
+    one go."""
+    puzzle = random_puzzle(np.random.default_rng(np.random.SeedSequence([9, seed])))
+    first, fresh = (compile_packing(bt_packing_spec(puzzle, 0)) for _ in range(2))
+    rotations = first.row_maps(False)
+    both = first.row_maps(True)
+    assert np.array_equal(both, fresh.row_maps(True))
+    assert np.array_equal(both[: len(rotations)], rotations)
