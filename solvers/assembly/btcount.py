@@ -91,7 +91,13 @@ class RowVerdicts:
     ``verdict(rows)`` is True (a solution), False (none) or None (not decided here: ask the
     general path); :attr:`level` then holds the solution's level string when asked for."""
 
-    def __init__(self, packing: Packing, limits: SearchLimits | None, want_levels: bool) -> None:
+    def __init__(
+        self,
+        packing: Packing,
+        limits: SearchLimits | None,
+        want_levels: bool,
+        frame: BTFrame | None = None,
+    ) -> None:
         self.packing = packing
         self.want_levels = want_levels
         problem = packing.problem
@@ -104,12 +110,13 @@ class RowVerdicts:
         self.row_hi = np.maximum.reduceat(every, self.row_ptr[:-1], axis=0)
         self.row_type = problem.row_type.astype(np.int64)
         self.piece = self.row_type != packing.hole_type
-        frame = BTFrame(packing)
+        frame = BTFrame(packing) if frame is None else frame  # the caller's, when it has one
         self.image = frame.image
         self.type_slot = {t: packing.problem.types[t].slots[0] for t, _ in frame.types}
         reflections = len(self.image.symmetries) == len(packing.symmetries)
         self.maps = packing.row_maps(reflections).astype(np.int64)
         self.keys = np.full(packing.n_rows, _UNKNOWN, dtype=np.int64)
+        self._orient_keys: dict[int, tuple[I64, I64]] = {}
         self.shared = {t: self.image.shared[slot] for t, slot in self.type_slot.items()}
         lim = limits or SearchLimits()
         total = -1 if lim.max_total_states is None else lim.max_total_states
@@ -119,13 +126,37 @@ class RowVerdicts:
         self.level: str | None = None
 
     def _key(self, rows: I64) -> I64:
-        """Each row's BurrTools placement key as one ordered integer (computed once a row)."""
+        """Each row's BurrTools placement key as one ordered integer (computed once a row).
+
+        A row is an orientation of its type's table moved by its offset, so its key is the
+        orientation's (BurrTools' rotation, its origin) moved by the same offset: one
+        :meth:`BTImage.placement_key` per orientation met, the rest in numpy."""
         keys = self.keys[rows]
-        for r in np.unique(rows[keys == _UNKNOWN]).tolist():
-            name = self.type_slot[int(self.row_type[r])]
-            t, x, y, z = self.image.placement_key(name, self.packing.placed(r).voxels)
-            self.keys[r] = (((t << 16 | x + _BIAS) << 16 | y + _BIAS) << 16) | z + _BIAS
+        todo = np.unique(rows[keys == _UNKNOWN])
+        if len(todo):
+            problem = self.packing.problem
+            types = self.row_type[todo]
+            for t in np.unique(types).tolist():
+                mine = todo[types == t]
+                local = mine - int(problem.row_start[t])
+                table = problem.table[t]
+                rot, origin = self._orientation_keys(t)
+                o = table.orientation[local]
+                p = table.offset[local] + origin[o] + _BIAS
+                self.keys[mine] = (((rot[o] << 16 | p[:, 0]) << 16 | p[:, 1]) << 16) | p[:, 2]
         return self.keys[rows]
+
+    def _orientation_keys(self, t: int) -> tuple[I64, I64]:
+        """Per orientation of type ``t``'s table (at the origin): BurrTools' rotation and where
+        the shape's origin lands (cached a type)."""
+        hit = self._orient_keys.get(t)
+        if hit is None:
+            orients = self.packing.problem.table[t].orientations
+            arr = self.image.placement_keys(
+                self.type_slot[t], np.stack([o.voxels for o in orients])
+            )
+            hit = self._orient_keys[t] = (arr[:, 0], arr[:, 1:])
+        return hit
 
     def image_rows(self, rows: I64) -> I64 | None:
         """The rows of the image BurrTools disassembles
@@ -252,7 +283,7 @@ def count_bt(
     frame = BTFrame(packing) if separations == "first" else None
     on_rows = None
     if fast and frame is not None and stuck is not None:
-        on_rows = RowVerdicts(packing, limits, levels is not None)
+        on_rows = RowVerdicts(packing, limits, levels is not None, frame)
     counts = deadline.progress.counts if deadline is not None else {}
     limit: SearchLimitError | None = None
     try:

@@ -28,7 +28,13 @@ import numpy as np
 
 from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
 from chaingeo.core.jit import njit
-from chaingeo.solvers.cover.placements import Int32Array, IntArray, Placements, target_index
+from chaingeo.solvers.cover.placements import (
+    Int32Array,
+    IntArray,
+    Placements,
+    fitting_shifts,
+    target_index,
+)
 from chaingeo.solvers.cover.problem import CoverError, CoverProblem, PieceType
 
 Cell = tuple[int, int, int]
@@ -90,16 +96,24 @@ class ColoredPiece:
         )[0]
 
     @cached_property
-    def _orientations(self) -> tuple[ColoredPiece, ...]:
+    def _orientation_codes(self) -> tuple[IntArray, int]:
+        """The distinct orientations' sorted codes (first occurrences, in rotation order)."""
         keys, base = self._keys
-        seen: set[bytes] = set()
-        first = []
-        for i, row in enumerate(keys):
-            b = row.tobytes()
-            if b not in seen:
-                seen.add(b)
-                first.append(i)
-        return tuple(ColoredPiece._decode(keys[first], base))
+        _, first = np.unique(keys, axis=0, return_index=True)
+        return keys[np.sort(first)], base
+
+    @cached_property
+    def orientation_arrays(self) -> tuple[IntArray, IntArray]:
+        """:meth:`orientations` as arrays, voxels ``(o, k, 3)`` (sorted, at the origin) and
+        colours ``(o, k)``: what the placements need, without a Python tuple a voxel."""
+        codes, base = self._orientation_codes
+        k = codes // COLOR_BASE
+        vox = np.stack([k // (base * base), (k // base) % base, k % base], axis=-1)
+        return vox, codes % COLOR_BASE
+
+    @cached_property
+    def _orientations(self) -> tuple[ColoredPiece, ...]:
+        return tuple(ColoredPiece._decode(*self._orientation_codes))
 
     def orientations(self) -> tuple[ColoredPiece, ...]:
         """The distinct coloured orientations, in :data:`ROTATIONS` order."""
@@ -222,10 +236,16 @@ class Packing:
 
     def row_maps(self, reflections: bool) -> Int32Array:
         """``maps[g, r]``: the row that symmetry ``g`` of :meth:`group` makes of row ``r``
-        (-1: its image is a piece the problem does not have)."""
+        (-1: its image is a piece the problem does not have). A symmetry's row is its own
+        business, so with the rotations' maps known only the reflections are looked up."""
         hit = self._maps.get(reflections)
         if hit is None:
-            hit = self._row_maps([self.symmetries[g] for g in self.group(reflections)])
+            rot = self._maps.get(False) if reflections else None
+            if rot is None or self.group(False) != list(range(len(rot))):
+                hit = self._row_maps([self.symmetries[g] for g in self.group(reflections)])
+            else:  # rotations come first and are known: map rows by the reflections only
+                flips = [s for s in self.symmetries if not s.proper]
+                hit = np.concatenate([rot, self._row_maps(flips)]) if flips else rot
             self._maps[reflections] = hit
         return hit
 
@@ -332,47 +352,27 @@ def _type_rows(
 ) -> tuple[Placements, IntArray]:
     """Every colour-compatible placement of ``piece`` in ``target`` and its sorted codes."""
     idx = target_index(target)
-    dims = np.asarray(idx.dims)
     occ = idx.grid >= 0
     color_grid = np.zeros(idx.dims, dtype=np.int64)
     rel = target.voxels - idx.origin
     color_grid[rel[:, 0], rel[:, 1], rel[:, 2]] = cell_color
-    fits = {c: occ & ok[c][color_grid] for c in set(piece.colors)}
-    orients = piece.orientations()
-    k = len(piece.voxels)
-    all_cells: list[np.ndarray] = []
-    all_codes: list[np.ndarray] = []
-    all_orient: list[np.ndarray] = []
-    all_offset: list[np.ndarray] = []
-    for o, orient in enumerate(orients):
-        vox = np.asarray(orient.voxels, dtype=np.int64)
-        span = dims - (vox.max(axis=0) + 1) + 1
-        if np.any(span <= 0):
-            continue
-        acc = np.ones(tuple(int(s) for s in span), dtype=bool)
-        for (x, y, z), c in zip(orient.voxels, orient.colors, strict=True):
-            acc &= fits[c][x : x + span[0], y : y + span[1], z : z + span[2]]
-        shifts = np.argwhere(acc).astype(np.int64)
-        if len(shifts) == 0:
-            continue
-        placed = vox[None, :, :] + shifts[:, None, :]
-        cells = idx.grid[placed[..., 0], placed[..., 1], placed[..., 2]].astype(np.int64)
-        codes = cells * COLOR_BASE + np.asarray(orient.colors, dtype=np.int64)[None, :]
-        order = np.argsort(cells, axis=1)
-        all_cells.append(np.take_along_axis(cells, order, axis=1).astype(np.int32))
-        all_codes.append(np.take_along_axis(codes, order, axis=1))
-        all_orient.append(np.full(len(shifts), o, dtype=np.int32))
-        all_offset.append(shifts + idx.origin)
+    vox, colors = piece.orientation_arrays
+    used, layer = np.unique(colors, return_inverse=True)
+    fits = occ[None] & ok[used][:, color_grid]
+    orient, shifts = fitting_shifts(fits, vox, layer.reshape(colors.shape))
+    placed = vox[orient] + shifts[:, None, :]
+    cells = idx.grid[placed[..., 0], placed[..., 1], placed[..., 2]].astype(np.int64)
+    order = np.argsort(cells, axis=1)
+    codes = np.take_along_axis(cells * COLOR_BASE + colors[orient], order, axis=1)
     table = Placements(
         shape=piece.shape,
-        orientations=tuple(p.shape for p in orients),
-        cells=np.concatenate(all_cells) if all_cells else np.zeros((0, k), np.int32),
-        orientation=np.concatenate(all_orient) if all_orient else np.zeros(0, np.int32),
-        offset=np.concatenate(all_offset) if all_offset else np.zeros((0, 3), np.int64),
-        lookup=np.full((len(orients), 1, 1, 1), -1, dtype=np.int32),  # not used here
+        orientations=tuple(Shape.from_sorted(v) for v in vox),
+        cells=np.take_along_axis(cells, order, axis=1).astype(np.int32),
+        orientation=orient.astype(np.int32),
+        offset=shifts + idx.origin,
+        lookup=np.full((len(vox), 1, 1, 1), -1, dtype=np.int32),  # not used here
         origin=idx.origin,
     )
-    codes = np.concatenate(all_codes) if all_codes else np.zeros((0, k), np.int64)
     return table, codes
 
 

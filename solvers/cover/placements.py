@@ -21,6 +21,7 @@ from chaingeo.core.geometry import SYMMETRIES, Shape
 
 IntArray = npt.NDArray[np.int64]
 Int32Array = npt.NDArray[np.int32]
+BoolArray = npt.NDArray[np.bool_]
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,6 +58,47 @@ def target_index(target: Shape) -> TargetIndex:
     grid[rel[:, 0], rel[:, 1], rel[:, 2]] = np.arange(len(target), dtype=np.int32)
     grid.setflags(write=False)
     return TargetIndex(target, origin, dims, grid)
+
+
+def fitting_shifts(fits: BoolArray, vox: IntArray, layer: IntArray) -> tuple[IntArray, IntArray]:
+    """Every ``(orientation, shift)`` putting each voxel ``vox[o, j]`` (orientations of ``k``
+    voxels, each at the origin) on a cell where ``fits[layer[o, j]]`` holds (``fits``:
+    ``(layers, *dims)``, a layer per colour), in orientation order then lexicographic shift
+    order, as one ``np.argwhere`` per orientation lists them.
+
+    The first voxel's fitting cells give each orientation's candidates; then all orientations
+    advance together, one voxel at a time, on a grid padded so that a voxel past the box is a
+    miss: ``k`` numpy steps on the surviving candidates instead of one slice per orientation
+    and voxel (0.09 s of Python on SolidSixPieceBurrs' 25 pieces). Memory stays that of the
+    candidates and of the grid (twice the box a side, one byte a cell)."""
+    dims = np.asarray(fits.shape[1:], dtype=np.int64)
+    n, k = vox.shape[0], vox.shape[1]
+    if n == 0 or k == 0:
+        return np.zeros(0, np.int64), np.zeros((0, 3), np.int64)
+    pad = 2 * dims - 1
+    grid = np.zeros((fits.shape[0], *pad.tolist()), dtype=bool)
+    grid[:, : dims[0], : dims[1], : dims[2]] = fits
+    flat = grid.reshape(-1)
+    stride = np.array([pad[1] * pad[2], pad[2], 1], dtype=np.int64)
+    offset = vox @ stride + layer * int(pad.prod())  # voxel j of o, in the flat padded grid
+    free = [np.argwhere(f) for f in fits]  # each layer's fitting cells, lexicographic
+    room = (vox.max(axis=1) < dims).all(axis=1)  # the orientation fits in the box at all
+    orients, shifts = [np.zeros(0, np.int64)], [np.zeros((0, 3), np.int64)]
+    for lay, cells in enumerate(free):
+        mine = np.flatnonzero(room & (layer[:, 0] == lay))
+        sh = cells[None, :, :] - vox[mine, 0][:, None, :]  # (orientations, cells, 3)
+        o, c = np.nonzero((sh >= 0).all(axis=2))
+        orients.append(mine[o])
+        shifts.append(sh[o, c])
+    orient, shift = np.concatenate(orients), np.concatenate(shifts).astype(np.int64)
+    if len(free) > 1:  # coloured: back to orientation order across the layers
+        order = np.argsort(orient, kind="stable")
+        orient, shift = orient[order], shift[order]
+    base = shift[:, 0] * stride[0] + shift[:, 1] * stride[1] + shift[:, 2]
+    at = np.arange(len(orient))
+    for j in range(1, k):
+        at = at[flat[base[at] + offset[orient[at], j]]]
+    return orient[at], shift[at]
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,39 +142,20 @@ def placements(shape: Shape, target: Shape) -> Placements:
 @lru_cache(maxsize=4096)
 def _placements(canon: Shape, target: Shape) -> Placements:
     idx = target_index(target)
-    dims = np.asarray(idx.dims)
-    occ = idx.grid >= 0
     orients = canon.orientations()
+    vox = np.stack([o.voxels for o in orients])
+    fits = (idx.grid >= 0)[None]
+    orient, rel = fitting_shifts(fits, vox, np.zeros(vox.shape[:2], dtype=np.int64))
+    placed = vox[orient] + rel[:, None, :]
+    cells = np.sort(idx.grid[placed[..., 0], placed[..., 1], placed[..., 2]], axis=1)
     lookup = np.full((len(orients), *idx.dims), -1, dtype=np.int32)
-    all_cells: list[Int32Array] = []
-    all_orient: list[Int32Array] = []
-    all_offset: list[IntArray] = []
-    count = 0
-    for o, orient in enumerate(orients):
-        ext = np.asarray(orient.extent)
-        span = dims - ext + 1
-        if np.any(span <= 0):
-            continue
-        acc = np.ones(tuple(int(s) for s in span), dtype=bool)
-        for x, y, z in orient.cells:
-            acc &= occ[x : x + span[0], y : y + span[1], z : z + span[2]]
-        rel = np.argwhere(acc).astype(np.int64)  # lexicographic translation order
-        if len(rel) == 0:
-            continue
-        vox = orient.voxels[None, :, :] + rel[:, None, :]
-        cells = np.sort(idx.grid[vox[..., 0], vox[..., 1], vox[..., 2]], axis=1)
-        lookup[o, rel[:, 0], rel[:, 1], rel[:, 2]] = np.arange(count, count + len(rel))
-        count += len(rel)
-        all_cells.append(cells.astype(np.int32))
-        all_orient.append(np.full(len(rel), o, dtype=np.int32))
-        all_offset.append(rel + idx.origin)
-    k = len(canon)
+    lookup[orient, rel[:, 0], rel[:, 1], rel[:, 2]] = np.arange(len(orient), dtype=np.int32)
     result = Placements(
         shape=canon,
         orientations=orients,
-        cells=np.concatenate(all_cells) if all_cells else np.zeros((0, k), dtype=np.int32),
-        orientation=np.concatenate(all_orient) if all_orient else np.zeros(0, dtype=np.int32),
-        offset=np.concatenate(all_offset) if all_offset else np.zeros((0, 3), dtype=np.int64),
+        cells=cells.astype(np.int32),
+        orientation=orient.astype(np.int32),
+        offset=rel + idx.origin,
         lookup=lookup,
         origin=idx.origin,
     )

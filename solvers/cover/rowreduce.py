@@ -5,8 +5,9 @@ piece that must be used exactly once) with no row compatible with it: rows that 
 with it, or are the same single-use piece, are gone. No cover holds a dead row, so removing it
 changes no count; removing rows can kill others, so passes repeat until none dies. The depth-
 first search then meets far fewer dead ends: on a 36-piece burr it finds assemblies at once
-where the unreduced search found none in minutes. Each test is one trial placement with
-column counts kept as in dancing links (~rows sharing a cell x their cells), in numba.
+where the unreduced search found none in minutes. Each test is one trial placement, each
+column's alive rows a bit set (one OR over the row's columns, one subset test per column), in
+numba.
 """
 
 from __future__ import annotations
@@ -33,57 +34,67 @@ def _dead_rows(
     max_passes: int,
 ) -> int:  # fmt: skip
     """Clear ``alive`` for every dead row (row ``r`` covers ``cols[row_ptr[r]:row_ptr[r+1]]``;
-    column ``c`` is covered by ``col_rows[col_ptr[c]:col_ptr[c+1]]``); returns rows killed."""
+    column ``c`` is covered by ``col_rows[col_ptr[c]:col_ptr[c+1]]``); returns rows killed.
+
+    Rows are tested one at a time, in order, each against the rows alive then. Row ``r`` is
+    dead when some required column it does not cover has alive rows, all of which share a
+    column with ``r``. With each column's alive rows as a bit set that is one OR over
+    ``r``'s columns and one subset test per column (the count-and-restore of dancing links
+    walked every conflicting row's cells: 0.05 s a pass on SolidSixPieceBurrs' 1241 rows)."""
     n_rows = row_ptr.shape[0] - 1
     n_cols = col_ptr.shape[0] - 1
-    count = np.zeros(n_cols, dtype=np.int64)
-    for r in range(n_rows):
-        if alive[r]:
-            for q in range(row_ptr[r], row_ptr[r + 1]):
-                count[cols[q]] += 1
-    mark = np.zeros(n_rows, dtype=np.int64)
+    words = (n_rows + 63) >> 6
+    bits = np.zeros((n_cols, words), dtype=np.uint64)
+    size = np.zeros(n_cols, dtype=np.int64)
+    for c in range(n_cols):
+        for p in range(col_ptr[c], col_ptr[c + 1]):
+            r = col_rows[p]
+            if alive[r]:
+                bits[c, r >> 6] |= np.uint64(1) << np.uint64(r & 63)
+                size[c] += 1
     own = np.zeros(n_cols, dtype=np.int64)
-    gone = np.empty(n_rows, dtype=np.int64)
-    stamp = 0
+    gone = np.zeros(words, dtype=np.uint64)
     killed = 0
     for _ in range(max_passes):
         changed = False
         for r in range(n_rows):
             if not alive[r]:
                 continue
-            stamp += 1
+            gone[:] = 0
             for q in range(row_ptr[r], row_ptr[r + 1]):
-                own[cols[q]] = stamp
-            n_gone = 0
-            for q in range(row_ptr[r], row_ptr[r + 1]):
-                c = cols[q]
-                for p in range(col_ptr[c], col_ptr[c + 1]):
-                    r2 = col_rows[p]
-                    if alive[r2] and mark[r2] != stamp:
-                        mark[r2] = stamp
-                        gone[n_gone] = r2
-                        n_gone += 1
-            dead = False
-            for g in range(n_gone):
-                r2 = gone[g]
-                for q in range(row_ptr[r2], row_ptr[r2 + 1]):
-                    c = cols[q]
-                    count[c] -= 1
-                    if count[c] == 0 and required[c] and own[c] != stamp:
-                        dead = True
-            for g in range(n_gone):
-                r2 = gone[g]
-                for q in range(row_ptr[r2], row_ptr[r2 + 1]):
-                    count[cols[q]] += 1
-            if dead:
+                own[cols[q]] = r + 1
+                for w in range(words):
+                    gone[w] |= bits[cols[q], w]
+            if _some_column_gone(bits, size, required, own, gone, r + 1):
                 alive[r] = False
                 killed += 1
                 changed = True
                 for q in range(row_ptr[r], row_ptr[r + 1]):
-                    count[cols[q]] -= 1
+                    bits[cols[q], r >> 6] &= ~(np.uint64(1) << np.uint64(r & 63))
+                    size[cols[q]] -= 1
         if not changed:
             break
     return killed
+
+
+@njit(cache=True)
+def _some_column_gone(
+    bits: npt.NDArray[np.uint64], size: I64, required: B1, own: I64,
+    gone: npt.NDArray[np.uint64], mine: int,
+) -> bool:  # fmt: skip
+    """Whether a required column outside the row (``own[c] != mine``) has alive rows, every
+    one of them in ``gone``."""
+    for c in range(bits.shape[0]):
+        if not required[c] or own[c] == mine or size[c] == 0:
+            continue
+        covered = True
+        for w in range(bits.shape[1]):
+            if bits[c, w] & ~gone[w]:
+                covered = False
+                break
+        if covered:
+            return True
+    return False
 
 
 def live_rows(problem: CoverProblem, rows: Int32Array | None = None) -> Int32Array:

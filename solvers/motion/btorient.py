@@ -35,19 +35,39 @@ def _normal(cells: np.ndarray) -> bytes:
     return bytes(c[np.lexsort(c.T[::-1])].tobytes())
 
 
+def _normals(stack: np.ndarray) -> list[bytes]:
+    """:func:`_normal` of each voxel set of a stack ``(n, k, 3)`` (distinct voxels), in one
+    sort: the lookups of a problem's shapes under 48 matrices each cost 0.02 s one at a time."""
+    c = stack - stack.min(axis=1, keepdims=True)
+    base = int(c.max()) + 1 if c.size else 1
+    order = np.argsort((c[..., 0] * base + c[..., 1]) * base + c[..., 2], axis=1)
+    rows = np.take_along_axis(c, order[..., None], axis=1).astype(np.int64)
+    return [bytes(r.tobytes()) for r in rows]
+
+
+def _images(mats: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    """``cells @ m.T`` for every matrix of a stack: ``(len(mats), len(cells), 3)``."""
+    out: np.ndarray = np.einsum("mij,kj->mki", mats, np.asarray(cells, dtype=np.int64))
+    return out
+
+
+_SYMMETRY_STACK = np.asarray(SYMMETRIES, dtype=np.int64).reshape(-1, 3, 3)
+
+
 def symmetries_of(cells: np.ndarray) -> list[Symmetry]:
     """The symmetries of a voxel set (every matrix of SYMMETRIES mapping it onto itself)."""
     base = cells.min(axis=0)
     want = _normal(cells)
-    out = []
-    for m in SYMMETRIES:
-        img = cells @ m.T
-        if _normal(img) == want:
-            out.append((np.asarray(m), base - img.min(axis=0)))
-    return out
+    imgs = _images(_SYMMETRY_STACK, cells)
+    return [
+        (np.asarray(m), base - img.min(axis=0))
+        for m, img, key in zip(SYMMETRIES, imgs, _normals(imgs), strict=True)
+        if key == want
+    ]
 
 
 _MATS = [np.asarray(m, dtype=np.int64) for m in TRANSFORMS_BT]
+_MAT_STACK = np.stack(_MATS)
 _INDEX = {m.tobytes(): i for i, m in enumerate(_MATS)}
 
 
@@ -66,19 +86,19 @@ def _piece_tables(
     rotation -> (the first rotation giving it, that rotation's min corner); and per transform
     A of the 48, that first rotation (-1: none, A mirrors a chiral shape) and the shift from
     A's min corner to the rotation's. Cached: a problem's shapes recur in every analysis."""
-    g = np.frombuffer(grid, dtype=np.int64).reshape(size, 3)
+    imgs = _images(_MAT_STACK, np.frombuffer(grid, dtype=np.int64).reshape(size, 3))
+    lows = imgs.min(axis=1)
+    keys = _normals(imgs)
     first: dict[bytes, tuple[int, np.ndarray]] = {}
     for t in range(24):
-        rot = g @ _MATS[t].T
-        first.setdefault(_normal(rot), (t, rot.min(axis=0)))
+        first.setdefault(keys[t], (t, lows[t]))
     table = []
-    for m in _MATS:
-        img = g @ m.T
-        hit = first.get(_normal(img))
+    for key, low in zip(keys, lows, strict=True):
+        hit = first.get(key)
         if hit is None:
             table.append((-1, np.zeros(3, dtype=np.int64)))
         else:
-            table.append((hit[0], img.min(axis=0) - hit[1]))
+            table.append((hit[0], low - hit[1]))
     return first, table
 
 
@@ -115,9 +135,10 @@ class BTImage:
         for n in names:
             g = np.ascontiguousarray(grids[n], dtype=np.int64)
             key = g.tobytes()
-            if key not in by_grid:
-                by_grid[key] = sum(_normal(g @ m.T) == _normal(g) for m, _ in res_syms)
-            self.shared[n] = by_grid[key]
+            if key not in by_grid and res_syms:
+                mats = np.stack([np.asarray(m, dtype=np.int64) for m, _ in res_syms])
+                by_grid[key] = _normals(_images(mats, g)).count(_normal(g))
+            self.shared[n] = by_grid.get(key, 0)
 
     def __call__(
         self, placed: Mapping[str, Shape], parts: Sequence[Sequence[str]]
@@ -167,6 +188,15 @@ class BTImage:
             for n, v in zip(part, ranked, strict=True):
                 image[n] = Shape(v)
         return image, np.asarray(m, dtype=np.int64)
+
+    def placement_keys(self, name: str, stack: np.ndarray) -> np.ndarray:
+        """:meth:`placement_key` of each voxel set of a stack ``(n, k, 3)``, as rows
+        ``(t, x, y, z)`` (one sort for all: a type's orientations)."""
+        found = self.find[name]
+        hits = [found[key] for key in _normals(stack)]
+        low = np.array([h[1] for h in hits], dtype=np.int64).reshape(-1, 3)
+        rot = np.array([h[0] for h in hits], dtype=np.int64).reshape(-1, 1)
+        return np.hstack([rot, stack.min(axis=1) - low])
 
     def placement_key(self, name: str, vox: np.ndarray) -> Key:
         """BurrTools' placement of a piece: its first rotation giving the voxels, and where the
