@@ -87,7 +87,7 @@ class _Back:
     proj: Projector
     k: int
     big: Pixels
-    front: list[Flat]
+    front: rasterjit.Packed | None  # the front frame edges
 
 
 @dataclass(frozen=True)
@@ -132,11 +132,11 @@ def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
     rasterjit.draw_flat(big, shapes)
     edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
     front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
-    return _Back(proj, k, big, front)
+    return _Back(proj, k, big, rasterjit.pack(front) if front else None)
 
 
 def _finish(back: _Back, big: Pixels) -> Pixels:
-    rasterjit.draw_flat(big, back.front)
+    rasterjit.paint_packed(big, back.front)
     return rasterjit.reduce2(big) if back.k > 1 else big
 
 
@@ -212,14 +212,12 @@ def _scratch(side: int, slot: int) -> Pixels:
 def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     """The picture without pieces, and inside the rectangle the faces and their labels cover:
     the faces on the background, the front edges, the reduction (of that rectangle only),
-    then every label that overlaps it."""
+    then every label that overlaps it. Only that rectangle of the background is copied to the
+    work picture: fills and lines do not read what they cover, so pixels outside it may hold
+    anything."""
     back, k = st.back, st.back.k
-    big = _scratch(size * k, 0)
-    np.copyto(big, back.big)
     pix = scaled(back.proj, k).screen(faces.corners)
     width = _Layout.of(size).edge_px(k)
-    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
-    rasterjit.draw_flat(big, back.front)
     labels = depth_label_steps(faces, cam, back.proj) if cam.depth_axis is not None else []
     box = _touched(pix, width + 2, k, size)
     for step in labels:
@@ -228,6 +226,10 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     out = st.plain.copy()
     if x0 >= x1 or y0 >= y1:
         return out
+    big = _scratch(size * k, 0)
+    big[y0 * k : y1 * k, x0 * k : x1 * k] = back.big[y0 * k : y1 * k, x0 * k : x1 * k]
+    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
+    rasterjit.paint_packed(big, back.front)
     image = big
     if k > 1:
         image = _scratch(size, 1)

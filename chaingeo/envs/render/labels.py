@@ -89,10 +89,11 @@ def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
     lo, hi = np.minimum(a, b) - reach, np.maximum(a, b) + reach
     box = (math.floor(lo[0]), math.floor(lo[1]), math.ceil(hi[0]) + 1, math.ceil(hi[1]) + 1)
     shapes = arrow_shapes(a, b, fill, width)
+    packed = rasterjit.pack(shapes) if shapes else None  # views paint their arrows often
     return Step(
         box,
         lambda im: draw_flat(ImageDraw.Draw(im), shapes),
-        lambda arr: rasterjit.draw_flat(arr, shapes),
+        lambda arr: rasterjit.paint_packed(arr, packed),
     )
 
 

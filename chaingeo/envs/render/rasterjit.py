@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -351,6 +352,18 @@ def draw_shapes(
 
 
 @njit(cache=True)
+def draw_packed(
+    img: U8, meta: npt.NDArray[np.int64], pts: npt.NDArray[np.float64], colors: U8
+) -> None:
+    """:func:`draw_shapes` of a :class:`Packed` list (``meta`` rows: kind, points, width)."""
+    n = meta.shape[0]
+    starts = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        starts[i + 1] = starts[i] + meta[i, 1]
+    draw_shapes(img, meta[:, 0].copy(), starts, pts, colors, meta[:, 2].copy())
+
+
+@njit(cache=True)
 def draw_faces(img: U8, corners: npt.NDArray[np.float64], fills: U8, edge: U8, width: int) -> None:
     """Each face (``corners`` (n, 4, 2) in pixels) filled, then its closed outline: the calls
     :func:`chaingeo.envs.render.raster.draw_faces` makes."""
@@ -432,18 +445,33 @@ def paste_mask(img: U8, mask: U8, x0: int, y0: int, c: U8) -> None:
                 img[y, x, ch] = ((t >> 8) + t) >> 8
 
 
+class Packed(NamedTuple):
+    """Flat shapes as the arrays :func:`draw_packed` takes: packed once, drawn any number of
+    times (packing a short list costs about eight times the drawing of an arrow)."""
+
+    meta: npt.NDArray[np.int64]  # (n, 3): kind, number of points, line width
+    pts: npt.NDArray[np.float64]  # (m, 2)
+    colors: U8  # (n, 3)
+
+
+def pack(shapes: Sequence[Flat]) -> Packed:
+    """The arrays of ``shapes`` (at least one), in drawing order."""
+    pts = np.concatenate([p for _, p, _, _ in shapes])
+    return Packed(
+        np.array([(kind, len(p), w) for kind, p, _, w in shapes], dtype=np.int64),
+        pts if pts.dtype == np.float64 else pts.astype(np.float64),
+        np.array([rgb for _, _, rgb, _ in shapes], dtype=np.uint8),
+    )
+
+
+def paint_packed(img: U8, packed: Packed | None) -> None:
+    """Draw packed shapes (None: nothing)."""
+    if packed is not None:
+        draw_packed(img, packed.meta, packed.pts, packed.colors)
+
+
 def draw_flat(img: U8, shapes: Sequence[Flat]) -> None:
     """Flat shapes drawn in one kernel call, as :func:`chaingeo.envs.render.raster.draw_flat`
     would."""
-    if not shapes:
-        return
-    starts = np.zeros(len(shapes) + 1, dtype=np.int64)
-    starts[1:] = np.cumsum([len(pts) for _, pts, _, _ in shapes])
-    draw_shapes(
-        img,
-        np.array([kind for kind, _, _, _ in shapes], dtype=np.int64),
-        starts,
-        np.concatenate([pts for _, pts, _, _ in shapes]).astype(np.float64),
-        np.array([rgb for _, _, rgb, _ in shapes], dtype=np.uint8),
-        np.array([w for _, _, _, w in shapes], dtype=np.int64),
-    )
+    if shapes:
+        paint_packed(img, pack(shapes))
