@@ -30,6 +30,7 @@ from PIL import Image
 
 from chaingeo.core.jit import mode as jit_mode
 from chaingeo.envs.render import rasterjit
+from chaingeo.envs.render.facesjit import visible_faces
 from chaingeo.envs.render.labels import (
     Step,
     depth_label_steps,
@@ -48,7 +49,6 @@ from chaingeo.envs.render.raster import (
     FloatArray,
     Projector,
     scaled,
-    visible_faces,
 )
 from chaingeo.envs.render.scene import (
     _BACKGROUND,

@@ -111,17 +111,22 @@ class Faces:
     normals: npt.NDArray[np.int64]  # index into NORMALS
 
 
+def no_faces() -> Faces:
+    """No faces at all (an empty scene)."""
+    return Faces(
+        np.zeros((0, 4, 2)),
+        np.zeros((0, 3), np.uint8),
+        np.zeros((0, 3), np.int64),
+        np.zeros(0, np.int64),
+    )
+
+
 def visible_faces(cells: npt.NDArray[np.int64], colors: FloatArray, cam: Camera) -> Faces:
     """Faces not shared by two filled cells and turned toward the camera, sorted far to near."""
     v = np.array(cam.toward_viewer)
     facing = np.flatnonzero(NORMALS @ v > 1e-9)
     if len(cells) == 0:
-        return Faces(
-            np.zeros((0, 4, 2)),
-            np.zeros((0, 3), np.uint8),
-            np.zeros((0, 3), np.int64),
-            np.zeros(0, np.int64),
-        )
+        return no_faces()
     lo = cells.min(axis=0) - 1
     dims = cells.max(axis=0) - lo + 2
     grid = np.zeros(tuple(int(d) for d in dims), dtype=np.bool_)
