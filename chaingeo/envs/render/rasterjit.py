@@ -102,9 +102,21 @@ def _roundf(f: float) -> float:
     return -float(math.floor(-f + 0.5))
 
 
+#: A picture as the kernels write it: its bytes flat (C order), its height and width. Writing
+#: through unsigned flat indices lets numba drop the negative-index checks of ``img[y, x, c]``
+#: and vectorise a span's stores (a long span fills about ten times faster).
+Canvas = tuple[U8, int, int]
+
+
 @njit(cache=True)
-def _hline(img: U8, x0: int, y: int, x1: int, c: U8) -> None:
-    h, w = img.shape[0], img.shape[1]
+def canvas(img: U8) -> Canvas:
+    """The canvas of a C-contiguous ``(h, w, 3)`` picture (its bytes, not a copy)."""
+    return img.reshape(img.size), img.shape[0], img.shape[1]
+
+
+@njit(cache=True)
+def _hline(cv: Canvas, x0: int, y: int, x1: int, c: U8) -> None:
+    flat, h, w = cv
     if y < 0 or y >= h:
         return
     if x0 < 0:
@@ -115,22 +127,30 @@ def _hline(img: U8, x0: int, y: int, x1: int, c: U8) -> None:
         return
     if x1 >= w:
         x1 = w - 1
-    for x in range(x0, x1 + 1):
-        img[y, x, 0] = c[0]
-        img[y, x, 1] = c[1]
-        img[y, x, 2] = c[2]
+    if x1 < x0:
+        return
+    c0, c1, c2 = c[0], c[1], c[2]
+    base = np.uint64((y * w + x0) * 3)
+    three, one, two = np.uint64(3), np.uint64(1), np.uint64(2)
+    for k in range(np.uint64(x1 + 1 - x0)):
+        j = base + three * k
+        flat[j] = c0
+        flat[j + one] = c1
+        flat[j + two] = c2
 
 
 @njit(cache=True)
-def _point(img: U8, x: int, y: int, c: U8) -> None:
-    if 0 <= x < img.shape[1] and 0 <= y < img.shape[0]:
-        img[y, x, 0] = c[0]
-        img[y, x, 1] = c[1]
-        img[y, x, 2] = c[2]
+def _point(cv: Canvas, x: int, y: int, c: U8) -> None:
+    flat, h, w = cv
+    if 0 <= x < w and 0 <= y < h:
+        j = (y * w + x) * 3
+        flat[j] = c[0]
+        flat[j + 1] = c[1]
+        flat[j + 2] = c[2]
 
 
 @njit(cache=True)
-def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
+def _line(cv: Canvas, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
     """Pillow's ``line32``: Bresenham from (x0, y0), the end point left out."""
     dx, xs = x1 - x0, 1
     if dx < 0:
@@ -140,11 +160,11 @@ def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
         dy, ys = -dy, -1
     if dx == 0:
         for _ in range(dy):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             y0 += ys
     elif dy == 0:
         for _ in range(dx):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             x0 += xs
     elif dx > dy:
         n = dx
@@ -152,7 +172,7 @@ def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
         e = dy - dx
         dx += dx
         for _ in range(n):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             if e >= 0:
                 y0 += ys
                 e -= dx
@@ -164,7 +184,7 @@ def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
         e = dx - dy
         dy += dy
         for _ in range(n):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             if e >= 0:
                 x0 += xs
                 e -= dy
@@ -225,21 +245,21 @@ def _corner(
 
 
 @njit(cache=True)
-def _polygon_generic(img: U8, sc: Scratch, n: int, c: U8) -> None:
+def _polygon_generic(cv: Canvas, sc: Scratch, n: int, c: U8) -> None:
     """Pillow's scanline fill of the first ``n`` edges (``polygon_generic``, no alpha)."""
     edges, dxs, table, xx = sc
-    ymin, ymax = img.shape[0] - 1, 0
+    ymin, ymax = cv[1] - 1, 0
     count = 0
     for i in range(n):
         ymin = min(ymin, edges[i, 1])
         ymax = max(ymax, edges[i, 3])
         if edges[i, 1] == edges[i, 3]:
-            _hline(img, edges[i, 0], edges[i, 1], edges[i, 2], c)
+            _hline(cv, edges[i, 0], edges[i, 1], edges[i, 2], c)
             continue
         table[count] = i
         count += 1
     ymin = max(ymin, 0)
-    ymax = min(ymax, img.shape[0])
+    ymax = min(ymax, cv[1])
     for y in range(ymin, ymax + 1):
         j = 0
         for ii in range(count):
@@ -261,11 +281,11 @@ def _polygon_generic(img: U8, sc: Scratch, n: int, c: U8) -> None:
                 k -= 1
             xx[k] = v
         for i in range(1, j, 2):
-            _hline(img, _round_up(xx[i - 1]), y, _round_down(xx[i]), c)
+            _hline(cv, _round_up(xx[i - 1]), y, _round_down(xx[i]), c)
 
 
 @njit(cache=True)
-def _fill_polygon(img: U8, xy: npt.NDArray[np.float64], c: U8, sc: Scratch) -> None:
+def _fill_polygon(cv: Canvas, xy: npt.NDArray[np.float64], c: U8, sc: Scratch) -> None:
     """``ImageDraw.polygon(xy, fill=c)``: ``ImagingDrawPolygon`` with its merged horizontals."""
     m = xy.shape[0]
     edges, dxs = sc[0], sc[1]
@@ -290,15 +310,17 @@ def _fill_polygon(img: U8, xy: npt.NDArray[np.float64], c: U8, sc: Scratch) -> N
     if x0 != fx or y0 != fy:
         _add_edge(edges, dxs, n, x0, y0, fx, fy)
         n += 1
-    _polygon_generic(img, sc, n, c)
+    _polygon_generic(cv, sc, n, c)
 
 
 @njit(cache=True)
-def _wide_line(img: U8, x0: int, y0: int, x1: int, y1: int, width: int, c: U8, sc: Scratch) -> None:
+def _wide_line(
+    cv: Canvas, x0: int, y0: int, x1: int, y1: int, width: int, c: U8, sc: Scratch
+) -> None:
     """Pillow's ``ImagingDrawWideLine``: the segment's quad, filled."""
     dx, dy = x1 - x0, y1 - y0
     if dx == 0 and dy == 0:
-        _point(img, x0, y0, c)
+        _point(cv, x0, y0, c)
         return
     big = math.hypot(dx, dy)
     small = (width - 1) / 2.0
@@ -311,22 +333,22 @@ def _wide_line(img: U8, x0: int, y0: int, x1: int, y1: int, width: int, c: U8, s
     for i in range(4):
         k = (i + 1) % 4
         _add_edge(sc[0], sc[1], i, vx[i], vy[i], vx[k], vy[k])
-    _polygon_generic(img, sc, 4, c)
+    _polygon_generic(cv, sc, 4, c)
 
 
 @njit(cache=True)
-def _polyline(img: U8, xy: npt.NDArray[np.float64], width: int, c: U8, sc: Scratch) -> None:
+def _polyline(cv: Canvas, xy: npt.NDArray[np.float64], width: int, c: U8, sc: Scratch) -> None:
     """``ImageDraw.line(xy, fill=c, width=width)`` without round joints (``draw_lines``)."""
     m = xy.shape[0]
     for i in range(m - 1):
         x0, y0 = int(xy[i, 0]), int(xy[i, 1])
         x1, y1 = int(xy[i + 1, 0]), int(xy[i + 1, 1])
         if width <= 1:
-            _line(img, x0, y0, x1, y1, c)
+            _line(cv, x0, y0, x1, y1, c)
         else:
-            _wide_line(img, x0, y0, x1, y1, width, c, sc)
+            _wide_line(cv, x0, y0, x1, y1, width, c, sc)
     if width <= 1 and m > 1:
-        _point(img, int(xy[m - 1, 0]), int(xy[m - 1, 1]), c)
+        _point(cv, int(xy[m - 1, 0]), int(xy[m - 1, 1]), c)
 
 
 @njit(cache=True)
@@ -343,12 +365,13 @@ def draw_shapes(
     for i in range(kinds.shape[0]):
         most = max(most, starts[i + 1] - starts[i])
     sc = scratch(most)
+    cv = canvas(img)
     for i in range(kinds.shape[0]):
         xy = pts[starts[i] : starts[i + 1]]
         if kinds[i] == POLYGON:
-            _fill_polygon(img, xy, colors[i], sc)
+            _fill_polygon(cv, xy, colors[i], sc)
         else:
-            _polyline(img, xy, widths[i], colors[i], sc)
+            _polyline(cv, xy, widths[i], colors[i], sc)
 
 
 @njit(cache=True)
@@ -369,11 +392,12 @@ def draw_faces(img: U8, corners: npt.NDArray[np.float64], fills: U8, edge: U8, w
     :func:`chaingeo.envs.render.raster.draw_faces` makes."""
     ring = np.empty((5, 2), np.float64)
     sc = scratch(5)
+    cv = canvas(img)
     for i in range(corners.shape[0]):
-        _fill_polygon(img, corners[i], fills[i], sc)
+        _fill_polygon(cv, corners[i], fills[i], sc)
         ring[:4] = corners[i]
         ring[4] = corners[i, 0]
-        _polyline(img, ring, width, edge, sc)
+        _polyline(cv, ring, width, edge, sc)
 
 
 @njit(cache=True)
@@ -385,49 +409,48 @@ def rectangle(img: U8, box: npt.NDArray[np.float64], fill: U8, outline: U8, edge
     if y0 > y1:
         y0, y1 = y1, y0
     top, bottom = max(y0, 0), min(y1, img.shape[0])
+    cv = canvas(img)
     for y in range(top, bottom + 1):
-        _hline(img, x0, y, x1, fill)
+        _hline(cv, x0, y, x1, fill)
     if edged:
-        _hline(img, x0, y0, x1, outline)
-        _hline(img, x0, y1, x1, outline)
-        _line(img, x1, y0 + 1, x1, y1, outline)
-        _line(img, x0, y0 + 1, x0, y1, outline)
+        _hline(cv, x0, y0, x1, outline)
+        _hline(cv, x0, y1, x1, outline)
+        _line(cv, x1, y0 + 1, x1, y1, outline)
+        _line(cv, x0, y0 + 1, x0, y1, outline)
 
 
 @njit(cache=True)
 def reduce2(img: U8) -> U8:
     """``Image.reduce(2)`` of an even-sized picture: each 2x2 block's mean, rounded half up."""
-    h, w = img.shape[0] // 2, img.shape[1] // 2
-    out = np.empty((h, w, 3), np.uint8)
-    flat = img.reshape(img.shape[0], img.shape[1] * 3)
-    dst = out.reshape(h, w * 3)
-    acc = np.empty(w * 6, np.uint16)
-    for y in range(h):
-        top, bottom = flat[2 * y], flat[2 * y + 1]
-        for i in range(w * 6):
-            acc[i] = np.uint16(top[i]) + np.uint16(bottom[i])
-        for x in range(w):
-            for ch in range(3):
-                s = acc[6 * x + ch] + acc[6 * x + 3 + ch] + 2
-                dst[y, 3 * x + ch] = s >> 2
+    out = np.empty((img.shape[0] // 2, img.shape[1] // 2, 3), np.uint8)
+    reduce2_into(img, out, 0, 0, out.shape[1], out.shape[0])
     return out
 
 
 @njit(cache=True)
 def reduce2_into(img: U8, out: U8, x0: int, y0: int, x1: int, y1: int) -> None:
-    """:func:`reduce2` of the output rectangle ``[x0, x1) x [y0, y1)`` only, into ``out``."""
+    """:func:`reduce2` of the output rectangle ``[x0, x1) x [y0, y1)`` only, into ``out``
+    (flat unsigned indices, as :func:`_hline`: about twice as fast as ``img[y, x, c]``)."""
+    if x1 <= x0:
+        return
+    src, dst = img.reshape(img.size), out.reshape(out.size)
+    row = np.uint64(img.shape[1] * 3)
+    zero, one, two = np.uint64(0), np.uint64(1), np.uint64(2)
+    three, six = np.uint64(3), np.uint64(6)
     for y in range(y0, y1):
-        top, bottom = img[2 * y], img[2 * y + 1]
-        for x in range(x0, x1):
-            for ch in range(3):
+        top = np.uint64(2 * y) * row + np.uint64(6 * x0)
+        at = np.uint64((y * out.shape[1] + x0) * 3)
+        for x in range(np.uint64(x1 - x0)):
+            i, o = top + six * x, at + three * x
+            for ch in (zero, one, two):
                 s = (
-                    np.int64(top[2 * x, ch])
-                    + np.int64(top[2 * x + 1, ch])
-                    + np.int64(bottom[2 * x, ch])
-                    + np.int64(bottom[2 * x + 1, ch])
-                    + 2
+                    np.uint16(src[i + ch])
+                    + np.uint16(src[i + ch + three])
+                    + np.uint16(src[i + ch + row])
+                    + np.uint16(src[i + ch + row + three])
+                    + np.uint16(2)
                 )
-                out[y, x, ch] = s >> 2
+                dst[o + ch] = s >> np.uint16(2)
 
 
 @njit(cache=True)
