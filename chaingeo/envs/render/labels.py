@@ -28,9 +28,8 @@ from chaingeo.envs.render.raster import (
     arrow_shapes,
     draw_flat,
     put_text,
-    text_box,
-    text_color,
-    text_mask_array,
+    text_color_of,
+    text_glyph,
 )
 
 Pixels = npt.NDArray[np.uint8]
@@ -74,8 +73,9 @@ def text_step(
     xy: Sequence[float] | FloatArray, text: str, px: int, fill: RGB, anchor: str = "mm"
 ) -> Step:
     at = (float(xy[0]), float(xy[1]))
-    box = text_box(at, text, px, anchor)
-    mask = text_mask_array(text, px, anchor)
+    mask, dx, dy = text_glyph(text, px, anchor)
+    x, y = round(at[0]) + dx, round(at[1]) + dy
+    box = (x, y, x + mask.shape[1], y + mask.shape[0])  # text_box, from the kept glyph
     color = ink(fill)
     return Step(
         box,
@@ -167,22 +167,24 @@ def depth_label_steps(faces: Faces, cam: Camera, proj: Projector) -> list[Step]:
     depth = cam.depth_axis
     assert depth is not None
     nearest: dict[tuple[int, int], int] = {}
-    others = [i for i in range(3) if i != depth]
-    for i, cell in enumerate(faces.cells.tolist()):
-        nearest[(cell[others[0]], cell[others[1]])] = i  # far to near: the last one is in front
+    a, b = [i for i in range(3) if i != depth]
+    cells = faces.cells.tolist()
+    for i, cell in enumerate(cells):
+        nearest[(cell[a], cell[b])] = i  # far to near: the last one is in front
     cell_px = proj.scale
     px = int(min(22, max(9, cell_px * 0.24)))
     if cell_px < 1.6 * px:
         return []  # too small to print legibly
     prefix = f"{AXIS_NAMES[depth]}=" if cell_px >= 3.2 * px else ""  # small cells: number only
     shown = sorted(nearest.values())
-    centres = proj.screen(faces.corners[shown].mean(axis=1))
+    centres = proj.screen(faces.corners[shown].mean(axis=1)).tolist()
+    fills = faces.fills.tolist()
     return [
         text_step(
             centres[j],
-            f"{prefix}{int(faces.cells[i][depth]) + 1}",
+            f"{prefix}{cells[i][depth] + 1}",
             px,
-            text_color(faces.fills[i]),
+            text_color_of((fills[i][0], fills[i][1], fills[i][2])),
         )
         for j, i in enumerate(shown)
     ]

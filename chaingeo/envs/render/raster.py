@@ -170,12 +170,21 @@ def text_color(fill: Iterable[int]) -> RGB:
     return (0, 0, 0) if 0.299 * r + 0.587 * g + 0.114 * b > 140 else (255, 255, 255)
 
 
+@lru_cache(maxsize=1024)
+def text_color_of(fill: RGB) -> RGB:
+    """:func:`text_color` of a colour triple, kept (a view prints dozens of labels on faces of
+    a few colours)."""
+    return text_color(fill)
+
+
 @lru_cache(maxsize=4096)
-def text_mask_array(text: str, px: int, anchor: str) -> npt.NDArray[np.uint8]:
-    """:func:`_text_mask`'s glyphs as a read-only array (for the kernels)."""
-    out = np.array(_text_mask(text, px, anchor)[0], dtype=np.uint8)
+def text_glyph(text: str, px: int, anchor: str) -> tuple[npt.NDArray[np.uint8], int, int]:
+    """:func:`_text_mask`'s glyphs as a read-only array (for the kernels), and its offset from
+    the anchor point."""
+    mask, dx, dy = _text_mask(text, px, anchor)
+    out = np.array(mask, dtype=np.uint8)
     out.flags.writeable = False
-    return out
+    return out, dx, dy
 
 
 @lru_cache(maxsize=4096)
