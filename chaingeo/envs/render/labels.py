@@ -101,37 +101,41 @@ def tick_steps(
     lo: Sequence[int], hi: Sequence[int], cam: Camera, proj: Projector, tick_px: int
 ) -> list[Step]:
     """1-based cell indices along one frame edge per displayed axis, then the axis name and an
-    arrow pointing the way the index grows."""
+    arrow pointing the way the index grows. The edge's geometry is plain float arithmetic, in
+    the order the array expressions it replaces took (a view whose frame moves makes these on
+    every picture, and two-element arrays cost more than the numbers)."""
     out: list[Step] = []
     centre = proj(np.add(lo, hi) / 2.0)
+    cx, cy = float(centre[0]), float(centre[1])
     for axis, spec in cam.tick_edges:
         base = np.array(
             [0.0 if s == "*" else float(lo[i] if s == "lo" else hi[i]) for i, s in enumerate(spec)]
         )
         start, end = base.copy(), base.copy()
         start[axis], end[axis] = lo[axis], hi[axis]
-        a, b = proj(start), proj(end)
-        d = b - a
-        length = float(np.hypot(*d))
+        (ax, ay), (bx, by) = proj(start).tolist(), proj(end).tolist()
+        dx, dy = bx - ax, by - ay
+        length = float(np.hypot(dx, dy))
         if length < 1e-6:
             continue
-        d /= length
-        normal = np.array([-d[1], d[0]])
-        mid = (a + b) / 2
-        if float(np.dot(normal, mid - centre)) < 0:
-            normal = -normal
+        dx, dy = dx / length, dy / length
+        nx, ny = -dy, dx
+        if nx * ((ax + bx) / 2 - cx) + ny * ((ay + by) / 2 - cy) < 0:  # far from zero
+            nx, ny = -nx, -ny
         count = hi[axis] - lo[axis]
         cell_px = length / count
         px = int(min(tick_px, max(8, cell_px * 0.8)))
         every = max(1, math.ceil(px * 1.4 / cell_px))
-        offset = normal * (px * 0.95 + 3)
-        out.extend(_ticks(base, axis, range(lo[axis], hi[axis]), every, proj, offset, px))
+        reach = px * 0.95 + 3
+        ox, oy = nx * reach, ny * reach
+        out.extend(_ticks(base, axis, range(lo[axis], hi[axis]), every, proj, (ox, oy), px))
         # The arrow continues the row of numbers; the axis name sits just outside it.
         color = AXIS_COLORS[axis]
-        tail = b + offset + d * (px * 0.5)
-        head = tail + d * (tick_px * 1.2)
-        out.append(arrow_step(tail, head, color, max(2, tick_px // 8)))
-        name_at = (tail + head) / 2 + normal * (tick_px * 0.9)
+        tx, ty = bx + ox + dx * (px * 0.5), by + oy + dy * (px * 0.5)
+        hx, hy = tx + dx * (tick_px * 1.2), ty + dy * (tick_px * 1.2)
+        out.append(arrow_step(np.array([tx, ty]), np.array([hx, hy]), color, max(2, tick_px // 8)))
+        away = tick_px * 0.9
+        name_at = ((tx + hx) / 2 + nx * away, (ty + hy) / 2 + ny * away)
         out.append(text_step(name_at, AXIS_NAMES[axis], tick_px + 3, color))
     return out
 
@@ -142,7 +146,7 @@ def _ticks(
     cells: range,
     every: int,
     proj: Projector,
-    offset: FloatArray,
+    offset: tuple[float, float],
     px: int,
 ) -> list[Step]:
     """The numbers along one edge: ``proj(p) + offset`` per shown cell, on scalars (the same
@@ -150,7 +154,7 @@ def _ticks(
     p = base.copy()
     right, up, scale = proj.right, proj.up, proj.scale
     ox, oy = proj.origin
-    dx, dy = float(offset[0]), float(offset[1])
+    dx, dy = offset
     out = []
     for i, c in enumerate(cells):
         if i % every and c != cells[-1]:
