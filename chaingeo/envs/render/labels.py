@@ -25,6 +25,7 @@ from chaingeo.envs.render.raster import (
     Faces,
     FloatArray,
     Projector,
+    arrow_points,
     arrow_shapes,
     draw_flat,
     put_text,
@@ -86,13 +87,24 @@ def text_step(
 
 def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
     reach = max(4.0, 3.2 * width) + width + 2
-    lo, hi = np.minimum(a, b) - reach, np.maximum(a, b) + reach
-    box = (math.floor(lo[0]), math.floor(lo[1]), math.ceil(hi[0]) + 1, math.ceil(hi[1]) + 1)
-    shapes = arrow_shapes(a, b, fill, width)
-    packed = rasterjit.pack(shapes) if shapes else None  # views paint their arrows often
+    ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+    box = (
+        math.floor(min(ax, bx) - reach),
+        math.floor(min(ay, by) - reach),
+        math.ceil(max(ax, bx) + reach) + 1,
+        math.ceil(max(ay, by) + reach) + 1,
+    )
+    pts = arrow_points(a, b, width)
+    packed = None  # arrow_shapes, packed for the kernels without the list (views paint often)
+    if pts is not None:
+        packed = rasterjit.Packed(
+            np.array([(1, 2, width), (0, 3, 0)], dtype=np.int64),
+            np.array(pts),
+            np.array([fill, fill], dtype=np.uint8),
+        )
     return Step(
         box,
-        lambda im: draw_flat(ImageDraw.Draw(im), shapes),
+        lambda im: draw_flat(ImageDraw.Draw(im), arrow_shapes(a, b, fill, width)),
         lambda arr: rasterjit.paint_packed(arr, packed),
     )
 

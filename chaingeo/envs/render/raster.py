@@ -301,20 +301,29 @@ def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
             draw.draw.draw_lines(ring, ink, width)
 
 
+def arrow_points(a: FloatArray, b: FloatArray, width: int) -> list[list[float]] | None:
+    """The arrow from ``a`` to ``b``: the shaft's two ends, then the head's three corners
+    (None when too short to draw). Plain float arithmetic in the order the array expressions
+    of the first version took (the same numbers: ticks make three arrows per picture)."""
+    ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+    dx, dy = bx - ax, by - ay
+    n = float(np.hypot(dx, dy))
+    if n < 1e-6:
+        return None
+    dx, dy = dx / n, dy / n
+    head = max(4.0, 3.2 * width)
+    base_x, base_y = bx - dx * head, by - dy * head
+    px, py = -dy * head * 0.55, dx * head * 0.55
+    left, right = [base_x + px, base_y + py], [base_x - px, base_y - py]
+    return [[ax, ay], [base_x, base_y], [bx, by], left, right]
+
+
 def arrow_shapes(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> list[Flat]:
     """A line from ``a`` to ``b`` with a filled head at ``b`` (the font has no arrow glyphs)."""
-    d = b - a
-    n = float(np.hypot(*d))
-    if n < 1e-6:
+    pts = arrow_points(a, b, width)
+    if pts is None:
         return []
-    d = d / n
-    head = max(4.0, 3.2 * width)
-    base = b - d * head
-    perp = np.array([-d[1], d[0]]) * head * 0.55
-    return [
-        (1, np.array([a, base]), fill, width),
-        (0, np.array([b, base + perp, base - perp]), fill, 0),
-    ]
+    return [(1, np.array(pts[:2]), fill, width), (0, np.array(pts[2:]), fill, 0)]
 
 
 def arrow(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:

@@ -211,7 +211,8 @@ def _add_edge(
 
 @njit(cache=True)
 def _x_at(edges: npt.NDArray[np.int64], dxs: npt.NDArray[np.float64], i: int, y: int) -> float:
-    return _f32(_f32(_f32(y - edges[i, 5]) * dxs[i]) + _f32(edges[i, 4]))
+    # float32 operations themselves (the same result as rounding each float64 step)
+    return float(np.float32(y - edges[i, 5]) * np.float32(dxs[i]) + np.float32(edges[i, 4]))
 
 
 @njit(cache=True)
