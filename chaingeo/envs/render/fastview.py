@@ -42,6 +42,7 @@ from chaingeo.envs.render.labels import (
 from chaingeo.envs.render.legend import clear_memo, legend_layout, paint_legend
 from chaingeo.envs.render.raster import (
     EDGE,
+    RGB,
     Box,
     Camera,
     Faces,
@@ -53,6 +54,7 @@ from chaingeo.envs.render.raster import (
 from chaingeo.envs.render.scene import (
     _BACKGROUND,
     _FRAME,
+    _GRID,
     _SUPERSAMPLE,
     CAMERAS,
     DEFAULT_SIZE,
@@ -67,7 +69,7 @@ from chaingeo.envs.render.scene import (
     _scene,
     _view_projector,
     _view_titles,
-    _wall_shapes,
+    wall_pixels,
 )
 from chaingeo.envs.render.scene import (
     _render_view as render_view,
@@ -126,13 +128,32 @@ def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
     proj = _view_projector(scene, cam, lay)
     big_proj = scaled(proj, k)
     big = rasterjit.blank(size * k, _BACKGROUND).copy()
-    shapes = _wall_shapes(scene, cam, big_proj, k)
-    for p, q in _frame_edges(scene, cam, back=True):
-        shapes.append((1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k))
-    rasterjit.draw_flat(big, shapes)
+    back_edges = [np.stack([big_proj(p), big_proj(q)]) for p, q in _frame_edges(scene, cam, True)]
+    rasterjit.paint_packed(big, _packed_walls(wall_pixels(scene, cam, big_proj), back_edges, k))
     edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
     front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
     return _Back(proj, k, big, rasterjit.pack(front) if front else None)
+
+
+def _packed_walls(
+    walls: list[tuple[RGB, FloatArray, FloatArray]], edges: list[FloatArray], k: int
+) -> rasterjit.Packed:
+    """``_wall_shapes`` and then the back frame edges, packed from their pixel arrays as they
+    come (a frame that follows the pieces draws its walls anew on most pictures)."""
+    pts: list[FloatArray] = []
+    meta: list[tuple[int, int, int]] = []
+    colors: list[RGB] = []
+    for fill, corners, ends in walls:
+        lines = len(ends) // 2
+        pts += [corners, ends]
+        meta += [(0, 4, 0), *[(1, 2, k)] * lines]
+        colors += [fill, *[_GRID] * lines]
+    pts += edges
+    meta += [(1, 2, k)] * len(edges)
+    colors += [_FRAME] * len(edges)
+    return rasterjit.Packed(
+        np.array(meta, dtype=np.int64), np.concatenate(pts), np.array(colors, dtype=np.uint8)
+    )
 
 
 def _finish(back: _Back, big: Pixels) -> Pixels:
