@@ -160,7 +160,7 @@ def _scene(pieces: PieceMap, box: Sequence[int] | None) -> _Scene:
         colors.append(np.tile(np.array(rgb, dtype=np.float64), (len(shape), 1)))
     cells = np.concatenate(chunks) if chunks else np.zeros((0, 3), dtype=np.int64)
     rgbs = np.concatenate(colors) if colors else np.zeros((0, 3))
-    if len(cells) and len(np.unique(cells, axis=0)) != len(cells):
+    if len(set(map(tuple, cells.tolist()))) != len(cells):  # np.unique(axis=0): ~10x slower
         owners: dict[tuple[int, int, int], str] = {}
         for name in sorted(pieces):
             for c in pieces[name][0]:
