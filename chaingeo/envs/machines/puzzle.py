@@ -219,9 +219,12 @@ class PuzzleState(BaseState):
             for b in parts if into is None else (into,):
                 if b == a:
                     continue
+                # _offset_of, its two offsets looked up once per pair (rows run to thousands)
+                oa, ob = self._asm.offsets[min(a)], self._asm.offsets[min(b)]
+                dx, dy, dz = oa[0] - ob[0], oa[1] - ob[1], oa[2] - ob[2]
                 for d in DIRECTIONS if direction is None else (direction,):
                     out.extend(
-                        Insertion(a, b, d, self._offset_of(a, b, (x, y, z)))
+                        Insertion(a, b, d, (dx + x, dy + y, dz + z))
                         for x, y, z in self._shift_rows(a, b, d).tolist()
                     )
         return out

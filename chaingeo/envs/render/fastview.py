@@ -30,6 +30,7 @@ from PIL import Image
 
 from chaingeo.core.jit import mode as jit_mode
 from chaingeo.envs.render import rasterjit
+from chaingeo.envs.render.facesjit import visible_faces
 from chaingeo.envs.render.labels import (
     Step,
     depth_label_steps,
@@ -41,6 +42,7 @@ from chaingeo.envs.render.labels import (
 from chaingeo.envs.render.legend import clear_memo, legend_layout, paint_legend
 from chaingeo.envs.render.raster import (
     EDGE,
+    RGB,
     Box,
     Camera,
     Faces,
@@ -48,11 +50,11 @@ from chaingeo.envs.render.raster import (
     FloatArray,
     Projector,
     scaled,
-    visible_faces,
 )
 from chaingeo.envs.render.scene import (
     _BACKGROUND,
     _FRAME,
+    _GRID,
     _SUPERSAMPLE,
     CAMERAS,
     DEFAULT_SIZE,
@@ -67,7 +69,7 @@ from chaingeo.envs.render.scene import (
     _scene,
     _view_projector,
     _view_titles,
-    _wall_shapes,
+    wall_pixels,
 )
 from chaingeo.envs.render.scene import (
     _render_view as render_view,
@@ -87,7 +89,7 @@ class _Back:
     proj: Projector
     k: int
     big: Pixels
-    front: list[Flat]
+    front: rasterjit.Packed | None  # the front frame edges
 
 
 @dataclass(frozen=True)
@@ -126,17 +128,36 @@ def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
     proj = _view_projector(scene, cam, lay)
     big_proj = scaled(proj, k)
     big = rasterjit.blank(size * k, _BACKGROUND).copy()
-    shapes = _wall_shapes(scene, cam, big_proj, k)
-    for p, q in _frame_edges(scene, cam, back=True):
-        shapes.append((1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k))
-    rasterjit.draw_flat(big, shapes)
+    back_edges = [np.stack([big_proj(p), big_proj(q)]) for p, q in _frame_edges(scene, cam, True)]
+    rasterjit.paint_packed(big, _packed_walls(wall_pixels(scene, cam, big_proj), back_edges, k))
     edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
     front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
-    return _Back(proj, k, big, front)
+    return _Back(proj, k, big, rasterjit.pack(front) if front else None)
+
+
+def _packed_walls(
+    walls: list[tuple[RGB, FloatArray, FloatArray]], edges: list[FloatArray], k: int
+) -> rasterjit.Packed:
+    """``_wall_shapes`` and then the back frame edges, packed from their pixel arrays as they
+    come (a frame that follows the pieces draws its walls anew on most pictures)."""
+    pts: list[FloatArray] = []
+    meta: list[tuple[int, int, int]] = []
+    colors: list[RGB] = []
+    for fill, corners, ends in walls:
+        lines = len(ends) // 2
+        pts += [corners, ends]
+        meta += [(0, 4, 0), *[(1, 2, k)] * lines]
+        colors += [fill, *[_GRID] * lines]
+    pts += edges
+    meta += [(1, 2, k)] * len(edges)
+    colors += [_FRAME] * len(edges)
+    return rasterjit.Packed(
+        np.array(meta, dtype=np.int64), np.concatenate(pts), np.array(colors, dtype=np.uint8)
+    )
 
 
 def _finish(back: _Back, big: Pixels) -> Pixels:
-    rasterjit.draw_flat(big, back.front)
+    rasterjit.paint_packed(big, back.front)
     return rasterjit.reduce2(big) if back.k > 1 else big
 
 
@@ -212,14 +233,12 @@ def _scratch(side: int, slot: int) -> Pixels:
 def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     """The picture without pieces, and inside the rectangle the faces and their labels cover:
     the faces on the background, the front edges, the reduction (of that rectangle only),
-    then every label that overlaps it."""
+    then every label that overlaps it. Only that rectangle of the background is copied to the
+    work picture: fills and lines do not read what they cover, so pixels outside it may hold
+    anything."""
     back, k = st.back, st.back.k
-    big = _scratch(size * k, 0)
-    np.copyto(big, back.big)
     pix = scaled(back.proj, k).screen(faces.corners)
     width = _Layout.of(size).edge_px(k)
-    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
-    rasterjit.draw_flat(big, back.front)
     labels = depth_label_steps(faces, cam, back.proj) if cam.depth_axis is not None else []
     box = _touched(pix, width + 2, k, size)
     for step in labels:
@@ -228,6 +247,10 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     out = st.plain.copy()
     if x0 >= x1 or y0 >= y1:
         return out
+    big = _scratch(size * k, 0)
+    big[y0 * k : y1 * k, x0 * k : x1 * k] = back.big[y0 * k : y1 * k, x0 * k : x1 * k]
+    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
+    rasterjit.paint_packed(big, back.front)
     image = big
     if k > 1:
         image = _scratch(size, 1)

@@ -25,12 +25,12 @@ from chaingeo.envs.render.raster import (
     Faces,
     FloatArray,
     Projector,
+    arrow_points,
     arrow_shapes,
     draw_flat,
     put_text,
-    text_box,
-    text_color,
-    text_mask_array,
+    text_color_of,
+    text_glyph,
 )
 
 Pixels = npt.NDArray[np.uint8]
@@ -74,8 +74,9 @@ def text_step(
     xy: Sequence[float] | FloatArray, text: str, px: int, fill: RGB, anchor: str = "mm"
 ) -> Step:
     at = (float(xy[0]), float(xy[1]))
-    box = text_box(at, text, px, anchor)
-    mask = text_mask_array(text, px, anchor)
+    mask, dx, dy = text_glyph(text, px, anchor)
+    x, y = round(at[0]) + dx, round(at[1]) + dy
+    box = (x, y, x + mask.shape[1], y + mask.shape[0])  # text_box, from the kept glyph
     color = ink(fill)
     return Step(
         box,
@@ -86,13 +87,25 @@ def text_step(
 
 def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
     reach = max(4.0, 3.2 * width) + width + 2
-    lo, hi = np.minimum(a, b) - reach, np.maximum(a, b) + reach
-    box = (math.floor(lo[0]), math.floor(lo[1]), math.ceil(hi[0]) + 1, math.ceil(hi[1]) + 1)
-    shapes = arrow_shapes(a, b, fill, width)
+    ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+    box = (
+        math.floor(min(ax, bx) - reach),
+        math.floor(min(ay, by) - reach),
+        math.ceil(max(ax, bx) + reach) + 1,
+        math.ceil(max(ay, by) + reach) + 1,
+    )
+    pts = arrow_points(a, b, width)
+    packed = None  # arrow_shapes, packed for the kernels without the list (views paint often)
+    if pts is not None:
+        packed = rasterjit.Packed(
+            np.array([(1, 2, width), (0, 3, 0)], dtype=np.int64),
+            np.array(pts),
+            np.array([fill, fill], dtype=np.uint8),
+        )
     return Step(
         box,
-        lambda im: draw_flat(ImageDraw.Draw(im), shapes),
-        lambda arr: rasterjit.draw_flat(arr, shapes),
+        lambda im: draw_flat(ImageDraw.Draw(im), arrow_shapes(a, b, fill, width)),
+        lambda arr: rasterjit.paint_packed(arr, packed),
     )
 
 
@@ -100,37 +113,41 @@ def tick_steps(
     lo: Sequence[int], hi: Sequence[int], cam: Camera, proj: Projector, tick_px: int
 ) -> list[Step]:
     """1-based cell indices along one frame edge per displayed axis, then the axis name and an
-    arrow pointing the way the index grows."""
+    arrow pointing the way the index grows. The edge's geometry is plain float arithmetic, in
+    the order the array expressions it replaces took (a view whose frame moves makes these on
+    every picture, and two-element arrays cost more than the numbers)."""
     out: list[Step] = []
     centre = proj(np.add(lo, hi) / 2.0)
+    cx, cy = float(centre[0]), float(centre[1])
     for axis, spec in cam.tick_edges:
         base = np.array(
             [0.0 if s == "*" else float(lo[i] if s == "lo" else hi[i]) for i, s in enumerate(spec)]
         )
         start, end = base.copy(), base.copy()
         start[axis], end[axis] = lo[axis], hi[axis]
-        a, b = proj(start), proj(end)
-        d = b - a
-        length = float(np.hypot(*d))
+        (ax, ay), (bx, by) = proj(start).tolist(), proj(end).tolist()
+        dx, dy = bx - ax, by - ay
+        length = float(np.hypot(dx, dy))
         if length < 1e-6:
             continue
-        d /= length
-        normal = np.array([-d[1], d[0]])
-        mid = (a + b) / 2
-        if float(np.dot(normal, mid - centre)) < 0:
-            normal = -normal
+        dx, dy = dx / length, dy / length
+        nx, ny = -dy, dx
+        if nx * ((ax + bx) / 2 - cx) + ny * ((ay + by) / 2 - cy) < 0:  # far from zero
+            nx, ny = -nx, -ny
         count = hi[axis] - lo[axis]
         cell_px = length / count
         px = int(min(tick_px, max(8, cell_px * 0.8)))
         every = max(1, math.ceil(px * 1.4 / cell_px))
-        offset = normal * (px * 0.95 + 3)
-        out.extend(_ticks(base, axis, range(lo[axis], hi[axis]), every, proj, offset, px))
+        reach = px * 0.95 + 3
+        ox, oy = nx * reach, ny * reach
+        out.extend(_ticks(base, axis, range(lo[axis], hi[axis]), every, proj, (ox, oy), px))
         # The arrow continues the row of numbers; the axis name sits just outside it.
         color = AXIS_COLORS[axis]
-        tail = b + offset + d * (px * 0.5)
-        head = tail + d * (tick_px * 1.2)
-        out.append(arrow_step(tail, head, color, max(2, tick_px // 8)))
-        name_at = (tail + head) / 2 + normal * (tick_px * 0.9)
+        tx, ty = bx + ox + dx * (px * 0.5), by + oy + dy * (px * 0.5)
+        hx, hy = tx + dx * (tick_px * 1.2), ty + dy * (tick_px * 1.2)
+        out.append(arrow_step(np.array([tx, ty]), np.array([hx, hy]), color, max(2, tick_px // 8)))
+        away = tick_px * 0.9
+        name_at = ((tx + hx) / 2 + nx * away, (ty + hy) / 2 + ny * away)
         out.append(text_step(name_at, AXIS_NAMES[axis], tick_px + 3, color))
     return out
 
@@ -141,7 +158,7 @@ def _ticks(
     cells: range,
     every: int,
     proj: Projector,
-    offset: FloatArray,
+    offset: tuple[float, float],
     px: int,
 ) -> list[Step]:
     """The numbers along one edge: ``proj(p) + offset`` per shown cell, on scalars (the same
@@ -149,7 +166,7 @@ def _ticks(
     p = base.copy()
     right, up, scale = proj.right, proj.up, proj.scale
     ox, oy = proj.origin
-    dx, dy = float(offset[0]), float(offset[1])
+    dx, dy = offset
     out = []
     for i, c in enumerate(cells):
         if i % every and c != cells[-1]:
@@ -166,22 +183,24 @@ def depth_label_steps(faces: Faces, cam: Camera, proj: Projector) -> list[Step]:
     depth = cam.depth_axis
     assert depth is not None
     nearest: dict[tuple[int, int], int] = {}
-    others = [i for i in range(3) if i != depth]
-    for i, cell in enumerate(faces.cells.tolist()):
-        nearest[(cell[others[0]], cell[others[1]])] = i  # far to near: the last one is in front
+    a, b = [i for i in range(3) if i != depth]
+    cells = faces.cells.tolist()
+    for i, cell in enumerate(cells):
+        nearest[(cell[a], cell[b])] = i  # far to near: the last one is in front
     cell_px = proj.scale
     px = int(min(22, max(9, cell_px * 0.24)))
     if cell_px < 1.6 * px:
         return []  # too small to print legibly
     prefix = f"{AXIS_NAMES[depth]}=" if cell_px >= 3.2 * px else ""  # small cells: number only
     shown = sorted(nearest.values())
-    centres = proj.screen(faces.corners[shown].mean(axis=1))
+    centres = proj.screen(faces.corners[shown].mean(axis=1)).tolist()
+    fills = faces.fills.tolist()
     return [
         text_step(
             centres[j],
-            f"{prefix}{int(faces.cells[i][depth]) + 1}",
+            f"{prefix}{cells[i][depth] + 1}",
             px,
-            text_color(faces.fills[i]),
+            text_color_of((fills[i][0], fills[i][1], fills[i][2])),
         )
         for j, i in enumerate(shown)
     ]

@@ -111,17 +111,22 @@ class Faces:
     normals: npt.NDArray[np.int64]  # index into NORMALS
 
 
+def no_faces() -> Faces:
+    """No faces at all (an empty scene)."""
+    return Faces(
+        np.zeros((0, 4, 2)),
+        np.zeros((0, 3), np.uint8),
+        np.zeros((0, 3), np.int64),
+        np.zeros(0, np.int64),
+    )
+
+
 def visible_faces(cells: npt.NDArray[np.int64], colors: FloatArray, cam: Camera) -> Faces:
     """Faces not shared by two filled cells and turned toward the camera, sorted far to near."""
     v = np.array(cam.toward_viewer)
     facing = np.flatnonzero(NORMALS @ v > 1e-9)
     if len(cells) == 0:
-        return Faces(
-            np.zeros((0, 4, 2)),
-            np.zeros((0, 3), np.uint8),
-            np.zeros((0, 3), np.int64),
-            np.zeros(0, np.int64),
-        )
+        return no_faces()
     lo = cells.min(axis=0) - 1
     dims = cells.max(axis=0) - lo + 2
     grid = np.zeros(tuple(int(d) for d in dims), dtype=np.bool_)
@@ -165,12 +170,21 @@ def text_color(fill: Iterable[int]) -> RGB:
     return (0, 0, 0) if 0.299 * r + 0.587 * g + 0.114 * b > 140 else (255, 255, 255)
 
 
+@lru_cache(maxsize=1024)
+def text_color_of(fill: RGB) -> RGB:
+    """:func:`text_color` of a colour triple, kept (a view prints dozens of labels on faces of
+    a few colours)."""
+    return text_color(fill)
+
+
 @lru_cache(maxsize=4096)
-def text_mask_array(text: str, px: int, anchor: str) -> npt.NDArray[np.uint8]:
-    """:func:`_text_mask`'s glyphs as a read-only array (for the kernels)."""
-    out = np.array(_text_mask(text, px, anchor)[0], dtype=np.uint8)
+def text_glyph(text: str, px: int, anchor: str) -> tuple[npt.NDArray[np.uint8], int, int]:
+    """:func:`_text_mask`'s glyphs as a read-only array (for the kernels), and its offset from
+    the anchor point."""
+    mask, dx, dy = _text_mask(text, px, anchor)
+    out = np.array(mask, dtype=np.uint8)
     out.flags.writeable = False
-    return out
+    return out, dx, dy
 
 
 @lru_cache(maxsize=4096)
@@ -287,20 +301,29 @@ def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
             draw.draw.draw_lines(ring, ink, width)
 
 
+def arrow_points(a: FloatArray, b: FloatArray, width: int) -> list[list[float]] | None:
+    """The arrow from ``a`` to ``b``: the shaft's two ends, then the head's three corners
+    (None when too short to draw). Plain float arithmetic in the order the array expressions
+    of the first version took (the same numbers: ticks make three arrows per picture)."""
+    ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+    dx, dy = bx - ax, by - ay
+    n = float(np.hypot(dx, dy))
+    if n < 1e-6:
+        return None
+    dx, dy = dx / n, dy / n
+    head = max(4.0, 3.2 * width)
+    base_x, base_y = bx - dx * head, by - dy * head
+    px, py = -dy * head * 0.55, dx * head * 0.55
+    left, right = [base_x + px, base_y + py], [base_x - px, base_y - py]
+    return [[ax, ay], [base_x, base_y], [bx, by], left, right]
+
+
 def arrow_shapes(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> list[Flat]:
     """A line from ``a`` to ``b`` with a filled head at ``b`` (the font has no arrow glyphs)."""
-    d = b - a
-    n = float(np.hypot(*d))
-    if n < 1e-6:
+    pts = arrow_points(a, b, width)
+    if pts is None:
         return []
-    d = d / n
-    head = max(4.0, 3.2 * width)
-    base = b - d * head
-    perp = np.array([-d[1], d[0]]) * head * 0.55
-    return [
-        (1, np.array([a, base]), fill, width),
-        (0, np.array([b, base + perp, base - perp]), fill, 0),
-    ]
+    return [(1, np.array(pts[:2]), fill, width), (0, np.array(pts[2:]), fill, 0)]
 
 
 def arrow(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:

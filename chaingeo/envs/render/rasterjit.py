@@ -8,6 +8,10 @@ so that a whole list of shapes is drawn in one call with the very same pixels; t
 them with Pillow on random shapes. Float32 steps are computed in float64 and rounded to float32
 after each operation, which gives the float32 result (double rounding is innocuous for + - * /).
 
+The per-pixel and per-row helpers are inlined into their callers in numba's own IR
+(``inline="always"``): as separate functions each call passed the picture's array struct and
+counted its references, about a tenth of a face's drawing.
+
 Shapes are flat: ``kinds[i]`` (0 polygon fill, 1 polyline), ``starts[i]:starts[i+1]`` its
 points in ``pts`` (float64 ``(m, 2)``), ``colors[i]`` its RGB and ``widths[i]`` its line width.
 """
@@ -17,6 +21,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -58,12 +63,12 @@ def scratch(points: int) -> Scratch:
     )
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _f32(v: float) -> float:
     return float(np.float32(v))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _round_up(f: float) -> int:
     """Pillow's ROUND_UP on a float32 (``floor(f + 0.5F)``, symmetric about zero)."""
     if f >= 0.0:
@@ -71,7 +76,7 @@ def _round_up(f: float) -> int:
     return -math.floor(abs(f) + 0.5)  # fabs() is a double: double arithmetic
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _round_down(f: float) -> int:
     if f >= 0.0:
         return math.ceil(_f32(f - 0.5))
@@ -101,9 +106,21 @@ def _roundf(f: float) -> float:
     return -float(math.floor(-f + 0.5))
 
 
+#: A picture as the kernels write it: its bytes flat (C order), its height and width. Writing
+#: through unsigned flat indices lets numba drop the negative-index checks of ``img[y, x, c]``
+#: and vectorise a span's stores (a long span fills about ten times faster).
+Canvas = tuple[U8, int, int]
+
+
 @njit(cache=True)
-def _hline(img: U8, x0: int, y: int, x1: int, c: U8) -> None:
-    h, w = img.shape[0], img.shape[1]
+def canvas(img: U8) -> Canvas:
+    """The canvas of a C-contiguous ``(h, w, 3)`` picture (its bytes, not a copy)."""
+    return img.reshape(img.size), img.shape[0], img.shape[1]
+
+
+@njit(cache=True, inline="always")
+def _hline(cv: Canvas, x0: int, y: int, x1: int, c: U8) -> None:
+    flat, h, w = cv
     if y < 0 or y >= h:
         return
     if x0 < 0:
@@ -114,22 +131,30 @@ def _hline(img: U8, x0: int, y: int, x1: int, c: U8) -> None:
         return
     if x1 >= w:
         x1 = w - 1
-    for x in range(x0, x1 + 1):
-        img[y, x, 0] = c[0]
-        img[y, x, 1] = c[1]
-        img[y, x, 2] = c[2]
+    if x1 < x0:
+        return
+    c0, c1, c2 = c[0], c[1], c[2]
+    base = np.uint64((y * w + x0) * 3)
+    three, one, two = np.uint64(3), np.uint64(1), np.uint64(2)
+    for k in range(np.uint64(x1 + 1 - x0)):
+        j = base + three * k
+        flat[j] = c0
+        flat[j + one] = c1
+        flat[j + two] = c2
+
+
+@njit(cache=True, inline="always")
+def _point(cv: Canvas, x: int, y: int, c: U8) -> None:
+    flat, h, w = cv
+    if 0 <= x < w and 0 <= y < h:
+        j = (y * w + x) * 3
+        flat[j] = c[0]
+        flat[j + 1] = c[1]
+        flat[j + 2] = c[2]
 
 
 @njit(cache=True)
-def _point(img: U8, x: int, y: int, c: U8) -> None:
-    if 0 <= x < img.shape[1] and 0 <= y < img.shape[0]:
-        img[y, x, 0] = c[0]
-        img[y, x, 1] = c[1]
-        img[y, x, 2] = c[2]
-
-
-@njit(cache=True)
-def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
+def _line(cv: Canvas, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
     """Pillow's ``line32``: Bresenham from (x0, y0), the end point left out."""
     dx, xs = x1 - x0, 1
     if dx < 0:
@@ -139,11 +164,11 @@ def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
         dy, ys = -dy, -1
     if dx == 0:
         for _ in range(dy):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             y0 += ys
     elif dy == 0:
         for _ in range(dx):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             x0 += xs
     elif dx > dy:
         n = dx
@@ -151,7 +176,7 @@ def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
         e = dy - dx
         dx += dx
         for _ in range(n):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             if e >= 0:
                 y0 += ys
                 e -= dx
@@ -163,7 +188,7 @@ def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
         e = dx - dy
         dy += dy
         for _ in range(n):
-            _point(img, x0, y0, c)
+            _point(cv, x0, y0, c)
             if e >= 0:
                 x0 += xs
                 e -= dy
@@ -171,7 +196,7 @@ def _line(img: U8, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
             y0 += ys
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _add_edge(
     edges: npt.NDArray[np.int64],
     dxs: npt.NDArray[np.float64],
@@ -188,9 +213,10 @@ def _add_edge(
     dxs[i] = 0.0 if y0 == y1 else _f32(_f32(x1 - x0) / _f32(y1 - y0))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _x_at(edges: npt.NDArray[np.int64], dxs: npt.NDArray[np.float64], i: int, y: int) -> float:
-    return _f32(_f32(_f32(y - edges[i, 5]) * dxs[i]) + _f32(edges[i, 4]))
+    # float32 operations themselves (the same result as rounding each float64 step)
+    return float(np.float32(y - edges[i, 5]) * np.float32(dxs[i]) + np.float32(edges[i, 4]))
 
 
 @njit(cache=True)
@@ -224,21 +250,21 @@ def _corner(
 
 
 @njit(cache=True)
-def _polygon_generic(img: U8, sc: Scratch, n: int, c: U8) -> None:
+def _polygon_generic(cv: Canvas, sc: Scratch, n: int, c: U8) -> None:
     """Pillow's scanline fill of the first ``n`` edges (``polygon_generic``, no alpha)."""
     edges, dxs, table, xx = sc
-    ymin, ymax = img.shape[0] - 1, 0
+    ymin, ymax = cv[1] - 1, 0
     count = 0
     for i in range(n):
         ymin = min(ymin, edges[i, 1])
         ymax = max(ymax, edges[i, 3])
         if edges[i, 1] == edges[i, 3]:
-            _hline(img, edges[i, 0], edges[i, 1], edges[i, 2], c)
+            _hline(cv, edges[i, 0], edges[i, 1], edges[i, 2], c)
             continue
         table[count] = i
         count += 1
     ymin = max(ymin, 0)
-    ymax = min(ymax, img.shape[0])
+    ymax = min(ymax, cv[1])
     for y in range(ymin, ymax + 1):
         j = 0
         for ii in range(count):
@@ -260,11 +286,11 @@ def _polygon_generic(img: U8, sc: Scratch, n: int, c: U8) -> None:
                 k -= 1
             xx[k] = v
         for i in range(1, j, 2):
-            _hline(img, _round_up(xx[i - 1]), y, _round_down(xx[i]), c)
+            _hline(cv, _round_up(xx[i - 1]), y, _round_down(xx[i]), c)
 
 
 @njit(cache=True)
-def _fill_polygon(img: U8, xy: npt.NDArray[np.float64], c: U8, sc: Scratch) -> None:
+def _fill_polygon(cv: Canvas, xy: npt.NDArray[np.float64], c: U8, sc: Scratch) -> None:
     """``ImageDraw.polygon(xy, fill=c)``: ``ImagingDrawPolygon`` with its merged horizontals."""
     m = xy.shape[0]
     edges, dxs = sc[0], sc[1]
@@ -289,15 +315,17 @@ def _fill_polygon(img: U8, xy: npt.NDArray[np.float64], c: U8, sc: Scratch) -> N
     if x0 != fx or y0 != fy:
         _add_edge(edges, dxs, n, x0, y0, fx, fy)
         n += 1
-    _polygon_generic(img, sc, n, c)
+    _polygon_generic(cv, sc, n, c)
 
 
 @njit(cache=True)
-def _wide_line(img: U8, x0: int, y0: int, x1: int, y1: int, width: int, c: U8, sc: Scratch) -> None:
+def _wide_line(
+    cv: Canvas, x0: int, y0: int, x1: int, y1: int, width: int, c: U8, sc: Scratch
+) -> None:
     """Pillow's ``ImagingDrawWideLine``: the segment's quad, filled."""
     dx, dy = x1 - x0, y1 - y0
     if dx == 0 and dy == 0:
-        _point(img, x0, y0, c)
+        _point(cv, x0, y0, c)
         return
     big = math.hypot(dx, dy)
     small = (width - 1) / 2.0
@@ -310,22 +338,22 @@ def _wide_line(img: U8, x0: int, y0: int, x1: int, y1: int, width: int, c: U8, s
     for i in range(4):
         k = (i + 1) % 4
         _add_edge(sc[0], sc[1], i, vx[i], vy[i], vx[k], vy[k])
-    _polygon_generic(img, sc, 4, c)
+    _polygon_generic(cv, sc, 4, c)
 
 
 @njit(cache=True)
-def _polyline(img: U8, xy: npt.NDArray[np.float64], width: int, c: U8, sc: Scratch) -> None:
+def _polyline(cv: Canvas, xy: npt.NDArray[np.float64], width: int, c: U8, sc: Scratch) -> None:
     """``ImageDraw.line(xy, fill=c, width=width)`` without round joints (``draw_lines``)."""
     m = xy.shape[0]
     for i in range(m - 1):
         x0, y0 = int(xy[i, 0]), int(xy[i, 1])
         x1, y1 = int(xy[i + 1, 0]), int(xy[i + 1, 1])
         if width <= 1:
-            _line(img, x0, y0, x1, y1, c)
+            _line(cv, x0, y0, x1, y1, c)
         else:
-            _wide_line(img, x0, y0, x1, y1, width, c, sc)
+            _wide_line(cv, x0, y0, x1, y1, width, c, sc)
     if width <= 1 and m > 1:
-        _point(img, int(xy[m - 1, 0]), int(xy[m - 1, 1]), c)
+        _point(cv, int(xy[m - 1, 0]), int(xy[m - 1, 1]), c)
 
 
 @njit(cache=True)
@@ -342,12 +370,25 @@ def draw_shapes(
     for i in range(kinds.shape[0]):
         most = max(most, starts[i + 1] - starts[i])
     sc = scratch(most)
+    cv = canvas(img)
     for i in range(kinds.shape[0]):
         xy = pts[starts[i] : starts[i + 1]]
         if kinds[i] == POLYGON:
-            _fill_polygon(img, xy, colors[i], sc)
+            _fill_polygon(cv, xy, colors[i], sc)
         else:
-            _polyline(img, xy, widths[i], colors[i], sc)
+            _polyline(cv, xy, widths[i], colors[i], sc)
+
+
+@njit(cache=True)
+def draw_packed(
+    img: U8, meta: npt.NDArray[np.int64], pts: npt.NDArray[np.float64], colors: U8
+) -> None:
+    """:func:`draw_shapes` of a :class:`Packed` list (``meta`` rows: kind, points, width)."""
+    n = meta.shape[0]
+    starts = np.zeros(n + 1, np.int64)
+    for i in range(n):
+        starts[i + 1] = starts[i] + meta[i, 1]
+    draw_shapes(img, meta[:, 0].copy(), starts, pts, colors, meta[:, 2].copy())
 
 
 @njit(cache=True)
@@ -356,11 +397,12 @@ def draw_faces(img: U8, corners: npt.NDArray[np.float64], fills: U8, edge: U8, w
     :func:`chaingeo.envs.render.raster.draw_faces` makes."""
     ring = np.empty((5, 2), np.float64)
     sc = scratch(5)
+    cv = canvas(img)
     for i in range(corners.shape[0]):
-        _fill_polygon(img, corners[i], fills[i], sc)
+        _fill_polygon(cv, corners[i], fills[i], sc)
         ring[:4] = corners[i]
         ring[4] = corners[i, 0]
-        _polyline(img, ring, width, edge, sc)
+        _polyline(cv, ring, width, edge, sc)
 
 
 @njit(cache=True)
@@ -372,49 +414,48 @@ def rectangle(img: U8, box: npt.NDArray[np.float64], fill: U8, outline: U8, edge
     if y0 > y1:
         y0, y1 = y1, y0
     top, bottom = max(y0, 0), min(y1, img.shape[0])
+    cv = canvas(img)
     for y in range(top, bottom + 1):
-        _hline(img, x0, y, x1, fill)
+        _hline(cv, x0, y, x1, fill)
     if edged:
-        _hline(img, x0, y0, x1, outline)
-        _hline(img, x0, y1, x1, outline)
-        _line(img, x1, y0 + 1, x1, y1, outline)
-        _line(img, x0, y0 + 1, x0, y1, outline)
+        _hline(cv, x0, y0, x1, outline)
+        _hline(cv, x0, y1, x1, outline)
+        _line(cv, x1, y0 + 1, x1, y1, outline)
+        _line(cv, x0, y0 + 1, x0, y1, outline)
 
 
 @njit(cache=True)
 def reduce2(img: U8) -> U8:
     """``Image.reduce(2)`` of an even-sized picture: each 2x2 block's mean, rounded half up."""
-    h, w = img.shape[0] // 2, img.shape[1] // 2
-    out = np.empty((h, w, 3), np.uint8)
-    flat = img.reshape(img.shape[0], img.shape[1] * 3)
-    dst = out.reshape(h, w * 3)
-    acc = np.empty(w * 6, np.uint16)
-    for y in range(h):
-        top, bottom = flat[2 * y], flat[2 * y + 1]
-        for i in range(w * 6):
-            acc[i] = np.uint16(top[i]) + np.uint16(bottom[i])
-        for x in range(w):
-            for ch in range(3):
-                s = acc[6 * x + ch] + acc[6 * x + 3 + ch] + 2
-                dst[y, 3 * x + ch] = s >> 2
+    out = np.empty((img.shape[0] // 2, img.shape[1] // 2, 3), np.uint8)
+    reduce2_into(img, out, 0, 0, out.shape[1], out.shape[0])
     return out
 
 
 @njit(cache=True)
 def reduce2_into(img: U8, out: U8, x0: int, y0: int, x1: int, y1: int) -> None:
-    """:func:`reduce2` of the output rectangle ``[x0, x1) x [y0, y1)`` only, into ``out``."""
+    """:func:`reduce2` of the output rectangle ``[x0, x1) x [y0, y1)`` only, into ``out``
+    (flat unsigned indices, as :func:`_hline`: about twice as fast as ``img[y, x, c]``)."""
+    if x1 <= x0:
+        return
+    src, dst = img.reshape(img.size), out.reshape(out.size)
+    row = np.uint64(img.shape[1] * 3)
+    zero, one, two = np.uint64(0), np.uint64(1), np.uint64(2)
+    three, six = np.uint64(3), np.uint64(6)
     for y in range(y0, y1):
-        top, bottom = img[2 * y], img[2 * y + 1]
-        for x in range(x0, x1):
-            for ch in range(3):
+        top = np.uint64(2 * y) * row + np.uint64(6 * x0)
+        at = np.uint64((y * out.shape[1] + x0) * 3)
+        for x in range(np.uint64(x1 - x0)):
+            i, o = top + six * x, at + three * x
+            for ch in (zero, one, two):
                 s = (
-                    np.int64(top[2 * x, ch])
-                    + np.int64(top[2 * x + 1, ch])
-                    + np.int64(bottom[2 * x, ch])
-                    + np.int64(bottom[2 * x + 1, ch])
-                    + 2
+                    np.uint16(src[i + ch])
+                    + np.uint16(src[i + ch + three])
+                    + np.uint16(src[i + ch + row])
+                    + np.uint16(src[i + ch + row + three])
+                    + np.uint16(2)
                 )
-                out[y, x, ch] = s >> 2
+                dst[o + ch] = s >> np.uint16(2)
 
 
 @njit(cache=True)
@@ -432,18 +473,33 @@ def paste_mask(img: U8, mask: U8, x0: int, y0: int, c: U8) -> None:
                 img[y, x, ch] = ((t >> 8) + t) >> 8
 
 
+class Packed(NamedTuple):
+    """Flat shapes as the arrays :func:`draw_packed` takes: packed once, drawn any number of
+    times (packing a short list costs about eight times the drawing of an arrow)."""
+
+    meta: npt.NDArray[np.int64]  # (n, 3): kind, number of points, line width
+    pts: npt.NDArray[np.float64]  # (m, 2)
+    colors: U8  # (n, 3)
+
+
+def pack(shapes: Sequence[Flat]) -> Packed:
+    """The arrays of ``shapes`` (at least one), in drawing order."""
+    pts = np.concatenate([p for _, p, _, _ in shapes])
+    return Packed(
+        np.array([(kind, len(p), w) for kind, p, _, w in shapes], dtype=np.int64),
+        pts if pts.dtype == np.float64 else pts.astype(np.float64),
+        np.array([rgb for _, _, rgb, _ in shapes], dtype=np.uint8),
+    )
+
+
+def paint_packed(img: U8, packed: Packed | None) -> None:
+    """Draw packed shapes (None: nothing)."""
+    if packed is not None:
+        draw_packed(img, packed.meta, packed.pts, packed.colors)
+
+
 def draw_flat(img: U8, shapes: Sequence[Flat]) -> None:
     """Flat shapes drawn in one kernel call, as :func:`chaingeo.envs.render.raster.draw_flat`
     would."""
-    if not shapes:
-        return
-    starts = np.zeros(len(shapes) + 1, dtype=np.int64)
-    starts[1:] = np.cumsum([len(pts) for _, pts, _, _ in shapes])
-    draw_shapes(
-        img,
-        np.array([kind for kind, _, _, _ in shapes], dtype=np.int64),
-        starts,
-        np.concatenate([pts for _, pts, _, _ in shapes]).astype(np.float64),
-        np.array([rgb for _, _, rgb, _ in shapes], dtype=np.uint8),
-        np.array([w for _, _, _, w in shapes], dtype=np.int64),
-    )
+    if shapes:
+        paint_packed(img, pack(shapes))

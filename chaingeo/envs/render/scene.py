@@ -160,7 +160,7 @@ def _scene(pieces: PieceMap, box: Sequence[int] | None) -> _Scene:
         colors.append(np.tile(np.array(rgb, dtype=np.float64), (len(shape), 1)))
     cells = np.concatenate(chunks) if chunks else np.zeros((0, 3), dtype=np.int64)
     rgbs = np.concatenate(colors) if colors else np.zeros((0, 3))
-    if len(cells) and len(np.unique(cells, axis=0)) != len(cells):
+    if len(set(map(tuple, cells.tolist()))) != len(cells):  # np.unique(axis=0): ~10x slower
         owners: dict[tuple[int, int, int], str] = {}
         for name in sorted(pieces):
             for c in pieces[name][0]:
@@ -227,26 +227,43 @@ def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
     return np.array(pts)
 
 
+def _grid_ends(scene: _Scene, axis: int, side: str) -> FloatArray:
+    """The ends of a wall's grid lines, two rows a line: across the wall at every cell
+    boundary along one of its axes, then along the other."""
+    b, c = [i for i in range(3) if i != axis]
+    blocks = []
+    for along, across in ((b, c), (c, b)):
+        t = np.arange(scene.lo[along], scene.hi[along] + 1, dtype=np.float64).repeat(2)
+        block = np.empty((len(t), 3))
+        block[:, axis] = scene.lo[axis] if side == "lo" else scene.hi[axis]
+        block[:, along] = t
+        block[0::2, across] = scene.lo[across]
+        block[1::2, across] = scene.hi[across]
+        blocks.append(block)
+    return np.concatenate(blocks)
+
+
+def wall_pixels(
+    scene: _Scene, cam: Camera, proj: Projector
+) -> list[tuple[RGB, FloatArray, FloatArray]]:
+    """Each back wall and the floor: its colour, its corners and its grid lines' ends (two rows
+    a line) in pixels, in drawing order."""
+    out = []
+    for axis in (2, 0, 1):
+        for side in ("lo", "hi"):
+            if _plane_is_back(axis, side, cam):
+                fill = _FLOOR if axis == 2 and side == "lo" else _WALL
+                corners = proj(_wall_corners(scene, axis, side))
+                out.append((fill, corners, proj(_grid_ends(scene, axis, side))))
+    return out
+
+
 def _wall_shapes(scene: _Scene, cam: Camera, proj: Projector, width: int) -> list[Flat]:
     """Back walls and floor with a line per cell boundary, so empty cells can be counted."""
     out: list[Flat] = []
-    for axis in (2, 0, 1):
-        for side in ("lo", "hi"):
-            if not _plane_is_back(axis, side, cam):
-                continue
-            fill = _FLOOR if axis == 2 and side == "lo" else _WALL
-            out.append((0, proj(_wall_corners(scene, axis, side)), fill, 0))
-            b, c = [i for i in range(3) if i != axis]
-            ends: list[list[float]] = []
-            for along, across in ((b, c), (c, b)):
-                for t in range(scene.lo[along], scene.hi[along] + 1):
-                    for at in (scene.lo[across], scene.hi[across]):
-                        p = [0.0, 0.0, 0.0]
-                        p[axis] = scene.lo[axis] if side == "lo" else scene.hi[axis]
-                        p[along], p[across] = t, at
-                        ends.append(p)
-            pix = proj(np.array(ends))
-            out.extend((1, pix[i : i + 2], _GRID, width) for i in range(0, len(pix), 2))
+    for fill, corners, pix in wall_pixels(scene, cam, proj):
+        out.append((0, corners, fill, 0))
+        out.extend((1, pix[i : i + 2], _GRID, width) for i in range(0, len(pix), 2))
     return out
 
 
