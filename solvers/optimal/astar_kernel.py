@@ -101,18 +101,9 @@ class Heap(NamedTuple):
     node: I64
 
 
-class Pieces(NamedTuple):
-    """The pieces' voxels and boxes (:meth:`PieceTable.part_arrays`), the group caps, and the
-    buffers :func:`chaingeo.solvers.motion.movement.node_moves` writes."""
-
-    vox: I64
-    starts: I64
-    lo: I64
-    hi: I64
-    max_group: int
-    group_limit: int
-    moves: I64
-    groups: U64
+#: The pieces' voxels and boxes, the group caps and the buffers of
+#: :func:`chaingeo.solvers.motion.movement.node_moves` (the bundle every search kernel takes).
+Pieces = mv.Pieces
 
 
 @njit(cache=True)

@@ -20,6 +20,7 @@ final). A state from which ``S`` never comes apart gets :data:`DEAD`.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -54,36 +55,40 @@ def _key_of(sid: int, state: I16, m: int, key: I16) -> None:
         key[1 + t] = state[3 + t] if 3 + t < 3 * m else 0
 
 
+class Component(NamedTuple):
+    """The growing arrays of one sub-puzzle's enumeration (:func:`sub_component`): state rows
+    and their hash ``table``, each state's database value or -1 (``known``), the moves
+    ``(from, to)`` and the removals ``(state, mask)`` seen."""
+
+    states: I16
+    table: I64
+    known: I32
+    edges: I64
+    rems: I64
+
+
+class Database(NamedTuple):
+    """A pattern database's arrays as a kernel reads them: key rows, values, hash table."""
+
+    keys: I16
+    vals: I32
+    table: I64
+
+
 @njit(cache=True)
 def sub_component(
-    states: I16,
-    n_states: int,
-    table: I64,
-    known: I32,
-    node: int,
-    edges: I64,
-    n_edges: int,
-    rems: I64,
-    n_rems: int,
-    vox: I64,
-    starts: I64,
-    lo: I64,
-    hi: I64,
-    max_group: int,
-    group_limit: int,
-    sid: int,
-    pkeys: I16,
-    pvals: I32,
-    ptable: I64,
-    moves_buf: I64,
-    groups_buf: U64,
-) -> tuple[int, int, int, int, int]:
+    comp: Component, n_states: int, node: int, n_edges: int, n_rems: int,
+    pieces: mv.Pieces, sid: int, db: Database,
+) -> tuple[int, int, int, int, int]:  # fmt: skip
     """Breadth first over the one-part states of a sub-puzzle from ``node`` on, recording every
     move ``(from, to)`` in ``edges`` and every removal ``(state, mask)`` in ``rems``. A new
     state already in the pattern database gets ``known`` = its value and is not expanded.
     Returns ``(status, next node, n_states, n_edges, n_rems)``; on a status other than
     SUB_DONE the caller grows the named buffer and calls again from ``next`` (whose edges and
     removals have been dropped)."""
+    states, table, known, edges, rems = comp
+    vox, starts, lo, hi, max_group, group_limit, moves_buf, groups_buf = pieces
+    pkeys, pvals, ptable = db
     m = starts.shape[0] - 1
     w = 3 * m
     gaps = np.empty((3, m, m), dtype=np.int64)
@@ -395,9 +400,10 @@ class PatternDB:
         while True:
             self.deadline.check()
             status, node, n_states, n_edges, n_rems = sub_component(
-                states, n_states, hash_, known, node, edges, n_edges, rems, n_rems,
-                vox, starts, lo, hi, self.max_group, self.group_limit, sid,
-                self.keys, self.vals, self.hash, moves_buf, groups_buf,
+                Component(states, hash_, known, edges, rems), n_states, node, n_edges, n_rems,
+                mv.Pieces(vox, starts, lo, hi, self.max_group, self.group_limit, moves_buf,
+                          groups_buf),
+                sid, Database(self.keys, self.vals, self.hash),
             )  # fmt: skip
             if status == SUB_DONE:
                 break
