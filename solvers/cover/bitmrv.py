@@ -308,7 +308,7 @@ def _exact_min_wide(
     return cell, best
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _place_wide(occ: Any, add: Any, primary: Any, here: Any) -> bool:
     """``here = occ | add`` (``W`` words); whether it covers every mandatory cell."""
     full = True
