@@ -75,3 +75,26 @@ def njit(*args: Any, **options: Any) -> Any:
 
 def _identity(fn: F) -> F:
     return fn
+
+
+def entry(kernel: F, *args: Any) -> F:
+    """``kernel``'s compiled specialisation for the types of ``args`` (compiled or loaded now if
+    new), to be called many times with arguments of exactly those types; interpreted: ``kernel``.
+
+    Numba's dispatcher types every argument of every call, and a NamedTuple bundle has no fast
+    path there (about 1 us a bundle, more with more fields, where an array costs 0.1 us): a
+    Python loop that calls a bundle-taking kernel hundreds of times per search (A*'s loop serving
+    pattern-database misses, one sub-puzzle enumeration per miss) lost 5-15% of a small search to
+    it. The entry point skips that typing, not the unboxing; it does not check the types, so an
+    argument of another type (another dtype, rank or layout of an array) would be misread: use it
+    only where the kernel is called again with the same kinds of arrays (buffers replaced by
+    grown copies)."""
+    dispatcher: Any = kernel
+    if not hasattr(dispatcher, "overloads"):  # interpreted, or a plain function standing in
+        return kernel
+    sig = tuple(dispatcher.typeof_pyval(a) for a in args)
+    compiled = dispatcher.overloads.get(sig)
+    if compiled is None:
+        dispatcher.compile(sig)
+        compiled = dispatcher.overloads[sig]
+    return compiled.entry_point  # type: ignore[no-any-return]

@@ -20,12 +20,12 @@ final). A state from which ``S`` never comes apart gets :data:`DEAD`.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.core.jit import entry, njit
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.motion import movement as mv
@@ -320,6 +320,7 @@ class PatternDB:
         self.hash = np.full(4096, -1, dtype=np.int64)
         self.n_keys = 0
         self.searches = 0  # sub-puzzle searches run
+        self._sub_component: Any = None  # sub_component typed for this database (jit.entry)
         self.searched_states = 0  # states those searches enumerated
         self._parts = {s: table.part_arrays(s) for s in self.family}
 
@@ -399,12 +400,15 @@ class PatternDB:
         self.searches += 1
         while True:
             self.deadline.check()
-            status, node, n_states, n_edges, n_rems = sub_component(
+            args = (
                 Component(states, hash_, known, edges, rems), n_states, node, n_edges, n_rems,
                 mv.Pieces(vox, starts, lo, hi, self.max_group, self.group_limit, moves_buf,
                           groups_buf),
                 sid, Database(self.keys, self.vals, self.hash),
             )  # fmt: skip
+            if self._sub_component is None:  # typed once per database (jit.entry)
+                self._sub_component = entry(sub_component, *args)
+            status, node, n_states, n_edges, n_rems = self._sub_component(*args)
             if status == SUB_DONE:
                 break
             if status == SUB_NEED_STATES:
