@@ -101,9 +101,10 @@ def sub_component(
             continue
         e0 = n_edges
         r0 = n_rems
+        row = states[node]  # once per node: a view taken per child costs a reference count
         for p in range(m):
             for t in range(3):
-                off[p, t] = states[node, 3 * p + t]
+                off[p, t] = row[3 * p + t]
         rows = mv.node_moves(
             vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
         )
@@ -126,7 +127,7 @@ def sub_component(
                     return SUB_NEED_STATES, node, n_states, e0, r0
                 if n_edges >= edges.shape[0]:
                     return SUB_NEED_EDGES, node, n_states, e0, r0
-                mv.shift_child(states[node], child, 0, None, m, moves_buf[r, 0], d, k)
+                mv.shift_child(row, child, 0, None, m, moves_buf[r, 0], d, k)
                 got = mv.find_or_insert(states, n_states, table, child)
                 if got < 0:
                     got = -1 - got
