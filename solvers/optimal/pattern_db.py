@@ -324,6 +324,10 @@ class PatternDB:
         self._sub_component: Any = None  # sub_component typed for this database (jit.entry)
         self.searched_states = 0  # states those searches enumerated
         self._parts = {s: table.part_arrays(s) for s in self.family}
+        # node_moves' buffers, shared by the enumerations (one runs at a time): a small search
+        # runs dozens, and each allocated its own
+        self._moves_buf = np.zeros((256, 4), dtype=np.int64)
+        self._groups_buf = np.zeros(min(group_limit, 1 << 16) + 1, dtype=np.uint64)
 
     def _reserve(self, extra: int) -> None:
         need = self.n_keys + extra
@@ -394,19 +398,18 @@ class PatternDB:
         known = np.full(cap, -1, dtype=np.int32)
         edges = np.zeros((4 * cap, 2), dtype=np.int64)
         rems = np.zeros((256, 2), dtype=np.int64)
-        moves_buf = np.zeros((256, 4), dtype=np.int64)
-        groups_buf = np.zeros(min(self.group_limit, 1 << 16) + 1, dtype=np.uint64)
+        pieces = mv.Pieces(
+            vox, starts, lo, hi, self.max_group, self.group_limit, self._moves_buf,
+            self._groups_buf,
+        )  # fmt: skip
+        db = Database(self.keys, self.vals, self.hash)  # not replaced while this runs
         mv.find_or_insert(states, 0, hash_, start)
         n_states, n_edges, n_rems, node = 1, 0, 0, 0
         self.searches += 1
         while True:
             self.deadline.check()
-            args = (
-                Component(states, hash_, known, edges, rems), n_states, node, n_edges, n_rems,
-                mv.Pieces(vox, starts, lo, hi, self.max_group, self.group_limit, moves_buf,
-                          groups_buf),
-                sid, Database(self.keys, self.vals, self.hash),
-            )  # fmt: skip
+            comp = Component(states, hash_, known, edges, rems)
+            args = (comp, n_states, node, n_edges, n_rems, pieces, sid, db)
             if self._sub_component is None:  # typed once per database (jit.entry)
                 self._sub_component = entry(sub_component, *args)
             status, node, n_states, n_edges, n_rems = self._sub_component(*args)
@@ -429,7 +432,8 @@ class PatternDB:
                 edges = np.concatenate([edges, np.zeros_like(edges)])
                 rems = np.concatenate([rems, np.zeros_like(rems)])
             elif status == SUB_NEED_MOVES:
-                moves_buf = np.zeros((2 * moves_buf.shape[0], 4), dtype=np.int64)
+                self._moves_buf = np.zeros((2 * self._moves_buf.shape[0], 4), dtype=np.int64)
+                pieces = pieces._replace(moves=self._moves_buf)
             else:
                 raise SearchLimitError(
                     f"more than {self.group_limit} movable groups along one direction; "
