@@ -75,3 +75,38 @@ def njit(*args: Any, **options: Any) -> Any:
 
 def _identity(fn: F) -> F:
     return fn
+
+
+_entries: dict[tuple[object, tuple[bytes, ...]], Any] = {}
+
+
+def entry(kernel: F, *args: Any) -> F:
+    """``kernel``'s compiled specialisation for the types of ``args`` (compiled or loaded now if
+    new), to be called many times with arguments of exactly those types; interpreted: ``kernel``.
+
+    Numba's dispatcher types every argument of every call, and a NamedTuple bundle costs about
+    1 us there (an array 0.05 us): a Python loop that calls a bundle-taking kernel hundreds of
+    times per search (A*'s loop serving pattern-database misses, one sub-puzzle enumeration per
+    miss) lost 5-15% of a small search to it. The entry point skips that typing, not the
+    unboxing, and does not check types: an argument of another type (another dtype, rank or
+    layout of an array) would be misread, so call it only with the same kinds of arrays (buffers
+    replaced by grown copies). Resolving costs numba's C fingerprints of ``args`` and a dict
+    look-up; the first time per types, numba's Python typing (about 10 us an array)."""
+    dispatcher: Any = kernel
+    if not hasattr(dispatcher, "overloads"):  # interpreted, or a plain function standing in
+        return kernel
+    from numba._dispatcher import compute_fingerprint
+
+    try:
+        key = (kernel, tuple(compute_fingerprint(a) for a in args))
+    except ValueError:  # a type numba has no fingerprint for: let the dispatcher type it
+        return kernel
+    found = _entries.get(key)
+    if found is None:
+        sig = tuple(dispatcher.typeof_pyval(a) for a in args)
+        compiled = dispatcher.overloads.get(sig)
+        if compiled is None:
+            dispatcher.compile(sig)
+            compiled = dispatcher.overloads[sig]
+        found = _entries[key] = compiled.entry_point
+    return found  # type: ignore[no-any-return]

@@ -16,10 +16,10 @@ order).
 
 Targets over 64 cells use ``W = ceil(cells / 64)`` words per mask (:func:`_expand_wide`); on
 one-word targets :func:`_expand` is the same algorithm on scalars; one driver :func:`mrv_run`
-serves both. Piece types carry count ranges
-exactly as in :mod:`chaingeo.solvers.cover.dlx`. ``nodes`` counts rows placed (as in the DLX kernel:
-a row that completes a cover or ends in a dead end counts too); ``updates`` counts rows tested by
-the filter (the unit of work here).
+serves both, compiled apart for each (its multi-word side is None on one-word targets).
+Piece types carry count ranges exactly as in :mod:`chaingeo.solvers.cover.dlx`. ``nodes``
+counts rows placed (as in the DLX kernel: a row that completes a cover or ends in a dead end
+counts too); ``updates`` counts rows tested by the filter (the unit of work here).
 """
 
 from __future__ import annotations
@@ -86,11 +86,10 @@ def _exact_min(live: Any, a: int, b: int, mask: Any, empty: Any, table: Any, tal
 
 
 class MRVRows(NamedTuple):
-    """The problem side of a search (read only): row masks (``mask``: the first word of
-    ``masks``, what one-word targets use), types and their count ranges, region pruning."""
+    """The problem side of a search (read only): row masks (``mask``: the first word, all that
+    one-word targets use), types and their count ranges, region pruning."""
 
     mask: U64
-    masks: U64
     rtype: I32
     rid: I32
     allrows: I32
@@ -107,8 +106,8 @@ class MRVRows(NamedTuple):
 
 class MRVStack(NamedTuple):
     """The search side, resumable: level ``k`` has the alive rows ``live[lstart[k] :
-    lstart[k + 1]]``, occupancy ``occ[k]`` (``W`` words) and branches ``br[k, :nbr[k]]``
-    (tried up to ``pos[k]``); the rest is scratch."""
+    lstart[k + 1]]``, occupancy ``occ[k]`` (its first word; :class:`MRVWide` has them all) and
+    branches ``br[k, :nbr[k]]`` (tried up to ``pos[k]``); the rest is scratch."""
 
     cnt: I32
     live: I32
@@ -116,12 +115,21 @@ class MRVStack(NamedTuple):
     occ: U64
     tcount: I32
     tally: I32
-    planes: U64
-    scratch: U64
     br: I32
     nbr: I64
     pos: I64
     chosen: I32
+
+
+class MRVWide(NamedTuple):
+    """The multi-word side of a search over more than 64 cells: row masks (rows, ``W``), the
+    occupancy of every level (levels, ``W``), the bit-sliced counters (5, ``W``) and scratch
+    (2, ``W``: the occupancy being placed, the empty cells)."""
+
+    masks: U64
+    occ: U64
+    planes: U64
+    scratch: U64
 
 
 @njit(cache=True, inline="always")
@@ -300,7 +308,7 @@ def _exact_min_wide(
     return cell, best
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _place_wide(occ: Any, add: Any, primary: Any, here: Any) -> bool:
     """``here = occ | add`` (``W`` words); whether it covers every mandatory cell."""
     full = True
@@ -312,37 +320,41 @@ def _place_wide(occ: Any, add: Any, primary: Any, here: Any) -> bool:
 
 
 @njit(cache=True)
-def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control) -> int:
+def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide | None) -> int:
     """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`
-    (:class:`MRVStack` describes the levels). One-word targets keep the occupancy in a
-    register and call :func:`_expand`, wider ones :func:`_expand_wide`."""
-    mask, masks, rtype, rid, allrows, primary, lo, hi, counters, pieces, table = rows[:11]
-    nb, region_gcd, region_min = rows[11:]
-    cnt, live, lstart, occ, tcount, tally, planes, scratch, br, nbr, pos, chosen = st
+    (:class:`MRVStack` describes the levels). ``wide`` is None on one-word targets: numba
+    prunes the branches on ``wide is None`` when it compiles, so one-word targets get a driver
+    with no multi-word code in its loop (the occupancy stays in a register; a test per node
+    and a 2-D occupancy cost the merged driver 4-7%) and wider ones call :func:`_expand_wide`."""
+    mask, rtype, rid, allrows, primary, lo, hi, counters, pieces, table = rows[:10]
+    nb, region_gcd, region_min = rows[10:]
+    cnt, live, lstart, occ, tcount, tally, br, nbr, pos, chosen = st
     regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
     status = regs[kn.REG_STATUS]
     if status == kn.DONE:
         return 0
-    wide = masks.shape[1] > 1
     p0 = primary[0]
     nodes = regs[kn.REG_NODES]
     updates = regs[kn.REG_UPDATES]
     found = 0
     n_out = 0
-    here = scratch[0]
+    if wide is not None:  # read once: the loop below runs per node
+        masks, wocc, planes, scratch = wide
+        here, empty = scratch[0], scratch[1]
     if status == kn.FRESH:
         k = 0
-        occ[0, :] = _NONE
+        occ[0] = _NONE
         lstart[0] = 0
-        if wide:
-            end, n_br = _expand_wide(
-                allrows, 0, len(allrows), live, 0, occ[0], primary, masks, rtype, lo, hi, cnt,
-                tcount, counters, pieces, table, tally, planes, scratch[1], br[0],
-            )  # fmt: skip
-        else:
+        if wide is None:
             end, n_br = _expand(
                 allrows, 0, len(allrows), live, 0, _NONE, p0, mask, rtype, lo, hi, cnt,
                 tcount, counters, pieces, table, tally, br[0],
+            )  # fmt: skip
+        else:
+            wocc[0, :] = _NONE
+            end, n_br = _expand_wide(
+                allrows, 0, len(allrows), live, 0, wocc[0], primary, masks, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, planes, empty, br[0],
             )  # fmt: skip
         updates += len(allrows)
         lstart[1] = end
@@ -362,8 +374,11 @@ def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control) -> int:
             pos[k] += 1
             nodes += 1
             chosen[k] = r
-            h0 = occ[k, 0] | mask[r]
-            full = _place_wide(occ[k], masks[r], primary, here) if wide else (h0 & p0) == p0
+            h0 = occ[k] | mask[r]
+            if wide is None:  # noqa: SIM108 (one branch per word count, like the others)
+                full = (h0 & p0) == p0
+            else:
+                full = _place_wide(wocc[k], masks[r], primary, here)
             t = rtype[r]
             cnt[t] += 1
             if full:  # every mandatory cell covered
@@ -381,28 +396,27 @@ def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control) -> int:
                         break
                 continue
             if region_min > 0 and not regions_ok(mask[r], p0 & ~h0, nb, region_gcd, region_min):
-                cnt[t] -= 1  # cuts off a region no set of pieces can fill
+                cnt[t] -= 1  # cuts off a region no set of pieces can fill (one-word targets)
                 continue
             a, b = lstart[k], lstart[k + 1]
             updates += b - a
-            if wide:
-                end, n_br = _expand_wide(
-                    live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
-                    tcount, counters, pieces, table, tally, planes, scratch[1], br[k + 1],
-                )  # fmt: skip
-            else:
+            if wide is None:
                 end, n_br = _expand(
                     live, a, b, live, b, h0, p0, mask, rtype, lo, hi, cnt,
                     tcount, counters, pieces, table, tally, br[k + 1],
+                )  # fmt: skip
+            else:
+                end, n_br = _expand_wide(
+                    live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
+                    tcount, counters, pieces, table, tally, planes, empty, br[k + 1],
                 )  # fmt: skip
             if n_br == 0:
                 cnt[t] -= 1
                 continue
             k += 1
-            if wide:
-                occ[k, :] = here
-            else:
-                occ[k, 0] = h0
+            occ[k] = h0
+            if wide is not None:
+                wocc[k, :] = here
             lstart[k + 1] = end
             nbr[k] = n_br
             pos[k] = 0
@@ -464,26 +478,35 @@ class MRVArrays:
         else:
             nb, gcd, smallest = np.zeros(8, np.uint64), 1, 0
         self.rows = MRVRows(
-            self.mask, masks, self.rtype, self.rid, self.allrows, primary, self.lo, self.hi,
+            self.mask, self.rtype, self.rid, self.allrows, primary, self.lo, self.hi,
             self.counters, self.pieces, DEBRUIJN_TABLE, nb, int(gcd), int(smallest),
         )  # fmt: skip
 
     def stack(self, depth: int, n_types: int) -> MRVStack:
         """Fresh search-side arrays for ``depth`` levels."""
-        W = self.words
         return MRVStack(
             cnt=np.zeros(n_types, dtype=np.int32),
             live=np.zeros((depth + 1) * max(len(self.rid), 1), dtype=np.int32),
             lstart=np.zeros(depth + 2, dtype=np.int64),
-            occ=np.zeros((depth + 1, W), dtype=np.uint64),
+            occ=np.zeros(depth + 1, dtype=np.uint64),
             tcount=np.zeros(max(n_types, 1), dtype=np.int32),
-            tally=np.zeros(64 * W, dtype=np.int32),
-            planes=np.zeros((5, W), dtype=np.uint64),
-            scratch=np.zeros((2, W), dtype=np.uint64),
+            tally=np.zeros(64 * self.words, dtype=np.int32),
             br=np.zeros((depth, self.max_col), dtype=np.int32),
             nbr=np.zeros(depth, dtype=np.int64),
             pos=np.zeros(depth, dtype=np.int64),
             chosen=np.zeros(depth, dtype=np.int32),
+        )
+
+    def wide(self, depth: int) -> MRVWide | None:
+        """The multi-word side for ``depth`` levels; None on one-word targets."""
+        W = self.words
+        if W == 1:
+            return None
+        return MRVWide(
+            self.masks,
+            np.zeros((depth + 1, W), dtype=np.uint64),
+            np.zeros((5, W), dtype=np.uint64),
+            np.zeros((2, W), dtype=np.uint64),
         )
 
 

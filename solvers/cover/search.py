@@ -198,6 +198,7 @@ class CoverSearch:
             self._cnt = np.zeros(len(problem.types), dtype=np.int32)
         else:
             self._stack = a.stack(depth, len(problem.types))
+            self._wide = a.wide(depth)
 
     @property
     def stats(self) -> CoverStats:
@@ -236,7 +237,7 @@ class CoverSearch:
                 self._cnt, self._perm, self._nbuf, self._pos, self._aux, self._chosen
             )
             return bitboard_run(a.rows, self._occ, lv, ctl)
-        return mrv_run(a.rows, self._stack, ctl)
+        return mrv_run(a.rows, self._stack, ctl, self._wide)
 
     def _call(self, max_store: int, stop_after: int) -> Int32Array:
         out = np.zeros((max(max_store, 1), self._depth), dtype=np.int32)

@@ -22,6 +22,7 @@ offsets relative to the part's first piece (BurrTools' ``disassemblerNode_c::ope
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -81,23 +82,18 @@ def _reach(gaps: I64, d: int, i: int, s: int, k: int, limit: int, todo: I64) -> 
     return mask
 
 
-@njit(cache=True)
-def _child(
-    states: I16, node: int, mask: np.int64, d: int, s: int, k: int, out: I16
-) -> None:  # fmt: skip
-    """``out``: the state ``node`` with the pieces of ``mask`` moved ``s`` along ``d``, the
-    part's first piece kept at the origin (the others move back instead)."""
-    a = d // 2
-    sign = 1 if d % 2 == 0 else -1
-    anchor = (mask & 1) != 0
-    for t in range(3 * k):
-        out[t] = states[node, t]
-    for p in range(k):
-        inside = ((mask >> p) & 1) != 0
-        if anchor and not inside:
-            out[3 * p + a] -= sign * s
-        elif not anchor and inside:
-            out[3 * p + a] += sign * s
+class PartGaps(NamedTuple):
+    """A part as :func:`part_search` reads it: the whole puzzle's :class:`PieceTable` arrays,
+    the part's pieces (``members``: rows of them) and the memo of their pair gaps
+    (:func:`chaingeo.solvers.motion.movement.memo_pair_gaps`, shared by a puzzle's parts)."""
+
+    vox: I64
+    starts: I64
+    lo: I64
+    hi: I64
+    members: I64
+    memo_rel: I64
+    memo_gap: I64
 
 
 @njit(cache=True)
@@ -114,22 +110,7 @@ def _leaving(gaps: I64, k: int, todo: I64) -> tuple[np.int64, int]:
 
 
 @njit(cache=True)
-def part_search(
-    vox: I64,
-    starts: I64,
-    lo: I64,
-    hi: I64,
-    members: I64,
-    memo_rel: I64,
-    memo_gap: I64,
-    states: I16,
-    parent: I64,
-    move: I64,
-    table: I64,
-    ctx: I64,
-    budget: int,
-    group_limit: int,
-) -> int:
+def part_search(part: PartGaps, tree: mv.Tree, ctx: I64, budget: int, group_limit: int) -> int:
     """Breadth-first search of one part in BurrTools' order up to its first separation.
 
     ``states`` row 0 is the start (relative offsets); ``ctx``: ``[n_states, next node,
@@ -137,9 +118,9 @@ def part_search(
     PAUSED or NEED_STATES can be repeated (the node being expanded starts over; the states it
     added stay, as BurrTools would have added them in the same order). ``move`` rows: mask,
     direction, distance of the move that found each state. The part's pieces are the table
-    rows ``members`` (``vox`` ... ``hi``: the whole puzzle's :class:`PieceTable` arrays), their
-    pair gaps kept in ``memo_rel``/``memo_gap``
-    (:func:`chaingeo.solvers.motion.movement.memo_pair_gaps`). Returns a status code."""
+    rows ``members`` of :class:`PartGaps`. Returns a status code."""
+    vox, starts, lo, hi, members, memo_rel, memo_gap = part
+    states, parent, move, table = tree
     k = members.shape[0]
     half = k // 2
     gaps = np.empty((3, k, k), dtype=np.int64)
@@ -216,7 +197,7 @@ def part_search(
                         f_mask[nf] = cand
                         f_step[nf] = s
                         nf += 1
-                        _child(states, node, cand, d, s, k, child)
+                        mv.shift_child(states[node], child, 0, None, k, cand, d, s)
                         if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
                             ctx[0] = n_states
                             ctx[1] = node
@@ -245,8 +226,7 @@ MAX_STATES, GROUP_LIMIT, BUDGET, MAX_TOTAL = 0, 1, 2, 3
 
 @njit(cache=True)
 def run_part(
-    vox: I64, starts: I64, lo: I64, hi: I64, members: I64, memo_rel: I64, memo_gap: I64,
-    start: I16, max_states: int, budget: int, group_limit: int,
+    part: PartGaps, start: I16, max_states: int, budget: int, group_limit: int
 ) -> tuple[int, I16, I64, I64, I64]:  # fmt: skip
     """:func:`part_search` from ``start`` with buffers grown as needed, up to ``max_states``
     states: ``(status, states, parent, move, ctx)`` (status ``-STATE_CAP`` past the cap)."""
@@ -261,8 +241,7 @@ def run_part(
     ctx[0] = 1
     while True:
         before = ctx[1]
-        status = part_search(vox, starts, lo, hi, members, memo_rel, memo_gap, states, parent,
-                             move, table, ctx, budget, group_limit)  # fmt: skip
+        status = part_search(part, mv.Tree(states, parent, move, table), ctx, budget, group_limit)
         budget -= ctx[1] - before
         if status != NEED_STATES:
             return status, states, parent, move, ctx
@@ -339,10 +318,10 @@ def first_tree(
             status, states, parent, move = SEPARATED, row.reshape(1, 3 * k), no_parent, no_move
             pctx = np.array([1, 0, 0, mask, direction], dtype=np.int64)
         else:
+            part = PartGaps(vox_all, starts_all, lo_all, hi_all, members, memo_rel, memo_gap)
             status, states, parent, move, pctx = run_part(
-                vox_all, starts_all, lo_all, hi_all, members, memo_rel, memo_gap, row,
-                params[MAX_STATES], params[BUDGET] - ctx[EXPANDED], params[GROUP_LIMIT],
-            )  # fmt: skip
+                part, row, params[MAX_STATES], params[BUDGET] - ctx[EXPANDED], params[GROUP_LIMIT]
+            )
         ctx[EXPANDED] += pctx[1]
         ctx[STATES] += pctx[0]
         if status == PAUSED:
@@ -426,9 +405,9 @@ def first_split(
     ctx = np.array([1, 0, 0, 0, 0], dtype=np.int64)
     while True:
         deadline.check()
-        status = part_search(table.vox, table.starts, table.lo, table.hi, local, memo_rel,
-                             memo_gap, states, parent, move, hash_table, ctx, CHUNK,
-                             limits.group_limit)  # fmt: skip
+        part = PartGaps(table.vox, table.starts, table.lo, table.hi, local, memo_rel, memo_gap)
+        tree = mv.Tree(states, parent, move, hash_table)
+        status = part_search(part, tree, ctx, CHUNK, limits.group_limit)
         if status == NEED_STATES:
             if ctx[0] + 1 >= states.shape[0]:
                 if states.shape[0] >= max_states:

@@ -161,9 +161,11 @@ def greedy(
         while True:
             before = node
             status, node, n_states, n_seps, n_layers = mv.expand(
-                states, n_states, parent, move, table, node, layers, n_layers, max_states,
-                params[BUDGET] - ctx[EXPANDED], vox, starts, lo, hi, params[MAX_GROUP],
-                params[GROUP_LIMIT], seps, n_seps, moves_buf, groups_buf,
+                mv.Tree(states, parent, move, table), n_states, node, layers, n_layers,
+                max_states, params[BUDGET] - ctx[EXPANDED],
+                mv.Pieces(vox, starts, lo, hi, params[MAX_GROUP], params[GROUP_LIMIT],
+                          moves_buf, groups_buf),
+                seps, n_seps,
             )  # fmt: skip
             ctx[EXPANDED] += node - before
             if status == mv.DONE:

@@ -14,6 +14,8 @@ Pieces are the voxels of one *part* (a sub-puzzle) in their assembled position; 
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import numpy.typing as npt
 
@@ -31,6 +33,32 @@ INF = 1 << 40
 DONE, NEED_STATES, NEED_SEPS, TOO_MANY_GROUPS, NEED_MOVES, PAUSED = 0, 1, 2, 3, 4, 7
 #: Most pieces one part may hold (groups are 64-bit masks).
 MAX_PIECES = 63
+
+
+class Pieces(NamedTuple):
+    """A part's pieces as :func:`node_moves` reads them (voxels sorted per axis, where each
+    piece's rows start, boxes: :meth:`chaingeo.solvers.motion.partsearch.PieceTable.part_arrays`),
+    the group caps (``max_group`` -1: any), and the buffers it writes (move rows, groups)."""
+
+    vox: I64
+    starts: I64
+    lo: I64
+    hi: I64
+    max_group: int
+    group_limit: int
+    moves: I64
+    groups: U64
+
+
+class Tree(NamedTuple):
+    """A breadth-first search's growing arrays: the state rows, each state's parent and the move
+    that made it (rows), and the open-addressing ``table`` over the rows (:func:`find_or_insert`);
+    a search replaces them as they fill (:func:`grow_search`, :func:`fit_table`)."""
+
+    states: I16
+    parent: I64
+    move: I64
+    table: I64
 
 
 @njit(cache=True)
@@ -401,7 +429,8 @@ def node_moves(
 
 @njit(cache=True, inline="always")
 def shift_child(
-    row: I16, child: I16, base: int, pieces: I64 | None, m: int, mask: int, d: int, k: int
+    row: I16, child: I16, base: int, pieces: I64 | None, m: int, mask: int | np.int64, d: int,
+    k: int,
 ) -> None:  # fmt: skip
     """``child`` = ``row`` with the group ``mask`` (bits of the piece indices ``pieces[:m]``,
     or ``0..m-1`` when ``pieces`` is None; offsets at ``base + 3 piece``) moved ``k`` units
@@ -513,27 +542,9 @@ def fit_table(table: I64, states: I16, n_states: int) -> I64:
 
 @njit(cache=True)
 def expand(
-    states: I16,
-    n_states: int,
-    parent: I64,
-    move: I64,
-    table: I64,
-    node: int,
-    layers: I64,
-    n_layers: int,
-    max_depth: int,
-    budget: int,
-    vox: I64,
-    starts: I64,
-    lo: I64,
-    hi: I64,
-    max_group: int,
-    group_limit: int,
-    seps: I64,
-    n_seps: int,
-    moves_buf: I64,
-    groups_buf: U64,
-) -> tuple[int, int, int, int, int]:
+    tree: Tree, n_states: int, node: int, layers: I64, n_layers: int, max_depth: int,
+    budget: int, pieces: Pieces, seps: I64, n_seps: int,
+) -> tuple[int, int, int, int, int]:  # fmt: skip
     """Breadth-first search, layer after layer in one call (no Python between layers).
 
     Layer ``d`` holds nodes ``layers[d]:layers[d + 1]`` (``n_layers`` entries); ``node`` is
@@ -547,6 +558,8 @@ def expand(
     scratch, so its removals are dropped first). ``layers`` holds two more entries than
     ``states`` rows (every layer has a node).
     """
+    states, parent, move, table = tree
+    vox, starts, lo, hi, max_group, group_limit, moves_buf, groups_buf = pieces
     n = starts.shape[0] - 1
     w = 3 * n
     gaps = np.empty((3, n, n), dtype=np.int64)

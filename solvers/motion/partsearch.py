@@ -191,11 +191,14 @@ class PartSearch:
         deepest = self.limits.max_states if max_depth is None else max_depth
         while True:
             self.deadline.check()
+            tree = mv.Tree(self.states, self.parent, self.move, self.hash)
+            pieces = mv.Pieces(
+                self.vox, self.starts, self.lo, self.hi, self.max_group,
+                self.limits.group_limit, self.moves_buf, self.groups_buf,
+            )  # fmt: skip
             status, self.node, self.n_states, self.n_seps, self.n_layers = mv.expand(
-                self.states, self.n_states, self.parent, self.move, self.hash, self.node,
-                self.layers, self.n_layers, deepest, self.chunk, self.vox, self.starts,
-                self.lo, self.hi, self.max_group, self.limits.group_limit, self.seps,
-                self.n_seps, self.moves_buf, self.groups_buf,
+                tree, self.n_states, self.node, self.layers, self.n_layers, deepest,
+                self.chunk, pieces, self.seps, self.n_seps,
             )  # fmt: skip
             if status == mv.DONE:
                 break

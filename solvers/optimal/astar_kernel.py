@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.core.jit import entry, njit
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.optimal.pattern_db import DEAD, KEY_WIDTH, lookup
@@ -101,18 +101,9 @@ class Heap(NamedTuple):
     node: I64
 
 
-class Pieces(NamedTuple):
-    """The pieces' voxels and boxes (:meth:`PieceTable.part_arrays`), the group caps, and the
-    buffers :func:`chaingeo.solvers.motion.movement.node_moves` writes."""
-
-    vox: I64
-    starts: I64
-    lo: I64
-    hi: I64
-    max_group: int
-    group_limit: int
-    moves: I64
-    groups: U64
+#: The pieces' voxels and boxes, the group caps and the buffers of
+#: :func:`chaingeo.solvers.motion.movement.node_moves` (the bundle every search kernel takes).
+Pieces = mv.Pieces
 
 
 @njit(cache=True)
@@ -120,9 +111,20 @@ def part_h(row: I16, n: int, label: int, size: int, pdb: PDBView) -> int:
     """The term of one part (module docstring of :mod:`chaingeo.solvers.optimal.astar`); -1 when a
     pattern database entry is missing (its key is written to ``pdb.miss``), ``DEAD`` when some
     subset can never come apart."""
+    fam, n_fam, keys, vals, table, key, miss = pdb
+    return _part_h(row, n, label, size, fam, n_fam, keys, vals, table, key, miss)
+
+
+@njit(cache=True)
+def _part_h(
+    row: I16, n: int, label: int, size: int, fam: I64, n_fam: int, keys: I16, vals: I32,
+    table: I64, key: I16, miss: I16,
+) -> int:  # fmt: skip
+    """:func:`part_h` on :class:`PDBView`'s fields. The expansion calls it per child with the
+    fields taken out once per node: a bundle passed per call and unpacked in the callee costs a
+    reference count per array per call (with :func:`_store`'s, 9% of a small A* search)."""
     if size < 2:
         return 0
-    fam, n_fam, keys, vals, table, key, miss = pdb  # locals: a tuple field read costs a refcount
     h = size - 1
     for f in range(n_fam):
         a = fam[f, 0]
@@ -305,10 +307,11 @@ def _split_h(
 ) -> tuple[int, int]:
     """``(h of both new parts, h of the child's active part)`` after :func:`_split` of the part
     ``act``; ``(-1, 0)`` on a missing entry, ``(DEAD, 0)`` when a part never comes apart."""
-    ha = part_h(child, n, la, sa, pdb)
+    fam, n_fam, keys, vals, table, key, miss = pdb
+    ha = _part_h(child, n, la, sa, fam, n_fam, keys, vals, table, key, miss)
     if ha < 0:
         return -1, 0
-    hb = part_h(child, n, lb, sb, pdb)
+    hb = _part_h(child, n, lb, sb, fam, n_fam, keys, vals, table, key, miss)
     if hb < 0:
         return -1, 0
     if ha >= DEAD or hb >= DEAD:
@@ -331,7 +334,7 @@ def _split_h(
         return ha + hb, ha
     if nact == lb:
         return ha + hb, hb
-    hc = part_h(child, n, nact, cnt[nact], pdb)
+    hc = _part_h(child, n, nact, cnt[nact], fam, n_fam, keys, vals, table, key, miss)
     if hc < 0:
         return -1, 0
     return ha + hb, hc
@@ -339,17 +342,18 @@ def _split_h(
 
 @njit(cache=True)
 def _store(
-    regs: I64, nodes: Nodes, heap: Heap, child: I16, cur: int, hgf: tuple[int, int, int, int],
-    move: tuple[int, int, int],
+    regs: I64, rows: I16, gv: I32, hv: I32, hact: I32, fv: I32, parent: I64, mmask: I64,
+    mdir: I64, mk: I64, closed: U8, table: I64, hkey: I64, hnode: I64, child: I16, cur: int,
+    hgf: tuple[int, int, int, int], move: tuple[int, int, int],
 ) -> int:  # fmt: skip
     """Store ``child`` of ``cur`` (``hgf``: its ``h``, active ``h``, ``g``, ``f``; ``move``:
-    mask, direction, ``k``) unless known at a ``g`` as small; -1, or the buffer to grow."""
+    mask, direction, ``k``) unless known at a ``g`` as small; -1, or the buffer to grow. Called
+    per child, it takes :class:`Nodes`' and :class:`Heap`'s arrays loose (see :func:`_part_h`)."""
     h, hc, g1, fc = hgf
-    rows, gv, hv, hact, fv, parent, mmask, mdir, mk, closed, table = nodes
     n_states = regs[R_STATES]
     if n_states >= rows.shape[0] or 2 * (n_states + 1) > table.shape[0]:
         return NEED_STATES
-    if regs[R_HEAP] + 1 >= heap.key.shape[0]:
+    if regs[R_HEAP] + 1 >= hkey.shape[0]:
         return NEED_HEAP
     got = mv.find_or_insert(rows, n_states, table, child)
     if got < 0:
@@ -369,7 +373,7 @@ def _store(
     mmask[got] = move[0]
     mdir[got] = move[1]
     mk[got] = move[2]
-    regs[R_HEAP] = _push(heap.key, heap.node, regs[R_HEAP], _heap_key(g1, hv[got]), got)
+    regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(g1, hv[got]), got)
     return -1
 
 
@@ -382,8 +386,12 @@ def _expand(
     ``fv`` (a partial expansion): -1 when done, else a status. ``work``: scratch (a child row,
     part sizes, the active part's pieces)."""
     child, cnt, members = work
+    # the per-child helpers take arrays: taken out of the bundles once per node (see _part_h)
+    rows, gv, hv, hact, fv, parent, mmask, mdir, mk, closed, table = nodes
+    hkey, hnode = heap
+    fam, n_fam, keys, vals, ptable, key, miss = pdb
     cur = regs[R_CUR]
-    row = nodes.rows[cur]
+    row = rows[cur]
     n = pieces.lo.shape[0]
     act, m = _active_part(row, n, cnt, members)
     nrows = _part_moves(row, n, members, m, pieces)
@@ -392,10 +400,10 @@ def _expand(
     if nrows == -1:
         return NEED_MOVES
     moves = pieces.moves
-    g1 = nodes.gv[cur] + 1
-    hbase = nodes.hv[cur] - nodes.hact[cur]
-    big_f = nodes.fv[cur]  # this (partial) expansion stores the children with f == big_f
-    first = big_f == nodes.gv[cur] + nodes.hv[cur]
+    g1 = gv[cur] + 1
+    hbase = hv[cur] - hact[cur]
+    big_f = fv[cur]  # this (partial) expansion stores the children with f == big_f
+    first = big_f == gv[cur] + hv[cur]
     nxt = DEAD
     for r in range(nrows):
         lmask = moves[r, 0]
@@ -409,7 +417,7 @@ def _expand(
         for k in range(1, last + 1):
             if k <= kmax:
                 mv.shift_child(row, child, n, members, m, gmask, d, k)
-                hc = part_h(child, n, act, m, pdb)
+                hc = _part_h(child, n, act, m, fam, n_fam, keys, vals, ptable, key, miss)
                 if hc < 0:
                     return NEED_PDB
                 if hc >= DEAD:
@@ -433,17 +441,19 @@ def _expand(
                 continue
             if fc < big_f and not first:
                 continue  # stored by an earlier expansion of cur
-            status = _store(regs, nodes, heap, child, cur, (h, hc, g1, fc), (gmask, d, kk))
+            status = _store(
+                regs, rows, gv, hv, hact, fv, parent, mmask, mdir, mk, closed, table, hkey, hnode,
+                child, cur, (h, hc, g1, fc), (gmask, d, kk),
+            )  # fmt: skip
             if status >= 0:
                 return status
     if nxt < DEAD:  # children with a larger f remain: come back at the next f
-        if regs[R_HEAP] + 1 >= heap.key.shape[0]:
+        if regs[R_HEAP] + 1 >= hkey.shape[0]:
             return NEED_HEAP
-        nodes.fv[cur] = nxt
-        key = _heap_key(nodes.gv[cur], nxt - nodes.gv[cur])
-        regs[R_HEAP] = _push(heap.key, heap.node, regs[R_HEAP], key, cur)
+        fv[cur] = nxt
+        regs[R_HEAP] = _push(hkey, hnode, regs[R_HEAP], _heap_key(gv[cur], nxt - gv[cur]), cur)
     else:
-        nodes.fv[cur] = -1
+        fv[cur] = -1
     return -1
 
 
@@ -591,6 +601,7 @@ class Run:
         max_exp = -1 if self.limits.max_expansions is None else self.limits.max_expansions
         bundles: tuple[Nodes, Heap, Pieces] | None = None
         view: PDBView | None = None
+        kernel = None
         while True:
             self.deadline.check()
             if bundles is None:  # the arrays were replaced (grown)
@@ -599,7 +610,10 @@ class Run:
                 view = pdb_view(pdb, self.miss)
             elif view.vals is not pdb.vals:
                 view = view._replace(vals=pdb.vals)
-            status = run_astar(self.regs, *bundles, view, max_exp, 20000)
+            args = (self.regs, *bundles, view, max_exp, 20000)
+            if kernel is None:  # one typing per search: the bundles keep their types (jit.entry)
+                kernel = entry(run_astar, *args)
+            status = kernel(*args)
             if status == FOUND:
                 return int(self.regs[R_GOAL])
             if status == EXHAUSTED:

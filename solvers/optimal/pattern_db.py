@@ -20,11 +20,12 @@ final). A state from which ``S`` never comes apart gets :data:`DEAD`.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.core.jit import entry, njit
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.motion import movement as mv
@@ -54,36 +55,40 @@ def _key_of(sid: int, state: I16, m: int, key: I16) -> None:
         key[1 + t] = state[3 + t] if 3 + t < 3 * m else 0
 
 
+class Component(NamedTuple):
+    """The growing arrays of one sub-puzzle's enumeration (:func:`sub_component`): state rows
+    and their hash ``table``, each state's database value or -1 (``known``), the moves
+    ``(from, to)`` and the removals ``(state, mask)`` seen."""
+
+    states: I16
+    table: I64
+    known: I32
+    edges: I64
+    rems: I64
+
+
+class Database(NamedTuple):
+    """A pattern database's arrays as a kernel reads them: key rows, values, hash table."""
+
+    keys: I16
+    vals: I32
+    table: I64
+
+
 @njit(cache=True)
 def sub_component(
-    states: I16,
-    n_states: int,
-    table: I64,
-    known: I32,
-    node: int,
-    edges: I64,
-    n_edges: int,
-    rems: I64,
-    n_rems: int,
-    vox: I64,
-    starts: I64,
-    lo: I64,
-    hi: I64,
-    max_group: int,
-    group_limit: int,
-    sid: int,
-    pkeys: I16,
-    pvals: I32,
-    ptable: I64,
-    moves_buf: I64,
-    groups_buf: U64,
-) -> tuple[int, int, int, int, int]:
+    comp: Component, n_states: int, node: int, n_edges: int, n_rems: int,
+    pieces: mv.Pieces, sid: int, db: Database,
+) -> tuple[int, int, int, int, int]:  # fmt: skip
     """Breadth first over the one-part states of a sub-puzzle from ``node`` on, recording every
     move ``(from, to)`` in ``edges`` and every removal ``(state, mask)`` in ``rems``. A new
     state already in the pattern database gets ``known`` = its value and is not expanded.
     Returns ``(status, next node, n_states, n_edges, n_rems)``; on a status other than
     SUB_DONE the caller grows the named buffer and calls again from ``next`` (whose edges and
     removals have been dropped)."""
+    states, table, known, edges, rems = comp
+    vox, starts, lo, hi, max_group, group_limit, moves_buf, groups_buf = pieces
+    pkeys, pvals, ptable = db
     m = starts.shape[0] - 1
     w = 3 * m
     gaps = np.empty((3, m, m), dtype=np.int64)
@@ -96,9 +101,10 @@ def sub_component(
             continue
         e0 = n_edges
         r0 = n_rems
+        row = states[node]  # once per node: a view taken per child costs a reference count
         for p in range(m):
             for t in range(3):
-                off[p, t] = states[node, 3 * p + t]
+                off[p, t] = row[3 * p + t]
         rows = mv.node_moves(
             vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
         )
@@ -121,7 +127,7 @@ def sub_component(
                     return SUB_NEED_STATES, node, n_states, e0, r0
                 if n_edges >= edges.shape[0]:
                     return SUB_NEED_EDGES, node, n_states, e0, r0
-                mv.shift_child(states[node], child, 0, None, m, moves_buf[r, 0], d, k)
+                mv.shift_child(row, child, 0, None, m, moves_buf[r, 0], d, k)
                 got = mv.find_or_insert(states, n_states, table, child)
                 if got < 0:
                     got = -1 - got
@@ -315,8 +321,13 @@ class PatternDB:
         self.hash = np.full(4096, -1, dtype=np.int64)
         self.n_keys = 0
         self.searches = 0  # sub-puzzle searches run
+        self._sub_component: Any = None  # sub_component typed for this database (jit.entry)
         self.searched_states = 0  # states those searches enumerated
         self._parts = {s: table.part_arrays(s) for s in self.family}
+        # node_moves' buffers, shared by the enumerations (one runs at a time): a small search
+        # runs dozens, and each allocated its own
+        self._moves_buf = np.zeros((256, 4), dtype=np.int64)
+        self._groups_buf = np.zeros(min(group_limit, 1 << 16) + 1, dtype=np.uint64)
 
     def _reserve(self, extra: int) -> None:
         need = self.n_keys + extra
@@ -387,18 +398,21 @@ class PatternDB:
         known = np.full(cap, -1, dtype=np.int32)
         edges = np.zeros((4 * cap, 2), dtype=np.int64)
         rems = np.zeros((256, 2), dtype=np.int64)
-        moves_buf = np.zeros((256, 4), dtype=np.int64)
-        groups_buf = np.zeros(min(self.group_limit, 1 << 16) + 1, dtype=np.uint64)
+        pieces = mv.Pieces(
+            vox, starts, lo, hi, self.max_group, self.group_limit, self._moves_buf,
+            self._groups_buf,
+        )  # fmt: skip
+        db = Database(self.keys, self.vals, self.hash)  # not replaced while this runs
         mv.find_or_insert(states, 0, hash_, start)
         n_states, n_edges, n_rems, node = 1, 0, 0, 0
         self.searches += 1
         while True:
             self.deadline.check()
-            status, node, n_states, n_edges, n_rems = sub_component(
-                states, n_states, hash_, known, node, edges, n_edges, rems, n_rems,
-                vox, starts, lo, hi, self.max_group, self.group_limit, sid,
-                self.keys, self.vals, self.hash, moves_buf, groups_buf,
-            )  # fmt: skip
+            comp = Component(states, hash_, known, edges, rems)
+            args = (comp, n_states, node, n_edges, n_rems, pieces, sid, db)
+            if self._sub_component is None:  # typed once per database (jit.entry)
+                self._sub_component = entry(sub_component, *args)
+            status, node, n_states, n_edges, n_rems = self._sub_component(*args)
             if status == SUB_DONE:
                 break
             if status == SUB_NEED_STATES:
@@ -418,7 +432,8 @@ class PatternDB:
                 edges = np.concatenate([edges, np.zeros_like(edges)])
                 rems = np.concatenate([rems, np.zeros_like(rems)])
             elif status == SUB_NEED_MOVES:
-                moves_buf = np.zeros((2 * moves_buf.shape[0], 4), dtype=np.int64)
+                self._moves_buf = np.zeros((2 * self._moves_buf.shape[0], 4), dtype=np.int64)
+                pieces = pieces._replace(moves=self._moves_buf)
             else:
                 raise SearchLimitError(
                     f"more than {self.group_limit} movable groups along one direction; "
