@@ -259,8 +259,8 @@ def disassembly_actions(asm: Assembly, max_group: int | None, table: PieceTable)
 
 
 def disassembly_ranges(asm: Assembly, max_group: int | None, table: PieceTable) -> list[MoveRange]:
-    """The same moves as one lazy block per (group, direction): one Python object per pair,
-    the way :class:`MoveTable` is checked (tests) and timed against (``chain bench actions``)."""
+    """The same moves as one lazy block per (group, direction), one Python object per pair:
+    the simple form :class:`MoveTable` is tested against (tests/envs/machines)."""
     chunks: list[MoveRange] = []
     for names, rows in _ranges(asm, max_group, table):
         groups = _groups(names, rows[:, 0])
