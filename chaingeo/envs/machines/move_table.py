@@ -201,8 +201,9 @@ def _group_keys(masks: np.ndarray, ranks: np.ndarray, width: int) -> np.ndarray:
 
 
 def _packed(ranks: list[int], width: int) -> list[int]:
-    """The key columns of one group's ascending ``ranks``, as :func:`_group_keys` packs them
-    (``[]``-padded past ``width`` columns: then no row of the table can equal it)."""
+    """The key columns of one group's ascending ``ranks``, as :func:`_group_keys` packs them,
+    zero-padded to ``width`` columns (a group too long for ``width`` gets more columns, and
+    then no row of the table can equal it)."""
     cols = [0] * max(width, -(-len(ranks) // _FIELDS))
     for slot, rank in enumerate(ranks):
         cols[slot // _FIELDS] |= (rank + 1) << (_BITS * (_FIELDS - 1 - slot % _FIELDS))
