@@ -4,14 +4,35 @@ differential tests' counts, gathered from every pytest-xdist worker and printed 
 from __future__ import annotations
 
 import dataclasses
+import os
 import sys
+import tempfile
+from pathlib import Path
 from typing import Any
 
 import pytest
 from hypothesis import settings
 
+from chaingeo.core import aot
+
 settings.register_profile("ci", derandomize=True, deadline=None, max_examples=100)
 settings.load_profile("ci")
+
+#: The kernels ``chain precompile`` stored for this user (what tests/core/test_aot.py checks).
+#: Every other test, and every ``chain`` it starts, sees an empty store, so that what
+#: ``--jit auto`` chooses does not depend on whether this machine has precompiled.
+USER_KERNELS = aot.store_dir()
+os.environ[aot.DIR_ENV] = os.path.join(tempfile.mkdtemp(prefix="chaingeo-tests-"), "no-kernels")
+
+
+@pytest.fixture
+def user_kernels() -> Path:
+    """The user's precompiled kernels (skips when there are none usable)."""
+    manifest, sentence = aot.status(USER_KERNELS)
+    if manifest is None or manifest.stale():
+        pytest.skip(f"{USER_KERNELS}: {sentence}")
+    return USER_KERNELS
+
 
 #: Outcomes the workers sent back (the controller's list; empty without xdist).
 _FROM_WORKERS: list[dict[str, str]] = []

@@ -1,16 +1,21 @@
-"""The one place kernels are compiled: numba's ``njit``, or the plain Python function.
+"""The one place kernels are compiled: numba's ``njit``, ahead of time, or the plain function.
 
 Every kernel of the toolkit is written once, for numba, on flat numpy arrays, and decorated with
-:func:`njit` from here. By default that is numba's ``njit``. In *interpreted* mode the decorator
-returns the function itself and numba is never imported: starting numba and loading its cached
-kernels costs ~0.3 s of a process, many times the work of a small puzzle, so ``chain analyze``
-runs a single small file interpreted and moves to numba when the work turns out larger (it starts
-itself again with the mode set, see :mod:`chaingeo.cli.commands.analyze`).
+:func:`njit` from here. By default that is numba's ``njit``. Starting numba and loading its
+cached kernels costs ~0.5 s of a process, many times the work of a small puzzle, so two other
+modes exist, both without importing numba:
 
-The mode is read from ``CHAINGEO_JIT`` (``numba``, the default, or ``python``) when a kernel
-module is first imported, so it is fixed for a process before any kernel is defined; changing it
-later raises. Interpreted kernels compute the same results: fixed-width numpy integers wrap as
-numba's do (numpy's overflow warnings are silenced in that mode).
+- *ahead-of-time* (``aot``): each kernel is an :class:`chaingeo.core.aot.AotKernel` calling the
+  functions ``chain precompile`` compiled for the argument types a workload used; ``chain
+  analyze`` uses them when they match the sources and starts again with numba on a miss;
+- *interpreted* (``python``): the decorator returns the function itself; ``chain analyze`` runs
+  a single small file so when nothing is precompiled, and moves to numba when the work turns
+  out larger (see :mod:`chaingeo.cli.commands.analyze`).
+
+The mode is read from ``CHAINGEO_JIT`` (``numba``, the default, ``aot`` or ``python``) when a
+kernel module is first imported, so it is fixed for a process before any kernel is defined;
+changing it later raises. Every mode computes the same results: fixed-width numpy integers wrap
+as numba's do (numpy's overflow warnings are silenced in interpreted mode).
 """
 
 from __future__ import annotations
@@ -21,9 +26,9 @@ from typing import Any, Final, Literal, TypeVar, overload
 
 import numpy as np
 
-Mode = Literal["numba", "python"]
+Mode = Literal["numba", "aot", "python"]
 ENV: Final = "CHAINGEO_JIT"
-MODES: Final[tuple[Mode, ...]] = ("numba", "python")
+MODES: Final[tuple[Mode, ...]] = ("numba", "aot", "python")
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -36,7 +41,7 @@ def mode() -> Mode:
         raw = os.environ.get(ENV, "numba").strip().lower() or "numba"
         if raw not in MODES:
             raise ValueError(f"{ENV}: expected one of {', '.join(MODES)}, got {raw!r}")
-        _fix("python" if raw == "python" else "numba")
+        _fix(raw)
     assert _mode is not None
     return _mode
 
@@ -53,6 +58,11 @@ def set_mode(wanted: Mode) -> None:
 
 def _fix(wanted: Mode) -> None:
     global _mode
+    if wanted == "aot" and _mode != "aot":
+        from chaingeo.core import aot
+
+        if aot.load() is None:
+            raise RuntimeError(f"no usable ahead-of-time kernels: {aot.status()[1]}")
     _mode = wanted
     if wanted == "python":
         np.seterr(over="ignore")  # numpy scalars warn where numba's integers wrap silently
@@ -63,18 +73,47 @@ def njit(fn: F, /) -> F: ...
 @overload
 def njit(**options: Any) -> Callable[[F], F]: ...
 def njit(*args: Any, **options: Any) -> Any:
-    """``numba.njit`` with the same arguments, or (interpreted) the function unchanged."""
-    if mode() == "python":
-        if args and callable(args[0]):
-            return args[0]
-        return _identity
-    import numba  # only here: interpreted processes never import it
+    """``numba.njit`` with the same arguments, the kernel compiled ahead of time, or
+    (interpreted) the function unchanged."""
+    current = mode()
+    if current == "python":
+        make: Callable[[Any], Any] = _identity
+    elif current == "aot":
+        make = _ahead_of_time
+    else:
+        import numba  # only here: the other modes never import it
 
-    return numba.njit(*args, **options)
+        compiled = numba.njit(**options)
+
+        def make(fn: Any) -> Any:
+            dispatcher = compiled(fn)
+            _dispatchers.append(dispatcher)
+            return dispatcher
+
+    if args and callable(args[0]):
+        return make(args[0])
+    return make
+
+
+_dispatchers: list[Any] = []
+
+
+def dispatchers() -> list[Any]:
+    """Every numba dispatcher :func:`njit` made in this process (what ``chain precompile``
+    reads the compiled signatures from)."""
+    return list(_dispatchers)
 
 
 def _identity(fn: F) -> F:
     return fn
+
+
+def _ahead_of_time(fn: Callable[..., Any]) -> Any:
+    from chaingeo.core import aot
+
+    loaded = aot.load()
+    assert loaded is not None  # the mode is set only once a build loaded
+    return aot.AotKernel(fn, loaded.exports_of(aot.kernel_name(fn)))
 
 
 _entries: dict[tuple[object, tuple[bytes, ...]], Any] = {}
@@ -93,6 +132,9 @@ def entry(kernel: F, *args: Any) -> F:
     replaced by grown copies). Resolving costs numba's C fingerprints of ``args`` and a dict
     look-up; the first time per types, numba's Python typing (about 10 us an array)."""
     dispatcher: Any = kernel
+    resolve = getattr(kernel, "resolve", None)
+    if resolve is not None:  # ahead of time
+        return resolve(args)  # type: ignore[no-any-return]
     if not hasattr(dispatcher, "overloads"):  # interpreted, or a plain function standing in
         return kernel
     from numba._dispatcher import compute_fingerprint

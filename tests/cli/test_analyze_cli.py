@@ -117,7 +117,7 @@ def test_auto_runs_a_small_file_interpreted_and_a_large_one_with_numba() -> None
 def test_a_bad_mode_in_the_environment_is_named() -> None:
     bad = _chain(str(DATA / "linked_rings.xmpuzzle"), env={"CHAINGEO_JIT": "fast"})
     assert bad.returncode == 2
-    assert "CHAINGEO_JIT: expected one of numba, python, got 'fast'" in bad.stderr
+    assert "CHAINGEO_JIT: expected one of numba, aot, python, got 'fast'" in bad.stderr
 
 
 def test_an_interpreted_analysis_never_imports_numba() -> None:

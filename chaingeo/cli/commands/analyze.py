@@ -13,7 +13,10 @@ A file that takes more than a few seconds reports on standard error what it is d
 enumeration of assemblies, every disassembly and the optimal search share one deadline (a spent
 optimal search alone is reported as ``optimal_error``).
 
-``--jit auto`` (default) runs a single small file with interpreted kernels: starting numba costs
+``--jit auto`` (default) uses the kernels ``chain precompile`` compiled ahead of time when they
+match the installed sources (loading them takes milliseconds, starting numba ~0.5 s); a call
+they were not compiled for makes the command start again with numba for the files not yet
+printed. Without them, a single small file runs with interpreted kernels: starting numba costs
 more than the work (:mod:`chaingeo.core.jit`); if the work takes more than
 :data:`INTERPRETED_SECONDS` of CPU time, the command starts again with numba.
 
@@ -118,9 +121,10 @@ def register(sub: Any) -> None:
     )
     p.add_argument(
         "--jit",
-        choices=("auto", "numba", "python"),
+        choices=("auto", "aot", "numba", "python"),
         default="auto",
-        help="kernels compiled by numba, interpreted, or interpreted for one small file",
+        help="kernels compiled ahead of time (chain precompile), by numba, interpreted, or "
+        "auto: ahead of time when compiled, else interpreted for one small file, else numba",
     )
     p.set_defaults(func=run)
 
@@ -131,16 +135,22 @@ def run(args: argparse.Namespace) -> int:
             raise CommandError(f"{flag}: expected a positive number of seconds, got {value}")
     if args.max_states < 1:
         raise CommandError(f"--max-states: expected a positive number, got {args.max_states}")
+    if _ahead_of_time_first(args):
+        return _run_ahead_of_time(args)
     if _interpreted_first(args):
         return _run_interpreted(args)
     if args.jit != "auto":
         _set_mode(args.jit)
-    return _run_all(args)
+    return _run_all(args, *_resumed())
 
 
-def _run_all(args: argparse.Namespace) -> int:
-    status = 0
-    for spec in args.files:
+def _run_all(args: argparse.Namespace, done: int = 0, status: int = 0) -> int:
+    """Analyse the files after the first ``done`` (printed by an earlier start of the command
+    whose exit status so far was ``status``), one JSON line each."""
+    for i, spec in enumerate(args.files):
+        if i < done:
+            continue
+        _printed[:] = [i, status]
         try:
             figures = analyze_file(spec, args)
             status = max(status, _cut_short(spec, figures))
@@ -224,6 +234,61 @@ def with_flag(reason: str, cap: str | None) -> str:
     return with_option(reason, cap, LIMIT_FLAGS)
 
 
+# -- kernels compiled ahead of time ---------------------------------------------------------
+
+#: Set for a command started again after a kernel miss: "files printed:exit status so far".
+RESUME_ENV: Final = "CHAINGEO_ANALYZE_RESUMED"
+#: [index of the file being analysed, exit status before it] (read when a kernel misses).
+_printed: list[int] = [0, 0]
+
+
+def _resumed() -> tuple[int, int]:
+    """Files printed and status so far when this process continues a restarted command."""
+    raw = os.environ.pop(RESUME_ENV, "")
+    try:
+        done, status = (int(x) for x in raw.split(":"))
+    except ValueError:
+        return 0, 0
+    return max(done, 0), min(max(status, 0), 2)
+
+
+def _ahead_of_time_first(args: argparse.Namespace) -> bool:
+    """Whether to use the precompiled kernels: ``--jit aot``, or ``--jit auto`` when they match
+    the sources, no mode is forced by ``CHAINGEO_JIT`` and the command can start itself again
+    (not a call of ``main``)."""
+    from chaingeo.core import aot, jit
+
+    if _aot_forced(args):
+        return True
+    argv = getattr(args, "command_line", None)
+    if args.jit != "auto" or argv is None or jit.ENV in os.environ or RESUME_ENV in os.environ:
+        return False
+    manifest, _ = aot.status()
+    return manifest is not None and manifest.stale() is None
+
+
+def _aot_forced(args: argparse.Namespace) -> bool:
+    from chaingeo.core.jit import ENV
+
+    return bool(args.jit == "aot" or (args.jit == "auto" and os.environ.get(ENV) == "aot"))
+
+
+def _run_ahead_of_time(args: argparse.Namespace) -> int:
+    """Analyse with the precompiled kernels; on a call they do not cover, start again with
+    numba for the files not yet printed (``--jit aot``: report the miss instead)."""
+    from chaingeo.core.aot import KernelMiss
+
+    _set_mode("aot")
+    try:
+        return _run_all(args)
+    except KernelMiss as miss:
+        if _aot_forced(args) or args.command_line is None:
+            raise CommandError(f"--jit aot: {miss} (run `chain precompile FILE`)") from None
+        done, status = _printed
+        _restart_with_numba(args.command_line, done, status)
+        raise AssertionError("unreachable") from None  # execve does not return
+
+
 # -- interpreted kernels for one small file ---------------------------------------------------
 
 
@@ -235,7 +300,7 @@ def _set_mode(wanted: str) -> None:
     from chaingeo.core.jit import set_mode
 
     try:
-        set_mode("python" if wanted == "python" else "numba")
+        set_mode("python" if wanted == "python" else "aot" if wanted == "aot" else "numba")
     except RuntimeError as e:  # the process has kernels already (a caller of main())
         raise CommandError(f"--jit {wanted}: {e}") from None
 
@@ -317,9 +382,10 @@ def _run_interpreted(args: argparse.Namespace) -> int:
     return status
 
 
-def _restart_with_numba(argv: list[str]) -> None:
+def _restart_with_numba(argv: list[str], done: int = 0, status: int = 0) -> None:
+    """Start the command again with numba's kernels, skipping the ``done`` files printed."""
     from chaingeo.core.jit import ENV
 
-    env = dict(os.environ, **{ENV: "numba"})
+    env = dict(os.environ, **{ENV: "numba", RESUME_ENV: f"{done}:{status}"})
     sys.stdout.flush()
     os.execve(sys.executable, [sys.executable, "-m", "chaingeo.cli.main", *argv], env)
