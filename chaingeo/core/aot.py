@@ -20,7 +20,6 @@ a ``BaseException`` no analysis code catches, and the command starts again with 
 
 from __future__ import annotations
 
-import hashlib
 import importlib.machinery
 import importlib.util
 import json
@@ -116,6 +115,8 @@ class Manifest:
 
 
 def file_digest(path: str) -> str:
+    import hashlib  # only for a file whose stamp changed (its import costs ~5 ms)
+
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
