@@ -189,7 +189,7 @@ def _figures(problems: st.SearchStrategy[tuple[PuzzleFigures, ...]]) -> Any:
         problems=problems,
         several=st.just(False),
         file=_TEXT,
-        kernels=st.none() | st.sampled_from(["numba", "python"]),
+        kernels=st.none() | st.sampled_from(["numba", "aot", "python"]),
         seconds=st.none() | st.floats(0, 1e4, allow_nan=False),
     )
 
