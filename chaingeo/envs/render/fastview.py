@@ -2,14 +2,15 @@
 
 A view is the frame's background (walls, floor grid, back frame edges), the pieces' faces, the
 front frame edges, then titles, axis ticks, depth labels and the legend. Here every shape and
-every label is drawn by :mod:`chaingeo.envs.render.rasterjit` (Pillow's own algorithms as numba
-kernels) on a numpy array; the legend is drawn by Pillow once per strip under it and then kept
-(:func:`chaingeo.envs.render.legend.paint_legend`). In a box (stacking) the frame stays put, so
-all but the faces, depth labels and legend are kept per layout (the background at drawing
-scale, and the picture without pieces): a step draws the faces on a work copy of the
-background and reduces and takes only the rectangle they (and their labels) cover, redrawing
-the labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass
-(on a recent background, with recent label steps: a frame recurs within an episode).
+every label is drawn by kernels (:mod:`chaingeo.envs.render.rasterjit`: Pillow's own algorithms
+in numba; :mod:`chaingeo.envs.render.texts`: runs of labels and swatches in one call each) on a
+numpy array. A layout's plan (projector, packed walls and edges, label steps) is kept long, its
+pixels shorter. In a box (stacking) the frame stays put, so all but the faces, depth labels and
+legend are kept per layout (the background at drawing scale, and the picture without pieces):
+a step draws the faces on a work copy of the background and reduces and takes only the
+rectangle they (and their labels) cover, redrawing the labels that overlap it. A puzzle's frame
+follows its pieces, so its views are drawn in one pass (on a recent background: a frame recurs
+within an episode; its plan also when the level is played again).
 Every drawing call is the one :mod:`chaingeo.envs.render.scene` makes, in the same order, so the
 pictures are the same bytes (tested over the shipped levels); ``render`` stays the reference
 (and draws where the kernels do not apply: lines wide enough for round joints, or

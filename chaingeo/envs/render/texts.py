@@ -18,7 +18,7 @@ import numpy.typing as npt
 
 from chaingeo.core.jit import njit
 from chaingeo.envs.render.raster import RGB, Box, text_glyph
-from chaingeo.envs.render.rasterjit import U8, canvas
+from chaingeo.envs.render.rasterjit import U8, Canvas, canvas, rectangle
 
 I64 = npt.NDArray[np.int64]
 #: One label: the anchor point (x, y), the text, its pixel size, colour and Pillow anchor.
@@ -98,30 +98,85 @@ def pack_texts(items: Sequence[TextItem]) -> Texts:
     return Texts(atlas.data, np.array(rows, dtype=np.int64), colors, (x0, y0, x1, y1))
 
 
+@njit(cache=True, inline="always")
+def _paste(cv: Canvas, atlas: U8, rows: I64, colors: U8, i: int) -> None:
+    """Label ``i``: its glyph mask pasted in its colour, clipped (``Image.paste(c, box, mask)``:
+    ``(out * (255 - m) + c * m) / 255`` rounded Pillow's way; where the mask is zero that
+    blend leaves the pixel as it is, so it is skipped)."""
+    flat, h_img, w_img = cv
+    off, h, w, x0, y0 = rows[i, 0], rows[i, 1], rows[i, 2], rows[i, 3], rows[i, 4]
+    c0, c1, c2 = np.int64(colors[i, 0]), np.int64(colors[i, 1]), np.int64(colors[i, 2])
+    for my in range(max(0, -y0), min(h, h_img - y0)):
+        src = off + my * w
+        dst = ((y0 + my) * w_img + x0) * 3
+        for mx in range(max(0, -x0), min(w, w_img - x0)):
+            m = np.int64(atlas[src + mx])
+            if m == 0:
+                continue
+            j = dst + 3 * mx
+            t = np.int64(flat[j]) * (255 - m) + c0 * m + 128
+            flat[j] = ((t >> 8) + t) >> 8
+            t = np.int64(flat[j + 1]) * (255 - m) + c1 * m + 128
+            flat[j + 1] = ((t >> 8) + t) >> 8
+            t = np.int64(flat[j + 2]) * (255 - m) + c2 * m + 128
+            flat[j + 2] = ((t >> 8) + t) >> 8
+
+
 @njit(cache=True)
 def paste_texts(img: U8, atlas: U8, rows: I64, colors: U8) -> None:
-    """Each row's glyph mask pasted in its colour, clipped, in order: ``Image.paste(c, box,
-    mask)`` per label (``(out * (255 - m) + c * m) / 255`` rounded Pillow's way; a zero of the
-    mask leaves the pixel as it is, which that blend does too)."""
-    flat, h_img, w_img = canvas(img)
+    """Every label of a run, in order."""
+    cv = canvas(img)
     for i in range(rows.shape[0]):
-        off, h, w, x0, y0 = rows[i, 0], rows[i, 1], rows[i, 2], rows[i, 3], rows[i, 4]
-        c0, c1, c2 = np.int64(colors[i, 0]), np.int64(colors[i, 1]), np.int64(colors[i, 2])
-        for my in range(max(0, -y0), min(h, h_img - y0)):
-            src = off + my * w
-            dst = ((y0 + my) * w_img + x0) * 3
-            for mx in range(max(0, -x0), min(w, w_img - x0)):
-                m = np.int64(atlas[src + mx])
-                if m == 0:
-                    continue
-                j = dst + 3 * mx
-                t = np.int64(flat[j]) * (255 - m) + c0 * m + 128
-                flat[j] = ((t >> 8) + t) >> 8
-                t = np.int64(flat[j + 1]) * (255 - m) + c1 * m + 128
-                flat[j + 1] = ((t >> 8) + t) >> 8
-                t = np.int64(flat[j + 2]) * (255 - m) + c2 * m + 128
-                flat[j + 2] = ((t >> 8) + t) >> 8
+        _paste(cv, atlas, rows, colors, i)
 
 
 def paint_texts(img: U8, texts: Texts) -> None:
     paste_texts(img, texts.atlas, texts.rows, texts.colors)
+
+
+class Swatches(NamedTuple):
+    """Colour swatches, each followed by its label (the legend's and the tray's names)."""
+
+    boxes: npt.NDArray[np.float64]  # (n, 4): the rectangles as ``ImageDraw.rectangle`` takes
+    fills: U8  # (n, 3)
+    edged: npt.NDArray[np.bool_]  # (n,): outlined (the outline's colour is not the fill)
+    texts: Texts  # label i after swatch i
+
+
+def pack_swatches(
+    swatches: Sequence[tuple[tuple[float, float, float, float], RGB, TextItem]], outline: RGB
+) -> Swatches:
+    """Swatches (box, fill, then the label drawn after it), at least one, outlined in
+    ``outline`` where the fill differs."""
+    return Swatches(
+        np.array([box for box, _, _ in swatches], dtype=np.float64),
+        np.array([fill for _, fill, _ in swatches], dtype=np.uint8),
+        np.array([fill != outline for _, fill, _ in swatches], dtype=np.bool_),
+        pack_texts([label for _, _, label in swatches]),
+    )
+
+
+@njit(cache=True)
+def _paint_swatches(
+    img: U8,
+    boxes: npt.NDArray[np.float64],
+    fills: U8,
+    outline: U8,
+    edged: npt.NDArray[np.bool_],
+    atlas: U8,
+    rows: I64,
+    colors: U8,
+) -> None:
+    cv = canvas(img)
+    for i in range(boxes.shape[0]):
+        rectangle(img, boxes[i], fills[i], outline, edged[i])
+        _paste(cv, atlas, rows, colors, i)
+
+
+def paint_swatches(img: U8, swatches: Swatches, outline: U8) -> None:
+    """Each swatch (:func:`chaingeo.envs.render.rasterjit.rectangle`, width 1), then its label,
+    in order: one kernel call."""
+    t = swatches.texts
+    _paint_swatches(
+        img, swatches.boxes, swatches.fills, outline, swatches.edged, t.atlas, t.rows, t.colors
+    )
