@@ -23,16 +23,17 @@ from chaingeo.envs.render.rasterjit import U8, Canvas, canvas, rectangle
 I64 = npt.NDArray[np.int64]
 #: One label: the anchor point (x, y), the text, its pixel size, colour and Pillow anchor.
 TextItem = tuple[float, float, str, int, RGB, str]
-#: Bytes of glyphs one atlas holds before a fresh one is started.
+#: Bytes of glyphs past which the next run starts a fresh atlas.
 ATLAS_BYTES: Final = 16 * 1024 * 1024
 
 
 class _Atlas:
     """Glyph masks laid end to end in one byte array, each placed once.
 
-    Glyphs are only ever appended: a full array is copied into a larger one, and past
-    :data:`ATLAS_BYTES` a fresh one is started. A :class:`Texts` keeps the array it was made
-    against, so its rows stay valid whatever happens to the atlas later."""
+    Glyphs are only ever appended: a full array is copied into a larger one (offsets stay),
+    and a run that finds more than :data:`ATLAS_BYTES` used starts a fresh one first, never
+    midway. A :class:`Texts` keeps the array it was made against, so its rows stay valid
+    whatever happens to the atlas later."""
 
     def __init__(self) -> None:
         self.data = np.zeros(0, dtype=np.uint8)
@@ -55,8 +56,6 @@ class _Atlas:
             return found
         mask, dx, dy = text_glyph(text, px, anchor)
         n = mask.size
-        if self.used + n > ATLAS_BYTES:
-            self.restart()
         if self.used + n > len(self.data):
             grown = np.zeros(max(2 * len(self.data), self.used + n), dtype=np.uint8)
             grown[: self.used] = self.data[: self.used]
@@ -85,6 +84,8 @@ def pack_texts(items: Sequence[TextItem]) -> Texts:
     """The labels of ``items`` (at least one) in order. A label's top-left pixel is its anchor
     point rounded (Python's ``round``) plus its glyphs' offset, as :func:`put_text` places it."""
     atlas = _ATLAS
+    if atlas.used > ATLAS_BYTES:
+        atlas.restart()
     rows = []
     x0 = y0 = 1 << 30
     x1 = y1 = -(1 << 30)
