@@ -149,7 +149,7 @@ class Shape:
         vox = _sort_unique(arr)
         vox.setflags(write=False)
         self._voxels: IntArray = vox
-        self._key: tuple[Cell, ...] = tuple((int(x), int(y), int(z)) for x, y, z in vox.tolist())
+        self._key: tuple[Cell, ...] = tuple(map(tuple, vox.tolist()))
 
     @classmethod
     def _from_sorted(cls, vox: IntArray) -> Shape:
@@ -158,7 +158,7 @@ class Shape:
         vox = np.ascontiguousarray(vox, dtype=np.int64)
         vox.setflags(write=False)
         obj._voxels = vox
-        obj._key = tuple((int(x), int(y), int(z)) for x, y, z in vox.tolist())
+        obj._key = tuple(map(tuple, vox.tolist()))
         return obj
 
     @classmethod

@@ -24,6 +24,8 @@ from chaingeo.envs.machines.state import BaseState
 if TYPE_CHECKING:  # pictures are drawn only when asked for
     from PIL import Image
 
+    from chaingeo.envs.machines.puzzle import PuzzleState
+
 #: The views rendered for every state (the tray and the target are added where they apply).
 VIEWS: Final[tuple[str, ...]] = ("front", "side", "top", "iso")
 DEFAULT_HISTORY: Final = 5
@@ -224,19 +226,30 @@ def scene(state: BaseState) -> tuple[PieceMap, tuple[int, int, int] | None, Piec
         tray = {n: (state.tables.shapes[n], rgb[n]) for n in state.tray}
         return placed, state.box, tray
     assert isinstance(state, PuzzleState)
+    return _puzzle_pieces(state, rgb), None, {}
+
+
+def _puzzle_pieces(state: PuzzleState, rgb: dict[str, str]) -> PieceMap:
+    """Each piece as it lies (its shape turned, then moved: the cells ``state.cells_of``
+    lists, without building them one by one), every part after the largest moved along +x.
+    A shape's voxels are sorted by x first, so its first and last give its x extent."""
+    from chaingeo.core.kinematics import oriented
+
+    asm = state.assembly
     pieces: PieceMap = {}
     cursor: int | None = None
     for part in ordered_parts(state):
-        cells = {n: state.cells_of(n) for n in sorted(part)}
-        if cursor is None:  # the largest part stays where it is
-            shift: Cell = (0, 0, 0)
-        else:
-            lo = [min(c[i] for cs in cells.values() for c in cs) for i in range(3)]
-            shift = (cursor - lo[0], 0, 0)
-        for n, cs in cells.items():
-            pieces[n] = (Shape(cs).translate(shift), rgb[n])
-        cursor = max(c[0] for n in part for c in pieces[n][0].cells) + 1 + _LAYOUT_GAP
-    return pieces, None, {}
+        names = sorted(part)
+        placed = [
+            oriented(asm.shapes[n], asm.rotation_of(n)).translate(asm.offsets[n]) for n in names
+        ]
+        if cursor is not None:  # the largest part stays where it is
+            shift: Cell = (cursor - min(s.cells[0][0] for s in placed), 0, 0)
+            placed = [s.translate(shift) for s in placed]
+        for n, shape in zip(names, placed, strict=True):
+            pieces[n] = (shape, rgb[n])
+        cursor = max(s.cells[-1][0] for s in placed) + 1 + _LAYOUT_GAP
+    return pieces
 
 
 def render_state(

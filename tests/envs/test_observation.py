@@ -2,10 +2,18 @@
 
 from __future__ import annotations
 
+import random
+
+import numpy as np
+
+from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Move
 from chaingeo.envs.actions.types import MoveAction
+from chaingeo.envs.demos import plan_texts
+from chaingeo.envs.gym import PuzzleEnv
 from chaingeo.envs.machines import new_state
-from chaingeo.envs.observation import observe, scene, state_text
+from chaingeo.envs.machines.puzzle import PuzzleState
+from chaingeo.envs.observation import observe, ordered_parts, scene, state_text
 from tests.support.env_levels import drop_level, puzzle_levels, soma_level
 
 
@@ -68,3 +76,45 @@ def test_images_are_png_per_view() -> None:
     assert observe(new_state(soma_level()), image_size=128).images == obs.images
     obs = observe(puzzle("lock3-assemble"), image_size=128)
     assert "target" in obs.images
+
+
+def _scene_cell_by_cell(state: PuzzleState) -> dict[str, tuple[Shape, str]]:
+    """The puzzle scene as it was first written: each piece from ``state.cells_of``."""
+    rgb = {p.name: p.rgb for p in state.level.pieces}
+    pieces: dict[str, tuple[Shape, str]] = {}
+    cursor: int | None = None
+    for part in ordered_parts(state):
+        cells = {n: state.cells_of(n) for n in sorted(part)}
+        shift = (
+            (0, 0, 0)
+            if cursor is None
+            else (cursor - min(c[0] for cs in cells.values() for c in cs), 0, 0)
+        )
+        for n, cs in cells.items():
+            pieces[n] = (Shape(cs).translate(shift), rgb[n])
+        cursor = max(c[0] for n in part for c in pieces[n][0].cells) + 1 + 2  # a gap of 2
+    return pieces
+
+
+def test_puzzle_scene_is_the_cells_piece_by_piece_along_plans_and_random_moves() -> None:
+    rng = random.Random(23)
+    levels = list(PuzzleEnv(images=False).levels.values())
+    turned = 0
+    for level in rng.sample(levels, 10):
+        state = new_state(level)
+        assert isinstance(state, PuzzleState)
+        for text in [*plan_texts(level)[:-1], *["?"] * 6]:
+            if text == "?":
+                moves = [a for a in state.legal_actions() if a.to_text() != "finish"]
+                if not moves:
+                    break
+                text = rng.choice(moves).to_text()
+            state.step_text(text)
+            pieces, _, _ = scene(state)
+            expected = _scene_cell_by_cell(state)
+            assert list(pieces) == list(expected)
+            for name, (shape, color) in pieces.items():
+                assert shape == expected[name][0] and color == expected[name][1]
+                assert np.array_equal(shape.voxels, expected[name][0].voxels)
+            turned += any(state.assembly.rotation_of(n) for n in pieces)
+    assert turned  # some states have turned pieces

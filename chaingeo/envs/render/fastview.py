@@ -2,14 +2,15 @@
 
 A view is the frame's background (walls, floor grid, back frame edges), the pieces' faces, the
 front frame edges, then titles, axis ticks, depth labels and the legend. Here every shape and
-every label is drawn by :mod:`chaingeo.envs.render.rasterjit` (Pillow's own algorithms as numba
-kernels) on a numpy array; the legend is drawn by Pillow once per strip under it and then kept
-(:func:`chaingeo.envs.render.legend.paint_legend`). In a box (stacking) the frame stays put, so
-all but the faces, depth labels and legend are kept per layout (the background at drawing
-scale, and the picture without pieces): a step draws the faces on a work copy of the
-background and reduces and takes only the rectangle they (and their labels) cover, redrawing
-the labels that overlap it. A puzzle's frame follows its pieces, so its views are drawn in one pass
-(on a recent background, with recent label steps: a frame recurs within an episode).
+every label is drawn by kernels (:mod:`chaingeo.envs.render.rasterjit`: Pillow's own algorithms
+in numba; :mod:`chaingeo.envs.render.texts`: runs of labels and swatches in one call each) on a
+numpy array. A layout's plan (projector, packed walls and edges, label steps) is kept long, its
+pixels shorter. In a box (stacking) the frame stays put, so all but the faces, depth labels and
+legend are kept per layout (the background at drawing scale, and the picture without pieces):
+a step draws the faces on a work copy of the background and reduces and takes only the
+rectangle they (and their labels) cover, redrawing the labels that overlap it. A puzzle's frame
+follows its pieces, so its views are drawn in one pass (on a recent background: a frame recurs
+within an episode; its plan also when the level is played again).
 Every drawing call is the one :mod:`chaingeo.envs.render.scene` makes, in the same order, so the
 pictures are the same bytes (tested over the shipped levels); ``render`` stays the reference
 (and draws where the kernels do not apply: lines wide enough for round joints, or
@@ -22,7 +23,7 @@ import math
 from collections import OrderedDict
 from collections.abc import Hashable, Sequence
 from dataclasses import dataclass
-from typing import Final
+from typing import Final, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -33,11 +34,13 @@ from chaingeo.envs.render import rasterjit
 from chaingeo.envs.render.facesjit import visible_faces
 from chaingeo.envs.render.labels import (
     Step,
-    depth_label_steps,
+    depth_labels,
+    grouped,
     overlaps,
     paint_steps,
-    tick_steps,
-    title_steps,
+    texts_step,
+    tick_marks,
+    titles,
 )
 from chaingeo.envs.render.legend import clear_memo, legend_layout, paint_legend
 from chaingeo.envs.render.raster import (
@@ -80,16 +83,26 @@ from chaingeo.envs.render.sheet import tray_pixels
 CAPACITY: Final = 48
 _EDGE: Final = np.array(EDGE, dtype=np.uint8)
 Pixels = npt.NDArray[np.uint8]
+_T = TypeVar("_T")
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """A layout's frame and labels as shapes and steps, before any pixel is drawn."""
+
+    proj: Projector
+    k: int  # drawing scale
+    walls: rasterjit.Packed  # walls, floor grid and back frame edges, at drawing scale
+    front: rasterjit.Packed | None  # the front frame edges
+    steps: tuple[Step, ...]  # titles and ticks, in drawing order
 
 
 @dataclass(frozen=True)
 class _Back:
-    """A view's frame drawn without pieces: at drawing scale ``k``, before the front edges."""
+    """A view's frame drawn without pieces: at drawing scale, before the front edges."""
 
-    proj: Projector
-    k: int
+    plan: _Plan
     big: Pixels
-    front: rasterjit.Packed | None  # the front frame edges
 
 
 @dataclass(frozen=True)
@@ -98,14 +111,18 @@ class _Static:
 
     back: _Back
     plain: Pixels  # the finished picture without pieces, depth labels or legend
-    steps: tuple[Step, ...]  # titles and ticks, in drawing order
 
 
 _STORE: OrderedDict[Hashable, _Static] = OrderedDict()
-#: A frame that follows the pieces (a puzzle's): its background and label steps, kept only
-#: while recent (a frame recurs within an episode, seldom later; no finished picture is kept).
-_FOLLOW: OrderedDict[Hashable, tuple[_Back, tuple[Step, ...]]] = OrderedDict()
+#: A frame that follows the pieces (a puzzle's): its background, kept only while recent (a
+#: frame recurs within an episode, seldom later; no finished picture is kept).
+_FOLLOW: OrderedDict[Hashable, _Back] = OrderedDict()
 FOLLOW_CAPACITY: Final = 16
+#: Plans are a few kilobytes (a background at 256 px is 200 kB to 800 kB), so many more are
+#: kept: a frame that follows the pieces recurs when its level is played again, and a box
+#: layout when its legend does.
+_PLANS: OrderedDict[Hashable, _Plan] = OrderedDict()
+PLAN_CAPACITY: Final = 512
 _SCRATCH: dict[tuple[int, int], Pixels] = {}
 
 
@@ -113,7 +130,24 @@ def clear() -> None:
     """Forget every kept layout."""
     _STORE.clear()
     _FOLLOW.clear()
+    _PLANS.clear()
     clear_memo()
+
+
+def _kept(store: OrderedDict[Hashable, _T], key: Hashable) -> _T | None:
+    """``store[key]``, now the most recent, or None."""
+    found = store.get(key)
+    if found is not None:
+        store.move_to_end(key)
+    return found
+
+
+def _keep(store: OrderedDict[Hashable, _T], key: Hashable, value: _T, capacity: int) -> _T:
+    """Keep ``value`` as the most recent, the least recent out past ``capacity``."""
+    store[key] = value
+    while len(store) > capacity:
+        store.popitem(last=False)
+    return value
 
 
 def _layout_key(scene: _Scene, cam: Camera, size: int, title: str | None) -> Hashable:
@@ -121,18 +155,30 @@ def _layout_key(scene: _Scene, cam: Camera, size: int, title: str | None) -> Has
     return (cam.name, size, scene.lo, scene.hi, title, legend_h, scene.has_box)
 
 
-def _back(scene: _Scene, cam: Camera, size: int) -> _Back:
-    """The steps of ``render._render_view`` before the pieces, drawn by the kernels."""
+def _plan(scene: _Scene, cam: Camera, size: int, title: str | None, key: Hashable) -> _Plan:
+    """The shapes ``render._render_view`` draws around the pieces, and its label steps (kept
+    by layout ``key``)."""
+    found = _kept(_PLANS, key)
+    if found is not None:
+        return found
     lay = _Layout.of(size)
     k = _SUPERSAMPLE if cam.depth_axis is None else 1
     proj = _view_projector(scene, cam, lay)
     big_proj = scaled(proj, k)
-    big = rasterjit.blank(size * k, _BACKGROUND).copy()
     back_edges = [np.stack([big_proj(p), big_proj(q)]) for p, q in _frame_edges(scene, cam, True)]
-    rasterjit.paint_packed(big, _packed_walls(wall_pixels(scene, cam, big_proj), back_edges, k))
+    walls = _packed_walls(wall_pixels(scene, cam, big_proj), back_edges, k)
     edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
     front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
-    return _Back(proj, k, big, rasterjit.pack(front) if front else None)
+    steps = _label_steps(scene, cam, size, proj, title)
+    made = _Plan(proj, k, walls, rasterjit.pack(front) if front else None, steps)
+    return _keep(_PLANS, key, made, PLAN_CAPACITY)
+
+
+def _back(plan: _Plan, size: int) -> _Back:
+    """The plan's background drawn by the kernels: walls, grid, back frame edges."""
+    big = rasterjit.blank(size * plan.k, _BACKGROUND).copy()
+    rasterjit.paint_packed(big, plan.walls)
+    return _Back(plan, big)
 
 
 def _packed_walls(
@@ -157,19 +203,23 @@ def _packed_walls(
 
 
 def _finish(back: _Back, big: Pixels) -> Pixels:
-    rasterjit.paint_packed(big, back.front)
-    return rasterjit.reduce2(big) if back.k > 1 else big
+    rasterjit.paint_packed(big, back.plan.front)
+    return rasterjit.reduce2(big) if back.plan.k > 1 else big
 
 
 def _label_steps(
     scene: _Scene, cam: Camera, size: int, proj: Projector, title: str | None
 ) -> tuple[Step, ...]:
     lay = _Layout.of(size)
-    titles = _view_titles(cam, scene)
-    lines = titles if title is None else [title, *titles[1:]]
-    return (
-        *title_steps(lines, size, lay.title_px),
-        *tick_steps(scene.lo, scene.hi, cam, proj, lay.tick_px),
+    heads = _view_titles(cam, scene)
+    lines = heads if title is None else [title, *heads[1:]]
+    return tuple(
+        grouped(
+            [
+                *titles(lines, size, lay.title_px),
+                *tick_marks(scene.lo, scene.hi, cam, proj, lay.tick_px),
+            ]
+        )
     )
 
 
@@ -180,20 +230,14 @@ def _static(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Static
     if not scene.has_box:
         return None
     key = _layout_key(scene, cam, size, title)
-    found = _STORE.get(key)
+    found = _kept(_STORE, key)
     if found is not None:
-        _STORE.move_to_end(key)
         return found
-    back = _back(scene, cam, size)
+    back = _back(_plan(scene, cam, size, title, key), size)
     plain = _finish(back, back.big.copy())
-    steps = _label_steps(scene, cam, size, back.proj, title)
-    paint_steps(plain, steps)
+    paint_steps(plain, back.plan.steps)
     plain.flags.writeable = False
-    made = _Static(back, plain, steps)
-    _STORE[key] = made
-    while len(_STORE) > CAPACITY:
-        _STORE.popitem(last=False)
-    return made
+    return _keep(_STORE, key, _Static(back, plain), CAPACITY)
 
 
 def _union(a: Box, b: Box) -> Box:
@@ -211,15 +255,25 @@ def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
 
 def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, FloatArray]:
     """The picture with the faces drawn (before labels), and their drawing pixels."""
-    if back.k > 1:  # drawn on a kept work picture: only the reduction is handed out
-        big = _scratch(size * back.k, 0)
+    k = back.plan.k
+    if k > 1:  # drawn on a kept work picture: only the reduction is handed out
+        big = _scratch(size * k, 0)
         np.copyto(big, back.big)
     else:
         big = back.big.copy()
-    pix = scaled(back.proj, back.k).screen(faces.corners)
-    width = _Layout.of(size).edge_px(back.k)
+    pix = scaled(back.plan.proj, k).screen(faces.corners)
+    width = _Layout.of(size).edge_px(k)
     rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
     return _finish(back, big), pix
+
+
+def _depth_steps(faces: Faces, cam: Camera, proj: Projector) -> list[Step]:
+    """The depth labels of an axis view as one step (none: an oblique view, or cells too
+    small to label)."""
+    if cam.depth_axis is None:
+        return []
+    items = depth_labels(faces, cam, proj)
+    return [texts_step(items)] if items else []
 
 
 def _scratch(side: int, slot: int) -> Pixels:
@@ -236,10 +290,11 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     then every label that overlaps it. Only that rectangle of the background is copied to the
     work picture: fills and lines do not read what they cover, so pixels outside it may hold
     anything."""
-    back, k = st.back, st.back.k
-    pix = scaled(back.proj, k).screen(faces.corners)
+    back, plan = st.back, st.back.plan
+    k = plan.k
+    pix = scaled(plan.proj, k).screen(faces.corners)
     width = _Layout.of(size).edge_px(k)
-    labels = depth_label_steps(faces, cam, back.proj) if cam.depth_axis is not None else []
+    labels = _depth_steps(faces, cam, plan.proj)
     box = _touched(pix, width + 2, k, size)
     for step in labels:
         box = _union(box, step.box)
@@ -250,42 +305,36 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
     big = _scratch(size * k, 0)
     big[y0 * k : y1 * k, x0 * k : x1 * k] = back.big[y0 * k : y1 * k, x0 * k : x1 * k]
     rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
-    rasterjit.paint_packed(big, back.front)
+    rasterjit.paint_packed(big, plan.front)
     image = big
     if k > 1:
         image = _scratch(size, 1)
         rasterjit.reduce2_into(big, image, x0, y0, x1, y1)
     rect = (x0, y0, x1, y1)
-    paint_steps(image, [s for s in st.steps if overlaps(s.box, rect)])
+    paint_steps(image, [s for s in plan.steps if overlaps(s.box, rect)])
     paint_steps(image, labels)
     out[y0:y1, x0:x1] = image[y0:y1, x0:x1]
     return out
 
 
-def _recent(
-    scene: _Scene, cam: Camera, size: int, title: str | None
-) -> tuple[_Back, tuple[Step, ...]]:
-    """The background and label steps of a frame that follows the pieces (kept while recent)."""
+def _recent(scene: _Scene, cam: Camera, size: int, title: str | None) -> _Back:
+    """The background of a frame that follows the pieces (kept while recent; its plan
+    longer)."""
     key = _layout_key(scene, cam, size, title)
-    found = _FOLLOW.get(key)
+    found = _kept(_FOLLOW, key)
     if found is not None:
-        _FOLLOW.move_to_end(key)
         return found
-    back = _back(scene, cam, size)
+    back = _back(_plan(scene, cam, size, title, key), size)
     back.big.flags.writeable = False
-    made = back, tuple(_label_steps(scene, cam, size, back.proj, title))
-    _FOLLOW[key] = made
-    while len(_FOLLOW) > FOLLOW_CAPACITY:
-        _FOLLOW.popitem(last=False)
-    return made
+    return _keep(_FOLLOW, key, back, FOLLOW_CAPACITY)
 
 
 def _one_pass(scene: _Scene, cam: Camera, size: int, title: str | None, faces: Faces) -> Pixels:
-    back, steps = _recent(scene, cam, size, title)
+    back = _recent(scene, cam, size, title)
     image = _pieces(back, faces, size)[0] if len(faces.fills) else _finish(back, back.big.copy())
-    paint_steps(image, steps)
-    if cam.depth_axis is not None and len(faces.cells):
-        paint_steps(image, depth_label_steps(faces, cam, back.proj))
+    paint_steps(image, back.plan.steps)
+    if len(faces.cells):
+        paint_steps(image, _depth_steps(faces, cam, back.plan.proj))
     return image
 
 

@@ -9,7 +9,7 @@ pieces changed; drawing every step in order is exactly what the renderer always 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from functools import lru_cache
 from typing import Final, NamedTuple
 
@@ -32,6 +32,7 @@ from chaingeo.envs.render.raster import (
     text_color_of,
     text_glyph,
 )
+from chaingeo.envs.render.texts import TextItem, pack_texts, paint_texts
 
 Pixels = npt.NDArray[np.uint8]
 TEXT: Final[RGB] = (20, 20, 20)
@@ -85,6 +86,46 @@ def text_step(
     )
 
 
+def item_step(item: TextItem) -> Step:
+    """:func:`text_step` of one label."""
+    x, y, text, px, fill, anchor = item
+    return text_step((x, y), text, px, fill, anchor)
+
+
+def texts_step(items: Sequence[TextItem]) -> Step:
+    """A run of labels (at least one) as one step: pasted by one kernel call
+    (:mod:`chaingeo.envs.render.texts`), or one :func:`put_text` each with Pillow."""
+    texts = pack_texts(items)
+    return Step(
+        texts.box,
+        lambda im: run_steps(im, [item_step(i) for i in items]),
+        lambda arr: paint_texts(arr, texts),
+    )
+
+
+def grouped(marks: Iterable[TextItem | Step]) -> list[Step]:
+    """``marks`` in order, each run of consecutive labels as one :func:`texts_step` (the
+    kernels' path: a step per label cost more than its pasting)."""
+    out: list[Step] = []
+    run: list[TextItem] = []
+    for mark in marks:
+        if isinstance(mark, Step):
+            if run:
+                out.append(texts_step(run))
+                run = []
+            out.append(mark)
+        else:
+            run.append(mark)
+    if run:
+        out.append(texts_step(run))
+    return out
+
+
+def one_by_one(marks: Iterable[TextItem | Step]) -> list[Step]:
+    """``marks`` in order, a step per label (the reference's path)."""
+    return [m if isinstance(m, Step) else item_step(m) for m in marks]
+
+
 def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
     reach = max(4.0, 3.2 * width) + width + 2
     ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
@@ -112,11 +153,18 @@ def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
 def tick_steps(
     lo: Sequence[int], hi: Sequence[int], cam: Camera, proj: Projector, tick_px: int
 ) -> list[Step]:
+    """:func:`tick_marks`, a step each."""
+    return one_by_one(tick_marks(lo, hi, cam, proj, tick_px))
+
+
+def tick_marks(
+    lo: Sequence[int], hi: Sequence[int], cam: Camera, proj: Projector, tick_px: int
+) -> list[TextItem | Step]:
     """1-based cell indices along one frame edge per displayed axis, then the axis name and an
     arrow pointing the way the index grows. The edge's geometry is plain float arithmetic, in
     the order the array expressions it replaces took (a view whose frame moves makes these on
     every picture, and two-element arrays cost more than the numbers)."""
-    out: list[Step] = []
+    out: list[TextItem | Step] = []
     centre = proj(np.add(lo, hi) / 2.0)
     cx, cy = float(centre[0]), float(centre[1])
     for axis, spec in cam.tick_edges:
@@ -148,7 +196,7 @@ def tick_steps(
         out.append(arrow_step(np.array([tx, ty]), np.array([hx, hy]), color, max(2, tick_px // 8)))
         away = tick_px * 0.9
         name_at = ((tx + hx) / 2 + nx * away, (ty + hy) / 2 + ny * away)
-        out.append(text_step(name_at, AXIS_NAMES[axis], tick_px + 3, color))
+        out.append((name_at[0], name_at[1], AXIS_NAMES[axis], tick_px + 3, color, "mm"))
     return out
 
 
@@ -160,25 +208,52 @@ def _ticks(
     proj: Projector,
     offset: tuple[float, float],
     px: int,
-) -> list[Step]:
-    """The numbers along one edge: ``proj(p) + offset`` per shown cell, on scalars (the same
-    arithmetic as :meth:`Projector.__call__` on one point, without its arrays)."""
+) -> list[TextItem]:
+    """The numbers along one edge: ``proj(p) + offset`` per shown cell, on scalars.
+
+    A label lands at its point rounded, and nothing else of the point is used. The dot
+    products are taken on Python floats, which may differ from numpy's (as
+    :meth:`Projector.__call__` takes them) in the last bits; the two round alike unless the
+    point lies within :data:`_HALF_GUARD` of a half pixel, where numpy's is taken."""
     p = base.copy()
     right, up, scale = proj.right, proj.up, proj.scale
+    r0, r1, r2 = right.tolist()
+    u0, u1, u2 = up.tolist()
+    b = base.tolist()
     ox, oy = proj.origin
     dx, dy = offset
-    out = []
+    out: list[TextItem] = []
     for i, c in enumerate(cells):
         if i % every and c != cells[-1]:
             continue
-        p[axis] = c + 0.5
-        x = float(p @ right) * scale + ox + dx
-        y = -float(p @ up) * scale + oy + dy
-        out.append(text_step((x, y), str(c + 1), px, TEXT))
+        b[axis] = c + 0.5
+        x = (b[0] * r0 + b[1] * r1 + b[2] * r2) * scale + ox + dx
+        y = -(b[0] * u0 + b[1] * u1 + b[2] * u2) * scale + oy + dy
+        if _near_half(x) or _near_half(y):
+            p[axis] = c + 0.5
+            x = float(p @ right) * scale + ox + dx
+            y = -float(p @ up) * scale + oy + dy
+        out.append((x, y, str(c + 1), px, TEXT, "mm"))
     return out
 
 
+#: How near a half pixel a label's point may be before the scalar dot products are not
+#: trusted to round as numpy's do. Both are within a few units in the last place of a dot
+#: of three terms below a few hundred (about 1e-13), times a scale of at most a few hundred
+#: pixels: far below this.
+_HALF_GUARD: Final = 1e-6
+
+
+def _near_half(v: float) -> bool:
+    return abs(v - math.floor(v) - 0.5) < _HALF_GUARD
+
+
 def depth_label_steps(faces: Faces, cam: Camera, proj: Projector) -> list[Step]:
+    """:func:`depth_labels`, a step each."""
+    return one_by_one(depth_labels(faces, cam, proj))
+
+
+def depth_labels(faces: Faces, cam: Camera, proj: Projector) -> list[TextItem]:
     """On each visible face of an axis view, the 1-based coordinate along the line of sight."""
     depth = cam.depth_axis
     assert depth is not None
@@ -196,20 +271,27 @@ def depth_label_steps(faces: Faces, cam: Camera, proj: Projector) -> list[Step]:
     centres = proj.screen(faces.corners[shown].mean(axis=1)).tolist()
     fills = faces.fills.tolist()
     return [
-        text_step(
-            centres[j],
+        (
+            centres[j][0],
+            centres[j][1],
             f"{prefix}{cells[i][depth] + 1}",
             px,
             text_color_of((fills[i][0], fills[i][1], fills[i][2])),
+            "mm",
         )
         for j, i in enumerate(shown)
     ]
 
 
 def title_steps(lines: Sequence[str], size: int, title_px: int) -> list[Step]:
+    return one_by_one(titles(lines, size, title_px))
+
+
+def titles(lines: Sequence[str], size: int, title_px: int) -> list[TextItem]:
+    """The title lines down the top left corner."""
     y = max(4, size // 100)
-    out = []
+    out: list[TextItem] = []
     for text in lines:
-        out.append(text_step((max(4, size // 64), y), text, title_px, TEXT, anchor="la"))
+        out.append((float(max(4, size // 64)), float(y), text, title_px, TEXT, "la"))
         y += int(title_px * 1.25)
     return out

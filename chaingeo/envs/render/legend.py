@@ -4,8 +4,6 @@ without the observation's colour table."""
 
 from __future__ import annotations
 
-import math
-from collections import OrderedDict
 from collections.abc import Sequence
 from functools import lru_cache
 from typing import Final
@@ -14,7 +12,8 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image, ImageDraw
 
-from chaingeo.envs.render.raster import EDGE, RGB, put_text, text_box, text_length
+from chaingeo.envs.render.raster import EDGE, RGB, put_text, text_length
+from chaingeo.envs.render.texts import Swatches, pack_swatches, paint_swatches
 
 #: (name, colour) per entry, in the order drawn.
 Entries = Sequence[tuple[str, RGB]]
@@ -75,61 +74,33 @@ def draw_legend(image: Image.Image, entries: Entries) -> None:
 
 
 Pixels = npt.NDArray[np.uint8]
-#: Legends kept: per (entries, size), a few (pixels under, pixels drawn) bottom strips.
-_MEMO: OrderedDict[tuple[tuple[tuple[str, RGB], ...], int], list[tuple[Pixels, Pixels]]] = (
-    OrderedDict()
-)
-MEMO_CAPACITY: Final = 64
-_VARIANTS: Final = 4
+_EDGE_INK: Final = np.array(EDGE, dtype=np.uint8)
 
 
-@lru_cache(maxsize=1024)
-def _strip_top(entries: tuple[tuple[str, RGB], ...], size: int) -> int:
-    """The first row the legend may change: its first row's swatches and names (a text's box
-    bounds every pixel it changes)."""
+@lru_cache(maxsize=256)
+def _swatches(entries: tuple[tuple[str, RGB], ...], size: int, bottom: int) -> Swatches:
+    """The calls :func:`draw_legend` makes in a picture ``size`` wide and ``bottom`` high,
+    packed for one kernel call."""
     px, height = legend_layout(entries, size)
-    y = size - height + px * 0.25
-    tops = [
-        text_box((x + px * 1.4, y + px / 2), n, px, "lm")[1]
-        for n, _, x in _rows(entries, px, size)[0]
-    ]
-    return max(0, min(math.floor(y) - 1, *tops))
+    y = bottom - height + px * 0.25
+    out = []
+    for row in _rows(entries, px, size):
+        for name, rgb, x in row:
+            label = (x + px * 1.4, y + px / 2, name, px, _TEXT, "lm")
+            out.append(((x, y, x + px, y + px), rgb, label))
+        y += px * 1.5
+    return pack_swatches(out, EDGE)
 
 
 def paint_legend(pixels: Pixels, entries: Entries) -> None:
-    """:func:`draw_legend` on an ``(size, size, 3)`` array, in place.
-
-    The legend is drawn over whatever lies under it (its text is blended), so a drawn legend
-    is kept with the strip it was drawn on and reused only where that strip is the same: the
-    same bytes as drawing, without Pillow. A drawing that changed a pixel above the strip is
-    copied whole and not kept."""
-    if not entries:
-        return
-    size = pixels.shape[1]
-    key = (tuple(entries), size)
-    top = _strip_top(key[0], size)
-    strip = pixels[top:]
-    kept = _MEMO.get(key)
-    if kept is not None:
-        _MEMO.move_to_end(key)
-        for under, over in kept:
-            if np.array_equal(under, strip):
-                strip[...] = over
-                return
-    image = Image.fromarray(pixels)
-    draw_legend(image, entries)
-    drawn = np.asarray(image)
-    if not np.array_equal(drawn[:top], pixels[:top]):
-        pixels[...] = drawn
-        return
-    variants = _MEMO.setdefault(key, [])
-    variants.insert(0, (strip.copy(), drawn[top:].copy()))
-    del variants[_VARIANTS:]
-    strip[...] = drawn[top:]
-    while len(_MEMO) > MEMO_CAPACITY:
-        _MEMO.popitem(last=False)
+    """:func:`draw_legend` on an ``(size, size, 3)`` array, in place: each swatch and name by
+    one kernel call (the same rectangles and pastes), laid out once per legend and size."""
+    if entries:
+        paint_swatches(
+            pixels, _swatches(tuple(entries), pixels.shape[1], pixels.shape[0]), _EDGE_INK
+        )
 
 
 def clear_memo() -> None:
-    """Forget every kept legend."""
-    _MEMO.clear()
+    """Forget every laid out legend."""
+    _swatches.cache_clear()

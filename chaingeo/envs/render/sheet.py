@@ -5,7 +5,8 @@ The tray changes with every piece placed or taken back, so it is drawn anew on m
 Through Pillow its pieces were drawn by the kernels but then turned into an image for the
 titles, swatches, names and grid lines, and back into an array for the environments; here
 every call is a kernel on the same array, in the renderer's order (swatches by
-:func:`chaingeo.envs.render.rasterjit.rectangle`, tested against Pillow).
+:func:`chaingeo.envs.render.rasterjit.rectangle`, tested against Pillow, each with its name in
+one kernel call).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy.typing as npt
 
 from chaingeo.core.jit import mode as jit_mode
 from chaingeo.envs.render import rasterjit
-from chaingeo.envs.render.labels import ink, paint_steps, text_step, title_steps
+from chaingeo.envs.render.labels import ink, paint_steps, title_steps
 from chaingeo.envs.render.raster import EDGE, Flat, text_length
 from chaingeo.envs.render.scene import (
     _BACKGROUND,
@@ -31,6 +32,7 @@ from chaingeo.envs.render.scene import (
     _sheet_layout,
     render_tray_image_with,
 )
+from chaingeo.envs.render.texts import pack_swatches, paint_swatches
 
 Pixels = npt.NDArray[np.uint8]
 _EDGE = ink(EDGE)
@@ -59,11 +61,12 @@ def tray_pixels(pieces: PieceMap, size: int, title: str = TRAY_TITLE) -> Pixels:
 def _labels(pixels: Pixels, sheet: _Sheet) -> None:
     """Each piece's swatch and name, as ``_render_tray`` draws them."""
     px = sheet.label_px
+    swatches = []
     for text, rgb, x, y in sheet.slots:
         left = x - (text_length(text, px) + px * 1.4) / 2
-        box = np.array([left, y - px / 2, left + px, y + px / 2])
-        rasterjit.rectangle(pixels, box, ink(rgb), _EDGE, rgb != EDGE)
-        text_step((left + px * 1.4, y), text, px, _TEXT, anchor="lm").paint(pixels)
+        label = (left + px * 1.4, y, text, px, _TEXT, "lm")
+        swatches.append(((left, y - px / 2, left + px, y + px / 2), rgb, label))
+    paint_swatches(pixels, pack_swatches(swatches, EDGE), _EDGE)
 
 
 def _grid(sheet: _Sheet, size: int) -> list[Flat]:

@@ -1,5 +1,5 @@
-"""The fast path's newer parts (kept legends, swatches, the tray on arrays) give the bytes the
-reference renderer gives, on random input."""
+"""The fast path's newer parts (legends and swatches by the kernels, the tray on arrays) give
+the bytes the reference renderer gives, on random input."""
 
 from __future__ import annotations
 
@@ -29,17 +29,17 @@ entries = st.lists(st.tuples(names, rgb), min_size=0, max_size=14, unique_by=lam
 
 @settings(max_examples=60, deadline=None)
 @given(entries, st.sampled_from([96, 128, 256]), st.integers(0, 2**32 - 1), st.booleans())
-def test_kept_legends_are_the_drawn_ones(
+def test_legends_on_arrays_are_the_drawn_ones(
     legend: list[tuple[str, tuple[int, int, int]]], size: int, seed: int, noisy: bool
 ) -> None:
     clear_memo()
     rng = np.random.default_rng(seed)
     plain = np.full((size, size, 3), 255, np.uint8)
     pictures = [plain, plain.copy()]
-    if noisy:  # something under the legend: kept legends must not be reused there
+    if noisy:  # something under the legend: its names are blended onto it
         pictures[1][rng.integers(size // 2, size), rng.integers(0, size)] = rng.integers(0, 256, 3)
     pictures.append(rng.integers(0, 256, (size, size, 3)).astype(np.uint8))
-    for _ in range(2):  # drawn, then (where the strip matches) reused
+    for _ in range(2):  # laid out, then painted from the kept layout
         for under in pictures:
             image = Image.fromarray(under)
             draw_legend(image, legend)
