@@ -136,7 +136,7 @@ class PartSearch:
         self.deadline = deadline
         self.chunk = chunk
         vox, starts, lo, hi = table.part_arrays(self.members)
-        cap = max(2, min(64, limits.max_states))  # most parts come apart in a few states
+        cap = max(2, min(128, limits.max_states))  # most parts come apart in a few states
         # The kernel's bundles are kept, and replaced only when a buffer grows: every call
         # expands one or two nodes on a typical part, so building them per call would cost
         # more than the call (and _expand relies on their types, fixed here).
