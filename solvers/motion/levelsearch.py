@@ -2,10 +2,10 @@
 
 Python set-up per part search (arrays, removals, splits, moves) cost ~40 us, several times the
 search itself on a six-piece burr, so the whole recursion runs here: breadth first to the first
-layer with removals (:func:`chaingeo.solvers.motion.movement.expand`), removals tried single pieces
-first, then both parts recursively, memoised per part configuration; the result is a flat tree that
-:mod:`chaingeo.solvers.motion.disassemble` decodes. Same order, tie-breaks and caps as its Python
-original, which still serves turning pieces and piece groups
+layer with removals (:func:`chaingeo.solvers.motion.bfs_kernel.expand`), removals tried single
+pieces first, then both parts recursively, memoised per part configuration; the result is a flat
+tree that :mod:`chaingeo.solvers.motion.disassemble` decodes. Same order, tie-breaks and caps as
+its Python original, which still serves turning pieces and piece groups
 (:meth:`chaingeo.solvers.motion.disassemble._Solver.greedy`).
 """
 
@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.jit import njit
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 
 I64 = npt.NDArray[np.int64]
@@ -160,20 +161,20 @@ def greedy(
         first_sep = n_seps
         while True:
             before = node
-            status, node, n_states, n_seps, n_layers = mv.expand(
-                mv.Tree(states, parent, move, table), n_states, node, layers, n_layers,
+            status, node, n_states, n_seps, n_layers = bfs.expand(
+                bfs.Tree(states, parent, move, table), n_states, node, layers, n_layers,
                 max_states, params[BUDGET] - ctx[EXPANDED],
                 mv.Pieces(vox, starts, lo, hi, params[MAX_GROUP], params[GROUP_LIMIT],
                           moves_buf, groups_buf),
                 seps, n_seps,
             )  # fmt: skip
             ctx[EXPANDED] += node - before
-            if status == mv.DONE:
+            if status == bfs.DONE:
                 break
-            if status == mv.PAUSED:
+            if status == bfs.PAUSED:
                 ctx[STATUS] = OVER_BUDGET
                 return -2
-            if status == mv.NEED_STATES:
+            if status == bfs.NEED_STATES:
                 cap = states.shape[0]
                 if n_states + 1 >= cap:
                     if cap >= max_states:
@@ -181,14 +182,14 @@ def greedy(
                         ctx[INFO] = k
                         return -2
                     new_cap = min(2 * cap, max_states)
-                    states, parent, move = mv.grow_search(states, parent, move, new_cap)
+                    states, parent, move = bfs.grow_search(states, parent, move, new_cap)
                     grown_layers = np.zeros(new_cap + 2, dtype=np.int64)
                     grown_layers[: cap + 2] = layers
                     layers = grown_layers
-                table = mv.fit_table(table, states, n_states)
-            elif status == mv.NEED_MOVES:
+                table = bfs.fit_table(table, states, n_states)
+            elif status == bfs.NEED_MOVES:
                 moves_buf = np.zeros((2 * moves_buf.shape[0], 4), dtype=np.int64)
-            elif status == mv.NEED_SEPS:
+            elif status == bfs.NEED_SEPS:
                 grown_seps = np.zeros((2 * seps.shape[0], 3), dtype=np.int64)
                 grown_seps[: seps.shape[0]] = seps
                 seps = grown_seps

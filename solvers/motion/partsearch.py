@@ -18,13 +18,14 @@ from chaingeo.core.jit import Pinned
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 
-#: :func:`chaingeo.solvers.motion.movement.expand` as :class:`PartSearch` calls it: the types
+#: :func:`chaingeo.solvers.motion.bfs_kernel.expand` as :class:`PartSearch` calls it: the types
 #: of its arguments are fixed by PartSearch's constructor (see :class:`Pinned`).
-_expand = Pinned(mv.expand)
+_expand = Pinned(bfs.expand)
 
 
 class PieceTable:
@@ -140,7 +141,7 @@ class PartSearch:
         # The kernel's bundles are kept, and replaced only when a buffer grows: every call
         # expands one or two nodes on a typical part, so building them per call would cost
         # more than the call (and _expand relies on their types, fixed here).
-        self.tree = mv.Tree(
+        self.tree = bfs.Tree(
             np.zeros((cap, 3 * n), dtype=np.int16),
             np.full(cap, -1, dtype=np.int64),
             np.zeros((cap, 3), dtype=np.int64),
@@ -196,9 +197,9 @@ class PartSearch:
                     "max_states",
                 )
             new_cap = min(2 * cap, self.limits.max_states)
-            states, parent, move = mv.grow_search(states, parent, move, new_cap)
+            states, parent, move = bfs.grow_search(states, parent, move, new_cap)
             self.layers = np.concatenate([self.layers, np.zeros_like(self.layers)])[: new_cap + 2]
-        self.tree = mv.Tree(states, parent, move, mv.fit_table(table, states, self.n_states))
+        self.tree = bfs.Tree(states, parent, move, bfs.fit_table(table, states, self.n_states))
 
     def expand_layer(self) -> list[Removal]:
         """Expand the deepest layer; return the removals found there (in search order)."""
@@ -216,16 +217,16 @@ class PartSearch:
                 self.tree, self.n_states, self.node, self.layers, self.n_layers, deepest,
                 self.chunk, self.pieces, self.seps, self.n_seps,
             )  # fmt: skip
-            if status == mv.DONE:
+            if status == bfs.DONE:
                 break
-            if status == mv.NEED_STATES:
+            if status == bfs.NEED_STATES:
                 self._grow_states()
-            elif status == mv.NEED_MOVES:
+            elif status == bfs.NEED_MOVES:
                 grown = np.zeros((2 * self.pieces.moves.shape[0], 4), dtype=np.int64)
                 self.pieces = self.pieces._replace(moves=grown)
-            elif status == mv.NEED_SEPS:
+            elif status == bfs.NEED_SEPS:
                 self.seps = np.concatenate([self.seps, np.zeros_like(self.seps)])
-            elif status == mv.TOO_MANY_GROUPS:
+            elif status == bfs.TOO_MANY_GROUPS:
                 raise SearchLimitError(
                     f"more than {self.limits.group_limit} movable groups along one direction "
                     "in one state",

@@ -31,6 +31,7 @@ import numpy.typing as npt
 from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
 from chaingeo.core.jit import njit
 from chaingeo.core.turns import quarter_index
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.sweep import FAR_LIMIT, rmax2, rmin2, turn_hit
 
@@ -382,7 +383,8 @@ def turn_pose(rot: int, off: I64, q: int, c: I64, out: I64) -> int:
     return int(COMPOSE[q, rot])
 
 
-#: Status of :func:`expand_turns` besides those of :func:`chaingeo.solvers.motion.movement.expand`.
+#: Status of :func:`expand_turns` besides those of
+#: :func:`chaingeo.solvers.motion.bfs_kernel.expand`.
 NEED_TURNS = 6
 
 
@@ -442,9 +444,9 @@ def expand_turns(
             vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
         )
         if rows == -2:
-            return mv.TOO_MANY_GROUPS, node, n_states, n_seps, 0
+            return bfs.TOO_MANY_GROUPS, node, n_states, n_seps, 0
         if rows == -1:
-            return mv.NEED_MOVES, node, n_states, n_seps, 0
+            return bfs.NEED_MOVES, node, n_states, n_seps, 0
         nt = node_turns(
             vox, starts, lo, hi, rod, off, st_start, st_end, st_cells, bound,
             max_group, group_limit, groups_buf, turns_buf,
@@ -452,7 +454,7 @@ def expand_turns(
         if nt == -1:
             return NEED_TURNS, node, n_states, n_seps, 0
         if nt == -2:
-            return mv.TOO_MANY_GROUPS, node, n_states, n_seps, 0
+            return bfs.TOO_MANY_GROUPS, node, n_states, n_seps, 0
         if nt == -3:
             return TOO_FAR, node, n_states, n_seps, 0
         for r in range(rows):
@@ -461,14 +463,14 @@ def expand_turns(
             kmax = moves_buf[r, 2]
             if moves_buf[r, 3]:
                 if n_seps >= seps.shape[0]:
-                    return mv.NEED_SEPS, node, n_states, n_seps, 0
+                    return bfs.NEED_SEPS, node, n_states, n_seps, 0
                 seps[n_seps, 0] = node
                 seps[n_seps, 1] = np.int64(mask)
                 seps[n_seps, 2] = d
                 n_seps += 1
             for k in range(1, kmax + 1):
                 if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                    return mv.NEED_STATES, node, n_states, n_seps, 0
+                    return bfs.NEED_STATES, node, n_states, n_seps, 0
                 mv.shift_child(states[node], child, 0, None, n, moves_buf[r, 0], d, k)
                 got = mv.find_or_insert(states, n_states, table, child)
                 if got < 0:
@@ -488,7 +490,7 @@ def expand_turns(
             anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
             q = QUARTERS[a, 1 - sense] if anchor_moves else QUARTERS[a, sense]
             if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                return mv.NEED_STATES, node, n_states, n_seps, 0
+                return bfs.NEED_STATES, node, n_states, n_seps, 0
             for t in range(w):
                 child[t] = states[node, t]
             for p in range(n):
@@ -506,4 +508,4 @@ def expand_turns(
                 move[n_states, 3] = c[1]
                 move[n_states, 4] = c[2]
                 n_states += 1
-    return mv.DONE, node_end, n_states, n_seps, 0
+    return bfs.DONE, node_end, n_states, n_seps, 0

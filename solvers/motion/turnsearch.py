@@ -28,6 +28,7 @@ from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitErro
 from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion import turnmoves as tm
 from chaingeo.solvers.motion.partsearch import Removal, Split, part_size
@@ -135,20 +136,20 @@ class TurnPartSearch:
                 self.max_group, self.limits.group_limit, self.seps, self.n_seps,
                 self.moves_buf, self.turns_buf, self.groups_buf,
             )  # fmt: skip
-            if status == mv.NEED_STATES:
+            if status == bfs.NEED_STATES:
                 self._grow_states()
-            elif status == mv.NEED_MOVES:
+            elif status == bfs.NEED_MOVES:
                 self.moves_buf = np.zeros((2 * self.moves_buf.shape[0], 4), dtype=np.int64)
             elif status == tm.NEED_TURNS:
                 self.turns_buf = np.zeros((2 * self.turns_buf.shape[0], 6), dtype=np.int64)
-            elif status == mv.NEED_SEPS:
+            elif status == bfs.NEED_SEPS:
                 self.seps = np.concatenate([self.seps, np.zeros_like(self.seps)])
             elif status == tm.TOO_FAR:
                 raise SearchLimitError(
                     f"pieces more than {FAR_LIMIT // 2} cells from a turn's axis: beyond the "
                     "exact integer range of the turn kernel"
                 )
-            elif status == mv.TOO_MANY_GROUPS:
+            elif status == bfs.TOO_MANY_GROUPS:
                 raise SearchLimitError(
                     f"more than {self.limits.group_limit} movable groups of one move in one state",
                     "group_limit",
