@@ -42,6 +42,7 @@ from chaingeo.solvers.motion.levelsearch import (
     STATES,
     STATUS,
     TOTAL_CAP,
+    LevelTree,
     _record,
 )
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable, part_size
@@ -338,7 +339,8 @@ def first_tree(
         if status == STUCK:
             return -1
         at, mask, direction = pctx[2], pctx[3], pctx[4]
-        idx = _record(nodes, moves, ctx, parent, move, members, at, mask, direction, no_sides)
+        idx = _record(LevelTree(nodes, moves), ctx, parent, move, members, at, mask, direction,
+                      no_sides)  # fmt: skip
         if idx == -2:
             return -2
         if parent_row < 0:

@@ -11,6 +11,8 @@ its Python original, which still serves turning pieces and piece groups
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import numpy.typing as npt
 
@@ -33,6 +35,37 @@ N_NODES, N_MOVES, N_MEMO, STATES, STATUS, INFO, EXPANDED = 0, 1, 2, 3, 4, 5, 6
 MAX_GROUP, GROUP_LIMIT, MAX_STATES, MAX_TOTAL, BUDGET = 0, 1, 2, 3, 4
 #: Rows a part's search starts with (most parts come apart in a few states).
 _FIRST_CAP = 64
+
+
+class Puzzle(NamedTuple):
+    """The whole puzzle's piece arrays that every part gathers its rows from
+    (:class:`chaingeo.solvers.motion.partsearch.PieceTable`: voxels sorted per axis, where each
+    piece's rows start, boxes)."""
+
+    vox: I64
+    starts: I64
+    lo: I64
+    hi: I64
+
+
+class LevelTree(NamedTuple):
+    """The tree :func:`greedy` writes: ``nodes`` rows (first move, move count, removed
+    sub-tree, left sub-tree) and ``moves`` rows (global mask, direction, distance; -1: a
+    removal); ``ctx`` counts the rows used."""
+
+    nodes: I64
+    moves: I64
+
+
+class Memo(NamedTuple):
+    """Parts already searched: ``keys`` rows (the part's pieces as a mask in four int16, then
+    offsets relative to its first piece), their open-addressing ``table``
+    (:func:`chaingeo.solvers.motion.movement.find_or_insert`) and ``val`` (the part's tree
+    index; -1: cannot come apart)."""
+
+    keys: I16
+    table: I64
+    val: I64
 
 
 @njit(cache=True)
@@ -83,9 +116,10 @@ def _memo_row(members: I64, width: int) -> I16:
 
 
 @njit(cache=True)
-def _memo_slot(members: I64, offsets: I64, ctx: I64, memo_keys: I16, memo_table: I64) -> int:
+def _memo_slot(members: I64, offsets: I64, ctx: I64, memo: Memo) -> int:
     """The memo entry of the part (its pieces, and offsets relative to its first piece):
     ``-1 - index`` when new, -(2**40) when the memo is full."""
+    memo_keys, memo_table = memo.keys, memo.table
     row = _memo_row(members, memo_keys.shape[1])
     for i in range(members.shape[0]):
         for t in range(3):
@@ -102,30 +136,17 @@ def _memo_slot(members: I64, offsets: I64, ctx: I64, memo_keys: I16, memo_table:
 
 @njit(cache=True)
 def greedy(
-    vox_all: I64,
-    starts_all: I64,
-    lo_all: I64,
-    hi_all: I64,
-    members: I64,
-    offsets: I64,
-    params: I64,
-    ctx: I64,
-    nodes: I64,
-    moves: I64,
-    memo_keys: I16,
-    memo_table: I64,
-    memo_val: I64,
+    puzzle: Puzzle, members: I64, offsets: I64, params: I64, ctx: I64, out: LevelTree, memo: Memo
 ) -> int:
     """The tree of the part ``members`` (global piece indices, ascending) at ``offsets``: its
-    index in ``nodes`` (rows: first move, move count, removed sub-tree, left sub-tree; -1: a
-    single piece), -1 if it cannot be taken apart, -2 on a status set in ``ctx``. ``moves``
-    rows: global mask, direction, distance (-1: removal)."""
-    slot = _memo_slot(members, offsets, ctx, memo_keys, memo_table)
+    index in ``out.nodes`` (-1: a single piece), -1 if it cannot be taken apart, -2 on a status
+    set in ``ctx``. Parts met before come from ``memo``."""
+    slot = _memo_slot(members, offsets, ctx, memo)
     if slot == -(1 << 40):
         ctx[STATUS] = NEED_BUFFERS
         return -2
     if slot >= 0:
-        return int(memo_val[slot])
+        return int(memo.val[slot])
     slot = -1 - slot
     if params[MAX_TOTAL] >= 0 and ctx[STATES] > params[MAX_TOTAL]:
         ctx[STATUS] = TOTAL_CAP
@@ -133,7 +154,7 @@ def greedy(
     k = members.shape[0]
     w = 3 * k
     max_states = params[MAX_STATES]
-    vox, starts, lo, hi = part_arrays(vox_all, starts_all, lo_all, hi_all, members)
+    vox, starts, lo, hi = part_arrays(puzzle.vox, puzzle.starts, puzzle.lo, puzzle.hi, members)
     cap = max(2, min(_FIRST_CAP, max_states))
     states = np.zeros((cap, w), dtype=np.int16)
     parent = np.full(cap, -1, dtype=np.int64)
@@ -231,10 +252,7 @@ def greedy(
                     sub_members[j] = members[sub[j]]
                     for t in range(3):
                         sub_off[j, t] = states[at, 3 * sub[j] + t]
-                got = greedy(
-                    vox_all, starts_all, lo_all, hi_all, sub_members, sub_off, params,
-                    ctx, nodes, moves, memo_keys, memo_table, memo_val,
-                )  # fmt: skip
+                got = greedy(puzzle, sub_members, sub_off, params, ctx, out, memo)
                 if got == -2:
                     return -2
                 if got == -1:
@@ -243,26 +261,23 @@ def greedy(
                 sides[side] = got
             if not ok:
                 continue
-            result = _record(nodes, moves, ctx, parent, move, members, at, mask, found[r, 2], sides)
+            result = _record(out, ctx, parent, move, members, at, mask, found[r, 2], sides)
             if result == -2:
                 return -2
             break
     ctx[STATES] += n_states
-    memo_val[slot] = result
-    if result == -1 and not _remember_stuck(members, states, n_states, ctx, memo_keys, memo_table,
-                                            memo_val):  # fmt: skip
+    memo.val[slot] = result
+    if result == -1 and not _remember_stuck(members, states, n_states, ctx, memo):
         return -2
     return result
 
 
 @njit(cache=True)
-def _remember_stuck(
-    members: I64, states: I16, n_states: int, ctx: I64, memo_keys: I16, memo_table: I64,
-    memo_val: I64,
-) -> bool:  # fmt: skip
+def _remember_stuck(members: I64, states: I16, n_states: int, ctx: I64, memo: Memo) -> bool:
     """Every state of a part's component that cannot come apart goes into the memo as stuck
     (from any of them the search would see the same component), so that no state of it is
     searched again; False (NEED_BUFFERS) when the memo is full."""
+    memo_keys, memo_table, memo_val = memo
     row = _memo_row(members, memo_keys.shape[1])
     w = states.shape[1]
     for node in range(1, n_states):
@@ -280,10 +295,11 @@ def _remember_stuck(
 
 @njit(cache=True)
 def _record(
-    nodes: I64, moves: I64, ctx: I64, parent: I64, move: I64, members: I64, at: int,
-    mask: np.int64, direction: int, sides: I64,
+    out: LevelTree, ctx: I64, parent: I64, move: I64, members: I64, at: int, mask: np.int64,
+    direction: int, sides: I64,
 ) -> int:  # fmt: skip
     """Append a tree node: the path to ``at``, then the removal; -2 when a buffer is full."""
+    nodes, moves = out
     length = 1
     p = at
     while p > 0:
