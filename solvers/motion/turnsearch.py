@@ -24,6 +24,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from chaingeo.core.geometry import ROTATIONS, rotation_index
+from chaingeo.core.jit import Pinned
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
 from chaingeo.solvers.deadline import Deadline
@@ -45,6 +46,11 @@ def _direction(vec: np.ndarray) -> int:
     return int(np.flatnonzero(np.all(vec == _DIR_VECS, axis=1))[0])
 
 
+#: :func:`chaingeo.solvers.motion.turnmoves.expand_turns` as :class:`TurnPartSearch` calls it:
+#: the types of its arguments are fixed by TurnPartSearch's constructor (see :class:`Pinned`).
+_expand_turns = Pinned(tm.expand_turns)
+
+
 class TurnPartSearch:
     """Layered breadth-first search of one part from one configuration, turns included."""
 
@@ -63,6 +69,7 @@ class TurnPartSearch:
         self.table = table
         self.members = tuple(members)
         self.max_group = -1 if max_group is None else int(max_group)
+        self.group_limit = int(limits.group_limit)
         self.limits = limits
         self.deadline = deadline
         self.chunk = chunk
@@ -128,14 +135,14 @@ class TurnPartSearch:
         while node < hi:
             self.deadline.check()
             end = min(hi, node + self.chunk)
-            st = stencils()
-            status, node, self.n_states, self.n_seps, _ = tm.expand_turns(
-                self.states, self.n_states, self.parent, self.move, self.hash, node, end,
-                self.vox, self.starts, self.lo, self.hi, self.rod,
-                st.start, st.end, st.cells, st.bound,
-                self.max_group, self.limits.group_limit, self.seps, self.n_seps,
-                self.moves_buf, self.turns_buf, self.groups_buf,
+            tree = bfs.Tree(self.states, self.parent, self.move, self.hash)
+            pieces = tm.TurnPieces(
+                self.vox, self.starts, self.lo, self.hi, self.rod, self.max_group,
+                self.group_limit, self.moves_buf, self.turns_buf, self.groups_buf,
             )  # fmt: skip
+            status, node, self.n_states, self.n_seps, _ = _expand_turns(
+                tree, self.n_states, node, end, pieces, stencils().arrays, self.seps, self.n_seps
+            )
             if status == bfs.NEED_STATES:
                 self._grow_states()
             elif status == bfs.NEED_MOVES:
