@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from typing import Any, Final, Literal, TypeVar, overload
+from typing import Any, Final, Generic, Literal, ParamSpec, TypeVar, overload
 
 import numpy as np
 
@@ -31,6 +31,8 @@ ENV: Final = "CHAINGEO_JIT"
 MODES: Final[tuple[Mode, ...]] = ("numba", "aot", "python")
 
 F = TypeVar("F", bound=Callable[..., Any])
+P = ParamSpec("P")
+R = TypeVar("R")
 
 _mode: Mode | None = None
 
@@ -152,3 +154,25 @@ def entry(kernel: F, *args: Any) -> F:
             compiled = dispatcher.overloads[sig]
         found = _entries[key] = compiled.entry_point
     return found  # type: ignore[no-any-return]
+
+
+class Pinned(Generic[P, R]):
+    """A kernel called through the entry point :func:`entry` resolves for its first call's
+    arguments, kept for the process.
+
+    For a kernel that one Python caller calls many times a search, each call doing little work,
+    with arguments whose types that caller fixes by construction (arrays it allocates with
+    explicit dtypes): numba's dispatcher types every call's bundles (about 1 us a NamedTuple),
+    and :func:`entry` fingerprints them (as much), where a part search's typical call expands
+    one or two nodes. A call with other argument types would be misread (see :func:`entry`),
+    so each caller keeps its own ``Pinned``."""
+
+    def __init__(self, kernel: Callable[P, R]) -> None:
+        self.kernel = kernel
+        self._call: Callable[P, R] | None = None
+
+    def __call__(self, *args: P.args, **kwargs: P.kwargs) -> R:
+        call = self._call
+        if call is None:
+            call = self._call = entry(self.kernel, *args)
+        return call(*args, **kwargs)

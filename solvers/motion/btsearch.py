@@ -31,6 +31,7 @@ from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Move, SearchLimitError
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.levelsearch import (
     EXPANDED,
@@ -41,6 +42,7 @@ from chaingeo.solvers.motion.levelsearch import (
     STATES,
     STATUS,
     TOTAL_CAP,
+    LevelTree,
     _record,
 )
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable, part_size
@@ -110,7 +112,7 @@ def _leaving(gaps: I64, k: int, todo: I64) -> tuple[np.int64, int]:
 
 
 @njit(cache=True)
-def part_search(part: PartGaps, tree: mv.Tree, ctx: I64, budget: int, group_limit: int) -> int:
+def part_search(part: PartGaps, tree: bfs.Tree, ctx: I64, budget: int, group_limit: int) -> int:
     """Breadth-first search of one part in BurrTools' order up to its first separation.
 
     ``states`` row 0 is the start (relative offsets); ``ctx``: ``[n_states, next node,
@@ -235,13 +237,13 @@ def run_part(
     states = np.zeros((cap, w), dtype=np.int16)
     parent = np.full(cap, -1, dtype=np.int64)
     move = np.zeros((cap, 3), dtype=np.int64)
-    table = mv.fit_table(np.full(1, -1, dtype=np.int64), states, 0)
+    table = bfs.fit_table(np.full(1, -1, dtype=np.int64), states, 0)
     mv.find_or_insert(states, 0, table, start)
     ctx = np.zeros(5, dtype=np.int64)
     ctx[0] = 1
     while True:
         before = ctx[1]
-        status = part_search(part, mv.Tree(states, parent, move, table), ctx, budget, group_limit)
+        status = part_search(part, bfs.Tree(states, parent, move, table), ctx, budget, group_limit)
         budget -= ctx[1] - before
         if status != NEED_STATES:
             return status, states, parent, move, ctx
@@ -249,8 +251,8 @@ def run_part(
             cap = states.shape[0]
             if cap >= max_states:
                 return -STATE_CAP, states, parent, move, ctx
-            states, parent, move = mv.grow_search(states, parent, move, min(2 * cap, max_states))
-        table = mv.fit_table(table, states, ctx[0])
+            states, parent, move = bfs.grow_search(states, parent, move, min(2 * cap, max_states))
+        table = bfs.fit_table(table, states, ctx[0])
 
 
 @njit(cache=True)
@@ -337,7 +339,8 @@ def first_tree(
         if status == STUCK:
             return -1
         at, mask, direction = pctx[2], pctx[3], pctx[4]
-        idx = _record(nodes, moves, ctx, parent, move, members, at, mask, direction, no_sides)
+        idx = _record(LevelTree(nodes, moves), ctx, parent, move, members, at, mask, direction,
+                      no_sides)  # fmt: skip
         if idx == -2:
             return -2
         if parent_row < 0:
@@ -406,7 +409,7 @@ def first_split(
     while True:
         deadline.check()
         part = PartGaps(table.vox, table.starts, table.lo, table.hi, local, memo_rel, memo_gap)
-        tree = mv.Tree(states, parent, move, hash_table)
+        tree = bfs.Tree(states, parent, move, hash_table)
         status = part_search(part, tree, ctx, CHUNK, limits.group_limit)
         if status == NEED_STATES:
             if ctx[0] + 1 >= states.shape[0]:
@@ -416,8 +419,8 @@ def first_split(
                         "max_states",
                     )
                 new = min(2 * states.shape[0], max_states)
-                states, parent, move = mv.grow_search(states, parent, move, new)
-            hash_table = mv.fit_table(hash_table, states, int(ctx[0]))
+                states, parent, move = bfs.grow_search(states, parent, move, new)
+            hash_table = bfs.fit_table(hash_table, states, int(ctx[0]))
         elif status == TOO_MANY_GROUPS:
             raise SearchLimitError(
                 f"more than {limits.group_limit} movable groups along one direction in one state",

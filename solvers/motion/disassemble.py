@@ -362,8 +362,8 @@ class _Solver:
             table = np.full(4 * cap, -1, dtype=np.int64)
             memo = np.full(cap, -3, dtype=np.int64)
             root = ls.greedy(
-                t.vox, t.starts, t.lo, t.hi, np.arange(n, dtype=np.int64), start, params, ctx,
-                nodes, moves, keys, table, memo,
+                ls.Puzzle(t.vox, t.starts, t.lo, t.hi), np.arange(n, dtype=np.int64), start,
+                params, ctx, ls.LevelTree(nodes, moves), ls.Memo(keys, table, memo),
             )  # fmt: skip
             return int(root)
 

@@ -2,19 +2,22 @@
 
 Python set-up per part search (arrays, removals, splits, moves) cost ~40 us, several times the
 search itself on a six-piece burr, so the whole recursion runs here: breadth first to the first
-layer with removals (:func:`chaingeo.solvers.motion.movement.expand`), removals tried single pieces
-first, then both parts recursively, memoised per part configuration; the result is a flat tree that
-:mod:`chaingeo.solvers.motion.disassemble` decodes. Same order, tie-breaks and caps as its Python
-original, which still serves turning pieces and piece groups
+layer with removals (:func:`chaingeo.solvers.motion.bfs_kernel.expand`), removals tried single
+pieces first, then both parts recursively, memoised per part configuration; the result is a flat
+tree that :mod:`chaingeo.solvers.motion.disassemble` decodes. Same order, tie-breaks and caps as
+its Python original, which still serves turning pieces and piece groups
 (:meth:`chaingeo.solvers.motion.disassemble._Solver.greedy`).
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.jit import njit
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 
 I64 = npt.NDArray[np.int64]
@@ -32,6 +35,37 @@ N_NODES, N_MOVES, N_MEMO, STATES, STATUS, INFO, EXPANDED = 0, 1, 2, 3, 4, 5, 6
 MAX_GROUP, GROUP_LIMIT, MAX_STATES, MAX_TOTAL, BUDGET = 0, 1, 2, 3, 4
 #: Rows a part's search starts with (most parts come apart in a few states).
 _FIRST_CAP = 64
+
+
+class Puzzle(NamedTuple):
+    """The whole puzzle's piece arrays that every part gathers its rows from
+    (:class:`chaingeo.solvers.motion.partsearch.PieceTable`: voxels sorted per axis, where each
+    piece's rows start, boxes)."""
+
+    vox: I64
+    starts: I64
+    lo: I64
+    hi: I64
+
+
+class LevelTree(NamedTuple):
+    """The tree :func:`greedy` writes: ``nodes`` rows (first move, move count, removed
+    sub-tree, left sub-tree) and ``moves`` rows (global mask, direction, distance; -1: a
+    removal); ``ctx`` counts the rows used."""
+
+    nodes: I64
+    moves: I64
+
+
+class Memo(NamedTuple):
+    """Parts already searched: ``keys`` rows (the part's pieces as a mask in four int16, then
+    offsets relative to its first piece), their open-addressing ``table``
+    (:func:`chaingeo.solvers.motion.movement.find_or_insert`) and ``val`` (the part's tree
+    index; -1: cannot come apart)."""
+
+    keys: I16
+    table: I64
+    val: I64
 
 
 @njit(cache=True)
@@ -82,9 +116,10 @@ def _memo_row(members: I64, width: int) -> I16:
 
 
 @njit(cache=True)
-def _memo_slot(members: I64, offsets: I64, ctx: I64, memo_keys: I16, memo_table: I64) -> int:
+def _memo_slot(members: I64, offsets: I64, ctx: I64, memo: Memo) -> int:
     """The memo entry of the part (its pieces, and offsets relative to its first piece):
     ``-1 - index`` when new, -(2**40) when the memo is full."""
+    memo_keys, memo_table = memo.keys, memo.table
     row = _memo_row(members, memo_keys.shape[1])
     for i in range(members.shape[0]):
         for t in range(3):
@@ -101,30 +136,17 @@ def _memo_slot(members: I64, offsets: I64, ctx: I64, memo_keys: I16, memo_table:
 
 @njit(cache=True)
 def greedy(
-    vox_all: I64,
-    starts_all: I64,
-    lo_all: I64,
-    hi_all: I64,
-    members: I64,
-    offsets: I64,
-    params: I64,
-    ctx: I64,
-    nodes: I64,
-    moves: I64,
-    memo_keys: I16,
-    memo_table: I64,
-    memo_val: I64,
+    puzzle: Puzzle, members: I64, offsets: I64, params: I64, ctx: I64, out: LevelTree, memo: Memo
 ) -> int:
     """The tree of the part ``members`` (global piece indices, ascending) at ``offsets``: its
-    index in ``nodes`` (rows: first move, move count, removed sub-tree, left sub-tree; -1: a
-    single piece), -1 if it cannot be taken apart, -2 on a status set in ``ctx``. ``moves``
-    rows: global mask, direction, distance (-1: removal)."""
-    slot = _memo_slot(members, offsets, ctx, memo_keys, memo_table)
+    index in ``out.nodes`` (-1: a single piece), -1 if it cannot be taken apart, -2 on a status
+    set in ``ctx``. Parts met before come from ``memo``."""
+    slot = _memo_slot(members, offsets, ctx, memo)
     if slot == -(1 << 40):
         ctx[STATUS] = NEED_BUFFERS
         return -2
     if slot >= 0:
-        return int(memo_val[slot])
+        return int(memo.val[slot])
     slot = -1 - slot
     if params[MAX_TOTAL] >= 0 and ctx[STATES] > params[MAX_TOTAL]:
         ctx[STATUS] = TOTAL_CAP
@@ -132,7 +154,7 @@ def greedy(
     k = members.shape[0]
     w = 3 * k
     max_states = params[MAX_STATES]
-    vox, starts, lo, hi = part_arrays(vox_all, starts_all, lo_all, hi_all, members)
+    vox, starts, lo, hi = part_arrays(puzzle.vox, puzzle.starts, puzzle.lo, puzzle.hi, members)
     cap = max(2, min(_FIRST_CAP, max_states))
     states = np.zeros((cap, w), dtype=np.int16)
     parent = np.full(cap, -1, dtype=np.int64)
@@ -160,20 +182,20 @@ def greedy(
         first_sep = n_seps
         while True:
             before = node
-            status, node, n_states, n_seps, n_layers = mv.expand(
-                mv.Tree(states, parent, move, table), n_states, node, layers, n_layers,
+            status, node, n_states, n_seps, n_layers = bfs.expand(
+                bfs.Tree(states, parent, move, table), n_states, node, layers, n_layers,
                 max_states, params[BUDGET] - ctx[EXPANDED],
                 mv.Pieces(vox, starts, lo, hi, params[MAX_GROUP], params[GROUP_LIMIT],
                           moves_buf, groups_buf),
                 seps, n_seps,
             )  # fmt: skip
             ctx[EXPANDED] += node - before
-            if status == mv.DONE:
+            if status == bfs.DONE:
                 break
-            if status == mv.PAUSED:
+            if status == bfs.PAUSED:
                 ctx[STATUS] = OVER_BUDGET
                 return -2
-            if status == mv.NEED_STATES:
+            if status == bfs.NEED_STATES:
                 cap = states.shape[0]
                 if n_states + 1 >= cap:
                     if cap >= max_states:
@@ -181,14 +203,14 @@ def greedy(
                         ctx[INFO] = k
                         return -2
                     new_cap = min(2 * cap, max_states)
-                    states, parent, move = mv.grow_search(states, parent, move, new_cap)
+                    states, parent, move = bfs.grow_search(states, parent, move, new_cap)
                     grown_layers = np.zeros(new_cap + 2, dtype=np.int64)
                     grown_layers[: cap + 2] = layers
                     layers = grown_layers
-                table = mv.fit_table(table, states, n_states)
-            elif status == mv.NEED_MOVES:
+                table = bfs.fit_table(table, states, n_states)
+            elif status == bfs.NEED_MOVES:
                 moves_buf = np.zeros((2 * moves_buf.shape[0], 4), dtype=np.int64)
-            elif status == mv.NEED_SEPS:
+            elif status == bfs.NEED_SEPS:
                 grown_seps = np.zeros((2 * seps.shape[0], 3), dtype=np.int64)
                 grown_seps[: seps.shape[0]] = seps
                 seps = grown_seps
@@ -230,10 +252,7 @@ def greedy(
                     sub_members[j] = members[sub[j]]
                     for t in range(3):
                         sub_off[j, t] = states[at, 3 * sub[j] + t]
-                got = greedy(
-                    vox_all, starts_all, lo_all, hi_all, sub_members, sub_off, params,
-                    ctx, nodes, moves, memo_keys, memo_table, memo_val,
-                )  # fmt: skip
+                got = greedy(puzzle, sub_members, sub_off, params, ctx, out, memo)
                 if got == -2:
                     return -2
                 if got == -1:
@@ -242,26 +261,23 @@ def greedy(
                 sides[side] = got
             if not ok:
                 continue
-            result = _record(nodes, moves, ctx, parent, move, members, at, mask, found[r, 2], sides)
+            result = _record(out, ctx, parent, move, members, at, mask, found[r, 2], sides)
             if result == -2:
                 return -2
             break
     ctx[STATES] += n_states
-    memo_val[slot] = result
-    if result == -1 and not _remember_stuck(members, states, n_states, ctx, memo_keys, memo_table,
-                                            memo_val):  # fmt: skip
+    memo.val[slot] = result
+    if result == -1 and not _remember_stuck(members, states, n_states, ctx, memo):
         return -2
     return result
 
 
 @njit(cache=True)
-def _remember_stuck(
-    members: I64, states: I16, n_states: int, ctx: I64, memo_keys: I16, memo_table: I64,
-    memo_val: I64,
-) -> bool:  # fmt: skip
+def _remember_stuck(members: I64, states: I16, n_states: int, ctx: I64, memo: Memo) -> bool:
     """Every state of a part's component that cannot come apart goes into the memo as stuck
     (from any of them the search would see the same component), so that no state of it is
     searched again; False (NEED_BUFFERS) when the memo is full."""
+    memo_keys, memo_table, memo_val = memo
     row = _memo_row(members, memo_keys.shape[1])
     w = states.shape[1]
     for node in range(1, n_states):
@@ -279,10 +295,11 @@ def _remember_stuck(
 
 @njit(cache=True)
 def _record(
-    nodes: I64, moves: I64, ctx: I64, parent: I64, move: I64, members: I64, at: int,
-    mask: np.int64, direction: int, sides: I64,
+    out: LevelTree, ctx: I64, parent: I64, move: I64, members: I64, at: int, mask: np.int64,
+    direction: int, sides: I64,
 ) -> int:  # fmt: skip
     """Append a tree node: the path to ``at``, then the removal; -2 when a buffer is full."""
+    nodes, moves = out
     length = 1
     p = at
     while p > 0:

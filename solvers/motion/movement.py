@@ -28,9 +28,6 @@ U64 = npt.NDArray[np.uint64]
 
 #: "Never meets": larger than any real gap.
 INF = 1 << 40
-#: Status codes returned by :func:`expand` (5 and 6 are :mod:`chaingeo.solvers.motion.turnmoves`'
-#: own).
-DONE, NEED_STATES, NEED_SEPS, TOO_MANY_GROUPS, NEED_MOVES, PAUSED = 0, 1, 2, 3, 4, 7
 #: Most pieces one part may hold (groups are 64-bit masks).
 MAX_PIECES = 63
 
@@ -48,17 +45,6 @@ class Pieces(NamedTuple):
     group_limit: int
     moves: I64
     groups: U64
-
-
-class Tree(NamedTuple):
-    """A breadth-first search's growing arrays: the state rows, each state's parent and the move
-    that made it (rows), and the open-addressing ``table`` over the rows (:func:`find_or_insert`);
-    a search replaces them as they fill (:func:`grow_search`, :func:`fit_table`)."""
-
-    states: I16
-    parent: I64
-    move: I64
-    table: I64
 
 
 @njit(cache=True)
@@ -509,113 +495,6 @@ def rebuild_table(states: I16, n_states: int, table: I64) -> None:
         while table[h] >= 0:
             h = (h + np.uint64(1)) & mask
         table[h] = s
-
-
-@njit(cache=True)
-def grow_search(
-    states: I16, parent: I64, move: I64, new_cap: int
-) -> tuple[I16, I64, I64]:  # fmt: skip
-    """A search's state rows, parents and moves copied into room for ``new_cap`` states."""
-    cap = states.shape[0]
-    grown = np.zeros((new_cap, states.shape[1]), dtype=np.int16)
-    grown[:cap] = states
-    grown_parent = np.full(new_cap, -1, dtype=np.int64)
-    grown_parent[:cap] = parent
-    grown_move = np.zeros((new_cap, 3), dtype=np.int64)
-    grown_move[:cap] = move
-    return grown, grown_parent, grown_move
-
-
-@njit(cache=True)
-def fit_table(table: I64, states: I16, n_states: int) -> I64:
-    """``table``, or a new one rebuilt over ``states`` once it has fewer than four slots per
-    state row (open addressing stays short)."""
-    if table.shape[0] >= 4 * states.shape[0]:
-        return table
-    size = 1
-    while size < 4 * states.shape[0]:
-        size *= 2
-    out = np.full(size, -1, dtype=np.int64)
-    rebuild_table(states, n_states, out)
-    return out
-
-
-@njit(cache=True)
-def expand(
-    tree: Tree, n_states: int, node: int, layers: I64, n_layers: int, max_depth: int,
-    budget: int, pieces: Pieces, seps: I64, n_seps: int,
-) -> tuple[int, int, int, int, int]:  # fmt: skip
-    """Breadth-first search, layer after layer in one call (no Python between layers).
-
-    Layer ``d`` holds nodes ``layers[d]:layers[d + 1]`` (``n_layers`` entries); ``node`` is
-    the next node of the deepest layer to expand. New states are appended with their parent
-    and the move that made them (``move`` rows: mask, direction, distance); every removal seen
-    is appended to ``seps`` as ``(node, mask, direction)``. Stops with DONE once a layer has
-    yielded a removal, the deepest layer is empty (every state expanded) or is deeper than
-    ``max_depth``; with PAUSED after ``budget`` nodes (the caller checks its deadline).
-    Returns ``(status, next node, n_states, n_seps, n_layers)``; on a status asking for a
-    buffer the caller grows it and calls again from ``next`` (that node is expanded again from
-    scratch, so its removals are dropped first). ``layers`` holds two more entries than
-    ``states`` rows (every layer has a node).
-    """
-    states, parent, move, table = tree
-    vox, starts, lo, hi, max_group, group_limit, moves_buf, groups_buf = pieces
-    n = starts.shape[0] - 1
-    w = 3 * n
-    gaps = np.empty((3, n, n), dtype=np.int64)
-    off = np.empty((n, 3), dtype=np.int64)
-    child = np.empty(w, dtype=np.int16)
-    while n_seps > 0 and seps[n_seps - 1, 0] >= node:
-        n_seps -= 1
-    done = 0
-    while True:
-        d = n_layers - 2
-        first = layers[d]
-        end = layers[d + 1]
-        if first == end or d > max_depth:
-            return DONE, node, n_states, n_seps, n_layers
-        while node < end:
-            if done >= budget:
-                return PAUSED, node, n_states, n_seps, n_layers
-            for p in range(n):
-                for t in range(3):
-                    off[p, t] = states[node, 3 * p + t]
-            rows = node_moves(
-                vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf,
-                moves_buf,
-            )  # fmt: skip
-            if rows == -2:
-                return TOO_MANY_GROUPS, node, n_states, n_seps, n_layers
-            if rows == -1:
-                return NEED_MOVES, node, n_states, n_seps, n_layers
-            for r in range(rows):
-                mask = np.uint64(moves_buf[r, 0])
-                dr = moves_buf[r, 1]
-                kmax = moves_buf[r, 2]
-                if moves_buf[r, 3]:
-                    if n_seps >= seps.shape[0]:
-                        return NEED_SEPS, node, n_states, n_seps, n_layers
-                    seps[n_seps, 0] = node
-                    seps[n_seps, 1] = np.int64(mask)
-                    seps[n_seps, 2] = dr
-                    n_seps += 1
-                for k in range(1, kmax + 1):
-                    if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                        return NEED_STATES, node, n_states, n_seps, n_layers
-                    shift_child(states[node], child, 0, None, n, moves_buf[r, 0], dr, k)
-                    got = find_or_insert(states, n_states, table, child)
-                    if got < 0:
-                        parent[n_states] = node
-                        move[n_states, 0] = np.int64(mask)
-                        move[n_states, 1] = dr
-                        move[n_states, 2] = k
-                        n_states += 1
-            node += 1
-            done += 1
-        layers[n_layers] = n_states
-        n_layers += 1
-        if n_seps > 0 and seps[n_seps - 1, 0] >= first:
-            return DONE, node, n_states, n_seps, n_layers
 
 
 @njit(cache=True)

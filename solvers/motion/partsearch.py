@@ -14,12 +14,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
+from chaingeo.core.jit import Pinned
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
+
+#: :func:`chaingeo.solvers.motion.bfs_kernel.expand` as :class:`PartSearch` calls it: the types
+#: of its arguments are fixed by PartSearch's constructor (see :class:`Pinned`).
+_expand = Pinned(bfs.expand)
 
 
 class PieceTable:
@@ -130,19 +136,27 @@ class PartSearch:
         self.limits = limits
         self.deadline = deadline
         self.chunk = chunk
-        self.vox, self.starts, self.lo, self.hi = table.part_arrays(self.members)
-        cap = max(2, min(64, limits.max_states))  # most parts come apart in a few states
-        self.states = np.zeros((cap, 3 * n), dtype=np.int16)
-        self.parent = np.full(cap, -1, dtype=np.int64)
-        self.move = np.zeros((cap, 3), dtype=np.int64)
-        self.hash = np.full(1 << (4 * cap - 1).bit_length(), -1, dtype=np.int64)
+        vox, starts, lo, hi = table.part_arrays(self.members)
+        cap = max(2, min(128, limits.max_states))  # most parts come apart in a few states
+        # The kernel's bundles are kept, and replaced only when a buffer grows: every call
+        # expands one or two nodes on a typical part, so building them per call would cost
+        # more than the call (and _expand relies on their types, fixed here).
+        self.tree = bfs.Tree(
+            np.zeros((cap, 3 * n), dtype=np.int16),
+            np.full(cap, -1, dtype=np.int64),
+            np.zeros((cap, 3), dtype=np.int64),
+            np.full(1 << (4 * cap - 1).bit_length(), -1, dtype=np.int64),
+        )
+        self.pieces = mv.Pieces(
+            vox, starts, lo, hi, self.max_group, int(limits.group_limit),
+            np.zeros((64, 4), dtype=np.int64),
+            np.empty(min(limits.group_limit, 1 << 16) + 1, dtype=np.uint64),
+        )  # fmt: skip
         self.seps = np.zeros((64, 3), dtype=np.int64)
-        self.moves_buf = np.zeros((64, 4), dtype=np.int64)
-        self.groups_buf = np.empty(min(limits.group_limit, 1 << 16) + 1, dtype=np.uint64)
         start = np.asarray(offsets, dtype=np.int64).reshape(n, 3)
         start = start - start[0]
         row = start.reshape(-1).astype(np.int16)
-        mv.find_or_insert(self.states, 0, self.hash, row)
+        mv.find_or_insert(self.tree.states, 0, self.tree.table, row)
         self.n_states = 1
         self.n_seps = 0
         # Layer d holds nodes layers[d]:layers[d + 1]; ``node``: the next one to expand.
@@ -160,24 +174,32 @@ class PartSearch:
         out: np.ndarray = self.states[node].astype(np.int64).reshape(self.n, 3)
         return out
 
+    @property
+    def states(self) -> np.ndarray:
+        """The state rows (``n_states`` of them filled)."""
+        return self.tree.states
+
+    @property
+    def parent(self) -> np.ndarray:
+        return self.tree.parent
+
+    @property
+    def move(self) -> np.ndarray:
+        return self.tree.move
+
     def _grow_states(self) -> None:
-        need = self.n_states + 1
-        cap = self.states.shape[0]
-        if need >= cap:
+        states, parent, move, table = self.tree
+        cap = states.shape[0]
+        if self.n_states + 1 >= cap:
             if cap >= self.limits.max_states:
                 raise SearchLimitError(
                     f"state cap of {self.limits.max_states} reached in a {self.n}-piece part",
                     "max_states",
                 )
             new_cap = min(2 * cap, self.limits.max_states)
-            self.states = np.concatenate([self.states, np.zeros_like(self.states)])[:new_cap]
-            self.parent = np.concatenate([self.parent, np.full(cap, -1, dtype=np.int64)])[:new_cap]
-            self.move = np.concatenate([self.move, np.zeros_like(self.move)])[:new_cap]
+            states, parent, move = bfs.grow_search(states, parent, move, new_cap)
             self.layers = np.concatenate([self.layers, np.zeros_like(self.layers)])[: new_cap + 2]
-        if self.hash.shape[0] < 4 * self.states.shape[0]:
-            size = 1 << (4 * self.states.shape[0] - 1).bit_length()  # a power of two
-            self.hash = np.full(size, -1, dtype=np.int64)
-            mv.rebuild_table(self.states, self.n_states, self.hash)
+        self.tree = bfs.Tree(states, parent, move, bfs.fit_table(table, states, self.n_states))
 
     def expand_layer(self) -> list[Removal]:
         """Expand the deepest layer; return the removals found there (in search order)."""
@@ -191,24 +213,20 @@ class PartSearch:
         deepest = self.limits.max_states if max_depth is None else max_depth
         while True:
             self.deadline.check()
-            tree = mv.Tree(self.states, self.parent, self.move, self.hash)
-            pieces = mv.Pieces(
-                self.vox, self.starts, self.lo, self.hi, self.max_group,
-                self.limits.group_limit, self.moves_buf, self.groups_buf,
+            status, self.node, self.n_states, self.n_seps, self.n_layers = _expand(
+                self.tree, self.n_states, self.node, self.layers, self.n_layers, deepest,
+                self.chunk, self.pieces, self.seps, self.n_seps,
             )  # fmt: skip
-            status, self.node, self.n_states, self.n_seps, self.n_layers = mv.expand(
-                tree, self.n_states, self.node, self.layers, self.n_layers, deepest,
-                self.chunk, pieces, self.seps, self.n_seps,
-            )  # fmt: skip
-            if status == mv.DONE:
+            if status == bfs.DONE:
                 break
-            if status == mv.NEED_STATES:
+            if status == bfs.NEED_STATES:
                 self._grow_states()
-            elif status == mv.NEED_MOVES:
-                self.moves_buf = np.zeros((2 * self.moves_buf.shape[0], 4), dtype=np.int64)
-            elif status == mv.NEED_SEPS:
+            elif status == bfs.NEED_MOVES:
+                grown = np.zeros((2 * self.pieces.moves.shape[0], 4), dtype=np.int64)
+                self.pieces = self.pieces._replace(moves=grown)
+            elif status == bfs.NEED_SEPS:
                 self.seps = np.concatenate([self.seps, np.zeros_like(self.seps)])
-            elif status == mv.TOO_MANY_GROUPS:
+            elif status == bfs.TOO_MANY_GROUPS:
                 raise SearchLimitError(
                     f"more than {self.limits.group_limit} movable groups along one direction "
                     "in one state",

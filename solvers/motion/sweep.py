@@ -20,6 +20,7 @@ wander.
 from __future__ import annotations
 
 from functools import cache
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -318,12 +319,23 @@ def build_stencils(bound: int) -> tuple[I64, I64, I64]:
     return start, end, out
 
 
+class StencilArrays(NamedTuple):
+    """The stencil table as the turn kernels take it (:func:`build_stencils`, and its
+    ``bound``)."""
+
+    start: I64
+    end: I64
+    cells: I64
+    bound: int
+
+
 class Stencils:
     """The stencil table (:func:`build_stencils`) for relative positions within ``bound``."""
 
     def __init__(self, bound: int) -> None:
         self.bound = bound
         self.start, self.end, self.cells = build_stencils(bound)
+        self.arrays = StencilArrays(self.start, self.end, self.cells, bound)
 
 
 @cache

@@ -24,6 +24,7 @@ the gap kernel. A state is one ``int16`` row of ``3 n`` offsets then ``n`` rotat
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -31,8 +32,9 @@ import numpy.typing as npt
 from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
 from chaingeo.core.jit import njit
 from chaingeo.core.turns import quarter_index
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
-from chaingeo.solvers.motion.sweep import FAR_LIMIT, rmax2, rmin2, turn_hit
+from chaingeo.solvers.motion.sweep import FAR_LIMIT, StencilArrays, rmax2, rmin2, turn_hit
 
 I64 = npt.NDArray[np.int64]
 U64 = npt.NDArray[np.uint64]
@@ -382,36 +384,34 @@ def turn_pose(rot: int, off: I64, q: int, c: I64, out: I64) -> int:
     return int(COMPOSE[q, rot])
 
 
-#: Status of :func:`expand_turns` besides those of :func:`chaingeo.solvers.motion.movement.expand`.
+#: Status of :func:`expand_turns` besides those of
+#: :func:`chaingeo.solvers.motion.bfs_kernel.expand`.
 NEED_TURNS = 6
+
+
+class TurnPieces(NamedTuple):
+    """A part's pieces in each of their 24 orientations as :func:`expand_turns` reads them
+    (:meth:`TurnTable.part_arrays`: voxels, starts, boxes, rod axes), the group caps
+    (``max_group`` -1: any), and the buffers its per-state kernels write (move rows, turn rows,
+    groups)."""
+
+    vox: I64
+    starts: I64
+    lo: I64
+    hi: I64
+    rod: I64
+    max_group: int
+    group_limit: int
+    moves: I64
+    turns: I64
+    groups: U64
 
 
 @njit(cache=True)
 def expand_turns(
-    states: npt.NDArray[np.int16],
-    n_states: int,
-    parent: I64,
-    move: I64,
-    table: I64,
-    node_start: int,
-    node_end: int,
-    vox_all: I64,
-    starts_all: I64,
-    lo_all: I64,
-    hi_all: I64,
-    rod_all: I64,
-    st_start: I64,
-    st_end: I64,
-    st_cells: I64,
-    bound: int,
-    max_group: int,
-    group_limit: int,
-    seps: I64,
-    n_seps: int,
-    moves_buf: I64,
-    turns_buf: I64,
-    groups_buf: U64,
-) -> tuple[int, int, int, int, int]:
+    tree: bfs.Tree, n_states: int, node_start: int, node_end: int, pieces: TurnPieces,
+    st: StencilArrays, seps: I64, n_seps: int,
+) -> tuple[int, int, int, int, int]:  # fmt: skip
     """Expand nodes ``node_start..node_end-1`` of a breadth-first search with translations and
     turns (rows: ``3 n`` offsets, then ``n`` rotation indices; piece 0 never moves: when it
     belongs to the moving group, the rest moves the opposite way instead).
@@ -422,6 +422,10 @@ def expand_turns(
     Returns ``(status, next node, n_states, n_seps, 0)``. On a status other than DONE (or
     ``TOO_FAR``, which ends the search) the caller grows that buffer and calls again from the
     next node (re-expanded from scratch)."""
+    states, parent, move, table = tree
+    (vox_all, starts_all, lo_all, hi_all, rod_all, max_group, group_limit, moves_buf, turns_buf,
+     groups_buf) = pieces  # fmt: skip
+    st_start, st_end, st_cells, bound = st
     n = starts_all.shape[0] // 24
     w = 4 * n
     gaps = np.empty((3, n, n), dtype=np.int64)
@@ -442,9 +446,9 @@ def expand_turns(
             vox, starts, lo, hi, off, max_group, group_limit, False, gaps, groups_buf, moves_buf
         )
         if rows == -2:
-            return mv.TOO_MANY_GROUPS, node, n_states, n_seps, 0
+            return bfs.TOO_MANY_GROUPS, node, n_states, n_seps, 0
         if rows == -1:
-            return mv.NEED_MOVES, node, n_states, n_seps, 0
+            return bfs.NEED_MOVES, node, n_states, n_seps, 0
         nt = node_turns(
             vox, starts, lo, hi, rod, off, st_start, st_end, st_cells, bound,
             max_group, group_limit, groups_buf, turns_buf,
@@ -452,7 +456,7 @@ def expand_turns(
         if nt == -1:
             return NEED_TURNS, node, n_states, n_seps, 0
         if nt == -2:
-            return mv.TOO_MANY_GROUPS, node, n_states, n_seps, 0
+            return bfs.TOO_MANY_GROUPS, node, n_states, n_seps, 0
         if nt == -3:
             return TOO_FAR, node, n_states, n_seps, 0
         for r in range(rows):
@@ -461,14 +465,14 @@ def expand_turns(
             kmax = moves_buf[r, 2]
             if moves_buf[r, 3]:
                 if n_seps >= seps.shape[0]:
-                    return mv.NEED_SEPS, node, n_states, n_seps, 0
+                    return bfs.NEED_SEPS, node, n_states, n_seps, 0
                 seps[n_seps, 0] = node
                 seps[n_seps, 1] = np.int64(mask)
                 seps[n_seps, 2] = d
                 n_seps += 1
             for k in range(1, kmax + 1):
                 if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                    return mv.NEED_STATES, node, n_states, n_seps, 0
+                    return bfs.NEED_STATES, node, n_states, n_seps, 0
                 mv.shift_child(states[node], child, 0, None, n, moves_buf[r, 0], d, k)
                 got = mv.find_or_insert(states, n_states, table, child)
                 if got < 0:
@@ -488,7 +492,7 @@ def expand_turns(
             anchor_moves = (mask & np.uint64(1)) != np.uint64(0)
             q = QUARTERS[a, 1 - sense] if anchor_moves else QUARTERS[a, sense]
             if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                return mv.NEED_STATES, node, n_states, n_seps, 0
+                return bfs.NEED_STATES, node, n_states, n_seps, 0
             for t in range(w):
                 child[t] = states[node, t]
             for p in range(n):
@@ -506,4 +510,4 @@ def expand_turns(
                 move[n_states, 3] = c[1]
                 move[n_states, 4] = c[2]
                 n_states += 1
-    return mv.DONE, node_end, n_states, n_seps, 0
+    return bfs.DONE, node_end, n_states, n_seps, 0

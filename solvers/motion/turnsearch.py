@@ -24,10 +24,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from chaingeo.core.geometry import ROTATIONS, rotation_index
+from chaingeo.core.jit import Pinned
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion import turnmoves as tm
 from chaingeo.solvers.motion.partsearch import Removal, Split, part_size
@@ -42,6 +44,11 @@ Frame = tuple[np.ndarray, np.ndarray]
 
 def _direction(vec: np.ndarray) -> int:
     return int(np.flatnonzero(np.all(vec == _DIR_VECS, axis=1))[0])
+
+
+#: :func:`chaingeo.solvers.motion.turnmoves.expand_turns` as :class:`TurnPartSearch` calls it:
+#: the types of its arguments are fixed by TurnPartSearch's constructor (see :class:`Pinned`).
+_expand_turns = Pinned(tm.expand_turns)
 
 
 class TurnPartSearch:
@@ -62,6 +69,7 @@ class TurnPartSearch:
         self.table = table
         self.members = tuple(members)
         self.max_group = -1 if max_group is None else int(max_group)
+        self.group_limit = int(limits.group_limit)
         self.limits = limits
         self.deadline = deadline
         self.chunk = chunk
@@ -127,28 +135,28 @@ class TurnPartSearch:
         while node < hi:
             self.deadline.check()
             end = min(hi, node + self.chunk)
-            st = stencils()
-            status, node, self.n_states, self.n_seps, _ = tm.expand_turns(
-                self.states, self.n_states, self.parent, self.move, self.hash, node, end,
-                self.vox, self.starts, self.lo, self.hi, self.rod,
-                st.start, st.end, st.cells, st.bound,
-                self.max_group, self.limits.group_limit, self.seps, self.n_seps,
-                self.moves_buf, self.turns_buf, self.groups_buf,
+            tree = bfs.Tree(self.states, self.parent, self.move, self.hash)
+            pieces = tm.TurnPieces(
+                self.vox, self.starts, self.lo, self.hi, self.rod, self.max_group,
+                self.group_limit, self.moves_buf, self.turns_buf, self.groups_buf,
             )  # fmt: skip
-            if status == mv.NEED_STATES:
+            status, node, self.n_states, self.n_seps, _ = _expand_turns(
+                tree, self.n_states, node, end, pieces, stencils().arrays, self.seps, self.n_seps
+            )
+            if status == bfs.NEED_STATES:
                 self._grow_states()
-            elif status == mv.NEED_MOVES:
+            elif status == bfs.NEED_MOVES:
                 self.moves_buf = np.zeros((2 * self.moves_buf.shape[0], 4), dtype=np.int64)
             elif status == tm.NEED_TURNS:
                 self.turns_buf = np.zeros((2 * self.turns_buf.shape[0], 6), dtype=np.int64)
-            elif status == mv.NEED_SEPS:
+            elif status == bfs.NEED_SEPS:
                 self.seps = np.concatenate([self.seps, np.zeros_like(self.seps)])
             elif status == tm.TOO_FAR:
                 raise SearchLimitError(
                     f"pieces more than {FAR_LIMIT // 2} cells from a turn's axis: beyond the "
                     "exact integer range of the turn kernel"
                 )
-            elif status == mv.TOO_MANY_GROUPS:
+            elif status == bfs.TOO_MANY_GROUPS:
                 raise SearchLimitError(
                     f"more than {self.limits.group_limit} movable groups of one move in one state",
                     "group_limit",
