@@ -17,9 +17,9 @@ from chaingeo.envs.machines import new_state
 from chaingeo.envs.machines.state import BaseState
 from tests.support.env_levels import puzzle_levels, stacking_levels
 from tests.support.paths import GOLDEN as GOLDEN_DIR
-from tests.support.paths import LEVELS
+from tests.support.shipped import shipped
 
-SHIPPED: list[Level] = load_levels(LEVELS) if LEVELS.is_dir() else []
+SHIPPED: list[Level] = shipped()
 #: The golden playthroughs' levels (hand-made, and a generated six-piece burr in both goals).
 GOLDEN: list[Level] = load_levels(GOLDEN_DIR / "levels")
 #: Shipped assembly levels are checked against the full legal-action list only up to this many

@@ -13,14 +13,14 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from chaingeo.core.level import Level, load_levels
+from chaingeo.core.level import Level
 from chaingeo.core.rules import PuzzleRules, StackingRules
 from chaingeo.envs.actions.types import Action
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.machines.state import BaseState
-from tests.support.paths import LEVELS
+from tests.support.shipped import shipped
 
-SHIPPED: list[Level] = load_levels(LEVELS) if LEVELS.is_dir() else []
+SHIPPED: list[Level] = shipped()
 #: Steps of one playout, and the texts no state may raise on (odd, empty, hostile).
 STEPS = 8
 #: Listed actions checked for acceptance at each state besides the one played.

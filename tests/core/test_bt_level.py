@@ -12,10 +12,11 @@ from chaingeo.cli.main import main
 from chaingeo.core.formats.bt_level import level_puzzle, rules_not_carried
 from chaingeo.core.formats.burrtools import read_xmpuzzle, write_xmpuzzle
 from chaingeo.core.geometry import Shape
-from chaingeo.core.level import Level, StackingSolution, load_levels
+from chaingeo.core.level import Level, StackingSolution
 from chaingeo.core.suite import suite_folder
+from tests.support.shipped import shipped
 
-LEVELS = load_levels(suite_folder())
+LEVELS = shipped()
 
 
 def _assembled(level: Level) -> dict[str, Shape]:

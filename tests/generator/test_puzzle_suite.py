@@ -11,7 +11,7 @@ import pytest
 from chaingeo.cli.main import main
 from chaingeo.core.formats.models import import_model
 from chaingeo.core.kinematics import disassembly_of_assembly_plan, replay_disassembly
-from chaingeo.core.level import Level, PuzzleSolution, level_bytes, load_levels
+from chaingeo.core.level import Level, PuzzleSolution, level_bytes
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.generator.imported import imported_puzzle_level
 from chaingeo.generator.puzzle import difficulty_of
@@ -21,9 +21,10 @@ from chaingeo.solvers.limits import SearchLimits
 from tests.support.env_levels import design_of
 from tests.support.paths import LEVELS as LEVELS_DIR
 from tests.support.shared_files import MODELS, needs_models
+from tests.support.shipped import shipped
 
 SUITE = LEVELS_DIR / "puzzle"
-LEVELS = load_levels(SUITE) if any(SUITE.glob("*.json")) else []
+LEVELS = shipped("puzzle")
 
 
 def _model(level: Level) -> str | None:

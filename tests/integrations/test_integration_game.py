@@ -12,18 +12,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from chaingeo.core import limits
-from chaingeo.core.level import Level, load_levels
-from chaingeo.core.suite import suite_folder
+from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.baselines import oracle_plan
 from chaingeo.evaluation.agents.tools import skipped_result, translate
 from chaingeo.integrations.game import Game, Outcome, Protocol, efficiency_reward, recent
 from chaingeo.integrations.game import total_reward as total
 from tests.support.plans import place_calls
+from tests.support.shipped import shipped
 
 
 @cache
 def stacking() -> tuple[Level, ...]:
-    return tuple(load_levels(suite_folder("stacking")))
+    return tuple(shipped("stacking"))
 
 
 def play(game: Game, replies: list[str]) -> int:
@@ -116,7 +116,7 @@ def test_an_unknown_protocol_or_outcome_is_refused() -> None:
 
 
 def test_a_puzzle_is_played_the_same_way() -> None:
-    level = next(lv for lv in load_levels(suite_folder("puzzle")) if lv.difficulty == "easy")
+    level = next(lv for lv in shipped("puzzle") if lv.difficulty == "easy")
     game = Game(level, images=False)
     game.opening()
     plan = oracle_plan(level)

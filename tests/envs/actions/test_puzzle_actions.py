@@ -15,13 +15,14 @@ from chaingeo.core.kinematics import (
     Move,
     insertion_shifts,
 )
-from chaingeo.core.level import Level, load_levels
+from chaingeo.core.level import Level
 from chaingeo.envs.actions.lists import ActionList
 from chaingeo.envs.actions.types import FinishAction, MoveAction
 from chaingeo.envs.machines.puzzle import PuzzleState
 from chaingeo.envs.machines.puzzle_actions import reference_actions, shifts
 from tests.support.env_levels import design_of, puzzle_levels
 from tests.support.paths import LEVELS
+from tests.support.shipped import shipped
 from tests.support.strategies import polycubes
 
 SUITE = LEVELS / "puzzle"
@@ -46,7 +47,7 @@ def test_insertion_kernel_is_the_reference(
 def small_levels() -> list[Level]:
     """The test levels and, per (shape, goal), the first shipped level of at most 6 pieces."""
     picked: dict[tuple[str, str], Level] = {}
-    for lv in load_levels(SUITE):
+    for lv in shipped("puzzle"):
         if len(lv.pieces) <= 6:
             picked.setdefault((design_of(lv), lv.goal), lv)
     return [*puzzle_levels(), *(picked[k] for k in sorted(picked))]
@@ -55,7 +56,7 @@ def small_levels() -> list[Level]:
 def large_assembly_levels() -> list[Level]:
     """The shipped assemble levels of 12 pieces and more (one per shape)."""
     picked: dict[str, Level] = {}
-    for lv in sorted(load_levels(SUITE), key=lambda lv: (-len(lv.pieces), lv.id)):
+    for lv in sorted(shipped("puzzle"), key=lambda lv: (-len(lv.pieces), lv.id)):
         if lv.goal == "assemble":
             picked.setdefault(design_of(lv), lv)
     return [lv for lv in picked.values() if len(lv.pieces) >= 12]

@@ -24,6 +24,7 @@ from chaingeo.evaluation.episode import EpisodeTask, run_episode
 from chaingeo.solvers.motion import sweep
 from chaingeo.solvers.motion.turnmoves import TurnTable
 from chaingeo.solvers.motion.turnsearch import fast_legal_turns, turn_problem, turn_rows
+from tests.support.jit import seconds_for
 from tests.support.puzzle_strategies import small_scenes
 from tests.support.scenes import turning_walk
 
@@ -189,7 +190,7 @@ def test_pieces_far_apart_cost_no_more_memory() -> None:
     assert [r.tolist() for _, r in rows] == [r.tolist() for _, r in warm]
     assert sum(len(r) for _, r in rows) > 0
     assert peak < 8 << 20, f"{peak / 2**20:.1f} MB"
-    assert took < 5.0
+    assert took < seconds_for(5.0)
 
 
 def test_random_episode_on_the_turn_level_is_bounded(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -213,7 +214,7 @@ def test_random_episode_on_the_turn_level_is_bounded(monkeypatch: pytest.MonkeyP
     took = time.perf_counter() - t0
     grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - peak_before
     assert record["status"] == "done", record.get("error")
-    assert took < 20.0
+    assert took < seconds_for(20.0)
     assert grown < 400 << 10, f"peak memory grew by {grown >> 10} MB"
     assert sweep.stencils() is table and table.bound == sweep.BOUND
     # a part wider than 13 cells puts cells more than 24 doubled units from some centre

@@ -19,6 +19,7 @@ from chaingeo.solvers.analysis import analyze_level
 from chaingeo.solvers.motion.disassemble import analyze_assembly, translations
 from chaingeo.solvers.optimal.classbound import band_blocks, class_lower_bound
 from chaingeo.solvers.optimal.classsearch import ClassSearchLimits, class_search_optimal
+from tests.support.jit import seconds_for
 from tests.support.paths import LEVELS
 from tests.support.puzzle_strategies import random_blocks, small_scenes
 
@@ -103,7 +104,8 @@ def test_chain_analyze_proves_a_multi_piece_tower(
     raw["rules"]["max_group"] = None
     path = tmp_path / "tower.json"
     path.write_text(json.dumps(raw))
-    assert main(["analyze", str(path), "--no-assemble", "--seconds", "60"]) == 0
+    budget = ["--seconds", f"{seconds_for(60):g}", "--optimal-seconds", f"{seconds_for(10):g}"]
+    assert main(["analyze", str(path), "--no-assemble", *budget]) == 0
     out = json.loads(capsys.readouterr().out)
     level = load_level(path)
     quick = analyze_assembly(
