@@ -43,18 +43,6 @@ def _local_outcomes() -> list[Any]:
     return list(module.OUTCOMES) if module is not None else []
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_cmdline_main(config: pytest.Config) -> None:
-    """``-n N`` schedules by work stealing (set here, before pytest-xdist's own default, rather
-    than in addopts, where ``--dist`` would break ``-p no:xdist``): a worker that runs dry takes
-    half of the other's queue, so a long test near the end leaves no core idle, and the workers
-    start at opposite ends of the suite, so on a cold numba cache they seldom compile the same
-    kernel at once. An explicit ``--dist`` is kept."""
-    option = config.option
-    if getattr(option, "numprocesses", None) and getattr(option, "dist", None) == "no":
-        option.dist = "worksteal"
-
-
 def pytest_sessionfinish(session: pytest.Session) -> None:
     """A worker hands its differential outcomes to the controller."""
     output = getattr(session.config, "workeroutput", None)
