@@ -47,7 +47,10 @@ def exports(dispatchers: Iterable[Any]) -> list[Export]:
         if d.targetoptions.get("inline") == "always":
             continue
         for args in d.signatures:
-            keys = [type_key(t) for t in args]
+            try:
+                keys = [type_key(t) for t in args]
+            except Exception:  # a type numba has and numpy lacks: left to numba, like no key
+                continue
             if any(k is None for k in keys):
                 continue
             sig = d.overloads[args].signature

@@ -118,10 +118,14 @@ def type_key(nbtype: Any) -> str | None:
         if nbtype.layout not in "CFA":
             return None
         return f"{'w' if nbtype.mutable else 'r'}{nbtype.layout}{nbtype.ndim}{key}"
+    if isinstance(nbtype, types.Literal):  # a kernel-to-kernel call with a constant: never
+        return None  # what numba types a Python argument as
     if isinstance(nbtype, types.Boolean):
         return "b"
-    if isinstance(nbtype, types.Integer | types.Float):
-        return np.dtype(str(nbtype)).str
+    if isinstance(nbtype, types.Integer):
+        return np.dtype(f"{'i' if nbtype.signed else 'u'}{nbtype.bitwidth // 8}").str
+    if isinstance(nbtype, types.Float):
+        return np.dtype(f"f{nbtype.bitwidth // 8}").str
     if isinstance(nbtype, types.NoneType):
         return "n"
     if isinstance(nbtype, types.BaseTuple):

@@ -97,6 +97,14 @@ def test_what_kernels_do_not_take_has_no_key() -> None:
     assert args_key((np.zeros(2), "x")) is None
 
 
+def test_literal_types_have_no_key() -> None:
+    """A kernel calling another with a constant compiles it for the literal; Python never
+    passes one, so such a signature is not precompiled."""
+    assert type_key(numba.types.literal(0)) is None
+    assert type_key(numba.types.Tuple((numba.types.literal(1), numba.types.int64))) is None
+    assert type_key(numba.types.int32) == "<i4" and type_key(numba.types.uint64) == "<u8"
+
+
 def test_layouts_and_writability_are_told_apart() -> None:
     a = np.zeros((3, 4), np.int64)
     keys = {value_key(a), value_key(a.T), value_key(a[:, ::2])}
