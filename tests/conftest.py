@@ -28,9 +28,9 @@ os.environ[aot.DIR_ENV] = os.path.join(tempfile.mkdtemp(prefix="chaingeo-tests-"
 @pytest.fixture
 def user_kernels() -> Path:
     """The user's precompiled kernels (skips when there are none usable)."""
-    manifest, sentence = aot.status(USER_KERNELS)
-    if manifest is None or manifest.stale():
-        pytest.skip(f"{USER_KERNELS}: {sentence}")
+    found = aot.status(USER_KERNELS)
+    if not found.usable:
+        pytest.skip(f"{USER_KERNELS}: {found.sentence}")
     return USER_KERNELS
 
 

@@ -136,32 +136,42 @@ class Loaded:
 _loaded: Loaded | None = None
 
 
-def status(directory: Path | None = None) -> tuple[Manifest | None, str]:
-    """The stored build's manifest and a sentence on whether it can be used."""
+@dataclass(frozen=True)
+class Status:
+    """What a store holds (``manifest``), whether it can be used, and a sentence saying so."""
+
+    manifest: Manifest | None
+    usable: bool
+    sentence: str
+
+
+def status(directory: Path | None = None) -> Status:
+    """The stored build's manifest, checked against this installation."""
     folder = directory or store_dir()
     try:
         manifest = Manifest.from_json((folder / MANIFEST).read_text(encoding="utf-8"))
     except OSError:
-        return None, f"no ahead-of-time kernels in {folder} (run `chain precompile`)"
+        return Status(None, False, f"no ahead-of-time kernels in {folder} (run `chain precompile`)")
     if manifest is None:
-        return None, f"{folder / MANIFEST} is unreadable or of another format"
+        return Status(None, False, f"{folder / MANIFEST} is unreadable or of another format")
     if not _module_path(folder).is_file():
-        return None, f"{folder} has a manifest but no {MODULE} module"
+        return Status(None, False, f"{folder} has a manifest but no {MODULE} module")
     why = manifest.stale()
     if why:
-        return manifest, f"stale: {why} (run `chain precompile` again)"
-    n = sum(len(v) for v in manifest.exports.values())
-    return manifest, f"ready: {n} compiled signatures of {len(manifest.exports)} kernels"
+        return Status(manifest, False, f"stale: {why} (run `chain precompile` again)")
+    n, kernels = sum(len(v) for v in manifest.exports.values()), len(manifest.exports)
+    return Status(manifest, True, f"ready: {n} compiled signatures of {kernels} kernels")
 
 
 def load(directory: Path | None = None) -> Loaded | None:
-    """The stored build if it matches this installation (loaded once a process), else ``None``."""
+    """The stored build if it matches this installation (checked and loaded once a process),
+    else ``None``."""
     global _loaded
     if _loaded is not None:
         return _loaded
     folder = directory or store_dir()
-    manifest, _ = status(folder)
-    if manifest is None or manifest.stale():
+    found = status(folder)
+    if not found.usable or found.manifest is None:
         return None
     spec = importlib.util.spec_from_file_location(
         MODULE, _module_path(folder), loader=None, submodule_search_locations=None
@@ -170,7 +180,7 @@ def load(directory: Path | None = None) -> Loaded | None:
         return None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    _loaded = Loaded(manifest, module)
+    _loaded = Loaded(found.manifest, module)
     return _loaded
 
 

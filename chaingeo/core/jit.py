@@ -64,7 +64,7 @@ def _fix(wanted: Mode) -> None:
         from chaingeo.core import aot
 
         if aot.load() is None:
-            raise RuntimeError(f"no usable ahead-of-time kernels: {aot.status()[1]}")
+            raise RuntimeError(f"no usable ahead-of-time kernels: {aot.status().sentence}")
     _mode = wanted
     if wanted == "python":
         np.seterr(over="ignore")  # numpy scalars warn where numba's integers wrap silently

@@ -122,10 +122,8 @@ def type_key(nbtype: Any) -> str | None:
         return None  # what numba types a Python argument as
     if isinstance(nbtype, types.Boolean):
         return "b"
-    if isinstance(nbtype, types.Integer):
-        return np.dtype(f"{'i' if nbtype.signed else 'u'}{nbtype.bitwidth // 8}").str
-    if isinstance(nbtype, types.Float):
-        return np.dtype(f"f{nbtype.bitwidth // 8}").str
+    if isinstance(nbtype, types.Integer | types.Float):
+        return np.dtype(str(nbtype)).str  # "int64", "float32": numpy's names too
     if isinstance(nbtype, types.NoneType):
         return "n"
     if isinstance(nbtype, types.BaseTuple):

@@ -70,10 +70,11 @@ def test_a_build_is_stale_once_a_source_or_numpy_differs(tmp_path: Path) -> None
 
 
 def test_no_store_is_said_plainly(tmp_path: Path) -> None:
-    manifest, sentence = aot.status(tmp_path / "none")
-    assert manifest is None and "chain precompile" in sentence
+    found = aot.status(tmp_path / "none")
+    assert (found.manifest, found.usable) == (None, False)
+    assert "chain precompile" in found.sentence
     (tmp_path / aot.MANIFEST).write_text("{")
-    assert aot.status(tmp_path)[0] is None
+    assert not aot.status(tmp_path).usable
 
 
 # -- with the user's build (CI runs `chain precompile` first) ------------------------------

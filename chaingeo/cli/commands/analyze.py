@@ -263,8 +263,7 @@ def _ahead_of_time_first(args: argparse.Namespace) -> bool:
     argv = getattr(args, "command_line", None)
     if args.jit != "auto" or argv is None or jit.ENV in os.environ or RESUME_ENV in os.environ:
         return False
-    manifest, _ = aot.status()
-    return manifest is not None and manifest.stale() is None
+    return aot.load() is not None  # checked once: setting the mode finds it loaded
 
 
 def _aot_forced(args: argparse.Namespace) -> bool:

@@ -49,8 +49,7 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.core import aot
 
     if args.status:
-        _, sentence = aot.status()
-        print(f"{aot.store_dir()}: {sentence}")
+        print(f"{aot.store_dir()}: {aot.status().sentence}")
         return 0
     if not args.seconds > 0:
         raise CommandError(f"--seconds: expected a positive number, got {args.seconds}")
