@@ -295,10 +295,28 @@ class Shape:
 
     # -- predicates -------------------------------------------------------------------------
     def is_connected(self) -> bool:
-        """True when the voxels form one 6-connected component (the empty shape is not)."""
-        if len(self) == 0:
+        """True when the voxels form one 6-connected component (the empty shape is not).
+
+        One flood fill from the first voxel, stopping at nothing else: the generators ask this
+        of hundreds of thousands of candidate pieces (:func:`components` also sorts and lists
+        every component, ~3x the time)."""
+        if not self._key:
             return False
-        return len(components(self.cells)) == 1
+        first = self._key[0]
+        remaining = set(self._key)
+        remaining.discard(first)
+        stack = [first]
+        while stack and remaining:
+            x, y, z = stack.pop()
+            for n in ((x + 1, y, z), (x - 1, y, z), (x, y + 1, z), (x, y - 1, z)):
+                if n in remaining:
+                    remaining.discard(n)
+                    stack.append(n)
+            for n in ((x, y, z + 1), (x, y, z - 1)):
+                if n in remaining:
+                    remaining.discard(n)
+                    stack.append(n)
+        return not remaining
 
     def overlaps(self, other: Shape) -> bool:
         return not self.cell_set.isdisjoint(other.cell_set)

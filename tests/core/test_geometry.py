@@ -158,3 +158,11 @@ def test_piece_sets_match_their_boxes() -> None:
     assert placed == box_cells((4, 4, 4)).cell_set
     for s in [*SOMA.pieces.values(), *PENTOMINOES.pieces.values(), *BEDLAM.pieces.values()]:
         assert s.is_connected() and s == s.normalized()
+
+
+@given(st.sets(st.tuples(*[st.integers(0, 3)] * 3), max_size=20))
+def test_is_connected_is_one_component(cells: set[tuple[int, int, int]]) -> None:
+    """The flood fill answers as the component listing does, on any voxel set."""
+    from chaingeo.core.geometry import components
+
+    assert Shape(list(cells)).is_connected() == (len(components(cells)) == 1)
