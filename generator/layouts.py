@@ -35,6 +35,11 @@ class Layout:
 
     def pieces(self, design: Sequence[int]) -> list[Shape]:
         """The pieces of ``design`` (owner slot per shared cell, -1 for empty)."""
+        return [Shape(cells) for cells in self.piece_cells(design)]
+
+    def piece_cells(self, design: Sequence[int]) -> list[list[Cell]]:
+        """The cells of each piece of ``design``, unsorted (no shapes built: the search asks
+        only whether they are connected, of many designs)."""
         shared = self.shared
         if len(design) != len(shared):
             raise ValueError(f"a design has {len(shared)} entries, got {len(design)}")
@@ -43,7 +48,7 @@ class Layout:
         for cell, owner in zip(shared, design, strict=True):
             if owner >= 0:
                 out[owner].append(cell)
-        return [Shape(cells) for cells in out]
+        return out
 
 
 @cache

@@ -18,7 +18,7 @@ from typing import Literal
 import numpy as np
 
 from chaingeo.core.colors import assign_colors
-from chaingeo.core.geometry import Shape, puzzle_signature
+from chaingeo.core.geometry import Shape, connected, puzzle_signature
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.level import (
     Difficulty,
@@ -35,7 +35,7 @@ from chaingeo.generator.candidate import Candidate, evaluate
 from chaingeo.generator.config import STANDARD_SHAPES, PuzzleConfig
 from chaingeo.generator.cubes import cube_search, interlocking_target
 from chaingeo.generator.deep import TOWERS, maze_candidate, tower_candidate
-from chaingeo.generator.layouts import get_layout
+from chaingeo.generator.layouts import Layout, get_layout
 from chaingeo.generator.maze import parse_maze_shape
 from chaingeo.generator.result import Rejection
 from chaingeo.generator.standard_burr import standard_burr_search
@@ -46,8 +46,9 @@ GENERATOR = "chaingeo.generator.puzzle"
 VERSION = "1"
 
 
-def _broken(shapes: Sequence[Shape]) -> int:
-    return sum(1 for s in shapes if len(s) == 0 or not s.is_connected())
+def _broken(layout: Layout, design: Sequence[int]) -> int:
+    """How many pieces of ``design`` are empty or fall apart."""
+    return sum(1 for cells in layout.piece_cells(design) if not connected(cells))
 
 
 def _mutate(owners: Sequence[int], current: int, hole_rate: float, rng: np.random.Generator) -> int:
@@ -67,13 +68,13 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> Candidate 
     best: Candidate | None = None
     for _ in range(40):  # repair towards connected pieces, then look for one that comes apart
         for _ in range(400):
-            broken = _broken(layout.pieces(design))
+            broken = _broken(layout, design)
             if broken == 0:
                 break
             i = int(rng.integers(len(design)))
             old = design[i]
             design[i] = _mutate(options[i], old, config.hole_rate, rng)
-            if _broken(layout.pieces(design)) > broken:
+            if _broken(layout, design) > broken:
                 design[i] = old
         shapes = layout.pieces(design)
         result = evaluate(shapes, config)

@@ -300,23 +300,7 @@ class Shape:
         One flood fill from the first voxel, stopping at nothing else: the generators ask this
         of hundreds of thousands of candidate pieces (:func:`components` also sorts and lists
         every component, ~3x the time)."""
-        if not self._key:
-            return False
-        first = self._key[0]
-        remaining = set(self._key)
-        remaining.discard(first)
-        stack = [first]
-        while stack and remaining:
-            x, y, z = stack.pop()
-            for n in ((x + 1, y, z), (x - 1, y, z), (x, y + 1, z), (x, y - 1, z)):
-                if n in remaining:
-                    remaining.discard(n)
-                    stack.append(n)
-            for n in ((x, y, z + 1), (x, y, z - 1)):
-                if n in remaining:
-                    remaining.discard(n)
-                    stack.append(n)
-        return not remaining
+        return connected(self._key)
 
     def overlaps(self, other: Shape) -> bool:
         return not self.cell_set.isdisjoint(other.cell_set)
@@ -365,6 +349,28 @@ def _window_all(grid: npt.NDArray[np.bool_], window: tuple[int, int, int]) -> bo
             for k in range(wz):
                 acc &= grid[i : i + acc.shape[0], j : j + acc.shape[1], k : k + acc.shape[2]]
     return bool(acc.any())
+
+
+def connected(cells: Sequence[Cell]) -> bool:
+    """Whether ``cells`` form one 6-connected component (no cells: not), by one flood fill from
+    the first cell that stops when everything is reached."""
+    if not cells:
+        return False
+    first = cells[0]
+    remaining = set(cells)
+    remaining.discard(first)
+    stack = [first]
+    while stack and remaining:
+        x, y, z = stack.pop()
+        for n in ((x + 1, y, z), (x - 1, y, z), (x, y + 1, z), (x, y - 1, z)):
+            if n in remaining:
+                remaining.discard(n)
+                stack.append(n)
+        for n in ((x, y, z + 1), (x, y, z - 1)):
+            if n in remaining:
+                remaining.discard(n)
+                stack.append(n)
+    return not remaining
 
 
 def components(cells: Iterable[Cell]) -> list[list[Cell]]:
