@@ -362,11 +362,9 @@ def connected(cells: Sequence[Cell]) -> bool:
     stack = [first]
     while stack and remaining:
         x, y, z = stack.pop()
-        for n in ((x + 1, y, z), (x - 1, y, z), (x, y + 1, z), (x, y - 1, z)):
-            if n in remaining:
-                remaining.discard(n)
-                stack.append(n)
-        for n in ((x, y, z + 1), (x, y, z - 1)):
+        for n in (
+            (x + 1, y, z), (x - 1, y, z), (x, y + 1, z), (x, y - 1, z), (x, y, z + 1), (x, y, z - 1)
+        ):  # fmt: skip
             if n in remaining:
                 remaining.discard(n)
                 stack.append(n)
