@@ -149,6 +149,11 @@ class Assembly:
     parts: tuple[frozenset[str], ...]
     rotations: Mapping[str, int] = field(default_factory=dict)
     rods: Mapping[str, Mapping[Cell, int]] = field(default_factory=dict)
+    #: Each piece's cells, filled as asked: searches ask for the same piece's cells many
+    #: times per state (every direction, group and distance), never for another state's.
+    _cells: dict[str, frozenset[Cell]] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @staticmethod
     def assembled(
@@ -166,9 +171,13 @@ class Assembly:
         return self.rotations.get(name, 0)
 
     def cells_of(self, name: str) -> frozenset[Cell]:
-        ox, oy, oz = self.offsets[name]
-        shape = oriented(self.shapes[name], self.rotation_of(name))
-        return frozenset((x + ox, y + oy, z + oz) for x, y, z in shape)
+        found = self._cells.get(name)
+        if found is None:
+            ox, oy, oz = self.offsets[name]
+            shape = oriented(self.shapes[name], self.rotation_of(name))
+            found = frozenset((x + ox, y + oy, z + oz) for x, y, z in shape)
+            self._cells[name] = found
+        return found
 
     def moved(
         self, offsets: Mapping[str, Cell], parts: tuple[frozenset[str], ...] | None = None
