@@ -23,7 +23,10 @@ from __future__ import annotations
 
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Final
+
+import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
 from chaingeo.core.level import Level
@@ -68,11 +71,12 @@ class StackingTables:
         }
         self.shapes: dict[str, Shape] = {p.name: p.shape for p in level.pieces}
         self.names: tuple[str, ...] = tuple(p.name for p in level.pieces)
+        turned = {n: s.orientations() for n, s in self.shapes.items()}
         self.orientations: dict[str, frozenset[tuple[Cell, ...]]] = {
-            n: frozenset(o.cells for o in s.orientations()) for n, s in self.shapes.items()
+            n: frozenset(o.cells for o in os) for n, os in turned.items()
         }
         self.placements: dict[str, list[Placement]] = {
-            n: self._enumerate(n) for n in sorted(self.shapes)
+            n: _placements(n, turned[n], self.box) for n in sorted(self.shapes)
         }
         self.by_action: dict[PlaceAction, Placement] = {
             p.action: p for ps in self.placements.values() for p in ps
@@ -84,38 +88,6 @@ class StackingTables:
             out |= self.bit[c]
         return out
 
-    def _enumerate(self, name: str) -> list[Placement]:
-        bx, by, bz = self.box
-        out: list[Placement] = []
-        for orient in self.shapes[name].orientations():
-            ex, ey, ez = orient.extent
-            for ox in range(bx - ex + 1):
-                for oy in range(by - ey + 1):
-                    for oz in range(bz - ez + 1):
-                        cells = orient.translate((ox, oy, oz)).cells
-                        out.append(self._placement(name, cells))
-        return sorted(out, key=lambda p: p.action.cells)
-
-    def _placement(self, name: str, cells: tuple[Cell, ...]) -> Placement:
-        own = set(cells)
-        around = 0
-        above = 0
-        for x, y, z in cells:
-            for dx, dy, dz in NEIGHBOURS:
-                n = (x + dx, y + dy, z + dz)
-                if n not in own and n in self.bit:
-                    around |= self.bit[n]
-            for zz in range(z + 1, self.box[2]):
-                if (x, y, zz) not in own:
-                    above |= self.bit[(x, y, zz)]
-        return Placement(
-            action=PlaceAction(name, cells),
-            mask=self.mask(cells),
-            around=around,
-            floor=any(z == 0 for _, _, z in cells),
-            above=above,
-        )
-
     def catalogue(self) -> list[Action]:
         """Every action that can ever be legal in this level, sorted: the gym action list."""
         places: list[Action] = [
@@ -123,6 +95,64 @@ class StackingTables:
         ]
         pickups: list[Action] = [PickupAction(n) for n in sorted(self.shapes)]
         return [*places, *pickups, FinishAction()]
+
+
+def _placements(
+    name: str, orients: tuple[Shape, ...], box: tuple[int, int, int]
+) -> list[Placement]:
+    """Every (normalised) orientation at every offset inside the box, sorted by cells; the
+    masks of all of them computed at once on boolean box grids and packed into integers."""
+    bx, by, bz = box
+    rows = []
+    for orient in orients:
+        ex, ey, ez = orient.extent
+        if ex <= bx and ey <= by and ez <= bz:
+            axes = (np.arange(bx - ex + 1), np.arange(by - ey + 1), np.arange(bz - ez + 1))
+            offsets = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+            rows.append(orient.voxels[None, :, :] + offsets[:, None, :])
+    if not rows:
+        return []
+    cells = np.concatenate(rows)  # (placements, cells, 3)
+    step = max(1, _GRID_BYTES // (bx * by * bz))
+    found = [p for i in range(0, len(cells), step) for p in _masks(name, cells[i : i + step], box)]
+    return sorted(found, key=lambda p: p.action.cells)
+
+
+#: Boolean box grids are built for at most this many bytes of placements at a time.
+_GRID_BYTES: Final = 1 << 22
+
+
+def _masks(name: str, cells: npt.NDArray[np.int64], box: tuple[int, int, int]) -> list[Placement]:
+    """The placements of ``cells`` (placements, cells, 3), each with its masks."""
+    own = np.zeros((len(cells), *box), dtype=np.bool_)
+    x, y, z = np.moveaxis(cells, 2, 0)
+    own[np.arange(len(cells))[:, None], x, y, z] = True
+    around = _face_neighbours(own) & ~own
+    above = np.logical_or.accumulate(own, axis=3) & ~own  # not own, an own cell under it
+    floor = own[..., 0].any(axis=(1, 2)).tolist()
+    masks, arounds, aboves = (_as_ints(g) for g in (own, around, above))
+    return [
+        Placement(PlaceAction.trusted(name, tuple(map(tuple, c))), m, a, f, up)
+        for c, m, a, f, up in zip(cells.tolist(), masks, arounds, floor, aboves, strict=True)
+    ]
+
+
+def _face_neighbours(grids: npt.NDArray[np.bool_]) -> npt.NDArray[np.bool_]:
+    """Per grid, the cells face-adjacent to one of its cells (inside the box)."""
+    out = np.zeros_like(grids)
+    for axis in (1, 2, 3):
+        head = [slice(None)] * 4
+        tail = [slice(None)] * 4
+        head[axis], tail[axis] = slice(1, None), slice(None, -1)
+        out[tuple(head)] |= grids[tuple(tail)]
+        out[tuple(tail)] |= grids[tuple(head)]
+    return out
+
+
+def _as_ints(grids: npt.NDArray[np.bool_]) -> list[int]:
+    """Each grid as the integer whose bit ``(x * by + y) * bz + z`` is cell (x, y, z)."""
+    packed = np.packbits(grids.reshape(len(grids), -1), axis=1, bitorder="little")
+    return [int.from_bytes(row.tobytes(), "little") for row in packed]
 
 
 @dataclass(frozen=True)

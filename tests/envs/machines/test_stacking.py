@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.core.geometry import Shape
+from chaingeo.core.geometry import NEIGHBOURS, Cell, Shape
 from chaingeo.core.level import Level, stacking_level
 from chaingeo.core.rules import placement_problem
 from chaingeo.envs.actions.types import (
@@ -15,8 +15,9 @@ from chaingeo.envs.actions.types import (
     PickupAction,
     PlaceAction,
 )
-from chaingeo.envs.machines.stacking import StackingState
+from chaingeo.envs.machines.stacking import StackingState, _placements
 from tests.support.env_levels import bedlam_level, drop_level, soma_level, tiny_level
+from tests.support.strategies import polycubes
 
 
 def brute_force_legal(state: StackingState) -> list[object]:
@@ -212,3 +213,45 @@ def test_tray_keeps_the_handed_orientation() -> None:
     for p in level.pieces:
         assert state.tables.shapes[p.name] == p.shape
         assert Shape(p.shape.cells).normalized().cells in state.tables.orientations[p.name]
+
+
+def _reference_placement(cells: tuple[Cell, ...], box: tuple[int, int, int]) -> tuple[object, ...]:
+    """(cells, mask, around, floor, above) of one placement, cell by cell from the definitions."""
+    _, by, bz = box
+    own = set(cells)
+
+    def bits(found: set[Cell]) -> int:
+        return sum(1 << ((x * by + y) * bz + z) for x, y, z in found)
+
+    def inside(c: Cell) -> bool:
+        return all(0 <= c[i] < box[i] for i in range(3))
+
+    around = {
+        n
+        for x, y, z in own
+        for dx, dy, dz in NEIGHBOURS
+        if inside(n := (x + dx, y + dy, z + dz)) and n not in own
+    }
+    above = {(x, y, h) for x, y, z in own for h in range(z + 1, bz) if (x, y, h) not in own}
+    return cells, bits(own), bits(around), any(z == 0 for _, _, z in own), bits(above)
+
+
+@settings(max_examples=60, deadline=None)
+@given(polycubes(1, 6), st.tuples(st.integers(1, 5), st.integers(1, 5), st.integers(1, 5)))
+def test_placement_tables_are_the_cell_by_cell_definitions(
+    shape: Shape, box: tuple[int, int, int]
+) -> None:
+    """The tables' masks, computed for every orientation and offset at once, are the cells each
+    placement fills, the box cells beside it, whether it touches the floor and the box cells
+    above it, one placement at a time; every placement inside the box, sorted by cells."""
+    orients = shape.orientations()
+    expected = sorted(
+        _reference_placement(o.translate((x, y, z)).cells, box)
+        for o in orients
+        for x in range(box[0] - o.extent[0] + 1)
+        for y in range(box[1] - o.extent[1] + 1)
+        for z in range(box[2] - o.extent[2] + 1)
+    )
+    found = _placements("p", orients, box)
+    assert [(p.action.cells, p.mask, p.around, p.floor, p.above) for p in found] == expected
+    assert all(p.action == PlaceAction("p", p.action.cells) for p in found)
