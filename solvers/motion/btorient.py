@@ -55,15 +55,44 @@ _SYMMETRY_STACK = np.asarray(SYMMETRIES, dtype=np.int64).reshape(-1, 3, 3)
 
 
 def symmetries_of(cells: np.ndarray) -> list[Symmetry]:
-    """The symmetries of a voxel set (every matrix of SYMMETRIES mapping it onto itself)."""
-    base = cells.min(axis=0)
-    want = _normal(cells)
-    imgs = _images(_SYMMETRY_STACK, cells)
-    return [
-        (np.asarray(m), base - img.min(axis=0))
+    """The symmetries of a voxel set (every matrix of SYMMETRIES mapping it onto itself), read
+    only. Cached by the set: every assembly of a problem asks for its result's, twice."""
+    return list(_symmetries(_set_key(cells)))
+
+
+def _set_key(cells: np.ndarray) -> bytes:
+    """The voxels in sorted order, as bytes (what the symmetries depend on)."""
+    rows = np.asarray(cells, dtype=np.int64).reshape(-1, 3)
+    return bytes(rows[np.lexsort(rows.T[::-1])].tobytes())
+
+
+@lru_cache(maxsize=4096)
+def _shared(grid: bytes, result: bytes) -> int:
+    """How many of the result's symmetries map the piece's voxels ``grid`` onto themselves
+    (up to translation)."""
+    found = _symmetries(result)
+    if not found:
+        return 0
+    g = np.frombuffer(grid, dtype=np.int64).reshape(-1, 3)
+    mats = np.stack([m for m, _ in found])
+    return _normals(_images(mats, g)).count(_normal(g))
+
+
+@lru_cache(maxsize=256)
+def _symmetries(cells: bytes) -> tuple[Symmetry, ...]:
+    rows = np.frombuffer(cells, dtype=np.int64).reshape(-1, 3)
+    base = rows.min(axis=0)
+    want = _normal(rows)
+    imgs = _images(_SYMMETRY_STACK, rows)
+    found = [
+        (np.asarray(m, dtype=np.int64), base - img.min(axis=0))
         for m, img, key in zip(SYMMETRIES, imgs, _normals(imgs), strict=True)
         if key == want
     ]
+    for m, shift in found:
+        m.setflags(write=False)
+        shift.setflags(write=False)
+    return tuple(found)
 
 
 _MATS = [np.asarray(m, dtype=np.int64) for m in TRANSFORMS_BT]
@@ -128,17 +157,12 @@ class BTImage:
         self.compose = [
             _compose(np.ascontiguousarray(m, dtype=np.int64).tobytes()) for m, _ in self.symmetries
         ]
-        res_syms = symmetries_of(result)
-        # Symmetries a piece shares with the result (the pivot has fewest), once per shape.
+        # Symmetries a piece shares with the result (the pivot has fewest).
+        whole = _set_key(result)
         self.shared: dict[str, int] = {}
-        by_grid: dict[bytes, int] = {}
         for n in names:
             g = np.ascontiguousarray(grids[n], dtype=np.int64)
-            key = g.tobytes()
-            if key not in by_grid and res_syms:
-                mats = np.stack([np.asarray(m, dtype=np.int64) for m, _ in res_syms])
-                by_grid[key] = _normals(_images(mats, g)).count(_normal(g))
-            self.shared[n] = by_grid.get(key, 0)
+            self.shared[n] = _shared(g.tobytes(), whole)
 
     def __call__(
         self, placed: Mapping[str, Shape], parts: Sequence[Sequence[str]]
