@@ -21,6 +21,7 @@ a test checks that it agrees with ``placement_problem`` exactly.
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass
 from typing import Any, Final
@@ -97,6 +98,23 @@ class StackingTables:
         return [*places, *pickups, FinishAction()]
 
 
+#: Tables of the levels in use, by the level object's id (an entry leaves with its level).
+_BUILT: dict[int, tuple[weakref.ref[Level], StackingTables]] = {}
+
+
+def tables_of(level: Level) -> StackingTables:
+    """The level's tables, built on first use and shared while the level object lives: every
+    state, clone and environment reset of one level reads the same (read-only) tables."""
+    key = id(level)
+    hit = _BUILT.get(key)
+    if hit is not None and hit[0]() is level:
+        return hit[1]
+    tables = StackingTables(level)
+    _BUILT[key] = (weakref.ref(level), tables)
+    weakref.finalize(level, _BUILT.pop, key, None)
+    return tables
+
+
 def _placements(
     name: str, orients: tuple[Shape, ...], box: tuple[int, int, int]
 ) -> list[Placement]:
@@ -168,7 +186,7 @@ class StackingState(BaseState):
 
     def __init__(self, level: Level, tables: StackingTables | None = None) -> None:
         super().__init__(level)
-        self.tables = tables if tables is not None else StackingTables(level)
+        self.tables = tables if tables is not None else tables_of(level)
         self._pos = StackingPosition((), 0)
 
     # -- position -----------------------------------------------------------------------------

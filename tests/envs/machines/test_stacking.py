@@ -255,3 +255,22 @@ def test_placement_tables_are_the_cell_by_cell_definitions(
     found = _placements("p", orients, box)
     assert [(p.action.cells, p.mask, p.around, p.floor, p.above) for p in found] == expected
     assert all(p.action == PlaceAction("p", p.action.cells) for p in found)
+
+
+def test_states_of_one_level_share_its_tables_while_it_lives() -> None:
+    """Every state of a level object reads one set of tables (an environment resets without
+    rebuilding them); another object gets its own; the entry leaves with its level."""
+    import dataclasses
+    import gc
+
+    from chaingeo.envs.machines import stacking
+
+    level = tiny_level()
+    first, second = StackingState(level), StackingState(level)
+    assert first.tables is second.tables is stacking.tables_of(level)
+    other = dataclasses.replace(level)
+    assert StackingState(other).tables is not first.tables
+    key = id(other)
+    del other
+    gc.collect()
+    assert key not in stacking._BUILT
