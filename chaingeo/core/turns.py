@@ -457,10 +457,13 @@ def _turn2(p: tuple[int, int], k: int) -> tuple[int, int]:
     return x, y
 
 
+@lru_cache(maxsize=1 << 16)
 def swept_squares(s: tuple[int, int], quarter: int) -> tuple[tuple[int, int], ...]:
     """The squares hit by square ``s`` turning by ``quarter`` (+1: +90, -1: -90) about O
     (doubled coordinates relative to O), sorted. Quarter-turn symmetry reduces every square to
-    one with ``x > 0, y >= 0``; a -90 turn is the mirror image (y -> -y) of a +90 one."""
+    one with ``x > 0, y >= 0``; a -90 turn is the mirror image (y -> -y) of a +90 one. Cached:
+    a search asks for the same few squares (a piece's cells about nearby centres) again and
+    again."""
     if quarter == -1:
         return tuple(sorted((x, -y) for x, y in swept_squares((s[0], -s[1]), 1)))
     if s == (0, 0):
