@@ -46,9 +46,31 @@ GENERATOR = "chaingeo.generator.puzzle"
 VERSION = "1"
 
 
-def _broken(layout: Layout, design: Sequence[int]) -> int:
-    """How many pieces of ``design`` are empty or fall apart."""
-    return sum(1 for cells in layout.piece_cells(design) if not connected(cells))
+def _repair(
+    layout: Layout,
+    design: list[int],
+    options: Sequence[Sequence[int]],
+    hole_rate: float,
+    rng: np.random.Generator,
+) -> None:
+    """Give shared cells other owners, at most 400 times, until no piece is empty or falls
+    apart; a change that leaves more such pieces is undone. A change touches two pieces only,
+    so only theirs are checked again."""
+    bad = [not connected(cells) for cells in layout.piece_cells(design)]
+    for _ in range(400):
+        if not any(bad):
+            return
+        i = int(rng.integers(len(design)))
+        old = design[i]
+        design[i] = _mutate(options[i], old, hole_rate, rng)
+        cells = layout.piece_cells(design)
+        after = list(bad)
+        for owner in {old, design[i]} - {-1}:
+            after[owner] = not connected(cells[owner])
+        if sum(after) > sum(bad):
+            design[i] = old
+        else:
+            bad = after
 
 
 def _mutate(owners: Sequence[int], current: int, hole_rate: float, rng: np.random.Generator) -> int:
@@ -67,15 +89,7 @@ def _layout_search(config: PuzzleConfig, rng: np.random.Generator) -> Candidate 
     ]
     best: Candidate | None = None
     for _ in range(40):  # repair towards connected pieces, then look for one that comes apart
-        for _ in range(400):
-            broken = _broken(layout, design)
-            if broken == 0:
-                break
-            i = int(rng.integers(len(design)))
-            old = design[i]
-            design[i] = _mutate(options[i], old, config.hole_rate, rng)
-            if _broken(layout, design) > broken:
-                design[i] = old
+        _repair(layout, design, options, config.hole_rate, rng)
         shapes = layout.pieces(design)
         result = evaluate(shapes, config)
         if result is not None:
