@@ -274,6 +274,10 @@ class Shape:
 
     def orientations(self) -> tuple[Shape, ...]:
         """The distinct normalised rotations of this shape, in :data:`ROTATIONS` order."""
+        return self._cached_orientations
+
+    @cached_property
+    def _cached_orientations(self) -> tuple[Shape, ...]:
         if len(self) == 0:
             return (self,)
         keys, base = self._cached_keys

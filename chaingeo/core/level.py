@@ -14,6 +14,7 @@ import re
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, Final, Literal
 
@@ -419,7 +420,7 @@ def _parse_stacking_solution(
             if c in covered:
                 raise r.fail(f, f"overlaps {covered[c]} at {list(c)}")
             covered[c] = p.name
-        if cells.normalized() not in p.shape.orientations():
+        if cells.canonical() != p.shape.canonical():  # not a rotated translate of it
             raise r.fail(f, f"is not a rotation of piece {p.name}'s shape")
         placements[p.name] = cells
     if set(covered) != box_cells(box).cell_set:
@@ -502,8 +503,25 @@ def revalidate(level: Level) -> Level:
 
 
 def load_level(path: str | os.PathLike[str]) -> Level:
-    """Read and fully validate one level file."""
-    source = str(path)
+    """Read and fully validate one level file. A file read before and unchanged since (the
+    same size, modification time and inode) gives the same Level again without being read:
+    environments, task sets and commands load the suite again and again, and a Level is a
+    value that nothing changes."""
+    try:
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return _load_level(str(path))  # says why it cannot be read
+    return _load_unchanged(str(path), st.st_size, st.st_mtime_ns, st.st_ino, st.st_dev)
+
+
+@lru_cache(maxsize=1024)
+def _load_unchanged(path: str, size: int, mtime_ns: int, inode: int, device: int) -> Level:
+    """:func:`_load_level`, remembered by the file's path and stamp."""
+    return _load_level(path)
+
+
+def _load_level(path: str) -> Level:
+    source = path
     try:
         raw = read_bounded(path, limits.MAX_FILE_BYTES)
     except UnreadableFile as e:

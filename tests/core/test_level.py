@@ -84,6 +84,24 @@ def test_stacking_round_trip_is_byte_identical(tmp_path: Path) -> None:
     assert level.optimal_steps == 13 and level.max_steps >= 30
 
 
+def test_an_unchanged_file_loads_once_and_a_changed_one_again(tmp_path: Path) -> None:
+    """The same Level object for a file read before and unchanged since; a file rewritten
+    (another level id, so other bytes) or a bad file in its place is read again."""
+    path = save_level(bedlam_level(), tmp_path / "a.json")
+    first = load_level(path)
+    assert load_level(path) is first and load_level(str(path)) is first
+    data = json.loads(path.read_text())
+    data["id"] = "bedlam-renamed"
+    path.write_text(json.dumps(data))
+    assert load_level(path).id == "bedlam-renamed"
+    path.write_text("{")
+    with pytest.raises(LevelError):
+        load_level(path)
+    path.unlink()
+    with pytest.raises(LevelError, match=r"a\.json"):
+        load_level(path)
+
+
 def test_puzzle_level_loads_and_round_trips(tmp_path: Path) -> None:
     level = parse_level(puzzle_json(), "lock")
     assert level.optimal_steps == 2
