@@ -84,6 +84,11 @@ class _Scene:
         self.v = np.array(cam.toward_viewer)
         self.shape = shape
         self.scale, self.origin = 1.0, np.zeros(2)
+        # every face of every piece in one array, in piece order (the order ties keep)
+        self._corners = np.concatenate([p.corners for p in pieces])
+        self._depth = np.concatenate([p.depth for p in pieces])
+        self._owner = np.repeat(np.arange(len(pieces)), [len(p.depth) for p in pieces])
+        self._shifts: dict[tuple[float, ...], tuple[float, float, float]] = {}
 
     def fit(self, solid: BoolArray) -> float:
         """Scale and offset from the bounding box of ``solid``; the relative mismatch of the
@@ -129,33 +134,76 @@ class _Scene:
         else:
             self.origin = self.origin + (np.array([d, 0.0]) if which == "x" else np.array([0.0, d]))
 
-    def draw(self, t: FloatArray) -> npt.NDArray[np.uint8]:
-        """The label image (0: nothing) with piece i translated by ``t[i]`` (cells)."""
-        polys: list[tuple[float, FloatArray, int]] = []
-        for p, off in zip(self.pieces, t, strict=True):
-            shift = np.array([off @ self.right, off @ self.up])
-            depth = p.depth + float(off @ self.v)
-            polys.extend(
-                zip(depth.tolist(), p.corners + shift, [p.label] * len(depth), strict=True)
+    def _shift(self, off: tuple[float, ...]) -> tuple[float, float, float]:
+        """A translation's shift on the picture plane and in depth, computed as the single
+        drawing did (one dot product each: the same floats), once per translation."""
+        out = self._shifts.get(off)
+        if out is None:
+            row = np.array(off)
+            out = self._shifts[off] = (
+                float(row @ self.right),
+                float(row @ self.up),
+                float(row @ self.v),
             )
-        polys.sort(key=lambda q: q[0])
+        return out
+
+    def _faces(self, t: FloatArray) -> tuple[npt.NDArray[np.intp], list[list[float]]]:
+        """Faces in drawing order (a stable sort by depth: ties keep piece, then face order)
+        and each face's pixel corners (x0, y0, ... x3, y3), in that order."""
+        s = np.array([self._shift(tuple(off)) for off in t.tolist()]).reshape(-1, 3)[self._owner]
+        order = np.argsort(self._depth + s[:, 2], kind="stable")
+        c = self._corners
+        x = (c[:, :, 0] + s[:, 0:1]) * self.scale + self.origin[0] - 0.5
+        y = -(c[:, :, 1] + s[:, 1:2]) * self.scale + self.origin[1] - 0.5
+        xy: list[list[float]] = np.stack([x, y], axis=2)[order].reshape(-1, 8).tolist()
+        return order, xy
+
+    def _paint(self, t: FloatArray, start: int | None = None) -> npt.NDArray[np.uint8]:
+        """The label image of the faces in drawing order, from the first face of piece
+        ``start`` on when given (earlier faces cannot show over it)."""
+        order, xy = self._faces(t)
+        labels: list[int] = (self._owner[order] + 1).tolist()
+        first = 0 if start is None else int(np.argmax(self._owner[order] == start))
         h, w = self.shape
         img = Image.new("L", (w, h), 0)
-        draw = ImageDraw.Draw(img)
-        for _, c, label in polys:
-            x = c[:, 0] * self.scale + self.origin[0] - 0.5
-            y = -c[:, 1] * self.scale + self.origin[1] - 0.5
-            draw.polygon(list(zip(x.tolist(), y.tolist(), strict=True)), fill=label)
+        core = ImageDraw.Draw(img).draw  # ImageDraw.polygon(fill=) without its wrapper
+        for k in range(first, len(xy)):
+            core.draw_polygon(xy[k], labels[k], 1)
         return np.asarray(img, dtype=np.uint8)
+
+    def draw(self, t: FloatArray) -> npt.NDArray[np.uint8]:
+        """The label image (0: nothing) with piece i translated by ``t[i]`` (cells)."""
+        return self._paint(t)
+
+    def mask(self, t: FloatArray, i: int) -> BoolArray:
+        """Where piece ``i`` shows in :meth:`draw` of ``t`` (the faces drawn before its first
+        one are skipped: they are overdrawn or elsewhere)."""
+        out: BoolArray = self._paint(t, i) == i + 1
+        return out
+
+
+class _Target:
+    """A seen silhouette and its one-pixel growth, scored against many drawn ones."""
+
+    def __init__(self, seen: BoolArray) -> None:
+        self.seen, self.grown, self.area = seen, dilate(seen, 1), np.count_nonzero(seen)
+
+    def iou(self, drawn: BoolArray) -> float:
+        """:func:`_iou` of ``drawn`` with the seen silhouette (the same sums)."""
+        total = np.count_nonzero(drawn) + self.area
+        if total == 0:
+            return 1.0
+        same = np.count_nonzero(drawn & self.grown) + np.count_nonzero(self.seen & dilate(drawn, 1))
+        return float(same) / total
 
 
 def _iou(a: BoolArray, b: BoolArray) -> float:
     """Agreement of two silhouettes, forgiving one pixel at the boundary (drawn edges and
     anti-aliasing move it): the Dice coefficient of each against the other grown by one."""
-    total = int(a.sum()) + int(b.sum())
+    total = np.count_nonzero(a) + np.count_nonzero(b)
     if total == 0:
         return 1.0
-    return float((a & dilate(b, 1)).sum() + (b & dilate(a, 1)).sum()) / total
+    return float(np.count_nonzero(a & dilate(b, 1)) + np.count_nonzero(b & dilate(a, 1))) / total
 
 
 def _labels(masks: list[BoolArray]) -> U8:
@@ -177,8 +225,8 @@ class _Tracker:
         self.gone = np.zeros(len(names), dtype=bool)
         self.span = int(np.ceil(max(scene.shape) / max(scene.scale, 1e-9))) + 2
 
-    def _score(self, i: int, t: FloatArray, seen: U8) -> float:
-        return _iou(self.scene.draw(t) == i + 1, seen == i + 1)
+    def _score(self, i: int, t: FloatArray, seen: _Target) -> float:
+        return seen.iou(self.scene.mask(t, i))
 
     def _candidates(self, i: int, far: bool) -> list[FloatArray]:
         """Poses one axis away from the piece's nearest lattice pose (no drift across axes)."""
@@ -225,11 +273,12 @@ class _Tracker:
         as good as its baseline), else anywhere along the three axes."""
         best, pose = now, self.t
         good = self.base[i] - SLACK / 2
+        target = _Target(seen == i + 1)
         for far in (False, True):
             if far and best >= self.base[i] - 2 * SLACK:
                 break
             for cand in self._candidates(i, far):
-                s = self._score(i, cand, seen)
+                s = self._score(i, cand, target)
                 if s > best + 0.01:
                     best, pose = s, cand
                 if best >= good:
@@ -268,12 +317,13 @@ class Fit:
         up to a cell from it along one axis (the tracker refits only on a clear loss)."""
         best: tuple[float, FloatArray, BoolArray] = (-1.0, self.poses[g][i], seen)
         steps = [(0, 0.0)] + [(a, d) for a in range(3) for d in NEAR if abs(d) <= 1.0]
+        target = _Target(seen)
         for a, d in steps:
             t = self.poses[g].copy()
             t[self.gone[g]] = 1e4  # pieces no longer followed: far off the picture
             t[i, a] += d
-            drawn = self.scene.draw(t) == i + 1
-            score = _iou(drawn, seen)
+            drawn = self.scene.mask(t, i)
+            score = target.iou(drawn)
             if score > best[0] + 1e-9:
                 best = (score, t[i], drawn)
         return best

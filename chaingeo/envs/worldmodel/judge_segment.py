@@ -75,9 +75,17 @@ def _table_rgb() -> FloatArray:
     return np.stack([(q >> 10) & 31, (q >> 5) & 31, q & 31], axis=1) * 8.0 + 4.0
 
 
-def _table_index(rgb: U8) -> npt.NDArray[np.int64]:
-    c = rgb.astype(np.int64) >> 3
-    out: npt.NDArray[np.int64] = (c[..., 0] << 10) | (c[..., 1] << 5) | c[..., 2]
+@lru_cache(maxsize=1)
+def _table_lab() -> FloatArray:
+    """CIELAB of every table colour (the same for every model: computed once)."""
+    return srgb_to_lab(_table_rgb())
+
+
+def _table_index(rgb: U8) -> npt.NDArray[np.uint16]:
+    """The 5-bit RGB index of each pixel (15 bits: 16-bit arithmetic suffices)."""
+    c = (rgb >> 3).astype(np.uint16)
+    ten, five = np.uint16(10), np.uint16(5)
+    out: npt.NDArray[np.uint16] = (c[..., 0] << ten) | (c[..., 1] << five) | c[..., 2]
     return out
 
 
@@ -113,7 +121,7 @@ def _palette_model(
 ) -> ColorModel:
     if not colors or len(colors) > 255:
         raise ValueError(f"1 to 255 piece colours, got {len(colors)}")
-    lab_table = srgb_to_lab(_table_rgb())
+    lab_table = _table_lab()
     best = np.full(len(lab_table), np.inf)
     label = np.zeros(len(lab_table), dtype=np.uint8)
     for i, (_, rgb) in enumerate(colors):
@@ -169,7 +177,7 @@ def clustered_model(frame: U8) -> ColorModel:
     peaks = _hue_peaks(hue[chromatic]) if chromatic.any() else []
     if not peaks:
         raise ValueError("the first frame shows no coloured piece (nothing has chroma)")
-    t_hue, t_chroma = _hue_chroma(srgb_to_lab(_table_rgb()))
+    t_hue, t_chroma = _hue_chroma(_table_lab())
     dist = np.stack([_angle(t_hue, p) for p in peaks], axis=1)
     table = (np.argmin(dist, axis=1) + 1).astype(np.uint8)
     table[(dist.min(axis=1) > HUE_RADIUS) | (t_chroma < MIN_CHROMA)] = 0
@@ -204,23 +212,57 @@ def shrink(frame: U8) -> U8:
 
 
 def _spread(mask: BoolArray, r: int, grow: bool) -> BoolArray:
-    """Dilation (grow) or erosion by a (2r+1)-square, separably; outside counts as empty."""
-    out = mask.copy()
-    for axis in (0, 1):
-        src = out.copy()
-        for s in range(1, r + 1):
-            for sign in (s, -s):
-                shifted = np.zeros_like(src)
-                if axis == 0:
-                    if sign > 0:
-                        shifted[sign:] = src[:-sign]
-                    else:
-                        shifted[:sign] = src[-sign:]
-                elif sign > 0:
-                    shifted[:, sign:] = src[:, :-sign]
-                else:
-                    shifted[:, :sign] = src[:, -sign:]
-                out = out | shifted if grow else out & shifted
+    """Dilation (grow) or erosion by a (2r+1)-square, separably; outside counts as empty.
+    (A kernel: the judge spreads masks some hundred thousand times a video.)"""
+    if r <= 0:
+        return mask.copy()
+    h, w = mask.shape
+    flat = np.ascontiguousarray(mask, dtype=np.bool_).ravel().view(np.uint8)
+    out: BoolArray = _spread_kernel(flat, h, w, r, grow).view(np.bool_).reshape(h, w)
+    return out
+
+
+@njit(cache=True)
+def _copy(dst: U8, src: U8) -> None:
+    """``dst[:] = src`` as a plain loop (cheaper than numba's slice assignment, row by row)."""
+    for k in range(len(dst)):
+        dst[k] = src[k]
+
+
+@njit(cache=True)
+def _merge(dst: U8, src: U8, grow: bool) -> None:
+    """``dst`` |= ``src`` (grow) or &= (shrink), elementwise: a loop the compiler vectorises."""
+    if grow:
+        for k in range(len(dst)):
+            dst[k] |= src[k]
+    else:
+        for k in range(len(dst)):
+            dst[k] &= src[k]
+
+
+@njit(cache=True)
+def _spread_kernel(flat: U8, h: int, w: int, r: int, grow: bool) -> U8:
+    """Square spread of a flat (h, w) 0/1 mask. The mask is laid in a frame of r empty pixels
+    (what lies outside: erosion's AND takes them as empty, dilation's OR ignores them), so each
+    pass is 2r + 1 whole-array ORs (ANDs) of the frame with itself shifted by whole rows, then
+    by single pixels (a shift across a row's end reads only the frame)."""
+    ww = w + 2 * r
+    size = (h + 2 * r) * ww
+    pad = np.zeros(size, dtype=np.uint8)
+    for y in range(h):
+        _copy(pad[(y + r) * ww + r : (y + r) * ww + r + w], flat[y * w : (y + 1) * w])
+    lo, hi = r * ww, (h + r) * ww  # the picture's rows in the frame
+    cols = np.zeros(size, dtype=np.uint8)
+    _copy(cols[lo:hi], pad[lo - r * ww : hi - r * ww])
+    for d in range(-r + 1, r + 1):
+        _merge(cols[lo:hi], pad[lo + d * ww : hi + d * ww], grow)
+    both = np.zeros(size, dtype=np.uint8)
+    _copy(both[lo:hi], cols[lo - r : hi - r])
+    for d in range(-r + 1, r + 1):
+        _merge(both[lo:hi], cols[lo + d : hi + d], grow)
+    out = np.empty(h * w, dtype=np.uint8)
+    for y in range(h):
+        _copy(out[y * w : (y + 1) * w], both[(y + r) * ww + r : (y + r) * ww + r + w])
     return out
 
 
@@ -240,15 +282,16 @@ def clean(mask: BoolArray) -> BoolArray:
 
 @njit(cache=True)
 def _label_kernel(flat: npt.NDArray[np.uint8], h: int, w: int) -> npt.NDArray[np.int32]:
-    """8-connected components of a flat mask: two passes over a union-find forest."""
-    parent = np.arange(h * w + 1, dtype=np.int32)
+    """8-connected components of a flat mask: two passes over a union-find forest (one
+    provisional label at most a set pixel)."""
+    parent = np.arange(np.count_nonzero(flat) + 1, dtype=np.int32)
     lab = np.zeros(h * w, dtype=np.int32)
     nxt = 1
+    roots = np.zeros(4, dtype=np.int32)  # one buffer: an allocation a pixel cost the most
     for i in range(h * w):
         if flat[i] == 0:
             continue
         y, x = i // w, i % w
-        roots = np.zeros(4, dtype=np.int32)
         k = 0
         for dy, dx in ((-1, -1), (-1, 0), (-1, 1), (0, -1)):
             yy, xx = y + dy, x + dx
@@ -296,7 +339,21 @@ def min_area(shape: tuple[int, ...]) -> int:
 
 def classify(frame: U8, model: ColorModel) -> U8:
     """Class per pixel (0: background), before cleaning."""
-    out: U8 = model.table[_table_index(frame)]
+    if frame.dtype != np.uint8 or frame.ndim != 3 or frame.shape[2] != 3:
+        out: U8 = model.table[_table_index(frame)]
+        return out
+    flat = np.ascontiguousarray(frame).ravel()
+    return _classify_kernel(flat, model.table).reshape(frame.shape[:2])
+
+
+@njit(cache=True)
+def _classify_kernel(flat: U8, table: U8) -> U8:
+    """The table's class of each RGB triple of a flat frame (the index and the look-up in
+    one pass: the judge classifies every frame)."""
+    out = np.empty(len(flat) // 3, dtype=np.uint8)
+    for i in range(len(out)):
+        r, g, b = np.int64(flat[3 * i]), np.int64(flat[3 * i + 1]), np.int64(flat[3 * i + 2])
+        out[i] = table[((r >> 3) << 10) | ((g >> 3) << 5) | (b >> 3)]
     return out
 
 

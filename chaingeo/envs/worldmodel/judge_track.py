@@ -19,7 +19,9 @@ from dataclasses import dataclass, field
 from typing import Final
 
 import numpy as np
+import numpy.typing as npt
 
+from chaingeo.core.jit import njit
 from chaingeo.envs.worldmodel.judge_segment import BoolArray, FloatArray, close, components, dilate
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
@@ -102,14 +104,39 @@ def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
 
 
 def _distances(mask: BoolArray, r: int) -> np.ndarray:
-    """Chessboard distance to ``mask`` (0 on it), capped at r + 1."""
-    out = np.full(mask.shape, r + 1, dtype=np.int64)
-    out[mask] = 0
-    grown = mask
-    for d in range(1, r + 1):
-        nxt = dilate(grown, 1)
-        out[nxt & ~grown] = d
-        grown = nxt
+    """Chessboard distance to ``mask`` (0 on it), capped at r + 1: what growing the mask a
+    pixel at a time within the picture gives (a shortest chessboard path stays within the
+    box of its ends), in two passes instead of r growths."""
+    h, w = mask.shape
+    flat = np.ascontiguousarray(mask, dtype=np.bool_).ravel()
+    return _chessboard_kernel(flat, h, w, r + 1).reshape(h, w)
+
+
+@njit(cache=True)
+def _chessboard_kernel(flat: BoolArray, h: int, w: int, cap: int) -> npt.NDArray[np.int64]:
+    """Two-pass chamfer over the 8 neighbours, all steps 1: exact for the chessboard metric."""
+    out = np.full(h * w, cap, dtype=np.int64)
+    for i in range(h * w):
+        if flat[i]:
+            out[i] = 0
+    for y in range(h):
+        for x in range(w):
+            d = out[y * w + x]
+            if x > 0:
+                d = min(d, out[y * w + x - 1] + 1)
+            if y > 0:
+                for xx in range(max(0, x - 1), min(w, x + 2)):
+                    d = min(d, out[(y - 1) * w + xx] + 1)
+            out[y * w + x] = d
+    for y in range(h - 1, -1, -1):
+        for x in range(w - 1, -1, -1):
+            d = out[y * w + x]
+            if x < w - 1:
+                d = min(d, out[y * w + x + 1] + 1)
+            if y < h - 1:
+                for xx in range(max(0, x - 1), min(w, x + 2)):
+                    d = min(d, out[(y + 1) * w + xx] + 1)
+            out[y * w + x] = d
     return out
 
 
