@@ -147,7 +147,7 @@ def _masks(name: str, cells: npt.NDArray[np.int64], box: tuple[int, int, int]) -
     own[np.arange(len(cells))[:, None], x, y, z] = True
     around = _face_neighbours(own) & ~own
     above = np.logical_or.accumulate(own, axis=3) & ~own  # not own, an own cell under it
-    floor = own[..., 0].any(axis=(1, 2)).tolist()
+    floor: list[bool] = np.any(own[..., 0], axis=(1, 2)).tolist()
     masks, arounds, aboves = (_as_ints(g) for g in (own, around, above))
     return [
         Placement(PlaceAction.trusted(name, tuple(map(tuple, c))), m, a, f, up)
