@@ -152,10 +152,11 @@ def test_random_stacking_plans_with_drop_support_are_valid(path: Path, picks: li
 # ---------------------------------------------------------------------------------------------
 
 
-def _copy(doc: Any) -> Any:
-    """A deep copy of a JSON document (through the C codec: ``copy.deepcopy`` of a whole
+def _copy(doc: dict[str, Any]) -> dict[str, Any]:
+    """A deep copy of a JSON object (through the C codec: ``copy.deepcopy`` of a whole
     trajectory cost more than checking it)."""
-    return json.loads(json.dumps(doc))
+    out: dict[str, Any] = json.loads(json.dumps(doc))
+    return out
 
 
 BASE = _doc(BURR)
