@@ -75,6 +75,43 @@ def fit_table(table: I64, states: I16, n_states: int) -> I64:
 
 
 @njit(cache=True)
+def slide_children(
+    tree: Tree, node: int, n: int, rows: int, moves_buf: I64, child: I16, seps: I64,
+    n_seps: int, n_states: int,
+) -> tuple[int, int, int]:  # fmt: skip
+    """The children of ``node`` (``n`` pieces) by the first ``rows`` slides of ``moves_buf``
+    (:func:`chaingeo.solvers.motion.movement.node_moves`' rows: mask, direction, farthest
+    distance, removes): each removal appended to ``seps`` as ``(node, mask, direction)``, each
+    new state to the tree with its parent and move (mask, direction, distance; any further
+    move columns 0). Returns ``(status, n_states, n_seps)``: DONE, or the buffer to grow (the
+    caller expands ``node`` again from scratch)."""
+    states, parent, move, table = tree
+    for r in range(rows):
+        mask = np.uint64(moves_buf[r, 0])
+        d = moves_buf[r, 1]
+        if moves_buf[r, 3]:
+            if n_seps >= seps.shape[0]:
+                return NEED_SEPS, n_states, n_seps
+            seps[n_seps, 0] = node
+            seps[n_seps, 1] = np.int64(mask)
+            seps[n_seps, 2] = d
+            n_seps += 1
+        for k in range(1, moves_buf[r, 2] + 1):
+            if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
+                return NEED_STATES, n_states, n_seps
+            shift_child(states[node], child, 0, None, n, moves_buf[r, 0], d, k)
+            if find_or_insert(states, n_states, table, child) < 0:
+                parent[n_states] = node
+                move[n_states, 0] = np.int64(mask)
+                move[n_states, 1] = d
+                move[n_states, 2] = k
+                for j in range(3, move.shape[1]):
+                    move[n_states, j] = 0
+                n_states += 1
+    return DONE, n_states, n_seps
+
+
+@njit(cache=True)
 def expand(
     tree: Tree, n_states: int, node: int, layers: I64, n_layers: int, max_depth: int,
     budget: int, pieces: Pieces, seps: I64, n_seps: int,
@@ -92,7 +129,7 @@ def expand(
     scratch, so its removals are dropped first). ``layers`` holds two more entries than
     ``states`` rows (every layer has a node).
     """
-    states, parent, move, table = tree
+    states = tree.states
     vox, starts, lo, hi, max_group, group_limit, moves_buf, groups_buf = pieces
     n = starts.shape[0] - 1
     w = 3 * n
@@ -122,28 +159,11 @@ def expand(
                 return TOO_MANY_GROUPS, node, n_states, n_seps, n_layers
             if rows == -1:
                 return NEED_MOVES, node, n_states, n_seps, n_layers
-            for r in range(rows):
-                mask = np.uint64(moves_buf[r, 0])
-                dr = moves_buf[r, 1]
-                kmax = moves_buf[r, 2]
-                if moves_buf[r, 3]:
-                    if n_seps >= seps.shape[0]:
-                        return NEED_SEPS, node, n_states, n_seps, n_layers
-                    seps[n_seps, 0] = node
-                    seps[n_seps, 1] = np.int64(mask)
-                    seps[n_seps, 2] = dr
-                    n_seps += 1
-                for k in range(1, kmax + 1):
-                    if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                        return NEED_STATES, node, n_states, n_seps, n_layers
-                    shift_child(states[node], child, 0, None, n, moves_buf[r, 0], dr, k)
-                    got = find_or_insert(states, n_states, table, child)
-                    if got < 0:
-                        parent[n_states] = node
-                        move[n_states, 0] = np.int64(mask)
-                        move[n_states, 1] = dr
-                        move[n_states, 2] = k
-                        n_states += 1
+            status, n_states, n_seps = slide_children(
+                tree, node, n, rows, moves_buf, child, seps, n_seps, n_states
+            )
+            if status != DONE:
+                return status, node, n_states, n_seps, n_layers
             node += 1
             done += 1
         layers[n_layers] = n_states

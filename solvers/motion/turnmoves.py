@@ -459,30 +459,11 @@ def expand_turns(
             return bfs.TOO_MANY_GROUPS, node, n_states, n_seps, 0
         if nt == -3:
             return TOO_FAR, node, n_states, n_seps, 0
-        for r in range(rows):
-            mask = np.uint64(moves_buf[r, 0])
-            d = moves_buf[r, 1]
-            kmax = moves_buf[r, 2]
-            if moves_buf[r, 3]:
-                if n_seps >= seps.shape[0]:
-                    return bfs.NEED_SEPS, node, n_states, n_seps, 0
-                seps[n_seps, 0] = node
-                seps[n_seps, 1] = np.int64(mask)
-                seps[n_seps, 2] = d
-                n_seps += 1
-            for k in range(1, kmax + 1):
-                if n_states >= states.shape[0] or 2 * (n_states + 1) > table.shape[0]:
-                    return bfs.NEED_STATES, node, n_states, n_seps, 0
-                mv.shift_child(states[node], child, 0, None, n, moves_buf[r, 0], d, k)
-                got = mv.find_or_insert(states, n_states, table, child)
-                if got < 0:
-                    parent[n_states] = node
-                    move[n_states, 0] = np.int64(mask)
-                    move[n_states, 1] = d
-                    move[n_states, 2] = k
-                    move[n_states, 3] = 0
-                    move[n_states, 4] = 0
-                    n_states += 1
+        status, n_states, n_seps = bfs.slide_children(
+            tree, node, n, rows, moves_buf, child, seps, n_seps, n_states
+        )
+        if status != bfs.DONE:
+            return status, node, n_states, n_seps, 0
         for r in range(nt):
             mask = np.uint64(turns_buf[r, 0])
             a = turns_buf[r, 1]
