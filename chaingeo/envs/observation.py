@@ -1,7 +1,7 @@
 """What an agent is shown each turn: the task, the pieces, recent turns, the budget, pictures.
 
 Text follows the agent convention: cells are 1-based (converted by
-:mod:`chaingeo.envs.actions.types`). The pictures come from :mod:`chaingeo.envs.render.scene`,
+:mod:`chaingeo.envs.actions.types`). The pictures come from :mod:`chaingeo.pictures.scene`,
 called from :func:`render_state` only. Stacking shows the box (placed pieces where they are) and the
 tray of unplaced pieces; a puzzle shows its largest part where it is and every other part laid out
 beside it along +x (parts apart never interact, so only their shapes matter), and its goal as
@@ -256,7 +256,7 @@ def render_state(
     state: BaseState, size: int = DEFAULT_IMAGE_SIZE, reference: bool = False
 ) -> dict[str, bytes]:
     """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (puzzles)."""
-    from chaingeo.envs.render.raster import png_bytes
+    from chaingeo.pictures.raster import png_bytes
 
     images = state_images(state, size, reference)
     return {name: png_bytes(img) for name, img in images.items()}
@@ -267,8 +267,8 @@ def state_images(
 ) -> dict[str, Image.Image]:
     """The pictures of an observation as images (:func:`render_state` encodes them; the
     Gymnasium environments take their pixels): the four views, then the extra picture.
-    ``reference`` draws them with :mod:`chaingeo.envs.render.scene` itself, the slower reference
-    of :mod:`chaingeo.envs.render.fastview` (the same pixels)."""
+    ``reference`` draws them with :mod:`chaingeo.pictures.scene` itself, the slower reference
+    of :mod:`chaingeo.pictures.fastview` (the same pixels)."""
     pieces, box, _ = scene(state)
     images = dict(_drawer(reference).render_images(pieces, box, VIEWS, size))
     images[extra_picture(state)] = extra_image(state, size, reference)
@@ -277,10 +277,10 @@ def state_images(
 
 def _drawer(reference: bool) -> ModuleType:
     if reference:
-        import chaingeo.envs.render.scene as render
+        import chaingeo.pictures.scene as render
 
         return render
-    import chaingeo.envs.render.fastview as fastview
+    import chaingeo.pictures.fastview as fastview
 
     return fastview
 

@@ -17,7 +17,7 @@ from typing import Any, Final
 from chaingeo.evaluation.agents.base import ObservationLike, StateLike
 from chaingeo.evaluation.agents.http import ChatClient, ServerSettings
 from chaingeo.evaluation.agents.prompt import user_content
-from chaingeo.evaluation.judges.selection import Candidate, FirstLegal, Judge
+from chaingeo.evaluation.judges.selection import CheckedReply, FirstLegal, Judge
 from chaingeo.evaluation.usage import Usage
 
 JUDGE_PROMPT: Final = (
@@ -48,11 +48,11 @@ class ModelJudge(Judge):
     def rank(
         self,
         state: StateLike,
-        candidates: Sequence[Candidate],
+        candidates: Sequence[CheckedReply],
         observation: ObservationLike | None = None,
     ) -> list[int]:
         order = FirstLegal().rank(state, candidates)
-        offered: list[Candidate] = []
+        offered: list[CheckedReply] = []
         seen: set[str] = set()
         for c in (candidates[i] for i in order):
             if c.legal and c.reply.action is not None and c.reply.action not in seen:
