@@ -239,9 +239,10 @@ def test_an_action_syntax_is_a_plug_in_and_a_name_is_taken_once() -> None:
     from chaingeo.core.registry import DuplicateNameError
     from chaingeo.envs.actions.parse import SYNTAXES, ActionSyntax, parse_text
 
-    done = ActionSyntax(
-        "surrender-word", lambda t, b: b.strip().lower() == "done", lambda t, b: FinishAction()
-    )
+    def claims(text: str, body: str) -> bool:
+        return body.strip().lower() == "surrender"
+
+    done = ActionSyntax("surrender-word", claims, lambda text, body: FinishAction())
     with pytest.raises(UnparseableActionError):
         parse_text("surrender")
     with SYNTAXES.registered("surrender-word", done):
