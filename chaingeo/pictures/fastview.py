@@ -27,7 +27,6 @@ from typing import Final, TypeVar
 
 import numpy as np
 import numpy.typing as npt
-from PIL import Image
 
 from chaingeo.kernels.jit import mode as jit_mode
 from chaingeo.pictures import rasterjit
@@ -61,7 +60,6 @@ from chaingeo.pictures.scene import (
     _SUPERSAMPLE,
     CAMERAS,
     DEFAULT_SIZE,
-    TRAY_TITLE,
     VIEWS,
     PieceMap,
     _check_size,
@@ -77,7 +75,6 @@ from chaingeo.pictures.scene import (
 from chaingeo.pictures.scene import (
     _render_view as render_view,
 )
-from chaingeo.pictures.sheet import tray_pixels
 
 #: Layouts kept per process (each about 1 MB at 256 px: the iso background is drawn at 2x).
 CAPACITY: Final = 48
@@ -367,22 +364,3 @@ def render_arrays(
     _check_views(views)
     scene = _scene(pieces, box)
     return {v: _view_pixels(scene, CAMERAS[v], size, title) for v in views}
-
-
-def render_images(
-    pieces: PieceMap,
-    box: Sequence[int] | None = None,
-    views: Sequence[str] = VIEWS,
-    size: int = DEFAULT_SIZE,
-    title: str | None = None,
-) -> dict[str, Image.Image]:
-    """:func:`chaingeo.pictures.scene.render_images`, the same pixels, faster."""
-    arrays = render_arrays(pieces, box, views, size, title)
-    return {v: Image.fromarray(a) for v, a in arrays.items()}
-
-
-def render_tray_image(
-    pieces: PieceMap, size: int = DEFAULT_SIZE, title: str = TRAY_TITLE
-) -> Image.Image:
-    """:func:`chaingeo.pictures.scene.render_tray_image`, the same pixels, faster."""
-    return Image.fromarray(tray_pixels(pieces, size, title))
