@@ -58,14 +58,17 @@ class Judge:
     ) -> list[int]:
         """Candidate indices, best first (every index exactly once): verified-legal ones
         first, then by :meth:`preference`, then in sampling order."""
-        prefer = self.preference(candidates)
+        prefer = self.preference(state, candidates, observation)
         return [
             c.index for c in sorted(candidates, key=lambda c: (not c.legal, prefer(c), c.index))
         ]
 
     def preference(
-        self, candidates: Sequence[CheckedReply]
-    ) -> Callable[[CheckedReply], tuple[int, ...]]:
+        self,
+        state: StateLike,
+        candidates: Sequence[CheckedReply],
+        observation: ObservationLike | None = None,
+    ) -> Preference:
         """How this judge orders legal candidates (smaller first); none by default."""
         return lambda c: ()
 
@@ -78,8 +81,11 @@ class Vote(Judge):
     name = "vote"
 
     def preference(
-        self, candidates: Sequence[CheckedReply]
-    ) -> Callable[[CheckedReply], tuple[int, ...]]:
+        self,
+        state: StateLike,
+        candidates: Sequence[CheckedReply],
+        observation: ObservationLike | None = None,
+    ) -> Preference:
         votes = Counter(c.result.action.to_text() for c in candidates if c.legal and c.result)
         return lambda c: (-votes[c.result.action.to_text()] if c.legal and c.result else 0,)
 
@@ -88,8 +94,11 @@ class ProgressJudge(Judge):
     name = "progress"
 
     def preference(
-        self, candidates: Sequence[CheckedReply]
-    ) -> Callable[[CheckedReply], tuple[int, ...]]:
+        self,
+        state: StateLike,
+        candidates: Sequence[CheckedReply],
+        observation: ObservationLike | None = None,
+    ) -> Preference:
         def key(c: CheckedReply) -> tuple[int, ...]:
             if c.after is None:
                 return ()
