@@ -9,6 +9,7 @@ motions, the same sweeps), and reported with forward frame numbers.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass
 from typing import Any, Final
@@ -271,13 +272,8 @@ class _Segments:
         groups: list[tuple[list[int], Motion]] = []
         for j, m in moving:
             for js, g in groups:
-                same = (g.a, g.b, g.kind, g.axis, g.k, g.quarter) == (
-                    m.a,
-                    m.b,
-                    m.kind,
-                    m.axis,
-                    m.k,
-                    m.quarter,
+                same = dataclasses.replace(g, pieces=(), pivot=m.pivot) == dataclasses.replace(
+                    m, pieces=()
                 )
                 if same and _same_motion(ps, m.a, m.b, j, js[0]):
                     js.append(j)
@@ -287,16 +283,7 @@ class _Segments:
         return [
             (
                 js,
-                Motion(
-                    tuple(sorted(ps.names[j] for j in js)),
-                    m.a,
-                    m.b,
-                    m.kind,
-                    m.axis,
-                    m.k,
-                    m.quarter,
-                    m.pivot,
-                ),
+                dataclasses.replace(m, pieces=tuple(sorted(ps.names[j] for j in js))),
             )
             for js, m in groups
         ]
