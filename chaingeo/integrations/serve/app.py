@@ -101,7 +101,7 @@ def serve(catalog: Catalog, options: ServeOptions) -> None:
         log_level="warning",
         lifespan="on",
     )
-    server = uvicorn.Server(config)
+    server = _server_class()(config)
     print(
         json.dumps(
             {"serving": f"http://{options.host}:{options.port}/", "levels": len(catalog.levels)}
@@ -109,3 +109,18 @@ def serve(catalog: Catalog, options: ServeOptions) -> None:
         flush=True,
     )
     server.run()
+    print(json.dumps({"stopped": f"http://{options.host}:{options.port}/"}), flush=True)
+
+
+def _server_class() -> type:
+    import uvicorn
+
+    class Server(uvicorn.Server):
+        """uvicorn's server, but a SIGTERM/SIGINT it shut down for ends the process normally
+        (uvicorn raises the signal again after its graceful shutdown: exit status -15)."""
+
+        def handle_exit(self, sig: int, frame: Any) -> None:
+            super().handle_exit(sig, frame)
+            self._captured_signals.clear()
+
+    return Server

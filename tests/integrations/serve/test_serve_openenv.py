@@ -10,6 +10,9 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
+
+pytest.importorskip("openenv", reason="chain serve needs the serve extra (openenv-core)")
+
 from openenv.core.generic_client import GenericEnvClient
 
 from chaingeo.core.suite import shipped_level
