@@ -81,7 +81,8 @@ class ChainEnvironment(Environment[ChainAction, ChainObservation, ChainState]): 
         level, participant, rest = self._level(options)
         opts = read_options(rest)
         study = self.catalog.study
-        play = Play(level, opts, seed, hide_optimal=study is not None)
+        agent = "human" if study is not None else "client"
+        play = Play(level, opts, seed, hide_optimal=study is not None, agent=agent)
         first = play.observation()  # may still refuse: nothing has changed yet
         self._abandon()
         self.play, self.episode_id, self.participant = play, episode_id, participant
@@ -134,7 +135,7 @@ class ChainEnvironment(Environment[ChainAction, ChainObservation, ChainState]): 
             self.participant = None  # recorded: not again
 
     def _abandon(self) -> None:
-        if self.play is not None and not self.play.done and self.play.events:
+        if self.play is not None and not self.play.done and self.play.steps:
             self._record()
 
     def close(self) -> None:

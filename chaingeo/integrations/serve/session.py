@@ -1,5 +1,6 @@
 """One episode behind the server: the reset options read strictly, then turns in and observations
-out. Every check runs before anything changes, so a refused request leaves the episode as it was.
+out, on the one :class:`~chaingeo.evaluation.episode.Episode` every door drives. Every check runs
+before anything changes, so a refused request leaves the episode as it was.
 """
 
 from __future__ import annotations
@@ -14,31 +15,33 @@ from typing import Any, Final
 
 from chaingeo.core import limits
 from chaingeo.core.level import Level
-from chaingeo.envs.machines import new_state
-from chaingeo.envs.machines.state import BaseState, StepResult
-from chaingeo.envs.observation import observe
-from chaingeo.evaluation.agents.prompt import extract_action
-from chaingeo.evaluation.agents.tools import tool_specs, translate
-from chaingeo.integrations.game import Outcome, total_reward
+from chaingeo.evaluation.agents.base import Reply, StepResultLike
+from chaingeo.evaluation.agents.dialects import DIALECTS, read_reply, tool_call
+from chaingeo.evaluation.agents.tools import tool_specs
+from chaingeo.evaluation.episode import Episode, Outcome, ProtocolConfig
+from chaingeo.integrations.game import total_reward
 from chaingeo.integrations.serve.errors import NoEpisodeError, RequestError
 from chaingeo.integrations.serve.models import ChainAction, ChainObservation
 from chaingeo.integrations.serve.scene import scene_json
 
-#: How a ``{"text": ...}`` action is read: ``action``, the text is one action as the state
-#: machine takes it (``move red +x 1``; CHAIN's JSON calls too); ``text``, a model's reply with
-#: the harness's ``<action>`` tags; ``chain``, CHAIN's JSON tool-call text.
-DIALECTS: Final = ("action", "text", "chain")
+#: How a ``{"text": ...}`` action is read: ``action`` (the default), the text is one action as
+#: the state machine takes it (``move red +x 1``, or one of CHAIN's JSON calls); any registered
+#: dialect (:mod:`chaingeo.evaluation.agents.dialects`: ``text``, a model's reply with the
+#: harness's ``<action>`` tags, ...) reads it as a model's whole reply.
+PLAIN: Final = "action"
 MAX_HISTORY: Final = 50
-MIN_IMAGE_SIZE, MAX_IMAGE_SIZE = 128, 1024
+
+
+def dialects() -> tuple[str, ...]:
+    return (PLAIN, *DIALECTS.names())
 
 
 @dataclass(frozen=True)
 class Options:
     """A reset's options, checked."""
 
-    dialect: str = "action"
+    dialect: str = PLAIN
     images: bool = False
-    image_size: int = 512
     history: int = 5
     max_steps: int | None = None
     legal: bool = False
@@ -70,16 +73,14 @@ def read_options(data: Mapping[str, Any]) -> Options:
     extra = sorted(str(k)[:40] for k in data if k not in known)
     if extra:
         raise RequestError(f"unknown reset option {extra[0]!r}; known: {', '.join(sorted(known))}")
-    dialect = data.get("dialect", "action")
-    if dialect not in DIALECTS:
-        raise RequestError(f"dialect must be one of {', '.join(DIALECTS)}")
-    size = _int(data, "image_size", 512, MIN_IMAGE_SIZE, MAX_IMAGE_SIZE)
+    dialect = data.get("dialect", PLAIN)
+    if dialect not in dialects():
+        raise RequestError(f"dialect must be one of {', '.join(dialects())}")
     history = _int(data, "history", 5, 0, MAX_HISTORY)
-    assert size is not None and history is not None
+    assert history is not None
     return Options(
         dialect=str(dialect),
         images=_bool(data, "images", False),
-        image_size=size,
         history=history,
         max_steps=_int(data, "max_steps", None, 1, limits.MAX_STEPS),
         legal=_bool(data, "legal", False),
@@ -89,84 +90,70 @@ def read_options(data: Mapping[str, Any]) -> Options:
 
 
 class Play:
-    """One level being played under a reset's options; ``events`` logs every turn with its
-    time (seconds since the reset) for a study's record."""
+    """One level being played under a reset's options (an :class:`Episode`); each step record
+    gets ``t``, its time in seconds since the reset, for a study's record."""
 
     def __init__(
-        self, level: Level, options: Options, seed: int | None, hide_optimal: bool
+        self, level: Level, options: Options, seed: int | None, hide_optimal: bool, agent: str
     ) -> None:
         if options.max_steps is not None:
             level = dataclasses.replace(level, max_steps=options.max_steps)
+        protocol = ProtocolConfig(history_window=options.history, text_state=options.text_state)
+        self.episode = Episode(
+            level, protocol, images=options.images, seed=seed or 0, agent=agent, keep_images=False
+        )
         self.level, self.options, self.seed = level, options, seed
         self.hide_optimal = hide_optimal
-        self.state: BaseState = new_state(level)
         self.tools = tool_specs(level)
         self.started = time.monotonic()
-        self.events: list[dict[str, Any]] = []
-        self.actions = 0
-        self.readable = 0
-        self.last: StepResult | None = None
-        self.sent: str | None = None
+        self.last: StepResultLike | None = None
+
+    @property
+    def state(self) -> Any:
+        return self.episode.state
 
     @property
     def done(self) -> bool:
-        s = self.state
-        return bool(s.is_success() or s.is_truncated() or s.finished)
+        return self.episode.done
 
-    def _action_text(self, action: ChainAction) -> tuple[str, bool]:
-        """(the text the state machine plays, whether the agent's turn was readable)."""
+    @property
+    def steps(self) -> list[dict[str, Any]]:
+        return self.episode.steps
+
+    def _reply(self, action: ChainAction) -> Reply:
         if action.tool is not None:
-            t = translate(action.tool, action.arguments or {}, self.tools)
-            return t.action, t.problem is None
+            call = tool_call("call_0", action.tool, action.arguments or {}, self.tools)
+            return read_reply("tools", "", (call,))
         assert action.text is not None
-        if self.options.dialect == "text":
-            found, _ = extract_action(action.text)
-            return found or "", found is not None
-        return action.text, True
+        if self.options.dialect == PLAIN:
+            return Reply(action.text, action.text)
+        return read_reply(self.options.dialect, action.text)
 
-    def step(self, action: ChainAction) -> StepResult:
+    def step(self, action: ChainAction) -> None:
         if self.done:
             raise NoEpisodeError("the episode is over; reset to play again")
-        text, readable = self._action_text(action)
-        result = self.state.step_text(text)
-        self.actions += 1
-        self.readable += int(readable and result.error != "unparseable")
-        self.last, self.sent = result, text
-        self.events.append(
-            {
-                "t": round(time.monotonic() - self.started, 3),
-                "sent": text,
-                "action": result.action.to_text() if result.action is not None else None,
-                "legal": result.legal,
-                "error": result.error,
-                "feedback": result.feedback,
-            }
-        )
-        return result
+        before = len(self.episode.steps)
+        results = self.episode.play(self._reply(action))
+        t = round(time.monotonic() - self.started, 3)
+        for rec in self.episode.steps[before:]:
+            rec["t"] = t
+        if results:
+            self.last = results[-1]
 
     def outcome(self) -> Outcome:
-        s = self.state
-        return Outcome(
-            level_id=self.level.id,
-            optimal_steps=self.level.optimal_steps,
-            success=bool(s.is_success()),
-            steps=int(s.steps_used),
-            actions=self.actions,
-            readable=self.readable,
-            finished=bool(s.finished),
-            truncated=bool(s.is_truncated()) and not s.is_success(),
-        )
+        return self.episode.outcome()
 
     def observation(self) -> ChainObservation:
-        opts, s, level = self.options, self.state, self.level
-        obs = observe(s, opts.history, opts.text_state, opts.images, opts.image_size)
+        opts, s, level, ep = self.options, self.state, self.level, self.episode
+        obs = ep.observation()
         last = None
         if self.last is not None:
-            last = {"sent": self.sent, "legal": self.last.legal, "error": self.last.error}
+            sent = ep.steps[-1]["sent"] if ep.steps else None
+            last = {"sent": sent, "legal": self.last.legal, "error": self.last.error}
         done = self.done
         return ChainObservation(
             done=done,
-            reward=total_reward(self.outcome()) if done else 0.0,
+            reward=total_reward(ep.outcome()) if done else 0.0,
             level_id=level.id,
             family=level.family,
             instruction=obs.instruction,

@@ -25,9 +25,8 @@ from typing import Any, Final
 import numpy as np
 
 from chaingeo.core import limits
-from chaingeo.core.level import Level, content_hash, level_set_hash
-from chaingeo.evaluation.logs import RunError, RunLog, episode_key, make_header
-from chaingeo.evaluation.usage import Usage
+from chaingeo.core.level import Level, level_set_hash
+from chaingeo.evaluation.logs import RunError, RunLog, make_header
 from chaingeo.integrations.serve.errors import StudyError
 from chaingeo.integrations.serve.session import Play
 
@@ -107,52 +106,20 @@ class Study:
 def study_record(
     play: Play, participant: str, sample: int, study: str, episode_id: str | None
 ) -> dict[str, Any]:
-    """The run record of one human episode (the fields ``chain eval`` writes)."""
-    level, state, events = play.level, play.state, play.events
-    success = bool(state.is_success())
-    steps = [
-        {
-            "turn": i,
-            "t": e["t"],
-            "reply": "",
-            "sent": e["sent"],
-            "action": e["action"],
-            "legal": e["legal"],
-            "error": e["error"],
-            "feedback": e["feedback"],
-            "usage": Usage().to_json(),
-        }
-        for i, e in enumerate(events)
-    ]
-    return {
-        "key": episode_key(level.id, sample),
-        "level_id": level.id,
-        "level_hash": content_hash(level),
-        "family": level.family,
-        "difficulty": level.difficulty,
-        "goal": level.goal,
-        "optimal_steps": level.optimal_steps,
-        "max_steps": level.max_steps,
-        "sample": sample,
-        "seed": play.seed or 0,
-        "protocol": "interactive",
-        "agent": HUMAN,
-        "model": None,
-        "participant": participant,
-        "study": study,
-        "episode_id": episode_id,
-        "status": "done",
-        "error": None,
-        "success": success,
-        "steps_used": int(state.steps_used),
-        "invalid": sum(1 for s in steps if not s["legal"]),
-        "unparseable": sum(1 for s in steps if s["error"] == "unparseable"),
-        "illegal": sum(1 for s in steps if s["error"] == "illegal"),
-        "ambiguous": sum(1 for s in steps if s["error"] == "ambiguous"),
-        "finished": bool(state.finished),
-        "truncated": bool(state.is_truncated()) and not success,
-        "usage": Usage().to_json(),
-        "wall_seconds": round(time.monotonic() - play.started, 3),
-        "solve_seconds": events[-1]["t"] if success and events else None,
-        "steps": steps,
-    }
+    """The run record of one human episode: the episode's own record (as ``chain eval`` writes
+    it, every step with its time ``t``) and who played it, when, how long."""
+    ep = play.episode
+    ep.sample = sample
+    record = ep.record()
+    times = [s["t"] for s in ep.steps]
+    record.update(
+        model=None,
+        participant=participant,
+        study=study,
+        episode_id=episode_id,
+        status="done",
+        error=None,
+        wall_seconds=round(time.monotonic() - play.started, 3),
+        solve_seconds=times[-1] if record["success"] and times else None,
+    )
+    return record

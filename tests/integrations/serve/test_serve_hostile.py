@@ -37,7 +37,7 @@ json_values = st.recursive(
 )
 keys = st.sampled_from(
     ["text", "tool", "arguments", "level", "seed", "images", "history", "legal", "dialect",
-     "max_steps", "scene", "image_size", "participant", "metadata", "episode_id", "x"]
+     "max_steps", "scene", "participant", "metadata", "episode_id", "x"]
 )  # fmt: skip
 payloads = st.dictionaries(
     keys, json_values | st.sampled_from([LEVEL, "finish", "move"]), max_size=4

@@ -33,7 +33,7 @@ BAD_RESETS: list[dict[str, Any]] = [
     {"level": PUZZLE, "colour": 1},
     {"level": PUZZLE, "seed": -4},
     {"level": PUZZLE, "participant": "p"},
-    {"level": PUZZLE, "image_size": 64, "images": True},
+    {"level": PUZZLE, "dialect": "klingon"},
 ]
 
 
@@ -83,7 +83,7 @@ def test_tool_calls_and_images(url: str) -> None:
 
     async def go() -> tuple[dict[str, Any], dict[str, Any]]:
         async with _client(url) as env:
-            r0 = await env.reset(level=STACKING, images=True, image_size=128)
+            r0 = await env.reset(level=STACKING, images=True)
             text = plan_texts(level)[0]
             piece, cells = text.split()[1], text.split(" ", 2)[2]
             triples = [json.loads("[" + c.strip("()") + "]") for c in cells.split(") (")]
