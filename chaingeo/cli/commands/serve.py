@@ -22,31 +22,31 @@ def register(sub: Any) -> None:
         "serve", help="serve the environment (OpenEnv), the 3D player and human studies"
     )
     add_level_list(p)
-    p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
-    p.add_argument("--port", type=int, default=8000, help="port (default 8000)")
+    p.add_argument("--host", default="127.0.0.1", help="address to bind")
+    p.add_argument("--port", type=int, default=8000, help="port")
     p.add_argument(
         "--token",
         default=None,
-        help="require this bearer token (default: $CHAIN_SERVE_TOKEN, else none)",
+        help="require this bearer token (else $CHAIN_SERVE_TOKEN, if set)",
     )
     p.add_argument(
         "--max-sessions",
         type=int,
         default=limits.MAX_SESSIONS,
-        help=f"sessions open at once (default {limits.MAX_SESSIONS})",
+        help="sessions open at once",
     )
     p.add_argument(
         "--idle",
         type=float,
         default=limits.SESSION_IDLE_SECONDS,
-        help=f"seconds before a silent session is closed (default {limits.SESSION_IDLE_SECONDS:g})",
+        help="seconds before a silent session is closed",
     )
     p.add_argument("--study", default=None, metavar="NAME", help="run a human-baseline study")
     p.add_argument(
         "--study-dir",
         type=Path,
         default=Path("studies"),
-        help="where a study writes its run (default ./studies/NAME)",
+        help="where a study writes its run (as DIR/NAME)",
     )
     p.add_argument("--seed", type=int, default=0, help="a study's seed for the level orders")
     p.set_defaults(func=run)
