@@ -49,13 +49,13 @@ def build_app(catalog: Catalog, options: ServeOptions = ServeOptions()) -> Guard
         functools.partial(ChainEnvironment, catalog),
         ChainAction,
         ChainObservation,
-        concurrency_config=ConcurrencyConfig(
-            max_concurrent_envs=options.max_sessions, session_timeout=options.idle_seconds
-        ),
+        # Idle sessions are closed by the guard (OpenEnv's reaper frees the slot but leaves the
+        # socket playing on the closed environment).
+        concurrency_config=ConcurrencyConfig(max_concurrent_envs=options.max_sessions),
     )
     app.add_exception_handler(ChainGeoError, _refused)
     _player_routes(app, catalog)
-    return Guard(app, options.token)
+    return Guard(app, options.token, options.idle_seconds)
 
 
 def _player_routes(app: FastAPI, catalog: Catalog) -> None:

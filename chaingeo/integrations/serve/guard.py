@@ -10,6 +10,7 @@ the session stays as it was; an HTTP request that fails gets its 4xx and a JSON 
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import hmac
 import json
@@ -59,8 +60,13 @@ def _headers(scope: Scope) -> dict[str, str]:
 class Guard:
     """Wraps the app; ``token`` None means no authentication (the default, on 127.0.0.1)."""
 
-    def __init__(self, app: ASGIApp, token: str | None = None) -> None:
-        self.app, self.token = app, token
+    def __init__(
+        self,
+        app: ASGIApp,
+        token: str | None = None,
+        idle_seconds: float = limits.SESSION_IDLE_SECONDS,
+    ) -> None:
+        self.app, self.token, self.idle_seconds = app, token, idle_seconds
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         kind = scope["type"]
@@ -82,7 +88,8 @@ class Guard:
         if kind == "websocket":
             # OpenEnv closes a socket its client already closed: nothing to say
             with contextlib.suppress(WebSocketDisconnect):
-                await self.app(scope, _FrameCheck(receive, send).receive, send)
+                check = _FrameCheck(receive, send, self.idle_seconds)
+                await self.app(scope, check.receive, send)
             return
         if self.token is not None and await _login(scope, send, self.token):
             return
@@ -243,16 +250,25 @@ def ws_error(message: str) -> str:
 
 
 class _FrameCheck:
-    """A WebSocket's ``receive`` that answers bad frames itself and passes only good ones on."""
+    """A WebSocket's ``receive`` that answers bad frames itself and passes only good ones on;
+    a session silent for ``idle`` seconds is told the client left (OpenEnv then closes the
+    session and the socket)."""
 
-    def __init__(self, receive: Receive, send: Send) -> None:
-        self._receive, self._send = receive, send
+    def __init__(self, receive: Receive, send: Send, idle: float) -> None:
+        self._receive, self._send, self.idle = receive, send, idle
         self.messages = 0
         self.bytes = 0
+        self.opened = False
 
     async def receive(self) -> Message:
         while True:
-            message = await self._receive()
+            if not self.opened:  # the handshake waits for no timer
+                self.opened = True
+                return await self._receive()
+            try:
+                message = await asyncio.wait_for(self._receive(), timeout=self.idle)
+            except TimeoutError:
+                return {"type": "websocket.disconnect", "code": 1001}
             if message["type"] != "websocket.receive":
                 return message
             problem = self._problem(message)

@@ -3,6 +3,7 @@ bodies (hypothesis) against a real server, a watched session checked after each;
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -18,6 +19,7 @@ from hypothesis import strategies as st
 
 pytest.importorskip("openenv", reason="chain serve needs the serve extra (openenv-core)")
 
+from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from chaingeo.core.suite import shipped_level
@@ -163,3 +165,28 @@ def test_chain_serve_starts_and_stops_on_sigterm(tmp_path: Any) -> None:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_sessions_are_bounded_in_count_idle_time_and_messages(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from chaingeo.core import limits
+
+    monkeypatch.setattr(limits, "MAX_SESSION_MESSAGES", 4)
+    with running(Catalog({LEVEL: shipped_level(LEVEL)}), max_sessions=2, idle_seconds=2.0) as url:
+        with _ws(url) as a, contextlib.ExitStack() as later:
+            assert _ask(a, {"type": "reset", "data": {"level": LEVEL}})["type"] == "observation"
+            b = later.enter_context(_ws(url))
+            assert _ask(b, {"type": "state"})["type"] == "state"
+            with _ws(url) as c:  # a third is refused: OpenEnv's capacity error, then closed
+                reply = json.loads(c.recv(timeout=30))
+                assert reply["data"]["code"] == "CAPACITY_REACHED"
+            for _ in range(3):
+                assert _ask(a, {"type": "state"})["type"] == "state"
+            refused = _ask(a, {"type": "state"})  # the fifth message of this session
+            assert refused["type"] == "error" and "SessionLimitError" in refused["data"]["message"]
+            time.sleep(2.5)  # b has been silent: closed
+            with pytest.raises(ConnectionClosed):
+                _ask(b, {"type": "state"})
+        with _ws(url) as d:  # its slot is free again
+            assert _ask(d, {"type": "state"})["type"] == "state"
