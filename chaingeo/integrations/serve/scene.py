@@ -37,9 +37,9 @@ def _tray(tray: dict[str, tuple[Shape, str]]) -> dict[str, Shape]:
 
 
 def scene_json(state: BaseState) -> dict[str, Any]:
-    """``{"box": [a,b,c] or None, "pieces": [{name, rgb, cells, place, part}]}`` in the level's
-    piece order; ``place`` is ``box`` / ``tray`` (stacking) or ``puzzle``, ``part`` a puzzle
-    piece's part (0 the largest)."""
+    """``{"box": [a,b,c] or None, "turns": whether the rules allow turns, "pieces": [{name, rgb,
+    cells, place, part}]}`` in the level's piece order; ``place`` is ``box`` / ``tray``
+    (stacking) or ``puzzle``, ``part`` a puzzle piece's part (0 the largest)."""
     placed, box, tray = scene(state)
     trayed = _tray(tray)
     part_of: dict[str, int] = {}
@@ -64,4 +64,5 @@ def scene_json(state: BaseState) -> dict[str, Any]:
         if place == "tray":
             entry["shape"] = _cells(state.level.piece(p.name).shape)
         pieces.append(entry)
-    return {"box": list(box) if box is not None else None, "pieces": pieces}
+    turns = bool(getattr(state.level.rules, "turns", False))
+    return {"box": list(box) if box is not None else None, "turns": turns, "pieces": pieces}

@@ -48,27 +48,27 @@ def _ready(page: Page, steps: int) -> dict[str, Any]:
     return status
 
 
-def _select(page: Page, group: list[str]) -> None:
-    """Click the group's pieces (shift for the rest); a piece no click can reach is taken from
-    the keyboard: ] moves the cursor, space adds it."""
+def _select(page: Page, group: list[str], keys_only: bool) -> None:
+    """Click the group's pieces (shift for the rest); a piece no click can reach, or every piece
+    with ``keys_only``, is taken from the keyboard: ] moves the cursor, space adds it."""
     for i, name in enumerate(group):
-        point = page.js(f"window.chainPlayer.pointOf({name!r})")
+        point = None if keys_only else page.js(f"window.chainPlayer.pointOf({name!r})")
         if point is not None:
             page.click(point[0], point[1], shift=i > 0)
             continue
-        while page.js("window.chainPlayer.status().cursor") != name:
-            page.key("]")
         if i == 0:
             page.key("Escape")
+        while page.js("window.chainPlayer.status().cursor") != name:
+            page.key("]")
         page.key(" ")
     assert page.js("window.chainPlayer.status().selected") == sorted(group)
 
 
-def _play(page: Page, text: str) -> None:
+def _play(page: Page, text: str, keys_only: bool = False) -> None:
     """One action of a plan, by the controls a person uses."""
     words = text.split()
     if words[0] == "place":
-        _select(page, [words[1]])
+        _select(page, [words[1]], keys_only)
         target = text.split(" ", 2)[2]
         for _ in range(500):
             if page.js("window.chainPlayer.status().ghost") == target:
@@ -76,7 +76,7 @@ def _play(page: Page, text: str) -> None:
             page.key("n")
         page.key("Enter")
         return
-    _select(page, words[1].split("+"))
+    _select(page, words[1].split("+"), keys_only)
     if words[0] == "rotate":
         page.key(words[2])
         page.key("r" if words[3] == "+90" else "f")
@@ -86,10 +86,10 @@ def _play(page: Page, text: str) -> None:
     page.key(DIRECTION_KEYS[words[2]])
 
 
-def _solve(page: Page, level: Level) -> None:
+def _solve(page: Page, level: Level, keys_only: bool) -> None:
     _ready(page, 0)
     for i, text in enumerate(plan_texts(level)):
-        _play(page, text)
+        _play(page, text, keys_only)
         status = _ready(page, i + 1)
         assert status["sent"][-1].startswith(text.split(" about")[0]), (text, status["sent"])
     page.wait("document.body.dataset.state === 'solved'")
@@ -97,16 +97,18 @@ def _solve(page: Page, level: Level) -> None:
     assert page.js("document.getElementById('solvedtitle').textContent") == "Solved!"
 
 
-@pytest.mark.parametrize("level_id", [PUZZLE, STACKING])
+@pytest.mark.parametrize(("level_id", "keys_only"), [(PUZZLE, False), (STACKING, True)])
 def test_a_study_participant_solves_a_level_by_clicks_and_keys(
-    devtools: str, tmp_path: Path, level_id: str
+    devtools: str, tmp_path: Path, level_id: str, keys_only: bool
 ) -> None:
+    """The puzzle by clicks (the keyboard where no click reaches a piece) and keys, the
+    stacking level by the keyboard alone."""
     level = shipped_level(level_id)
     study = Study.create("browser", tmp_path, [level], seed=1)
     with running(Catalog({level_id: level}, study)) as url:
         page = open_page(devtools, f"{url}/play/study?participant=tester")
         try:
-            _solve(page, level)
+            _solve(page, level, keys_only)
             assert page.js("document.getElementById('optimal').textContent") == "hidden"
             assert page.js("document.getElementById('undo').disabled") is True
         finally:

@@ -236,6 +236,7 @@ function draw(sceneData) {
   game.selected = new Set([...game.selected].filter((n) => names.includes(n)));
   game.cursor = Math.min(game.cursor, names.length - 1);
   if (!framed) frame();
+  for (const b of [ui.turnplus, ui.turnminus]) b.hidden = !sceneData.turns && !sceneData.box;
   pieceList();
   updateGhost();
   render();
@@ -286,6 +287,7 @@ function render() {
     label.style.left = `${((p.x + 1) / 2) * ui.canvas.clientWidth}px`;
     label.style.top = `${((1 - p.y) / 2) * ui.canvas.clientHeight}px`;
     label.classList.toggle("on", on);
+    label.classList.toggle("cursor", names()[game.cursor] === piece.name);
   }
   renderer.render(scene3, camera);
 }
@@ -412,6 +414,7 @@ function setDistance(d) {
 
 function turn(angle) {
   if (game.obs.family === "stacking") { if (stackingPiece()) turnGhost("xyz".indexOf(game.axis)); return; }
+  if (!game.scene.turns) { say("This level's rules allow no turns.", true); return; }
   if (!game.selected.size) { say("Select a piece first.", true); return; }
   const key = `${group()} ${game.axis} ${angle}`;
   const legal = game.turns.get(key) || [];
@@ -464,17 +467,19 @@ function pieceList() {
   }));
 }
 
+// The cursor only points; space adds or removes the piece it points at.
 function moveCursor(step) {
   const all = names();
   if (!all.length) return;
   game.cursor = (game.cursor + step + all.length) % all.length;
-  select(all[game.cursor], "one");
+  pieceList();
+  render();
 }
 
 const KEYS = [
   ["click", "select a piece (shift+click: add or remove it; double-click: its whole part)"],
-  ["] / [", "select the next / previous piece"],
-  ["space", "add or remove the piece under the cursor"],
+  ["] / [", "move the cursor to the next / previous piece (dashed in the list and the labels)"],
+  ["space", "select or unselect the cursor's piece (escape: unselect all)"],
   ["g", "select the cursor piece's whole part (puzzles)"],
   ["d / a", "+x / -x: move the selection (puzzles) or the ghost (stacking)"],
   ["w / s", "+y / -y"],
@@ -528,7 +533,7 @@ function onKey(ev) {
   else if (k === "p") pickup();
   else if (k === "u") undo();
   else if (k === "v") toggleView();
-  else if (k === "Escape") { game.selected.clear(); select(null); pieceList(); render(); }
+  else if (k === "Escape") { game.selected.clear(); game.ghost = null; updateGhost(); pieceList(); render(); }
   else if (k.startsWith("Arrow")) orbit(k);
   else if (k === "+" || k === "=") zoom(0.85);
   else if (k === "-") zoom(1 / 0.85);
