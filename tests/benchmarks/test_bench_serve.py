@@ -20,11 +20,11 @@ def test_served_episodes_take_the_steps_in_process_ones_take() -> None:
     catalog = Catalog({i: shipped_level(i) for i in bench.LEVELS})
     with running(catalog) as url:
         for policy in bench.POLICIES:
-            here = bench.in_process(policy, 6)
-            there = bench.served(url, policy, 6, 3)
+            here = bench.in_process(policy, 4)
+            there = bench.served(url, policy, 4, 2)
             assert here.steps == there.steps == len(there.latencies) > 0
-    oracle = sum(lv.optimal_steps for lv, _ in bench._tasks(6))
-    assert bench.in_process("oracle", 6).steps == oracle
+    oracle = sum(lv.optimal_steps for lv, _ in bench._tasks(4))
+    assert bench.in_process("oracle", 4).steps == oracle
 
 
 @pytest.mark.slow

@@ -80,7 +80,7 @@ def watched(url: str) -> Iterator[tuple[Any, dict[str, Any]]]:
         yield ws, _ask(ws, {"type": "state"})
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck))
 @given(batch=st.lists(frames, min_size=1, max_size=6))
 def test_random_frames_get_answers_never_a_broken_session(
     url: str, watched: tuple[Any, dict[str, Any]], batch: list[str]
@@ -97,7 +97,7 @@ def test_random_frames_get_answers_never_a_broken_session(
     assert _ask(ws_watched, {"type": "state"}) == before
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck))
+@settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck))
 @given(
     path=st.sampled_from(["/reset", "/step", "/state", "/health", "/schema", "/levels", "/"]),
     body=st.one_of(payloads.map(json.dumps), st.text(max_size=40), json_values.map(json.dumps)),

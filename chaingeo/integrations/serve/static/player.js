@@ -2,6 +2,8 @@
 // the actions an agent has. Everything the server says is set as text (textContent), never as
 // markup. Cells are 0-based lattice cells on the wire; action text is 1-based (the agent's).
 import * as THREE from "./three.min.js";
+import { FACES, cellsOf, cellsText, pieceObject } from "./geometry.js";
+import { KEYS } from "./keys.js";
 
 const body = document.body;
 const STUDY = body.dataset.study === "1";
@@ -140,15 +142,6 @@ function buildLegal(legal) {
   }
 }
 
-function cellsOf(text) {
-  return [...text.matchAll(/\((-?\d+),(-?\d+),(-?\d+)\)/g)].map((m) => [+m[1] - 1, +m[2] - 1, +m[3] - 1]);
-}
-
-function cellsText(cells) {
-  const sorted = cells.map((c) => c.slice()).sort((a, b) => a[0] - b[0] || a[1] - b[1] || a[2] - b[2]);
-  return sorted.map((c) => `(${c[0] + 1},${c[1] + 1},${c[2] + 1})`).join(" ");
-}
-
 // ---------------------------------------------------------------------------------------------
 // The 3D scene
 // ---------------------------------------------------------------------------------------------
@@ -168,44 +161,6 @@ const world = new THREE.Group();
 scene3.add(world);
 const meshes = new Map();
 let framed = false;
-
-const FACES = [
-  [[1, 0, 0], [[1, 0, 0], [1, 1, 0], [1, 1, 1], [1, 0, 1]]],
-  [[-1, 0, 0], [[0, 1, 0], [0, 0, 0], [0, 0, 1], [0, 1, 1]]],
-  [[0, 1, 0], [[1, 1, 0], [0, 1, 0], [0, 1, 1], [1, 1, 1]]],
-  [[0, -1, 0], [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]]],
-  [[0, 0, 1], [[0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]]],
-  [[0, 0, -1], [[0, 1, 0], [1, 1, 0], [1, 0, 0], [0, 0, 0]]],
-];
-
-// A solid of unit cubes: only the faces no other cell of the piece covers.
-function solid(cells) {
-  const have = new Set(cells.map((c) => c.join(",")));
-  const pos = [];
-  const nor = [];
-  for (const c of cells) {
-    for (const [n, quad] of FACES) {
-      if (have.has([c[0] + n[0], c[1] + n[1], c[2] + n[2]].join(","))) continue;
-      for (const i of [0, 1, 2, 0, 2, 3]) {
-        pos.push(c[0] + quad[i][0], c[1] + quad[i][1], c[2] + quad[i][2]);
-        nor.push(...n);
-      }
-    }
-  }
-  const g = new THREE.BufferGeometry();
-  g.setAttribute("position", new THREE.Float32BufferAttribute(pos, 3));
-  g.setAttribute("normal", new THREE.Float32BufferAttribute(nor, 3));
-  return g;
-}
-
-function pieceObject(cells, rgb, opacity) {
-  const geom = solid(cells);
-  const mat = new THREE.MeshLambertMaterial({ color: new THREE.Color(rgb), transparent: opacity < 1, opacity });
-  const mesh = new THREE.Mesh(geom, mat);
-  const edges = new THREE.LineSegments(new THREE.EdgesGeometry(geom, 30), new THREE.LineBasicMaterial({ color: 0x222222 }));
-  mesh.add(edges);
-  return mesh;
-}
 
 function draw(sceneData) {
   if (!sceneData) return;
@@ -475,26 +430,6 @@ function moveCursor(step) {
   pieceList();
   render();
 }
-
-const KEYS = [
-  ["click", "select a piece (shift+click: add or remove it; double-click: its whole part)"],
-  ["] / [", "move the cursor to the next / previous piece (dashed in the list and the labels)"],
-  ["space", "select or unselect the cursor's piece (escape: unselect all)"],
-  ["g", "select the cursor piece's whole part (puzzles)"],
-  ["d / a", "+x / -x: move the selection (puzzles) or the ghost (stacking)"],
-  ["w / s", "+y / -y"],
-  ["e / q", "+z / -z"],
-  ["1-9, 0", "the distance of the next move; 0 = to infinity (out of the puzzle)"],
-  ["x / y / z", "the axis of turns"],
-  ["r / f", "turn +90 / -90 about that axis (puzzles whose rules allow turns; stacking: turn the ghost)"],
-  ["n / b", "stacking: the ghost to the next / previous legal placement"],
-  ["enter", "stacking: place the piece where the ghost is"],
-  ["p", "stacking: pick the selected piece up"],
-  ["shift+f", "finish (end the episode)"],
-  ["u", "undo (free play only)"],
-  ["v", "switch the 3D view and the agent's view (pictures and text)"],
-  ["arrows, + / -", "orbit and zoom the camera (mouse: drag, wheel, right-drag to pan)"],
-];
 
 function legend() {
   ui.keys.replaceChildren(...KEYS.map(([k, what]) => {
