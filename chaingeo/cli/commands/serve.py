@@ -10,8 +10,11 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import os
+import re
 from pathlib import Path
 from typing import Any
+
+TOKEN_RE = re.compile(r"[A-Za-z0-9._~+/=-]{16,256}")
 
 
 def register(sub: Any) -> None:
@@ -72,6 +75,8 @@ def run(args: argparse.Namespace) -> int:
     if args.study is not None:
         study = Study.create(args.study, args.study_dir, list(levels.values()), args.seed)
     token = args.token if args.token is not None else os.environ.get("CHAIN_SERVE_TOKEN") or None
+    if token is not None and not TOKEN_RE.fullmatch(token):
+        raise CommandError("a token is 16-256 letters, digits or -._~+/= (it goes in a cookie)")
     catalog = Catalog(levels, study)
     serve(catalog, ServeOptions(args.host, args.port, token, args.max_sessions, args.idle))
     return 0

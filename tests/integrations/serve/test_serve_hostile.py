@@ -28,7 +28,7 @@ from chaingeo.integrations.serve.environment import Catalog
 from tests.support.serve import free_port, get, post, running
 
 LEVEL = "puzzle-easy-07-burr3"
-TOKEN = "s3cret-token"
+TOKEN = "s3cret-token-0123"
 
 json_values = st.recursive(
     st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(max_size=20),

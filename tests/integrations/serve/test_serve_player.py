@@ -166,6 +166,10 @@ def test_canvas_colours_undo_and_markup_stays_text(devtools: str) -> None:
             _ready(page, 1)
             page.key("u")
             _ready(page, 0)
+            page.key("v")  # the agent's view: its pictures and its text
+            page.wait("document.querySelectorAll('#agentimages img').length === 5")
+            text = page.js("document.getElementById('agenttext').textContent")
+            assert text.startswith("Take the interlocking puzzle apart") and "Views: " in text
         finally:
             page.close()
         page = open_page(devtools, f"{url}/play/probe")
@@ -179,7 +183,7 @@ def test_canvas_colours_undo_and_markup_stays_text(devtools: str) -> None:
             assert PROBE in feedback and "<b>bold</b>" in feedback
             labels = page.js("[...document.querySelectorAll('.label')].map(e => e.textContent)")
             assert PROBE in labels
-            assert page.js("document.querySelectorAll('img').length") == 0
+            assert page.js("document.querySelectorAll('img').length") == 0  # no agent view here
             assert (
                 page.js("document.querySelectorAll('#feedback *, #labels b, #pieces b').length")
                 == 0
