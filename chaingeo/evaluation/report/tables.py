@@ -25,17 +25,16 @@ from pathlib import Path
 from typing import Any
 
 from chaingeo.evaluation import stats
+from chaingeo.evaluation.episode import Outcome
 from chaingeo.evaluation.logs import HEADER, RunError, RunLog
 from chaingeo.evaluation.metrics import (
     DIFFICULTIES,
     FAMILIES,
     METRICS,
     Metric,
-    Outcome,
     Summary,
     summarize,
 )
-from chaingeo.evaluation.runner import outcome_of
 from chaingeo.evaluation.stats import Estimate
 
 
@@ -88,7 +87,7 @@ def load_run(path: str | Path) -> Run:
         label=str(header.get("label") or header["agent"]["name"]),
         protocol=dict(header.get("protocol", {})),
         header=header,
-        outcomes=[outcome_of(r) for r in latest],
+        outcomes=[Outcome.from_record(r) for r in latest],
         errors=sum(1 for r in latest if r.get("status") == "error"),
     )
 
