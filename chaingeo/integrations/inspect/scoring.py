@@ -3,7 +3,7 @@
 A sample's score is its success (1 or 0) with, in its metadata, the episode's steps, ``o_i``
 (the level's optimal steps), Dist2Opt and NormDist, and sums the metrics add up: ``solved``,
 ``episodes`` and the step figures summed over solved episodes. The reducers (``mean``,
-``pass_at_epochs``: Pass@k, ``pass_all_epochs``: Pass^k, with k the number of epochs, unbiased
+``pass_at_k``: Pass@k, ``pass_hat_k``: Pass^k, with k the number of epochs, unbiased
 as in :mod:`chaingeo.evaluation.metrics`) add those sums over a level's epochs, so the metrics
 below give the same figures as ``chain report`` (NormDist averaged over solved episodes) after
 any reducer. k follows ``--epochs`` (inspect_ai fixes a task's reducers before it knows the
@@ -145,7 +145,7 @@ def mean_epochs() -> ScoreReducer:
     return reduce
 
 
-@score_reducer(name="pass_at_epochs")
+@score_reducer(name="pass_at_k")
 def pass_at_epochs() -> ScoreReducer:
     """Pass@k with k the level's epochs (unbiased; at least one of k succeeds)."""
 
@@ -156,7 +156,7 @@ def pass_at_epochs() -> ScoreReducer:
     return reduce
 
 
-@score_reducer(name="pass_all_epochs")
+@score_reducer(name="pass_hat_k")
 def pass_all_epochs() -> ScoreReducer:
     """Pass^k with k the level's epochs (all k succeed)."""
 
@@ -168,5 +168,11 @@ def pass_all_epochs() -> ScoreReducer:
 
 
 #: The task's metrics: accuracy with its standard error, and the step figures.
-METRICS: list[Metric] = [accuracy(), stderr(), normdist(), dist2opt(), avg_steps()]
+METRICS: list[Metric | dict[str, list[Metric]]] = [
+    accuracy(),
+    stderr(),
+    normdist(),
+    dist2opt(),
+    avg_steps(),
+]
 REDUCERS: list[ScoreReducer] = [mean_epochs(), pass_at_epochs(), pass_all_epochs()]

@@ -81,7 +81,9 @@ def tool_infos(level: Level, protocol: str) -> list[ToolInfo]:
     return out
 
 
-def first_messages(episode: Episode, dialect: str, views: Sequence[str] | None) -> list[ChatMessage]:
+def first_messages(
+    episode: Episode, dialect: str, views: Sequence[str] | None
+) -> list[ChatMessage]:
     """The sample's input: the system prompt and the first observation."""
     system = DIALECTS.get(dialect).system_prompt(episode.oneshot)
     return [ChatMessageSystem(content=system), _observation(episode, views)]
@@ -135,7 +137,9 @@ def play_level(
         turn = 0
         while not episode.done:
             if model is not None:
-                output = await model.generate([system, *before, shown], tools=offered, config=config)
+                output = await model.generate(
+                    [system, *before, shown], tools=offered, config=config
+                )
             else:
                 output = oracle_output(level, episode, dialect, turn)
             message = output.message
@@ -195,4 +199,3 @@ def _note(turn: int, reply: Reply, results: Sequence[Any]) -> None:
         },
         source="chaingeo",
     )
-
