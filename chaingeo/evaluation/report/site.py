@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any, Final
 
 from chaingeo.evaluation.logs import IMAGES, RunError, RunLog
-from chaingeo.evaluation.report.tables import Run, Table, tables, write_report
+from chaingeo.evaluation.report.tables import Run, Table, sort_value, tables, write_report
 from chaingeo.evaluation.usage import PriceTable, Usage
 
 MARKER: Final = ".chain-site"
@@ -172,6 +172,8 @@ class _Builder:
         )
         for name, table in tables(self.runs):
             parts.append(f"<h2>{escape(table.title)}</h2>")
+            if table.caption:
+                parts.append(f'<p class="note">Uncertainty: {escape(table.caption)}.</p>')
             parts.append(_report_table(name, table))
         parts.append("<h2>Cost versus success</h2>")
         parts.append(
@@ -453,11 +455,11 @@ def _sortable(table_id: str, head: Sequence[tuple[str, bool]], rows: Iterable[li
 def _report_table(name: str, table: Table) -> str:
     """A report table with its own formatters for the text and the raw values for sorting."""
     numeric = [
-        all(isinstance(row[j], int | float) or row[j] is None for row in table.rows) and j > 0
+        all(isinstance(sort_value(row[j]), int | float | None) for row in table.rows) and j > 0
         for j in range(len(table.columns))
     ]
     rows = [
-        [_Cell(fmt(v), _sort_key(v)) for fmt, v in zip(table.formats, row, strict=True)]
+        [_Cell(fmt(v), _sort_key(sort_value(v))) for fmt, v in zip(table.formats, row, strict=True)]
         for row in table.rows
     ]
     return _sortable(name, list(zip(table.columns, numeric, strict=True)), rows)
