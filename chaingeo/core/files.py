@@ -1,13 +1,18 @@
-"""Files in and out: the one bounded reader of input files and the one atomic-write helper
+"""Files in and out: the one bounded reader of input files (and of JSON documents: levels,
+trajectories, run headers and records, kernel manifests, prices), and the one atomic-write helper
 (a reader never sees half of a file we write)."""
 
 from __future__ import annotations
 
+import json
 import os
 import stat
 import uuid
+from collections import Counter
 from pathlib import Path
+from typing import Any
 
+from chaingeo.core import limits
 from chaingeo.core.errors import ChainGeoError
 
 
@@ -22,20 +27,68 @@ class UnreadableFile(ChainGeoError):
 
 def read_bounded(path: str | os.PathLike[str], max_bytes: int) -> bytes:
     """The bytes of a regular file of at most ``max_bytes``, refused before reading when it is
-    larger or not a regular file (a FIFO would block the read forever)."""
+    larger or not a regular file (``/dev/zero`` never ends, a FIFO would block forever). The file
+    is opened without blocking and checked on the open descriptor, so it cannot be swapped for
+    another between the check and the read."""
     try:
-        st = Path(path).stat()
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as e:
+        raise UnreadableFile(f"cannot read: {e.strerror or e}") from None
+    try:
+        st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
             raise UnreadableFile("not a regular file")
         if st.st_size > max_bytes:
             raise UnreadableFile(f"{st.st_size} bytes; at most {max_bytes}")
-        with open(path, "rb") as fh:
+        with os.fdopen(fd, "rb", closefd=False) as fh:
             raw = fh.read(max_bytes + 1)
     except OSError as e:
         raise UnreadableFile(f"cannot read: {e.strerror or e}") from None
-    if len(raw) > max_bytes:  # it grew since stat
+    finally:
+        os.close(fd)
+    if len(raw) > max_bytes:  # it grew since fstat
         raise UnreadableFile(f"more than {max_bytes} bytes")
     return raw
+
+
+class JsonObject(dict[str, Any]):
+    """A decoded JSON object; ``repeated`` names the keys written more than once (the last value
+    is kept). A parser keeps them beside the object, never under a key of its own, which a
+    document could write too."""
+
+    repeated: tuple[str, ...] = ()
+
+
+def _object(pairs: list[tuple[str, Any]]) -> JsonObject:
+    out = JsonObject(pairs)
+    if len(out) != len(pairs):
+        counts = Counter(k for k, _ in pairs)
+        out.repeated = tuple(sorted(k for k, n in counts.items() if n > 1))
+    return out
+
+
+def parse_json(text: str | bytes) -> Any:
+    """A JSON document within :mod:`chaingeo.core.limits` (depth checked before parsing, integer
+    digits, finite numbers), its objects as :class:`JsonObject`; :class:`UnreadableFile` naming
+    what is wrong (and where) otherwise."""
+    if isinstance(text, bytes):
+        try:
+            text = text.decode("utf-8")
+        except UnicodeDecodeError:
+            raise UnreadableFile("not UTF-8 text") from None
+    try:
+        return limits.loads_bounded(text, object_pairs_hook=_object)
+    except limits.LimitError as e:
+        raise UnreadableFile(str(e)) from None
+    except json.JSONDecodeError as e:
+        raise UnreadableFile(f"invalid JSON at line {e.lineno} column {e.colno}: {e.msg}") from None
+    except (ValueError, RecursionError) as e:  # defensive: never a traceback for a file
+        raise UnreadableFile(f"invalid JSON: {type(e).__name__}") from None
+
+
+def read_json(path: str | os.PathLike[str], max_bytes: int) -> Any:
+    """The one bounded JSON reader: :func:`read_bounded`, then :func:`parse_json`."""
+    return parse_json(read_bounded(path, max_bytes))
 
 
 def atomic_write(path: str | os.PathLike[str], data: bytes, *, durable: bool = False) -> Path:

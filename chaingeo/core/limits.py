@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Callable
 from typing import Any, Final
 
 import numpy as np
@@ -128,7 +129,7 @@ def _bounded_int(text: str) -> int:
     return int(text)
 
 
-def loads_bounded(text: str) -> Any:
+def loads_bounded(text: str, object_pairs_hook: Callable[[Any], Any] | None = None) -> Any:
     """``json.loads`` with the nesting depth checked first (the decoder recurses), integer
     literals of at most :data:`MAX_INT_DIGITS` digits and finite numbers only; :class:`LimitError`
     past any of them. ``NaN``, ``Infinity`` and overflowing literals (``1e999``) are caught by
@@ -148,7 +149,11 @@ def loads_bounded(text: str) -> Any:
         return value if math.isfinite(value) else non_finite(literal)
 
     data = json.loads(
-        text, parse_int=_bounded_int, parse_float=finite_float, parse_constant=non_finite
+        text,
+        parse_int=_bounded_int,
+        parse_float=finite_float,
+        parse_constant=non_finite,
+        object_pairs_hook=object_pairs_hook,
     )
     if found:
         literal = found[0].literal
