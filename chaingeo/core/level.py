@@ -199,6 +199,11 @@ def default_step_budget(optimal_steps: int) -> int:
 # ---------------------------------------------------------------------------------------------
 
 
+def is_level_id(text: object) -> bool:
+    """Whether ``text`` is a level id as a level file may write it (matched whole)."""
+    return isinstance(text, str) and _ID_RE.fullmatch(text) is not None
+
+
 def parse_level(data: Any, source: str = "<level>") -> Level:
     """Validate a decoded JSON value and build the level; :class:`LevelError` if anything is off."""
     r = Reader(source)

@@ -84,6 +84,13 @@ MAX_RETRY_AFTER_SECONDS: Final = 60.0
 MAX_RETRY_SECONDS: Final = 900.0
 #: Same-origin HTTP 307/308 redirects followed per request (other redirects never are).
 MAX_REDIRECTS: Final = 3
+#: Run folders read back (``chain report``, ``--resume``): bytes of ``header.json``, of
+#: ``episodes.jsonl`` and of one stored picture, and the samples per level a record may name
+#: (each checked before the work; records are checked field by field as they are read).
+MAX_RUN_HEADER_BYTES: Final = 1024 * 1024
+MAX_RUN_LOG_BYTES: Final = 1024 * 1024 * 1024
+MAX_RUN_IMAGE_BYTES: Final = 64 * 1024 * 1024
+MAX_SAMPLES: Final = 10_000
 #: Run logs: characters of one logged string (longer ones keep a head and their length and
 #: SHA-256), bytes of one reply's record (a step, a plan, a candidate) and of one episode's
 #: record; past the episode budget later steps keep only their outcome.
@@ -274,3 +281,11 @@ MAX_TRAJECTORY_BYTES: Final = 64 * 1024 * 1024
 MAX_TRAJECTORY_FRAMES: Final = 50_000
 MAX_TRAJECTORY_POSES: Final = 1_000_000
 MAX_TRAJECTORY_COORD: Final = 1e6
+
+# ---------------------------------------------------------------------------------------------
+# The precompiled-kernel store (chaingeo/core/aot.py, issue #37, item 2)
+# ---------------------------------------------------------------------------------------------
+
+#: Bytes of a store's manifest and of any file it hashes (the extension module, a source).
+MAX_KERNEL_MANIFEST_BYTES: Final = 16 * 1024 * 1024
+MAX_KERNEL_FILE_BYTES: Final = 256 * 1024 * 1024

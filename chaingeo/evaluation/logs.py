@@ -29,9 +29,10 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any, Final
 
-from chaingeo.core import canonical_json
+from chaingeo.core import canonical_json, limits
 from chaingeo.core.errors import ChainGeoError
-from chaingeo.core.files import atomic_write
+from chaingeo.core.files import UnreadableFile, atomic_write, parse_json, read_bounded, read_json
+from chaingeo.evaluation.records import header_problem, record_problem
 from chaingeo.evaluation.sanitize import clean, dumps_line
 
 RUN_FORMAT: Final = "chain-run/1"
@@ -165,12 +166,16 @@ class RunLog:
         return log
 
     def header(self) -> dict[str, Any]:
+        """The header, read with the bounded JSON reader and checked (:func:`header_problem`)."""
         try:
-            data = json.loads((self.path / HEADER).read_text("utf-8"))
-        except (OSError, json.JSONDecodeError) as e:
-            raise RunError(f"{self.path}: no readable {HEADER}: {e}") from None
+            data = read_json(self.path / HEADER, limits.MAX_RUN_HEADER_BYTES)
+        except UnreadableFile as e:
+            raise RunError(f"{self.path}: no readable {HEADER}: {e.reason}") from None
         if not isinstance(data, dict) or data.get("format") != RUN_FORMAT:
             raise RunError(f"{self.path}/{HEADER}: not a {RUN_FORMAT} header")
+        problem = header_problem(data)
+        if problem:
+            raise RunError(f"{self.path}/{HEADER}: {problem}")
         return data
 
     # -- writing ---------------------------------------------------------------------------
@@ -208,7 +213,10 @@ class RunLog:
         if not file.exists():
             file.touch()
             return
-        data = file.read_bytes()
+        try:
+            data = read_bounded(file, limits.MAX_RUN_LOG_BYTES)
+        except UnreadableFile as e:
+            raise RunError(f"{file}: {e.reason}") from None
         keep = data.rfind(b"\n") + 1
         if keep != len(data):
             with open(file, "r+b") as fh:
@@ -236,23 +244,26 @@ class RunLog:
 
 
 def read_records(file: Path) -> list[dict[str, Any]]:
+    """The records of ``episodes.jsonl``, each line through the bounded JSON reader and checked
+    field by field (:func:`record_problem`); RunError naming the line otherwise."""
     try:
-        data = file.read_bytes()
-    except OSError as e:
-        raise RunError(f"{file}: cannot read: {e.strerror or e}") from None
+        data = read_bounded(file, limits.MAX_RUN_LOG_BYTES)
+    except UnreadableFile as e:
+        raise RunError(f"{file}: {e.reason}") from None
     lines = data.split(b"\n")
     out: list[dict[str, Any]] = []
     for i, raw in enumerate(lines):
         if not raw.strip():
             continue
         try:
-            rec = json.loads(raw)
-        except json.JSONDecodeError:
+            rec = parse_json(raw)
+        except UnreadableFile as e:
             if i == len(lines) - 1:  # unfinished last line of a killed run
                 break
-            raise RunError(f"{file}: line {i + 1} is not JSON") from None
-        if not isinstance(rec, dict) or "key" not in rec:
-            raise RunError(f"{file}: line {i + 1} is not an episode record")
+            raise RunError(f"{file}: line {i + 1}: {e.reason}") from None
+        problem = record_problem(rec)
+        if problem:
+            raise RunError(f"{file}: line {i + 1} is not an episode record: {problem}")
         out.append(rec)
     return out
 

@@ -33,6 +33,7 @@ Why it looks the way it does:
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 import shutil
 from collections.abc import Iterable, Mapping, Sequence
@@ -42,6 +43,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Final
 
+from chaingeo.core import limits
+from chaingeo.core.files import UnreadableFile, read_bounded
 from chaingeo.evaluation.logs import IMAGES, RunError, RunLog
 from chaingeo.evaluation.report.tables import Run, Table, tables, write_report
 from chaingeo.evaluation.usage import PriceTable, Usage
@@ -145,9 +148,13 @@ class _Builder:
         name = str(name)
         if name not in self.copied:
             source = run.path / IMAGES / name
-            if not (_IMAGE_NAME.fullmatch(name) and source.is_file()):
+            inside = os.path.realpath(run.path) + os.sep + IMAGES + os.sep + name
+            if not (_IMAGE_NAME.fullmatch(name) and os.path.realpath(source) == inside):
                 return f'<p class="muted">picture missing: {escape(name)}</p>'
-            data = source.read_bytes()
+            try:  # a regular file of the run itself (no link out of it), bounded
+                data = read_bounded(source, limits.MAX_RUN_IMAGE_BYTES)
+            except UnreadableFile:
+                return f'<p class="muted">picture missing: {escape(name)}</p>'
             if hashlib.sha256(data).hexdigest() + ".png" != name:
                 return f'<p class="muted">picture altered: {escape(name)}</p>'
             (self.root / "images").mkdir(exist_ok=True)
