@@ -263,7 +263,11 @@ def _ahead_of_time_first(args: argparse.Namespace) -> bool:
     argv = getattr(args, "command_line", None)
     if args.jit != "auto" or argv is None or jit.ENV in os.environ or RESUME_ENV in os.environ:
         return False
-    return aot.load() is not None  # checked once: setting the mode finds it loaded
+    if aot.load() is not None:  # checked once: setting the mode finds it loaded
+        return True
+    if aot.refused:  # a store is there but fails its checks: one line, then numba
+        print(f"chain analyze: precompiled kernels {aot.refused}; using numba", file=sys.stderr)
+    return False
 
 
 def _aot_forced(args: argparse.Namespace) -> bool:
