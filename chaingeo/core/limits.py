@@ -54,6 +54,13 @@ MAX_XMPUZZLE_XML_BYTES: Final = 32 * 1024 * 1024
 MAX_BT_GRID_CELLS: Final = 1_000_000
 MAX_BT_SHAPES: Final = 4096
 MAX_BT_PROBLEMS: Final = 1024
+#: The XML tree of an ``.xmpuzzle``: nesting and elements, checked as it is built (issue #37,
+#: item 4: a deep stored solution broke the recursion limit; millions of elements cost a
+#: gigabyte), and the grid cells of all shapes together, before any voxel string is read.
+#: BurrTools' examples: depth 19, 1,004 elements, 27 grids of 216 cells.
+MAX_BT_XML_DEPTH: Final = 256
+MAX_BT_XML_ELEMENTS: Final = 250_000
+MAX_BT_TOTAL_GRID_CELLS: Final = 2_000_000
 
 #: The ``optimal_steps`` re-check of ``chain validate``: a search capped at this many states
 #: (the same cap the tests use); larger puzzles are reported as not re-checked.
