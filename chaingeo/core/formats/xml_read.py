@@ -34,16 +34,18 @@ def parse_bounded(data: bytes, max_depth: int, max_elements: int) -> ET.Element:
     problem = doctype_problem(data)
     if problem is not None:
         raise XmlRefused(problem)
-    parser = ET.XMLPullParser(events=("start", "end"))
+    parser: ET.XMLPullParser[ET.Element] = ET.XMLPullParser(events=("start", "end"))
     depth = elements = 0
     root: ET.Element | None = None
     try:
         for at in range(0, max(len(data), 1), CHUNK):
             parser.feed(data[at : at + CHUNK])
-            for event, element in parser.read_events():
+            for event, found in parser.read_events():
                 if event == "end":
                     depth -= 1
                     continue
+                assert isinstance(found, ET.Element)  # "start" events carry the element
+                element = found
                 depth += 1
                 elements += 1
                 root = element if root is None else root
