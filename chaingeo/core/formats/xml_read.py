@@ -40,7 +40,7 @@ def parse_bounded(data: bytes, max_depth: int, max_elements: int) -> ET.Element:
     try:
         for at in range(0, max(len(data), 1), CHUNK):
             parser.feed(data[at : at + CHUNK])
-            for event, found in parser.read_events():
+            for event, found in parser.read_events():  # type: ignore[misc]
                 if event == "end":
                     depth -= 1
                     continue
