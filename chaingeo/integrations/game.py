@@ -193,15 +193,17 @@ class Game:
         return result
 
     def _calls(self, calls: Sequence[Call]) -> list[str]:
-        """The action text of each call (a malformed one reads as unparseable)."""
-        return [translate(name, args, self.tools).action for _, name, args in calls]
+        """The action text of each call (a malformed one, or one that is not an (id, name,
+        arguments) triple, reads as unparseable)."""
+        return [translate(*_name_args(call), self.tools).action for call in calls]
 
     def answer(self, reply: str, calls: Sequence[Call] = ()) -> list[Message] | None:
         """Play ``reply`` (its tool calls, when tools are offered and it made any, else its
         text); the next user turn's messages, or None once the episode is over."""
         if self.over:
             raise RuntimeError("the episode is over")
-        calls = calls if self.tools else ()
+        reply = reply_text(reply)
+        calls = list(calls) if self.tools and isinstance(calls, list | tuple) else []
         if self.protocol == "oneshot":
             plan = self._calls(calls[: limits.MAX_TOOL_CALLS]) if calls else extract_plan(reply)[0]
             for text in plan:
@@ -217,7 +219,7 @@ class Game:
         self._step(action or "")
         return self._next([], note)
 
-    def _play_calls(self, calls: Sequence[Call]) -> list[Message] | None:
+    def _play_calls(self, calls: Sequence[Any]) -> list[Message] | None:
         """Each call in order until one is rejected (or the game ends; at most
         :data:`~chaingeo.core.limits.MAX_TOOL_CALLS`); one ``tool`` message per call, played or
         not (the chat protocol wants every call answered), then the next observation."""
@@ -232,8 +234,8 @@ class Game:
         rejected = None if legal else len(feedback) - 1
         skipped = "Not executed. Nothing changed." if rejected is None else skipped_result(rejected)
         answers = [
-            {"role": "tool", "tool_call_id": cid, "content": (feedback + [skipped] * len(calls))[i]}
-            for i, (cid, _, _) in enumerate(calls)
+            {"role": "tool", "tool_call_id": _call_id(call), "content": text}
+            for call, text in zip(calls, feedback + [skipped] * len(calls), strict=False)
         ]
         return self._next(answers, None)
 
@@ -255,3 +257,29 @@ class Game:
             finished=bool(s.finished),
             truncated=bool(s.is_truncated()) and not s.is_success(),
         )
+
+
+def reply_text(reply: Any) -> str:
+    """A reply's text: a string, or the text parts of OpenAI content parts (a list of
+    ``{"type": "text", "text": ...}``); anything else reads as no text (an unreadable reply)."""
+    if isinstance(reply, str):
+        return reply
+    if isinstance(reply, list):
+        parts = [
+            p["text"]
+            for p in reply
+            if isinstance(p, dict) and p.get("type") == "text" and isinstance(p.get("text"), str)
+        ]
+        return "\n".join(parts)
+    return ""
+
+
+def _name_args(call: Any) -> tuple[Any, Any]:
+    if isinstance(call, list | tuple) and len(call) == 3:
+        return call[1], call[2]
+    return None, None
+
+
+def _call_id(call: Any) -> str:
+    found = call[0] if isinstance(call, list | tuple) and call else ""
+    return found if isinstance(found, str) else ""
