@@ -9,6 +9,8 @@ import os
 import stat
 import uuid
 from collections import Counter
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -108,3 +110,71 @@ def atomic_write(path: str | os.PathLike[str], data: bytes, *, durable: bool = F
     finally:
         tmp.unlink(missing_ok=True)
     return target
+
+
+@contextmanager
+def atomic_path(path: str | os.PathLike[str], *, durable: bool = False) -> Iterator[Path]:
+    """A unique temporary path beside ``path`` (same suffix, for writers that choose a format by
+    it) to write to; renamed into place when the block ends, removed when it raises (a full
+    disk leaves no partial file under the real name). ``durable`` fsyncs it first."""
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    tmp = target.with_name(f".{target.stem}.{os.getpid()}.{uuid.uuid4().hex[:12]}{target.suffix}")
+    try:
+        yield tmp
+        if durable:
+            fd = os.open(tmp, os.O_RDONLY)
+            try:
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+        os.replace(tmp, target)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+class FolderBusy(ChainGeoError, RuntimeError):
+    """Another process is writing the same output folder."""
+
+
+def lock_folder(folder: str | os.PathLike[str]) -> int:
+    """Take the advisory lock of an output folder (``fcntl.flock`` on ``.NAME.lock`` beside it,
+    so the folder itself may be created, replaced or renamed under it) and return its
+    descriptor; :class:`FolderBusy` naming the holder's process when another has it. The lock
+    ends with the descriptor (:func:`unlock_folder`, or the process' end, even by SIGKILL)."""
+    import fcntl
+
+    target = Path(folder).absolute()
+    target.parent.mkdir(parents=True, exist_ok=True)
+    lock = target.with_name(f".{target.name}.lock")
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "?"
+        os.close(fd)
+        raise FolderBusy(
+            f"{target}: another chain process (pid {holder}) is writing it; "
+            "wait for it to finish or choose another folder"
+        ) from None
+    except OSError:
+        os.close(fd)
+        raise
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode("ascii"), 0)
+    return fd
+
+
+def unlock_folder(fd: int) -> None:
+    """Release a lock taken by :func:`lock_folder`."""
+    os.close(fd)
+
+
+@contextmanager
+def folder_locked(folder: str | os.PathLike[str]) -> Iterator[Path]:
+    """``with folder_locked(out):`` holds :func:`lock_folder` for the block."""
+    fd = lock_folder(folder)
+    try:
+        yield Path(folder)
+    finally:
+        unlock_folder(fd)

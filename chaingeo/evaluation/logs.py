@@ -23,7 +23,9 @@ import hashlib
 import json
 import os
 import platform
+import shutil
 import subprocess
+import tempfile
 from collections.abc import Iterable, Mapping
 from importlib import metadata
 from pathlib import Path
@@ -31,7 +33,15 @@ from typing import Any, Final
 
 from chaingeo.core import canonical_json, limits
 from chaingeo.core.errors import ChainGeoError
-from chaingeo.core.files import UnreadableFile, atomic_write, parse_json, read_bounded, read_json
+from chaingeo.core.files import (
+    UnreadableFile,
+    atomic_write,
+    lock_folder,
+    parse_json,
+    read_bounded,
+    read_json,
+    unlock_folder,
+)
 from chaingeo.evaluation.records import header_problem, record_problem
 from chaingeo.evaluation.sanitize import clean, dumps_line
 
@@ -126,6 +136,7 @@ class RunLog:
     def __init__(self, path: str | os.PathLike[str], secrets: Iterable[str] = ()) -> None:
         self.path = Path(path)
         self._secrets = sorted({s for s in secrets if s}, key=len, reverse=True)
+        self._lock: int | None = None
 
     # -- opening ---------------------------------------------------------------------------
 
@@ -137,33 +148,52 @@ class RunLog:
         resume: bool = False,
         secrets: Iterable[str] = (),
     ) -> RunLog:
-        """Start a new run, or with ``resume`` continue one whose header agrees."""
+        """Start a new run, or with ``resume`` continue one whose header agrees. The folder's
+        lock is held until :meth:`close` (a second writer is refused: two resumes at once
+        recorded episodes twice); a new run is made whole in a temporary folder and renamed
+        into place, so a full disk leaves no half run that ``--resume`` would refuse."""
         log = RunLog(path, secrets)
-        head = log.path / HEADER
-        if head.exists():
+        log._lock = lock_folder(log.path)
+        try:
+            log._open(header, resume)
+        except BaseException:
+            log.close()
+            raise
+        return log
+
+    def _open(self, header: Mapping[str, Any], resume: bool) -> None:
+        if (self.path / HEADER).exists():
             if not resume:
-                raise RunError(f"{log.path}: a run is already there; pass --resume to continue it")
-            old = log.header()
+                raise RunError(f"{self.path}: a run is already there; pass --resume to continue it")
+            old = self.header()
             for key in IDENTITY_FIELDS:
                 if old.get(key) != header.get(key):
                     raise RunError(
-                        f"{log.path}: cannot resume: {key} differs from the recorded run "
+                        f"{self.path}: cannot resume: {key} differs from the recorded run "
                         f"({_short(old.get(key))} there, {_short(header.get(key))} now)"
                     )
-            log._drop_partial_tail()
-            return log
-        if log.path.exists() and any(log.path.iterdir()):
-            raise RunError(f"{log.path}: exists and is not a run directory")
-        (log.path / IMAGES).mkdir(parents=True, exist_ok=True)
-        atomic_write(
-            head,
-            log.redact(canonical_json.dumps(clean(dict(header), redact=log.redact))).encode(
-                "utf-8"
-            ),
-            durable=True,
-        )
-        (log.path / EPISODES).touch()
-        return log
+            self._drop_partial_tail()
+            return
+        if self.path.exists() and (not self.path.is_dir() or any(self.path.iterdir())):
+            raise RunError(f"{self.path}: exists and is not a run directory")
+        text = canonical_json.dumps(clean(dict(header), redact=self.redact))
+        fresh = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.", dir=self.path.parent))
+        try:
+            fresh.chmod(0o755)
+            (fresh / IMAGES).mkdir()
+            atomic_write(fresh / HEADER, self.redact(text).encode("utf-8"), durable=True)
+            (fresh / EPISODES).touch()
+            if self.path.exists():
+                self.path.rmdir()  # empty, checked above
+            fresh.rename(self.path)
+        finally:
+            shutil.rmtree(fresh, ignore_errors=True)
+
+    def close(self) -> None:
+        """Release the folder's lock (a writer's; readers never take it)."""
+        if self._lock is not None:
+            unlock_folder(self._lock)
+            self._lock = None
 
     def header(self) -> dict[str, Any]:
         """The header, read with the bounded JSON reader and checked (:func:`header_problem`)."""

@@ -301,4 +301,5 @@ def evaluate(
             bar.add(rec)
     finally:
         bar.close()
+        log.close()
     return [outcome_of(r) for r in log.latest().values()]

@@ -75,6 +75,7 @@ def test_records_append_images_by_hash_and_partial_tail(tmp_path: Path) -> None:
     assert [r["key"] for r in log.records()] == ["a#0", "b#0"]
     assert log.finished_keys() == {"a#0", "b#0"}
     assert log.finished_keys(retry_errors=True) == {"a#0"}
+    log.close()  # one writer at a time: the folder's lock
     again = RunLog.create(log.path, _header(), resume=True)
     again.append(_rec("c#0"))
     lines = (log.path / EPISODES).read_text().splitlines()
@@ -85,7 +86,7 @@ def test_records_append_images_by_hash_and_partial_tail(tmp_path: Path) -> None:
 
 
 def test_resume_refuses_a_different_run_and_new_refuses_existing(tmp_path: Path) -> None:
-    RunLog.create(tmp_path / "run", _header())
+    RunLog.create(tmp_path / "run", _header()).close()
     with pytest.raises(RunError, match="--resume"):
         RunLog.create(tmp_path / "run", _header())
     with pytest.raises(RunError, match="level_set_hash differs"):

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from chaingeo.core.files import atomic_path, atomic_write
 from chaingeo.evaluation.logs import HEADER, RunError, RunLog
 from chaingeo.evaluation.metrics import DIFFICULTIES, FAMILIES, Outcome, Summary, summarize
 from chaingeo.evaluation.runner import outcome_of
@@ -279,7 +280,8 @@ def cost_plot(runs: Sequence[Run], path: str | Path) -> Path:
     fig.tight_layout()
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, format="png", metadata={"Software": None})
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, format="png", metadata={"Software": None})
     plt.close(fig)
     return out
 
@@ -302,7 +304,6 @@ def write_report(runs: Sequence[Run], out_dir: str | Path) -> list[Path]:
     for name, table in tables(runs):
         for suffix, text in ((".md", table.markdown()), (".csv", table.csv())):
             f = out / f"{name}{suffix}"
-            f.write_text(text, encoding="utf-8")
-            written.append(f)
+            written.append(atomic_write(f, text.encode("utf-8")))
     written.append(cost_plot(runs, out / "cost_success.png"))
     return written
