@@ -271,11 +271,13 @@ MAX_DATASET_SHARD_BYTES: Final = 256 * 1024 * 1024
 #: Bytes of one video file (stat before opening; CHAIN's clips are at most 4 MB).
 MAX_VIDEO_BYTES: Final = 512 * 1024 * 1024
 #: Pixels of one frame (4K UHD), frames of one video (10 minutes at 30 fps) and pixels of all
-#: frames together, checked from the container's header before decoding and again while
-#: decoding (a header can lie). CHAIN's clips: 2.1 Mpx frames, 150 frames, 3.1e8 pixels.
+#: frames together, checked from the container's header before decoding and on every decoded
+#: frame as it arrives (a header can lie, and a raw H.264 stream or a streamed MKV has no
+#: frame count: issue #37, item 5). CHAIN's clips: 2.1 Mpx frames, 150 frames, 3.1e8 pixels;
+#: the total is five times that (decoding it takes seconds, not half a minute).
 MAX_VIDEO_FRAME_PIXELS: Final = 3840 * 2160
 MAX_VIDEO_FRAMES: Final = 18_000
-MAX_VIDEO_TOTAL_PIXELS: Final = 4_000_000_000
+MAX_VIDEO_TOTAL_PIXELS: Final = 1_600_000_000
 
 # ---------------------------------------------------------------------------------------------
 # chain check-trajectory: pose trajectory files (issue #22)
