@@ -123,3 +123,27 @@ def test_an_image_linked_from_outside_the_run_is_not_copied(
     assert not (site / "images" / name).exists()
     pages = "".join(p.read_text() for p in site.rglob("*.html"))
     assert f"picture missing: {name}" in pages
+
+
+@pytest.mark.parametrize("kind", ["/dev/zero", "fifo", "nested", "digits"])
+def test_every_other_json_file_goes_through_the_bounded_reader(
+    tmp_path: Path, kind: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Price tables, replay plans and ``chain cover --pieces`` files: one typed error each."""
+    from chaingeo.core.errors import ChainGeoError
+    from chaingeo.evaluation.agents.replay import ReplayAgent
+    from chaingeo.evaluation.usage import PriceTable
+
+    path = tmp_path / "f.json"
+    if kind == "/dev/zero":
+        path.symlink_to("/dev/zero")
+    elif kind == "fifo":
+        os.mkfifo(path)
+    else:
+        path.write_text("[" * 100_000 if kind == "nested" else "[" + "9" * 5000 + "]")
+    with pytest.raises(ChainGeoError):
+        PriceTable.load(path)
+    with pytest.raises(ValueError, match="cannot read replay file"):
+        ReplayAgent({"file": str(path)})
+    assert main(["cover", "--pieces", str(path), "--box", "2x2x2"]) == 2
+    assert "--pieces" in capsys.readouterr().err
