@@ -59,7 +59,7 @@ MAX_BT_PROBLEMS: Final = 1024
 #: gigabyte), and the grid cells of all shapes together, before any voxel string is read.
 #: BurrTools' examples: depth 19, 1,004 elements, 27 grids of 216 cells.
 MAX_BT_XML_DEPTH: Final = 256
-MAX_BT_XML_ELEMENTS: Final = 250_000
+MAX_BT_XML_ELEMENTS: Final = 100_000
 MAX_BT_TOTAL_GRID_CELLS: Final = 2_000_000
 
 #: The ``optimal_steps`` re-check of ``chain validate``: a search capped at this many states
