@@ -277,4 +277,5 @@ def evaluate(
             bar.add(rec)
     finally:
         bar.close()
+        log.close()
     return [Outcome.from_record(r) for r in log.latest().values()]

@@ -25,7 +25,13 @@ from chaingeo.evaluation.agents.base import ToolCall
 from chaingeo.evaluation.agents.dialects import DIALECTS, read_reply, tool_call
 from chaingeo.evaluation.agents.prompt import user_content
 from chaingeo.evaluation.agents.tools import skipped_result, tool_specs
-from chaingeo.evaluation.episode import PROTOCOLS, Episode, Outcome, ProtocolConfig
+from chaingeo.evaluation.episode import (
+    PROTOCOLS,
+    Episode,
+    EpisodeOverError,
+    Outcome,
+    ProtocolConfig,
+)
 
 Protocol = Literal["interactive", "oneshot"]
 Message = dict[str, Any]
@@ -139,8 +145,12 @@ class Game:
     def answer(self, reply: str, calls: Sequence[Call] = ()) -> list[Message] | None:
         """Play ``reply`` (its tool calls, when tools are offered and it made any, else its
         text); the next user turn's messages, or None once the episode is over."""
-        made = tuple(tool_call(cid, name, args, self.tools) for cid, name, args in calls)
         ep = self.episode
+        if ep.done:
+            raise EpisodeOverError(f"{self.level.id}: the episode is over")
+        reply = reply_text(reply)
+        given = list(calls) if isinstance(calls, list | tuple) else []
+        made = tuple(tool_call(_call_id(c), *_name_args(c), self.tools) for c in given)
         results = ep.play(
             read_reply(self.dialect, reply, made if self.tools else (), oneshot=ep.oneshot)
         )
@@ -166,3 +176,31 @@ def _tool_messages(
         {"role": "tool", "tool_call_id": c.id, "content": (feedback + [skipped] * len(calls))[i]}
         for i, c in enumerate(calls)
     ]
+
+
+def reply_text(reply: Any) -> str:
+    """A reply's text: a string, or the text parts of OpenAI content parts (a list of
+    ``{"type": "text", "text": ...}``); anything else reads as no text (an unreadable reply)."""
+    if isinstance(reply, str):
+        return reply
+    if isinstance(reply, list):
+        parts = [
+            p["text"]
+            for p in reply
+            if isinstance(p, dict) and p.get("type") == "text" and isinstance(p.get("text"), str)
+        ]
+        return "\n".join(parts)
+    return ""
+
+
+def _name_args(call: Any) -> tuple[Any, Any]:
+    """A call's function name and arguments; a call that is not an (id, name, arguments)
+    triple reads as one with neither (translated as malformed: an unparseable step)."""
+    if isinstance(call, list | tuple) and len(call) == 3:
+        return call[1], call[2]
+    return None, None
+
+
+def _call_id(call: Any) -> str:
+    found = call[0] if isinstance(call, list | tuple) and call else ""
+    return found if isinstance(found, str) else ""

@@ -79,7 +79,9 @@ def build(found: list[Export], folder: Path | None = None) -> aot.Manifest:
             export(_wrapper(e.dispatcher, len(e.signature.args), name))
             table.setdefault(e.kernel, {})[e.key] = name
         cc.compile()
-        manifest = aot.Manifest(table, np.__version__, numba.__version__, _sources())
+        module = aot.module_path(work)
+        stamp = (module.stat().st_size, aot.file_digest(module))
+        manifest = aot.Manifest(table, np.__version__, numba.__version__, _sources(), stamp)
         (work / aot.MANIFEST).write_text(manifest.to_json(), encoding="utf-8")
         _replace(work, target)
     finally:

@@ -21,6 +21,7 @@ as numba's do (numpy's overflow warnings are silenced in interpreted mode).
 from __future__ import annotations
 
 import os
+import sys
 from collections.abc import Callable
 from typing import Any, Final, Generic, Literal, ParamSpec, TypeVar, overload
 
@@ -43,7 +44,11 @@ def mode() -> Mode:
         raw = os.environ.get(ENV, "numba").strip().lower() or "numba"
         if raw not in MODES:
             raise ValueError(f"{ENV}: expected one of {', '.join(MODES)}, got {raw!r}")
-        _fix(raw)
+        try:
+            _fix(raw)
+        except RuntimeError as e:  # an unusable store: one line, then numba's kernels
+            print(f"chaingeo: {ENV}=aot: {e}; using numba", file=sys.stderr)
+            _fix("numba")
     assert _mode is not None
     return _mode
 

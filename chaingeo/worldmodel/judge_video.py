@@ -12,12 +12,14 @@ as a verdict.
 
 from __future__ import annotations
 
+import itertools
 import os
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Final
 
 import numpy as np
+import numpy.typing as npt
 from PIL import Image
 
 from chaingeo.core import limits
@@ -94,15 +96,48 @@ def _check_header(frames: float, w: int, h: int) -> None:
         )
 
 
+class _Budget:
+    """The limits checked on each decoded frame as it arrives (a header can lie or say
+    nothing: a raw H.264 stream or a streamed MKV has no frame count): its pixels, the frames
+    so far and the pixels of all of them together."""
+
+    def __init__(self) -> None:
+        self.frames = 0
+        self.pixels = 0
+
+    def take(self, frame: npt.NDArray[Any]) -> npt.NDArray[Any]:
+        if frame.ndim != 3 or frame.shape[2] < 3:
+            raise VideoJudgeError(f"a frame of shape {frame.shape}")
+        pixels = frame.shape[0] * frame.shape[1]
+        self.frames += 1
+        self.pixels += pixels
+        if pixels > limits.MAX_VIDEO_FRAME_PIXELS:
+            raise VideoJudgeError(
+                f"a frame of {frame.shape[1]}x{frame.shape[0]} pixels; "
+                f"at most {limits.MAX_VIDEO_FRAME_PIXELS} are read"
+            )
+        if self.frames > limits.MAX_VIDEO_FRAMES:
+            raise VideoJudgeError(f"more than {limits.MAX_VIDEO_FRAMES} frames")
+        if self.pixels > limits.MAX_VIDEO_TOTAL_PIXELS:
+            raise VideoJudgeError(
+                f"more than {limits.MAX_VIDEO_TOTAL_PIXELS} pixels in {self.frames} frames"
+            )
+        return frame
+
+
 def _read_gif(path: Path) -> Clip:
     with Image.open(path) as im:
         w, h = im.size
-        n = int(getattr(im, "n_frames", 1))
-        _check_header(n, w, h)
+        _check_header(0, w, h)
+        budget = _Budget()
         out = []
-        for i in range(n):
-            im.seek(i)
-            out.append(shrink(np.asarray(im.convert("RGB"), dtype=np.uint8)))
+        for i in itertools.count():
+            try:
+                im.seek(i)
+            except EOFError:
+                break
+            frame = budget.take(np.asarray(im.convert("RGB"), dtype=np.uint8))
+            out.append(shrink(frame))
         ms = float(im.info.get("duration", 100) or 100)
     return Clip(tuple(out), 1000.0 / ms, (w, h))
 
@@ -118,12 +153,9 @@ def _read_ffmpeg(path: Path) -> Clip:
         duration = float(meta.get("duration") or 0.0)
         _check_header(duration * max(fps, 1.0), w, h)
         out: list[U8] = []
+        budget = _Budget()
         for frame in reader:  # type: ignore[attr-defined]
-            if len(out) >= limits.MAX_VIDEO_FRAMES:
-                raise VideoJudgeError(f"more than {limits.MAX_VIDEO_FRAMES} frames")
-            arr = np.asarray(frame, dtype=np.uint8)
-            if arr.ndim != 3 or arr.shape[1] * arr.shape[0] > limits.MAX_VIDEO_FRAME_PIXELS:
-                raise VideoJudgeError(f"a frame of shape {arr.shape}")
+            arr = budget.take(np.asarray(frame, dtype=np.uint8))
             out.append(shrink(np.ascontiguousarray(arr[..., :3])))
     finally:
         reader.close()

@@ -15,6 +15,7 @@ import json
 from pathlib import Path
 from typing import Final
 
+from chaingeo.core.files import atomic_write
 from chaingeo.core.level import Level
 from chaingeo.pictures.raster import png_bytes
 from chaingeo.worldmodel.video import PlanVideo, VideoError, plan_video, write_video
@@ -99,8 +100,8 @@ def write_worldmodel(level: Level, out: Path, fmt: str = "mp4", size: int = 384)
         "prompt": out / "prompt.txt",
         "ground_truth": out / f"ground_truth.{fmt}",
     }
-    files["reference"].write_bytes(png_bytes(video.frames[0]))
-    files["prompt"].write_bytes(worldmodel_prompt(level).encode("utf-8"))
+    atomic_write(files["reference"], png_bytes(video.frames[0]))
+    atomic_write(files["prompt"], worldmodel_prompt(level).encode("utf-8"))
     write_video(video, files["ground_truth"])
     manifest = {
         "level": level.id,
@@ -113,5 +114,5 @@ def write_worldmodel(level: Level, out: Path, fmt: str = "mp4", size: int = 384)
     }
     files["manifest"] = out / "manifest.json"
     text = json.dumps(manifest, indent=2, sort_keys=True) + "\n"
-    files["manifest"].write_bytes(text.encode("utf-8"))
+    atomic_write(files["manifest"], text.encode("utf-8"))
     return files

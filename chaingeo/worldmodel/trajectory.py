@@ -32,11 +32,10 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.errors import ChainGeoError
-from chaingeo.core.files import atomic_write
+from chaingeo.core.files import UnreadableFile, atomic_write, parse_json
 from chaingeo.core.geometry import ROTATIONS, Cell, Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, disassembly_of_assembly_plan
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
-from chaingeo.core.limits import LimitError, loads_bounded
 from chaingeo.core.turns import AXES, TurnMove
 from chaingeo.worldmodel.video import (
     OUT_FRAMES,
@@ -119,28 +118,16 @@ def _pose(raw: Any, where: str, limits: Any) -> Pose:
     return Pose(np.array(rows, dtype=np.float64), np.array(t, dtype=np.float64))
 
 
-def _pairs(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    """JSON objects, a key written twice kept under ``"\\0dup"`` (a trajectory names a piece
-    once a frame; a duplicate is a verdict, not a parse error)."""
-    out: dict[str, Any] = {}
-    for k, v in pairs:
-        if k in out:
-            out.setdefault("\0dup", []).append(k)
-        out[k] = v
-    return out
-
-
-def parse_trajectory(text: str) -> Trajectory:
-    """A ``chain-trajectory/1`` document (already read, bounded); TrajectoryError otherwise."""
+def parse_trajectory(text: str | bytes) -> Trajectory:
+    """A ``chain-trajectory/1`` document (already read, bounded); TrajectoryError otherwise. A
+    piece named twice in one frame is a verdict, not a parse error: the reader keeps the keys
+    written twice beside each object (:class:`chaingeo.core.files.JsonObject`), never in it."""
     from chaingeo.core import limits
 
     try:
-        loads_bounded(text)  # depth, digits and finiteness first
-    except LimitError as e:
-        raise TrajectoryError(str(e)) from None
-    except ValueError as e:
-        raise TrajectoryError(f"not JSON: {e}") from None
-    data = json.loads(text, object_pairs_hook=_pairs)
+        data = parse_json(text)
+    except UnreadableFile as e:
+        raise TrajectoryError(e.reason) from None
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise TrajectoryError(f'expected an object with "format": "{FORMAT}"')
     frames = data.get("frames")
@@ -158,7 +145,7 @@ def parse_trajectory(text: str) -> Trajectory:
         poses = fr.get("poses") if isinstance(fr, dict) else None
         if not isinstance(poses, dict):
             raise TrajectoryError(f"frames[{i}].poses: expected an object keyed by piece name")
-        dups += [(i, str(k)) for k in sorted(set(poses.pop("\0dup", [])))]
+        dups += [(i, k) for k in getattr(poses, "repeated", ())]
         total += len(poses)
         if len(poses) > limits.MAX_PIECES or total > limits.MAX_TRAJECTORY_POSES:
             raise TrajectoryError(

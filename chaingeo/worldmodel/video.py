@@ -539,10 +539,38 @@ def write_mp4(video: PlanVideo, path: Path) -> Path:
 
 
 def write_video(video: PlanVideo, path: Path) -> Path:
-    """``.gif`` or ``.mp4``, by the file's suffix."""
+    """``.gif`` or ``.mp4``, by the file's suffix, written to a temporary name, checked whole
+    (:func:`written_whole`) and renamed into place: a full disk leaves no file, never an
+    unreadable one reported as written."""
+    from chaingeo.core.files import atomic_path
+
     suffix = path.suffix.lower()
-    if suffix == ".gif":
-        return write_gif(video, path)
-    if suffix == ".mp4":
-        return write_mp4(video, path)
-    raise VideoError(f"unknown video format {path.suffix!r}: use .mp4 or .gif")
+    if suffix not in (".gif", ".mp4"):
+        raise VideoError(f"unknown video format {path.suffix!r}: use .mp4 or .gif")
+    with atomic_path(path, durable=True) as tmp:
+        try:
+            (write_gif if suffix == ".gif" else write_mp4)(video, tmp)
+        except OSError as e:  # ffmpeg's broken pipe on a full disk hides the real cause
+            raise VideoError(f"{path}: could not be written ({e.strerror or e})") from None
+        if not written_whole(tmp):
+            raise VideoError(f"{path}: the video could not be written whole (is the disk full?)")
+    return path
+
+
+def written_whole(path: Path) -> bool:
+    """Whether a GIF ends with its trailer, or an MP4's top-level boxes span the file exactly
+    and hold the movie header (``moov``) and the data (``mdat``): what a writer stopped by a
+    full disk does not leave."""
+    data = path.read_bytes()
+    if path.suffix.lower() == ".gif":
+        return data[:6] in (b"GIF87a", b"GIF89a") and data.endswith(b";")
+    at, kinds = 0, set()
+    while at + 8 <= len(data):
+        size, kind = int.from_bytes(data[at : at + 4], "big"), data[at + 4 : at + 8]
+        if size == 1 and at + 16 <= len(data):
+            size = int.from_bytes(data[at + 8 : at + 16], "big")
+        if size < 8:
+            return False
+        kinds.add(kind)
+        at += size
+    return at == len(data) and {b"moov", b"mdat"} <= kinds

@@ -50,7 +50,9 @@ def test_a_kernel_calls_the_export_of_its_argument_types_and_misses_others() -> 
 def _manifest(source: Path) -> aot.Manifest:
     st = source.stat()
     stamp = (st.st_size, st.st_mtime_ns, aot.file_digest(str(source)))
-    return aot.Manifest({"m:k": {"<i8": "k0"}}, np.__version__, "0", {str(source): stamp})
+    kernel = f"{source.parent.name}.{source.stem}:k"  # its module is among the sources
+    module = (5, "ab" * 32)
+    return aot.Manifest({kernel: {"<i8": "k0"}}, np.__version__, "0", {str(source): stamp}, module)
 
 
 def test_a_build_is_stale_once_a_source_or_numpy_differs(tmp_path: Path) -> None:

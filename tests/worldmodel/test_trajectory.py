@@ -37,7 +37,8 @@ from chaingeo.worldmodel.video import read_plan
 from tests.support.paths import LEVELS
 
 TURNS = load_level(LEVELS / "puzzle" / "puzzle-easy-01-luban-3-piece.json")  # has a turn
-BURR = load_level(LEVELS / "puzzle" / "puzzle-easy-04-burr6.json")  # slides only
+BURR_PATH = LEVELS / "puzzle" / "puzzle-easy-04-burr6.json"
+BURR = load_level(BURR_PATH)  # slides only
 SMALL = sorted(
     (p for p in (LEVELS / "puzzle").glob("puzzle-easy-*.json")), key=lambda p: p.name
 ) + sorted((LEVELS / "stacking").glob("stacking-2x2x*.json"))
@@ -375,3 +376,46 @@ def test_commands(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     again = tmp_path / "again.json"
     write_trajectory(load_level(level), None, again)  # the same plan gives the same bytes
     assert again.read_bytes() == traj.read_bytes()
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue #37, item 1: no in-band sentinel. The parser kept a piece named twice in a frame under
+# the key "\0dup", which a file can write too: an int there crashed, a string or list invented
+# "listed twice" violations.
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", [7, "red", ["red", "blue"], {"cells": [[0, 0, 0]]}, None])
+def test_the_parsers_old_sentinel_key_is_an_ordinary_piece_name(value: Any) -> None:
+    doc = _doc(BURR)
+    doc["frames"][0]["poses"]["\u0000dup"] = value
+    try:
+        verdict = _check(BURR, doc)
+    except TrajectoryError:
+        return  # a malformed pose: a typed refusal
+    assert not verdict.valid
+    assert not any("twice" in v["reason"] for v in verdict.violations), verdict.violations[:3]
+
+
+def test_a_piece_named_twice_in_a_frame_is_still_reported() -> None:
+    text = json.dumps(_doc(BURR))
+    name = sorted(p.name for p in BURR.pieces)[0]
+    head, sep, tail = text.partition(f'"{name}": ')
+    pose = tail[: tail.index("}") + 1]
+    doubled = head + f'"{name}": {pose}, ' + sep + tail
+    verdict = _check(BURR, doubled)
+    assert any(v["frame"] == 0 and v["piece"] == name for v in verdict.violations)
+
+
+@pytest.mark.parametrize("special", ["/dev/zero", "fifo"])
+def test_check_trajectory_refuses_a_non_regular_file(
+    tmp_path: Path, special: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import os
+
+    path = Path(special)
+    if special == "fifo":
+        path = tmp_path / "t.json"
+        os.mkfifo(path)
+    assert main(["check-trajectory", str(BURR_PATH), str(path)]) == 2
+    assert "not a regular file" in capsys.readouterr().err

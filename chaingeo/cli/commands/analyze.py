@@ -40,6 +40,7 @@ import signal
 import sys
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 from types import FrameType
@@ -146,13 +147,19 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_all(args: argparse.Namespace, done: int = 0, status: int = 0) -> int:
     """Analyse the files after the first ``done`` (printed by an earlier start of the command
-    whose exit status so far was ``status``), one JSON line each."""
+    whose exit status so far was ``status``), one JSON line each, all within the command's one
+    ``--seconds``: a file (or problem) the deadline does not reach is reported as not reached."""
+    end = time.monotonic() + args.seconds
     for i, spec in enumerate(args.files):
         if i < done:
             continue
         _printed[:] = [i, status]
+        if end - time.monotonic() <= 0:
+            print(replace(_not_reached(args), file=str(spec)).to_json(LIMIT_FLAGS), flush=True)
+            status = max(status, 1)
+            continue
         try:
-            figures = analyze_file(spec, args)
+            figures = analyze_file(spec, args, end)
             status = max(status, _cut_short(spec, figures))
             line = figures.to_json(LIMIT_FLAGS)
         except CommandError as e:
@@ -167,7 +174,13 @@ def _run_all(args: argparse.Namespace, done: int = 0, status: int = 0) -> int:
 def _cut_short(spec: str, figures: PuzzleFigures) -> int:
     """Say on stderr which cap cut counting short, naming its flag, and return the exit
     status: 1 when some count is a lower bound, else 0."""
+    missed = [r for r in figures.cut_short() if (r.limit or "").startswith("not reached")]
+    if missed:
+        limit = with_flag(missed[0].limit or "", missed[0].limit_cap)
+        print(f"chain analyze: {spec}: {len(missed)} not analysed ({limit})", file=sys.stderr)
     for row in figures.cut_short():
+        if row in missed:
+            continue
         limit = with_flag(row.limit or "", row.limit_cap)
         print(
             f"chain analyze: {spec}: counting stopped ({limit}); the counts are lower "
@@ -177,33 +190,37 @@ def _cut_short(spec: str, figures: PuzzleFigures) -> int:
     return 1 if figures.cut_short() else 0
 
 
-def analyze_file(spec: str, args: argparse.Namespace) -> PuzzleFigures:
-    """The figures of one file (``CommandError`` for any failure, with the reason)."""
-    from dataclasses import replace
+def _not_reached(args: argparse.Namespace, **known: Any) -> PuzzleFigures:
+    """The figures of a file or problem the command's deadline did not reach."""
+    from chaingeo.solvers.figures import PuzzleFigures
 
+    reason = f"not reached: the command's time limit ({args.seconds:g} s) was spent"
+    return PuzzleFigures(counts_complete=False, limit=reason, limit_cap="seconds", **known)
+
+
+def analyze_file(spec: str, args: argparse.Namespace, end: float | None = None) -> PuzzleFigures:
+    """The figures of one file within the command's deadline ``end`` (``time.monotonic``;
+    default ``--seconds`` from now); ``CommandError`` for any failure, with the reason. The
+    problems of a BurrTools file are analysed one by one, each with the time left."""
     from chaingeo.core.errors import ChainGeoError
+    from chaingeo.core.formats.burrtools import BTPuzzle
     from chaingeo.core.kinematics import SearchLimitError
-    from chaingeo.solvers.analysis import analyze
-    from chaingeo.solvers.deadline import Deadline
-    from chaingeo.solvers.limits import SearchLimits
+    from chaingeo.kernels.jit import mode
+    from chaingeo.solvers.figures import PuzzleFigures
 
-    limits = SearchLimits(
-        max_states=args.max_states, seconds=args.seconds, optimal_seconds=args.optimal_seconds
-    )
-    deadline = Deadline(limits.seconds)
+    end = time.monotonic() + args.seconds if end is None else end
     start = time.perf_counter()
     try:
-        with ProgressLines(f"chain analyze: {spec}", deadline.progress):
-            source = read_puzzle(spec) if Path(spec).suffix == ".xmpuzzle" else find_level(spec)
-            figures = analyze(
-                source,
-                limits=limits,
-                problem=args.problem,
-                optimal=not args.no_optimal,
-                assemble=not args.no_assemble,
-                mirrors=args.mirrors,
-                deadline=deadline,
-            )
+        source = read_puzzle(spec) if Path(spec).suffix == ".xmpuzzle" else find_level(spec)
+        if isinstance(source, BTPuzzle) and args.problem is None and len(source.problems) > 1:
+            rows = [
+                _within(source, k, args, end, spec) or _not_reached(args, problem=k, name=p.name)
+                for k, p in enumerate(source.problems)
+            ]
+            rows = [replace(r, file=None, kernels=None, seconds=None) for r in rows]
+            figures = PuzzleFigures(problems=tuple(rows), several=True, kernels=mode())
+        else:
+            figures = _within(source, args.problem, args, end, spec) or _not_reached(args)
     except SearchLimitError as e:
         raise CommandError(limit_message(e)) from None
     except (ChainGeoError, FileNotFoundError) as e:
@@ -211,6 +228,34 @@ def analyze_file(spec: str, args: argparse.Namespace) -> PuzzleFigures:
     except (IndexError, RuntimeError, ValueError) as e:
         raise CommandError(str(e)) from None
     return replace(figures, file=str(spec), seconds=round(time.perf_counter() - start, 3))
+
+
+def _within(
+    source: Any, problem: int | None, args: argparse.Namespace, end: float, spec: str
+) -> PuzzleFigures | None:
+    """``analyze`` of ``source`` (one problem) with the time left before ``end``; None when
+    none is left."""
+    from chaingeo.solvers.analysis import analyze
+    from chaingeo.solvers.deadline import Deadline
+    from chaingeo.solvers.limits import SearchLimits
+
+    left = end - time.monotonic()
+    if left <= 0:
+        return None
+    limits = SearchLimits(
+        max_states=args.max_states, seconds=left, optimal_seconds=args.optimal_seconds
+    )
+    deadline = Deadline(limits.seconds, stated=args.seconds)
+    with ProgressLines(f"chain analyze: {spec}", deadline.progress):
+        return analyze(
+            source,
+            limits=limits,
+            problem=problem,
+            optimal=not args.no_optimal,
+            assemble=not args.no_assemble,
+            mirrors=args.mirrors,
+            deadline=deadline,
+        )
 
 
 @lru_cache(maxsize=1)
@@ -263,7 +308,11 @@ def _ahead_of_time_first(args: argparse.Namespace) -> bool:
     argv = getattr(args, "command_line", None)
     if args.jit != "auto" or argv is None or jit.ENV in os.environ or RESUME_ENV in os.environ:
         return False
-    return aot.load() is not None  # checked once: setting the mode finds it loaded
+    if aot.load() is not None:  # checked once: setting the mode finds it loaded
+        return True
+    if aot.refused:  # a store is there but fails its checks: one line, then numba
+        print(f"chain analyze: precompiled kernels {aot.refused}; using numba", file=sys.stderr)
+    return False
 
 
 def _aot_forced(args: argparse.Namespace) -> bool:

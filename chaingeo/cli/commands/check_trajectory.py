@@ -47,11 +47,9 @@ def run(args: argparse.Namespace) -> int:
     level = find_level(args.level)
     try:
         raw = read_bounded(args.trajectory, MAX_TRAJECTORY_BYTES)
-        traj = parse_trajectory(raw.decode("utf-8"))
+        traj = parse_trajectory(raw)
     except UnreadableFile as e:
         raise CommandError(f"{args.trajectory}: {e.reason}") from None
-    except UnicodeDecodeError:
-        raise CommandError(f"{args.trajectory}: not UTF-8 text") from None
     except TrajectoryError as e:
         raise CommandError(f"{args.trajectory}: {e}") from None
     verdict = check_trajectory(level, traj, args.max_jump)

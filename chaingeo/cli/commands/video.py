@@ -56,10 +56,7 @@ def run(args: argparse.Namespace) -> int:
         video = plan_video(level, text, args.size)
         if args.trajectory_out is not None:
             write_trajectory(level, text, args.trajectory_out)
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = args.out.with_name(f".{args.out.stem}.tmp{args.out.suffix}")
-        write_video(video, tmp)
-        tmp.replace(args.out)
+        write_video(video, args.out)
     except VideoError as e:
         raise CommandError(str(e)) from None
     seconds = time.perf_counter() - start

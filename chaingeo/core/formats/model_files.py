@@ -38,7 +38,7 @@ from chaingeo.core.formats.mesh_lattice import (
     PartMesh,
     rpy_matrix,
 )
-from chaingeo.core.formats.xml_guard import doctype_problem
+from chaingeo.core.formats.xml_read import XmlRefused, parse_bounded
 from chaingeo.core.level_reader import short
 
 _VERTEX_RE: Final = re.compile(r"^[ \t]*v[ \t]([^\n]*)", re.MULTILINE)
@@ -199,13 +199,10 @@ def load_urdf_part(urdf: Path, model_dir: Path) -> PartMesh:
     at = _Where(str(model_dir), urdf_field)
     path = _inside(root_dir, urdf, "the URDF", at)
     data = _read_bounded(path, limits.MAX_URDF_BYTES, "the URDF", at)
-    problem = doctype_problem(data)
-    if problem is not None:
-        raise at.fail(problem)
-    try:
-        root = ET.fromstring(data)
-    except ET.ParseError as e:
-        raise at.fail(f"not readable XML: {e}") from None
+    try:  # the one bounded XML reader: no DOCTYPE, depth and elements bounded as it is built
+        root = parse_bounded(data, limits.MAX_BT_XML_DEPTH, limits.MAX_BT_XML_ELEMENTS)
+    except XmlRefused as e:
+        raise at.fail(e.reason) from None
     named = _materials(root, at)
     visuals = list(root.iter("visual"))
     if len(visuals) > limits.MAX_PART_MESHES:

@@ -33,8 +33,10 @@ Why it looks the way it does:
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 import shutil
+import tempfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from html import escape
@@ -42,6 +44,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Final
 
+from chaingeo.core import limits
+from chaingeo.core.files import UnreadableFile, atomic_write, folder_locked, read_bounded
 from chaingeo.evaluation.logs import IMAGES, RunError, RunLog
 from chaingeo.evaluation.report.tables import Run, Table, sort_value, tables, write_report
 from chaingeo.evaluation.usage import PriceTable, Usage
@@ -81,18 +85,17 @@ def write_site(runs: Sequence[Run], out_dir: str | Path, prices: PriceTable | No
         raise RunError(f"{out}: not a folder")
     if out.exists() and not (out / MARKER).exists() and any(out.iterdir()):
         raise RunError(f"{out}: exists and was not written by `chain report --html`; pick another")
-    build = out.parent / f".{out.name}.building"
-    if build.exists():
-        shutil.rmtree(build)
-    build.mkdir(parents=True)
-    try:
-        _Builder(runs, build, prices or PriceTable.load()).build()
-        if out.exists():
-            shutil.rmtree(out)
-        build.rename(out)
-    finally:
-        if build.exists():
-            shutil.rmtree(build)
+    with folder_locked(out):  # a second writer is refused, not raced
+        build = Path(tempfile.mkdtemp(prefix=f".{out.name}.building.", dir=out.parent))
+        try:
+            build.chmod(0o755)
+            _Builder(runs, build, prices or PriceTable.load()).build()
+            if out.exists():
+                shutil.rmtree(out)
+            build.rename(out)
+        finally:
+            if build.exists():
+                shutil.rmtree(build)
     return out
 
 
@@ -125,7 +128,7 @@ class _Builder:
     def write(self, rel: str, text: str) -> None:
         path = self.root / rel
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(text.encode("utf-8"))
+        atomic_write(path, text.encode("utf-8"))
 
     def build(self) -> None:
         (self.root / MARKER).write_bytes(b"written by chain report --html\n")
@@ -145,13 +148,17 @@ class _Builder:
         name = str(name)
         if name not in self.copied:
             source = run.path / IMAGES / name
-            if not (_IMAGE_NAME.fullmatch(name) and source.is_file()):
+            inside = os.path.realpath(run.path) + os.sep + IMAGES + os.sep + name
+            if not (_IMAGE_NAME.fullmatch(name) and os.path.realpath(source) == inside):
                 return f'<p class="muted">picture missing: {escape(name)}</p>'
-            data = source.read_bytes()
+            try:  # a regular file of the run itself (no link out of it), bounded
+                data = read_bounded(source, limits.MAX_RUN_IMAGE_BYTES)
+            except UnreadableFile:
+                return f'<p class="muted">picture missing: {escape(name)}</p>'
             if hashlib.sha256(data).hexdigest() + ".png" != name:
                 return f'<p class="muted">picture altered: {escape(name)}</p>'
             (self.root / "images").mkdir(exist_ok=True)
-            (self.root / "images" / name).write_bytes(data)
+            atomic_write(self.root / "images" / name, data)
             self.copied.add(name)
         return f'<img src="{up}images/{name}" alt="{escape(alt)}" loading="lazy">'
 

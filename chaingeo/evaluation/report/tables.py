@@ -26,6 +26,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any, Final
 
+from chaingeo.core.files import atomic_path, atomic_write
 from chaingeo.evaluation import stats
 from chaingeo.evaluation.episode import Outcome
 from chaingeo.evaluation.logs import HEADER, RunError, RunLog
@@ -301,7 +302,8 @@ def cost_plot(runs: Sequence[Run], path: str | Path) -> Path:
     fig.tight_layout()
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, format="png", metadata={"Software": None})
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, format="png", metadata={"Software": None})
     plt.close(fig)
     return out
 
@@ -375,7 +377,6 @@ def write_report(runs: Sequence[Run], out_dir: str | Path) -> list[Path]:
     for name, table in tables(runs):
         for suffix, text in ((".md", table.markdown()), (".csv", table.csv())):
             f = out / f"{name}{suffix}"
-            f.write_text(text, encoding="utf-8")
-            written.append(f)
+            written.append(atomic_write(f, text.encode("utf-8")))
     written.append(cost_plot(runs, out / "cost_success.png"))
     return written
