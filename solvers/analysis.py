@@ -202,7 +202,7 @@ def level_analysis_row(
     limits: SearchLimits,
     optimal: bool,
     assemble: bool,
-    mirrors: Mirrors = "keep",
+    mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """The figures of one of our puzzle levels (a dict, with ``plan``): BurrTools' assemblies and
@@ -256,6 +256,12 @@ def grace_deadline(limits: SearchLimits) -> Deadline:
     return Deadline(seconds)
 
 
+#: The name the figures give each way of counting mirror images (``convention``): burrTxt's
+#: (BurrTools' command-line solver, the default: an assembly and its mirror image are one) or
+#: BurrTools' stored figures (its GUI's "keep mirror solutions").
+CONVENTIONS: Final[dict[str, str]] = {"drop": "burrtxt", "keep": "mirrors-kept"}
+
+
 def count_figures(
     packing: Packing,
     out: dict[str, Any],
@@ -277,7 +283,7 @@ def count_figures(
         deadline=deadline,
         partial=True,
     )
-    out.update(assemblies=rep.assemblies, solutions=rep.solutions)
+    out.update(assemblies=rep.assemblies, solutions=rep.solutions, convention=CONVENTIONS[mirrors])
     if rep.limit is not None:
         out.update(counts_complete=False, limit=rep.limit.reason, limit_cap=rep.limit.cap)
     return rep
@@ -303,7 +309,7 @@ def problem_analysis_row(
     limits: SearchLimits,
     optimal: bool,
     assemble: bool,
-    mirrors: Mirrors = "keep",
+    mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
 ) -> dict[str, Any]:
     """The figures of one problem of a BurrTools puzzle (a dict, with ``plan``): BurrTools'
@@ -372,7 +378,7 @@ def analyze(
     problem: int | None = None,
     optimal: bool = True,
     assemble: bool = True,
-    mirrors: Mirrors = "keep",
+    mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
 ) -> PuzzleFigures:
     """Assemblies, solutions, level, moves and o_i of a puzzle, as ``chain analyze`` prints

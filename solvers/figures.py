@@ -22,6 +22,7 @@ __all__ = ["PuzzleFigures"]
 ALWAYS: tuple[str, ...] = ("assemblies", "solutions", "level", "moves", "optimal_steps")
 #: Keys written only when set (``counts_complete`` only when false).
 OPTIONAL: tuple[str, ...] = (
+    "convention",
     "problem",
     "name",
     "limit",
@@ -43,7 +44,9 @@ class PuzzleFigures:
     ``counts_complete`` false: a cap (``limit``, the field of ``SearchLimits`` in
     ``limit_cap``) cut counting short and the counts are lower bounds. ``optimal_error``: why o_i
     is unknown (``optimal_limit_cap`` the cap reached). ``plan``: one optimal full disassembly
-    when o_i was searched (not written to JSON)."""
+    when o_i was searched (not written to JSON). ``convention``: how the counts treat mirror
+    images (``burrtxt``: an assembly and its mirror image are one, as burrTxt prints;
+    ``mirrors-kept``: BurrTools' stored figures); None when nothing was counted."""
 
     assemblies: int | None = None
     solutions: int | None = None
@@ -51,6 +54,7 @@ class PuzzleFigures:
     moves: int | None = None
     optimal_steps: int | None = None
     counts_complete: bool = True
+    convention: str | None = None
     limit: str | None = None
     limit_cap: str | None = None
     optimal_error: str | None = None

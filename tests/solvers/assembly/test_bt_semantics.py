@@ -273,13 +273,20 @@ def test_chain_analyze_lists_every_problem(
     soma = EXAMPLES["soma_problems"]()
     small = BTPuzzle(soma.shapes, soma.problems[1:], colors=soma.colors)
     path = write_xmpuzzle(small, Path(str(tmp_path)) / "two.xmpuzzle")
-    assert main(["analyze", str(path), "--no-optimal"]) == 0
+    assert main(["analyze", str(path), "--no-optimal", "--mirrors", "keep"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert [(p["problem"], p["assemblies"], p["solutions"]) for p in out["problems"]] == [
         (0, 122, 122),
         (1, 20, 20),
     ]
-    assert main(["analyze", str(path), "--problem", "1", "--mirrors", "drop"]) == 0
+    assert {p["convention"] for p in out["problems"]} == {"mirrors-kept"}
+    assert main(["analyze", str(path), "--no-optimal"]) == 0  # burrTxt's figures by default
+    out = json.loads(capsys.readouterr().out)
+    assert [(p["assemblies"], p["convention"]) for p in out["problems"]] == [
+        (61, "burrtxt"),
+        (18, "burrtxt"),
+    ]
+    assert main(["analyze", str(path), "--problem", "1"]) == 0
     one = json.loads(capsys.readouterr().out)
     assert (one["problem"], one["name"], one["assemblies"], one["solutions"]) == (
         1,
