@@ -34,7 +34,12 @@ from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.figures import PuzzleFigures
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, Rods, analyze_assembly
+from chaingeo.solvers.motion.disassemble import (
+    Analysis,
+    OptimalLimitError,
+    Rods,
+    analyze_assembly,
+)
 from chaingeo.solvers.motion.movement import MAX_PIECES
 
 if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imports
@@ -180,21 +185,49 @@ def disassembly_figures(
     )
     out.update(level=first.level, moves=first.moves, optimal_steps=None)
     if optimal and first.disassemblable:
-        deadline.progress.stage = "searching for the optimal plan"
-        try:
-            best = analyze_puzzle(
+        out.update(
+            optimal_figures(
                 shapes,
                 max_group=max_group,
                 limits=limits,
+                deadline=deadline,
+                stage="searching for the optimal plan",
                 blocks=blocks,
                 turns=turns,
                 rods=rods,
-                deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
             )
-            out.update(optimal_steps=best.optimal_steps, plan=best.plan)
-        except SearchLimitError as e:
-            out.update(optimal_error_of(e))
+        )
     return out
+
+
+def optimal_figures(
+    shapes: Mapping[str, Shape],
+    *,
+    max_group: int | None,
+    limits: SearchLimits,
+    deadline: Deadline,
+    stage: str,
+    blocks: Sequence[Sequence[str]] | None = None,
+    turns: bool = False,
+    rods: Rods | None = None,
+) -> dict[str, Any]:
+    """``optimal_steps`` and ``plan`` of an assembly known to come apart, searched within
+    ``limits.optimal_seconds`` of ``deadline``; past a cap, :func:`optimal_error_of`'s
+    entries instead."""
+    deadline.progress.stage = stage
+    try:
+        best = analyze_puzzle(
+            shapes,
+            max_group=max_group,
+            limits=limits,
+            blocks=blocks,
+            turns=turns,
+            rods=rods,
+            deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
+        )
+    except SearchLimitError as e:
+        return optimal_error_of(e)
+    return {"optimal_steps": best.optimal_steps, "plan": best.plan}
 
 
 def level_analysis_row(
@@ -204,6 +237,7 @@ def level_analysis_row(
     assemble: bool,
     mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
+    jobs: int | None = 1,
 ) -> dict[str, Any]:
     """The figures of one of our puzzle levels (a dict, with ``plan``): BurrTools' assemblies and
     solutions of the level written as a BurrTools file (:func:`level_puzzle`: each piece its
@@ -221,7 +255,7 @@ def level_analysis_row(
         from chaingeo.core.formats.bt_level import level_puzzle
 
         packing = compile_packing(bt_packing_spec(level_puzzle(level), 0))
-        rep = count_figures(packing, out, mirrors, max_group, limits, deadline, "")
+        rep = count_figures(packing, out, mirrors, max_group, limits, deadline, "", jobs)
         deadline = deadline if rep.complete else grace_deadline(limits)
     out.update(
         disassembly_figures(
@@ -240,9 +274,13 @@ def level_analysis_row(
 
 def optimal_error_of(e: SearchLimitError) -> dict[str, Any]:
     """The figures' entries for an optimal search stopped by a cap: ``optimal_error`` (the
-    reason) and ``optimal_limit_cap`` (the field of ``SearchLimits`` reached, for a front end
-    to name its own option: ``chain analyze`` names the flag and drops this key)."""
-    return {"optimal_error": e.reason, "optimal_limit_cap": e.cap}
+    reason), ``optimal_limit_cap`` (the field of ``SearchLimits`` reached, for a front end
+    to name its own option: ``chain analyze`` names the flag and drops this key) and, when the
+    search proved them, ``optimal_bounds`` ``(lo, hi)`` with ``lo <= o_i <= hi``."""
+    out: dict[str, Any] = {"optimal_error": e.reason, "optimal_limit_cap": e.cap}
+    if isinstance(e, OptimalLimitError):
+        out["optimal_bounds"] = (e.lo, e.hi)
+    return out
 
 
 #: Seconds the figures of a known assembly get when counting spent the analysis' time.
@@ -270,6 +308,7 @@ def count_figures(
     limits: SearchLimits,
     deadline: Deadline,
     label: str,
+    jobs: int | None = 1,
 ) -> BTReport:
     """Count BurrTools' assemblies and solutions into ``out``; a cap reached ends the count,
     and ``out`` then says so: ``counts_complete`` false, the counts lower bounds, ``limit``
@@ -282,6 +321,7 @@ def count_figures(
         limits=limits,
         deadline=deadline,
         partial=True,
+        jobs=jobs,
     )
     out.update(assemblies=rep.assemblies, solutions=rep.solutions, convention=CONVENTIONS[mirrors])
     if rep.limit is not None:
@@ -311,6 +351,7 @@ def problem_analysis_row(
     assemble: bool,
     mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
+    jobs: int | None = 1,
 ) -> dict[str, Any]:
     """The figures of one problem of a BurrTools puzzle (a dict, with ``plan``): BurrTools'
     assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.assembly.btassemble`), then
@@ -326,7 +367,9 @@ def problem_analysis_row(
     first: Analysis | None = None
     if assemble:
         packing = compile_packing(bt_packing_spec(puzzle, index))
-        rep = count_figures(packing, out, mirrors, None, limits, deadline, f"problem {index}: ")
+        rep = count_figures(
+            packing, out, mirrors, None, limits, deadline, f"problem {index}: ", jobs
+        )
         if rep.first_packing is not None:
             found, first = (rep.first_packing, piece_groups(packing)), rep.first_analysis
         if not rep.complete:
@@ -352,17 +395,12 @@ def problem_analysis_row(
     else:  # the level is known: the assembler's disassembler found it
         out.update(level=first.level, moves=first.moves, optimal_steps=None)
         if optimal:
-            deadline.progress.stage = f"problem {index}: searching for the optimal plan"
-            try:
-                best = analyze_puzzle(
-                    shapes,
-                    max_group=None,
-                    limits=limits,
-                    deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
+            stage = f"problem {index}: searching for the optimal plan"
+            out.update(
+                optimal_figures(
+                    shapes, max_group=None, limits=limits, deadline=deadline, stage=stage
                 )
-                out.update(optimal_steps=best.optimal_steps, plan=best.plan)
-            except SearchLimitError as e:
-                out.update(optimal_error_of(e))
+            )
     return out
 
 
@@ -380,6 +418,7 @@ def analyze(
     assemble: bool = True,
     mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
+    jobs: int | None = None,
 ) -> PuzzleFigures:
     """Assemblies, solutions, level, moves and o_i of a puzzle, as ``chain analyze`` prints
     them (:meth:`PuzzleFigures.to_json`).
@@ -389,9 +428,12 @@ def analyze(
     puzzle (default: its only one, or every one in ``problems``; ignored for levels).
     ``optimal`` / ``assemble``: search o_i / count assemblies. ``mirrors``: see
     :mod:`chaingeo.solvers.assembly.btassemble`. Everything runs within ``deadline`` (default:
-    one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`)."""
+    one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`). ``jobs``: worker
+    processes for the counts (None: the machine's cores); the figures do not depend on it."""
     from chaingeo.core.jit import mode
+    from chaingeo.solvers.assembly.btparallel import check_jobs
 
+    jobs = check_jobs(jobs)
     limits = DEFAULT_LIMITS if limits is None else limits
     deadline = Deadline(limits.seconds) if deadline is None else deadline
     start = time.perf_counter()
@@ -401,12 +443,12 @@ def analyze(
     several = False
     if isinstance(source, BTPuzzle):
         several = problem is None and len(source.problems) != 1
-        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline)
+        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline, jobs)
     else:
         from chaingeo.core.suite import load_level
 
         level = load_level(source) if isinstance(source, str | os.PathLike) else source
-        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline)]
+        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline, jobs)]
     meta: dict[str, Any] = {"file": file, "kernels": mode()}
     meta["seconds"] = round(time.perf_counter() - start, 3)
     if several:
@@ -422,14 +464,17 @@ def _puzzle_rows(
     assemble: bool,
     mirrors: Mirrors,
     deadline: Deadline,
+    jobs: int | None,
 ) -> list[dict[str, Any]]:
     """The rows of problem ``problem``, or with None of the puzzle's only problem, or of every
     one."""
     if problem is not None or len(puzzle.problems) == 1:
         return [
-            problem_analysis_row(puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline)
+            problem_analysis_row(
+                puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline, jobs
+            )
         ]
     return [
-        problem_analysis_row(puzzle, i, limits, optimal, assemble, mirrors, deadline)
+        problem_analysis_row(puzzle, i, limits, optimal, assemble, mirrors, deadline, jobs)
         for i in range(len(puzzle.problems))
     ]

@@ -29,6 +29,7 @@ OPTIONAL: tuple[str, ...] = (
     "limit_cap",
     "optimal_error",
     "optimal_limit_cap",
+    "optimal_bounds",
     "disassembly_error",
 )
 #: What the run adds at the top: the source named, the kernels' mode, the wall time.
@@ -43,7 +44,8 @@ class PuzzleFigures:
 
     ``counts_complete`` false: a cap (``limit``, the field of ``SearchLimits`` in
     ``limit_cap``) cut counting short and the counts are lower bounds. ``optimal_error``: why o_i
-    is unknown (``optimal_limit_cap`` the cap reached). ``plan``: one optimal full disassembly
+    is unknown (``optimal_limit_cap`` the cap reached; ``optimal_bounds`` what the search proved
+    by then: ``lo <= o_i <= hi``). ``plan``: one optimal full disassembly
     when o_i was searched (not written to JSON). ``convention``: how the counts treat mirror
     images (``burrtxt``: an assembly and its mirror image are one, as burrTxt prints;
     ``mirrors-kept``: BurrTools' stored figures); None when nothing was counted."""
@@ -59,6 +61,7 @@ class PuzzleFigures:
     limit_cap: str | None = None
     optimal_error: str | None = None
     optimal_limit_cap: str | None = None
+    optimal_bounds: tuple[int, int] | None = None
     disassembly_error: str | None = None
     problem: int | None = None
     name: str | None = None
@@ -85,6 +88,9 @@ class PuzzleFigures:
         kw["problems"] = tuple(cls.from_dict(p) for p in row.get("problems", ()))
         kw["several"] = "problems" in row
         kw["plan"] = tuple(row.get("plan", ()))
+        if row.get("optimal_bounds") is not None:
+            lo, hi = row["optimal_bounds"]
+            kw["optimal_bounds"] = (int(lo), int(hi))
         return cls(**kw)
 
     @classmethod
@@ -101,6 +107,8 @@ class PuzzleFigures:
             return out
         out.update({k: getattr(self, k) for k in ALWAYS})
         out.update({k: getattr(self, k) for k in OPTIONAL if getattr(self, k) is not None})
+        if self.optimal_bounds is not None:
+            out["optimal_bounds"] = list(self.optimal_bounds)
         if not self.counts_complete:
             out["counts_complete"] = False
         if flags is not None:

@@ -32,6 +32,14 @@ from chaingeo.solvers.assembly.btassemble import (
     named_assembly,
     piece_groups,
 )
+from chaingeo.solvers.assembly.btparallel import (
+    NO,
+    STUCK,
+    YES,
+    WorkerChecks,
+    check_jobs,
+    verdicts,
+)
 from chaingeo.solvers.cover.constrained import Packing
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
@@ -257,6 +265,7 @@ def count_bt(
     levels: list[str] | None = None,
     partial: bool = False,
     fast: bool = True,
+    jobs: int | None = 1,
 ) -> BTReport:
     """BurrTools' assemblies and solutions of a packing, and the first solution. The search
     and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
@@ -268,7 +277,9 @@ def count_bt(
     was counted (lower bounds) and the error. The running counts are kept in the deadline's
     :class:`chaingeo.solvers.deadline.Progress` as the search goes. ``fast``: BurrTools' verdicts on
     rows (:class:`RowVerdicts`) where they apply; False sends every assembly through the
-    general path (the two are compared in the tests)."""
+    general path (the two are compared in the tests). ``jobs``: processes that take the
+    assemblies apart (None: the machine's cores; :mod:`chaingeo.solvers.assembly.btparallel`),
+    the same figures whatever it is."""
     start = time.perf_counter()
     if deadline is None and limits is not None:
         deadline = Deadline(limits.seconds)
@@ -286,20 +297,21 @@ def count_bt(
         on_rows = RowVerdicts(packing, limits, levels is not None, frame)
     counts = deadline.progress.counts if deadline is not None else {}
     limit: SearchLimitError | None = None
+    worker = None
+    if on_rows is not None:
+        worker = WorkerChecks(packing, limits, levels is not None)
+    stream = verdicts(
+        classes, stuck, on_rows, jobs=check_jobs(jobs), deadline=deadline, worker=worker
+    )
     try:
-        for rows in classes:
+        for rows, code, level in stream:
             tally.assemblies += 1
             counts["assemblies"] = tally.assemblies
-            if stuck is not None and stuck(rows):
+            if code in (STUCK, NO):
                 continue
-            if on_rows is not None:
-                if deadline is not None:
-                    deadline.check()
-                verdict = on_rows.verdict(rows)
-                if verdict is False or (verdict and tally.first is not None):
-                    if verdict:
-                        tally.solution(on_rows.level, counts)
-                    continue
+            if code == YES and tally.first is not None:
+                tally.solution(level, counts)
+                continue
             asm = named_assembly(packing, rows)
             if frame is not None:
                 if len(asm) < 2:
@@ -317,6 +329,8 @@ def count_bt(
         if not partial:
             raise
         limit = e  # an assembly being taken apart then is counted, its verdict is not
+    finally:
+        stream.close()  # stops the workers, if any
     label = None if anchor is None else anchor.label
     seconds = time.perf_counter() - start
     return BTReport(

@@ -28,6 +28,10 @@ lower bounds) and ``limit`` naming the cap and its flag, and still gives level, 
 the known assembly (the first solution found, a ``.xmpuzzle``'s stored assembly, or a level's
 own), which get a further :data:`chaingeo.solvers.analysis.GRACE_SECONDS` at most.
 
+``--jobs N`` (default: the machine's cores) counts with N worker processes taking the
+assemblies apart while one search enumerates them (:mod:`chaingeo.solvers.assembly.btparallel`):
+the same bytes whatever N, in less wall time on a large count.
+
 Exit status: 0 when every figure is complete; 1 when counting was cut short by a cap; 2 when
 some file failed (its line carries ``error``; the message is also on standard error).
 """
@@ -118,6 +122,13 @@ def register(sub: Any) -> None:
         "reported unknown, with the reason; the other figures stand)",
     )
     p.add_argument("--max-states", type=int, default=2_000_000, help="state cap per part")
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        help="worker processes that take the assemblies apart while counting (default: the "
+        "machine's cores); the figures are the same whatever it is",
+    )
     p.add_argument("--no-optimal", action="store_true", help="skip the optimal-plan search")
     p.add_argument(
         "--no-assemble", action="store_true", help="skip counting assemblies (level only)"
@@ -138,6 +149,8 @@ def run(args: argparse.Namespace) -> int:
             raise CommandError(f"{flag}: expected a positive number of seconds, got {value}")
     if args.max_states < 1:
         raise CommandError(f"--max-states: expected a positive number, got {args.max_states}")
+    if args.jobs is not None and args.jobs < 1:
+        raise CommandError(f"--jobs: expected a positive number of processes, got {args.jobs}")
     if _ahead_of_time_first(args):
         return _run_ahead_of_time(args)
     if _interpreted_first(args):
@@ -206,6 +219,7 @@ def analyze_file(spec: str, args: argparse.Namespace) -> PuzzleFigures:
                 assemble=not args.no_assemble,
                 mirrors=args.mirrors,
                 deadline=deadline,
+                jobs=args.jobs,
             )
     except SearchLimitError as e:
         raise CommandError(limit_message(e)) from None
