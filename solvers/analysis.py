@@ -431,7 +431,7 @@ def analyze(
     one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`). ``jobs``: worker
     processes for the counts (None: the machine's cores); the figures do not depend on it."""
     from chaingeo.core.jit import mode
-    from chaingeo.solvers.assembly.btparallel import check_jobs
+    from chaingeo.solvers.jobs import check_jobs
 
     jobs = check_jobs(jobs)
     limits = DEFAULT_LIMITS if limits is None else limits

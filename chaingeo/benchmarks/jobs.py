@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.core.formats.bt_level import level_puzzle
     from chaingeo.core.formats.burrtools import write_xmpuzzle
     from chaingeo.core.suite import load_level
-    from chaingeo.solvers.assembly.btparallel import default_jobs
+    from chaingeo.solvers.jobs import default_jobs
 
     reason = why_unavailable()
     if reason is not None:

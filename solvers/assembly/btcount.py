@@ -36,12 +36,11 @@ from chaingeo.solvers.assembly.btparallel import (
     NO,
     STUCK,
     YES,
-    WorkerChecks,
-    check_jobs,
     verdicts,
 )
 from chaingeo.solvers.cover.constrained import Packing
 from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.jobs import check_jobs
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import btsearch as bt
 from chaingeo.solvers.motion import levelsearch as ls
@@ -235,6 +234,18 @@ class StuckCheck:
 
     def __call__(self, rows: Int32Array) -> bool:
         return bool(mv.stuck(self.pos, self.box, self.row_ptr, self.cells, rows[self.piece[rows]]))
+
+
+class WorkerChecks:
+    """How a worker builds its checks of one packing (picklable, for spawned workers)."""
+
+    def __init__(self, packing: Packing, limits: SearchLimits | None, want_levels: bool) -> None:
+        self.packing = packing
+        self.limits = limits
+        self.want_levels = want_levels
+
+    def __call__(self) -> tuple[StuckCheck, RowVerdicts]:
+        return StuckCheck(self.packing), RowVerdicts(self.packing, self.limits, self.want_levels)
 
 
 @dataclass(frozen=True)

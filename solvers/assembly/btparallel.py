@@ -15,19 +15,31 @@ compiled kernels); where fork is unavailable they are spawned.
 from __future__ import annotations
 
 import multiprocessing as mp
-import os
 from collections import deque
 from collections.abc import Callable, Generator, Iterable, Iterator
 from multiprocessing.pool import AsyncResult, Pool
-from typing import TYPE_CHECKING, Final
+from typing import Final, Protocol
 
-from chaingeo.solvers.cover.constrained import Packing
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.jobs import check_jobs, default_jobs
 
-if TYPE_CHECKING:
-    from chaingeo.solvers.assembly.btcount import RowVerdicts, StuckCheck
+__all__ = ["check_jobs", "default_jobs", "verdicts"]
+
+
+class StuckTest(Protocol):
+    """Whether nothing can move in an assembly (its rows)."""
+
+    def __call__(self, rows: Int32Array) -> bool: ...
+
+
+class VerdictSource(Protocol):
+    """BurrTools' verdict on an assembly (None: not decided here) and its level string."""
+
+    level: str | None
+
+    def verdict(self, rows: Int32Array) -> bool | None: ...
+
 
 #: What is known of one assembly: nothing can move, BurrTools' disassembler does not take it
 #: apart, it does, or the fast path cannot say (the general path decides).
@@ -45,32 +57,12 @@ IN_FLIGHT: Final = 3
 POLL_SECONDS: Final = 0.05
 
 Verdict = tuple[Int32Array, int, str | None]
-#: How a worker builds its checks of the packing (:class:`WorkerChecks`).
-WorkerFactory = Callable[[], "tuple[StuckCheck, RowVerdicts]"]
+#: How a worker builds its checks of the packing
+#: (:class:`chaingeo.solvers.assembly.btcount.WorkerChecks`).
+WorkerFactory = Callable[[], tuple[StuckTest, VerdictSource]]
 
 
-def default_jobs() -> int:
-    """The cores this process may run on (``os.process_cpu_count``, else its affinity)."""
-    count = getattr(os, "process_cpu_count", None)
-    if count is not None:
-        n = count()
-    elif hasattr(os, "sched_getaffinity"):
-        n = len(os.sched_getaffinity(0))
-    else:
-        n = os.cpu_count()
-    return max(1, int(n or 1))
-
-
-def check_jobs(jobs: int | None) -> int:
-    """``jobs`` as a number of processes (None: :func:`default_jobs`); ValueError below 1."""
-    if jobs is None:
-        return default_jobs()
-    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
-        raise ValueError(f"jobs: expected a positive number of processes, got {jobs!r}")
-    return jobs
-
-
-def judge(rows: Int32Array, stuck: StuckCheck | None, on_rows: RowVerdicts | None) -> Verdict:
+def judge(rows: Int32Array, stuck: StuckTest | None, on_rows: VerdictSource | None) -> Verdict:
     """One assembly's verdict in this process (``stuck`` None: piece groups, where a part may
     be done without moving)."""
     if stuck is not None and stuck(rows):
@@ -83,8 +75,8 @@ def judge(rows: Int32Array, stuck: StuckCheck | None, on_rows: RowVerdicts | Non
 
 def verdicts(
     classes: Iterable[Int32Array],
-    stuck: StuckCheck | None,
-    on_rows: RowVerdicts | None,
+    stuck: StuckTest | None,
+    on_rows: VerdictSource | None,
     *,
     jobs: int,
     deadline: Deadline | None,
@@ -151,7 +143,7 @@ def _pool(jobs: int, worker: WorkerFactory) -> Pool:
     return mp.get_context(method).Pool(jobs, initializer=_start, initargs=(worker,))
 
 
-_CHECKS: list[tuple[StuckCheck, RowVerdicts]] = []
+_CHECKS: list[tuple[StuckTest, VerdictSource]] = []
 
 
 def _start(worker: WorkerFactory) -> None:
@@ -161,17 +153,3 @@ def _start(worker: WorkerFactory) -> None:
 def _answer(batch: list[Int32Array]) -> list[tuple[int, str | None]]:
     stuck, on_rows = _CHECKS[0]
     return [judge(rows, stuck, on_rows)[1:] for rows in batch]
-
-
-class WorkerChecks:
-    """How a worker builds its checks of one packing (picklable, for spawned workers)."""
-
-    def __init__(self, packing: Packing, limits: SearchLimits | None, want_levels: bool) -> None:
-        self.packing = packing
-        self.limits = limits
-        self.want_levels = want_levels
-
-    def __call__(self) -> tuple[StuckCheck, RowVerdicts]:
-        from chaingeo.solvers.assembly.btcount import RowVerdicts, StuckCheck
-
-        return StuckCheck(self.packing), RowVerdicts(self.packing, self.limits, self.want_levels)

@@ -12,6 +12,7 @@ import pytest
 from chaingeo.core.formats.bt_level import level_puzzle
 from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
 from chaingeo.core.suite import load_level
+from chaingeo.solvers import jobs as jobs_mod
 from chaingeo.solvers.analysis import analyze
 from chaingeo.solvers.assembly import btparallel
 from chaingeo.solvers.assembly.btassemble import bt_packing_spec
@@ -92,11 +93,11 @@ def test_a_deadline_stops_the_workers(small_batches: list[int]) -> None:
 @pytest.mark.parametrize("jobs", [0, -1, True, 1.5])
 def test_jobs_must_be_a_positive_count(jobs: object) -> None:
     with pytest.raises(ValueError, match="jobs"):
-        btparallel.check_jobs(jobs)  # type: ignore[arg-type]
+        jobs_mod.check_jobs(jobs)  # type: ignore[arg-type]
 
 
 def test_default_jobs_is_the_cores_this_process_may_use() -> None:
-    assert 1 <= btparallel.check_jobs(None) == btparallel.default_jobs()
+    assert 1 <= jobs_mod.check_jobs(None) == jobs_mod.default_jobs()
     limits = SearchLimits(seconds=30)
     assert (
         analyze(DATA / "soma_problems.xmpuzzle", problem=1, limits=limits).convention == "burrtxt"
