@@ -29,7 +29,12 @@ from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.solvers.assembly.btassemble import Mirrors, bt_packing_spec, piece_groups
 from chaingeo.solvers.assembly.btcount import BTReport, count_bt
-from chaingeo.solvers.assembly.groups import PieceGroups, analyze_grouped
+from chaingeo.solvers.assembly.groups import (
+    RULE_TWO,
+    PieceGroups,
+    analyze_grouped,
+    optimal_grouped,
+)
 from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.figures import PuzzleFigures
@@ -210,23 +215,33 @@ def optimal_figures(
     blocks: Sequence[Sequence[str]] | None = None,
     turns: bool = False,
     rods: Rods | None = None,
+    groups: PieceGroups | None = None,
 ) -> dict[str, Any]:
-    """``optimal_steps`` and ``plan`` of an assembly known to come apart, searched within
-    ``limits.optimal_seconds`` of ``deadline``; past a cap, :func:`optimal_error_of`'s
-    entries instead."""
+    """``optimal_steps`` and ``plan`` of an assembly known to come apart (with ``groups``:
+    under BurrTools' group rule, :func:`chaingeo.solvers.assembly.groups.optimal_grouped`),
+    searched within ``limits.optimal_seconds`` of ``deadline``; past a cap,
+    :func:`optimal_error_of`'s entries instead."""
     deadline.progress.stage = stage
+    within = deadline.within(limits.optimal_seconds, "optimal_seconds")
     try:
-        best = analyze_puzzle(
-            shapes,
-            max_group=max_group,
-            limits=limits,
-            blocks=blocks,
-            turns=turns,
-            rods=rods,
-            deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
-        )
+        if groups is not None:
+            best = optimal_grouped(
+                shapes, groups, max_group=max_group, limits=limits, deadline=within
+            )
+        else:
+            best = analyze_puzzle(
+                shapes,
+                max_group=max_group,
+                limits=limits,
+                blocks=blocks,
+                turns=turns,
+                rods=rods,
+                deadline=within,
+            )
     except SearchLimitError as e:
         return optimal_error_of(e)
+    if best.optimal_steps is None:
+        return {"optimal_error": RULE_TWO}
     return {"optimal_steps": best.optimal_steps, "plan": best.plan}
 
 
@@ -356,7 +371,7 @@ def problem_analysis_row(
     """The figures of one problem of a BurrTools puzzle (a dict, with ``plan``): BurrTools'
     assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.assembly.btassemble`), then
     level, moves and o_i of the first solution (with ``assemble`` off: of the first stored
-    assembly). With piece groups o_i is not searched (``optimal_error`` says so). Everything runs
+    assembly); with piece groups o_i under BurrTools' group rule. Everything runs
     within ``deadline`` (default: one of ``limits.seconds``)."""
     if deadline is None:
         deadline = Deadline(limits.seconds)
@@ -385,7 +400,17 @@ def problem_analysis_row(
         result = first or analyze_grouped(shapes, groups, limits=limits, deadline=deadline)
         out.update(level=result.level, moves=result.moves, optimal_steps=None)
         if optimal and result.disassemblable:
-            out["optimal_error"] = "o_i is not searched for problems with piece groups"
+            stage = f"problem {index}: searching for the optimal plan"
+            out.update(
+                optimal_figures(
+                    shapes,
+                    max_group=None,
+                    limits=limits,
+                    deadline=deadline,
+                    stage=stage,
+                    groups=groups,
+                )
+            )
     elif first is None:
         out.update(
             disassembly_figures(

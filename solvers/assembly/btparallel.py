@@ -14,7 +14,6 @@ compiled kernels); where fork is unavailable they are spawned.
 
 from __future__ import annotations
 
-import multiprocessing as mp
 from collections import deque
 from collections.abc import Callable, Generator, Iterable, Iterator
 from multiprocessing.pool import AsyncResult, Pool
@@ -22,7 +21,7 @@ from typing import Final, Protocol
 
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.jobs import check_jobs, default_jobs
+from chaingeo.solvers.jobs import check_jobs, default_jobs, fork_pool
 
 __all__ = ["check_jobs", "default_jobs", "verdicts"]
 
@@ -139,8 +138,7 @@ def _take(it: Iterator[Int32Array], n: int) -> list[Int32Array]:
 def _pool(jobs: int, worker: WorkerFactory) -> Pool:
     """``jobs`` processes, each with the checks ``worker`` builds (forked where possible: the
     compiled kernels and the packing come along)."""
-    method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
-    return mp.get_context(method).Pool(jobs, initializer=_start, initargs=(worker,))
+    return fork_pool(jobs, _start, (worker,))
 
 
 _CHECKS: list[tuple[StuckTest, VerdictSource]] = []

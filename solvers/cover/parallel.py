@@ -12,9 +12,7 @@ whatever it is. Workers are forked (they inherit the compiled kernels and the pr
 
 from __future__ import annotations
 
-import multiprocessing as mp
 from collections.abc import Sequence
-from multiprocessing.pool import Pool
 from typing import Final
 
 import numpy as np
@@ -23,6 +21,7 @@ from chaingeo.solvers.cover.bitboard import scan_order
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
 from chaingeo.solvers.cover.search import CoverSearch, Engine, choose_kernel
+from chaingeo.solvers.jobs import fork_pool
 
 #: Subtrees the tree is cut into (when it is that wide: the last level cut stops there; each
 #: subtree's search costs its own set-up), and levels cut at most.
@@ -145,8 +144,7 @@ def _map(
     if jobs <= 1:
         _start(problem, engine)
         return [_search(w) for w in work]
-    method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
-    pool: Pool = mp.get_context(method).Pool(jobs, initializer=_start, initargs=(problem, engine))
+    pool = fork_pool(jobs, _start, (problem, engine))
     try:
         return pool.map(_search, work, chunksize=1)
     finally:

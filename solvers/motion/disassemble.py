@@ -385,17 +385,22 @@ class _Solver:
         return tree is not None, tree
 
     # -- optimal full disassembly --------------------------------------------------------------
+    def min_removals(self, members: tuple[int, ...]) -> int:
+        """Removals any plan needs to finish the part: every piece comes apart (with piece
+        groups, :class:`chaingeo.solvers.assembly.groups.GroupedSolver` needs fewer)."""
+        return len(members) - 1
+
     def optimal(
         self, members: tuple[int, ...], offsets: np.ndarray, budget: int, floor: int = 0
     ) -> tuple[int, list[Move | TurnMove] | None]:
         """``(f, plan)`` with ``f`` the fewest moves to take the part apart if that is below
         ``budget``; otherwise ``(lower bound >= budget, None)``. ``floor`` is a proven lower
         bound on ``f`` from the caller: the search stops as soon as a plan meets it."""
-        n = len(members)
-        if n == 1:
+        least = self.min_removals(members)
+        if least == 0:
             return 0, []
-        if n - 1 >= budget:
-            return n - 1, None
+        if least >= budget:
+            return least, None
         k = self.key(members, offsets)
         memo = self.opt_memo.get(k)
         if memo is not None:
@@ -421,26 +426,27 @@ class _Solver:
     ) -> tuple[int, list[Move | TurnMove] | None]:
         """:meth:`optimal` past its memo: the search itself (``top``: the whole puzzle's
         bounds, updated as they are proved, when this is the outermost call)."""
-        n = len(members)
+        after = self.min_removals(members) - 1  # removals still needed after the first
         s = self.search(members, offsets)
         best, best_plan = budget, None
-        while not s.exhausted and s.depth + 1 + (n - 2) < best and best > floor:
+        while not s.exhausted and s.depth + 1 + after < best and best > floor:
             if top is not None:
                 # Every removal above the next layer has been tried: a shorter plan first
-                # separates there or deeper, then needs n - 2 more removals.
-                top[0] = max(top[0], min(best, s.depth + n - 1))
-            removals = s.expand_layers(best - n)
+                # separates there or deeper, then needs ``after`` more removals.
+                top[0] = max(top[0], min(best, s.depth + 1 + after))
+            removals = s.expand_layers(best - 2 - after)
             if top is not None and removals:
-                top[0] = max(top[0], min(best, removals[0].depth + n - 1))
+                top[0] = max(top[0], min(best, removals[0].depth + 1 + after))
             for sp in s.unique_splits(removals):
                 if best <= floor:
                     break
                 r = sp.removal
                 rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
                 base = r.depth + 1
-                if base + (len(rm) - 1) + (len(lm) - 1) >= best:
+                left_least = self.min_removals(lm)
+                if base + self.min_removals(rm) + left_least >= best:
                     continue
-                fa, pa = self.optimal(rm, roff, best - base - (len(lm) - 1))
+                fa, pa = self.optimal(rm, roff, best - base - left_least)
                 if pa is None:
                     continue
                 fb, pb = self.optimal(lm, loff, best - base - fa)
@@ -605,7 +611,7 @@ def analyze_assembly(
         bound = seed.total_moves()
         if bound > floor:
             # BurrTools' own plan (``tree``) may be the shorter: an upper bound too.
-            solver.bounds = [max(floor, n - 1), min(bound, total)]
+            solver.bounds = [max(floor, solver.min_removals(members)), min(bound, total)]
             try:
                 found, better = solver.optimal(members, offsets, bound, floor)
             except SearchLimitError as e:
