@@ -455,7 +455,7 @@ def analyze(
     :mod:`chaingeo.solvers.assembly.btassemble`. Everything runs within ``deadline`` (default:
     one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`). ``jobs``: worker
     processes for the counts (None: the machine's cores); the figures do not depend on it."""
-    from chaingeo.core.jit import mode
+    from chaingeo.kernels.jit import mode
     from chaingeo.solvers.jobs import check_jobs
 
     jobs = check_jobs(jobs)

@@ -34,25 +34,11 @@ from dataclasses import dataclass
 from math import comb
 from statistics import fmean
 
+from chaingeo.evaluation.episode import Outcome
 from chaingeo.evaluation.usage import Usage, total_usage
 
 FAMILIES = ("puzzle", "stacking")
 DIFFICULTIES = ("easy", "mid", "hard")
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """What the metrics need to know about one episode."""
-
-    level_id: str
-    family: str
-    difficulty: str
-    optimal_steps: int
-    success: bool
-    steps: int
-    sample: int = 0
-    usage: Usage = Usage()
-    cost_usd: float | None = 0.0
 
 
 def pass_at_k_unbiased(n: int, c: int, k: int) -> float:

@@ -29,7 +29,8 @@ from chaingeo.core.level import (
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.agents.baselines import oracle_plan
-from chaingeo.evaluation.episode import EpisodeTask, ProtocolConfig, run_episode
+from chaingeo.evaluation.episode import ProtocolConfig
+from chaingeo.evaluation.play import EpisodeTask, run_episode
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from tests.support.fake_openai import Script, fake_openai, reply
 

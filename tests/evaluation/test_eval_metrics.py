@@ -11,13 +11,14 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from chaingeo.evaluation import metrics as m
+from chaingeo.evaluation.episode import Outcome
 from chaingeo.evaluation.usage import Price, PriceError, PriceTable, Usage, UsageError, total_usage
 
 U = Usage(input_tokens=1000, output_tokens=500, calls=1)
 
 
-def _o(level: str, fam: str, diff: str, opt: int, ok: bool, steps: int, sample: int) -> m.Outcome:
-    return m.Outcome(level, fam, diff, opt, ok, steps, sample, U, 0.01)
+def _o(level: str, fam: str, diff: str, opt: int, ok: bool, steps: int, sample: int) -> Outcome:
+    return Outcome(level, fam, diff, opt, ok, steps, sample, U, 0.01)
 
 
 # Level A (stacking easy, o=4): solved in 6, then failed at the 30-step budget.
@@ -59,10 +60,10 @@ def test_efficiency_metrics_by_hand() -> None:
     # 6 episodes x 1500 tokens = 9000 tokens; 6 x $0.01 = $0.06; 3 solved.
     assert m.solved_per_million_tokens(RUN) == pytest.approx(3 / 0.009)
     assert m.solved_per_usd(RUN) == pytest.approx(3 / 0.06)
-    free = [m.Outcome("A", "stacking", "easy", 4, True, 4)]
+    free = [Outcome("A", "stacking", "easy", 4, True, 4)]
     assert m.solved_per_million_tokens(free) is None
     assert m.solved_per_usd(free) is None
-    unknown = [*RUN[:1], m.Outcome("B", "puzzle", "mid", 5, False, 30, 0, U, None)]
+    unknown = [*RUN[:1], Outcome("B", "puzzle", "mid", 5, False, 30, 0, U, None)]
     assert m.run_cost(unknown) is None and m.solved_per_usd(unknown) is None
 
 
