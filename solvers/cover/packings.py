@@ -44,6 +44,7 @@ first yield what they found. Every function also takes a ``deadline``
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -262,12 +263,16 @@ def count_packings(
     symmetry: bool = True,
     anchor: str | None = None,
     deadline: Deadline | None = None,
+    jobs: int = 1,
 ) -> CoverResult:
-    """Count all solutions and (if asked) the distinct ones up to the target's symmetries."""
+    """Count all solutions and (if asked) the distinct ones up to the target's symmetries.
+    ``jobs`` > 1: the searches' subtrees on that many worker processes
+    (:mod:`chaingeo.solvers.cover.parallel`; not with a node limit or a deadline), the same
+    counts."""
     problem = _problem(pieces, target, optional, reflections)
     syms, _ = problem.symmetry
     plan = anchor_plan(problem, anchor) if symmetry else None
-    budget = _Budget(node_limit, deadline)
+    budget = _Budget(node_limit, deadline, jobs, engine)
     if plan is None:
         search = budget.search(problem, None, engine)
         if not distinct:
@@ -275,7 +280,11 @@ def count_packings(
             return CoverResult(total, None, budget.stats, len(syms), None)
         every = budget.collect(search)
         return CoverResult(
-            search.found, _count_distinct_forms(problem, every), budget.stats, len(syms), None
+            sum(len(b) for b in every),
+            _count_distinct_forms(problem, every),
+            budget.stats,
+            len(syms),
+            None,
         )
     h = len(plan.group)
     total = 0
@@ -309,13 +318,50 @@ def count_packings(
 class _Budget:
     """Shares one node limit (and the deadline) across the several searches of a count."""
 
-    def __init__(self, node_limit: int | None, deadline: Deadline | None) -> None:
+    def __init__(
+        self,
+        node_limit: int | None,
+        deadline: Deadline | None,
+        jobs: int = 1,
+        engine: Engine = "auto",
+    ) -> None:
         if node_limit is not None and node_limit < 0:
             raise CoverError(f"node_limit: must be >= 0, got {node_limit}")
+        if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+            raise CoverError(f"jobs: expected a positive number of processes, got {jobs!r}")
         self.limit = node_limit
         self.deadline = deadline
         self.stats = CoverStats()
         self.found = 0
+        bounded = deadline is not None and deadline.bounded
+        self.jobs = jobs if node_limit is None and not bounded else 1
+        self.engine = engine
+
+    def _parallel(self, search: CoverSearch, collect: bool) -> list[Int32Array]:
+        """The search's subtrees on the workers (its own kernel never runs)."""
+        from chaingeo.solvers.cover import parallel
+
+        t0 = time.perf_counter()
+        if collect:
+            blocks, nodes = parallel.collect_parallel(
+                search.problem, search.rows, self.engine, self.jobs
+            )
+            found = sum(len(b) for b in blocks)
+        else:
+            blocks = []
+            found, nodes = parallel.count_parallel(
+                search.problem, search.rows, self.engine, self.jobs
+            )
+        seconds = time.perf_counter() - t0
+        self.stats += CoverStats(nodes, 0, seconds, search.engine, search.kernel)
+        self.found += found
+        self.parallel_found = found
+        return blocks
+
+    def _worth_workers(self, search: CoverSearch) -> bool:
+        from chaingeo.solvers.cover.parallel import MIN_ROWS
+
+        return self.jobs > 1 and len(search.rows) >= MIN_ROWS
 
     def search(self, problem: CoverProblem, rows: Int32Array | None, engine: Engine) -> CoverSearch:
         left = None if self.limit is None else max(self.limit - self.stats.nodes, 0)
@@ -336,10 +382,15 @@ class _Budget:
         return blocks
 
     def count(self, search: CoverSearch) -> int:
+        if self._worth_workers(search):
+            self._parallel(search, False)
+            return self.parallel_found
         self._run(search, False)
         return search.found
 
     def collect(self, search: CoverSearch) -> list[Int32Array]:
+        if self._worth_workers(search):
+            return self._parallel(search, True)
         return self._run(search, True)
 
 
