@@ -18,11 +18,13 @@ from __future__ import annotations
 
 import csv
 import io
+import math
+import statistics
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import Any, Final
 
 from chaingeo.evaluation import stats
 from chaingeo.evaluation.episode import Outcome
@@ -304,8 +306,85 @@ def cost_plot(runs: Sequence[Run], path: str | Path) -> Path:
     return out
 
 
+# ---------------------------------------------------------------------------------------------
+# Human baselines (chain serve --study): solve times by tier, as the paper calibrates its tiers
+# ---------------------------------------------------------------------------------------------
+
+#: The paper's tiers of human solve time, in seconds: easy under 5 minutes, medium 5-15, hard
+#: over 15.
+TIME_TIERS: Final = ((0.0, 300.0), (300.0, 900.0), (900.0, math.inf))
+
+
+def wilson(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
+    """The Wilson score interval of a rate (95% by default); (0, 1) with no trials."""
+    if n == 0:
+        return 0.0, 1.0
+    p = successes / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def _mean_se(values: Sequence[float]) -> str:
+    if not values:
+        return "—"
+    mean = statistics.fmean(values)
+    se = statistics.stdev(values) / math.sqrt(len(values)) if len(values) > 1 else 0.0
+    return f"{mean:.2f} ± {se:.2f}"
+
+
+def is_human(run: Run) -> bool:
+    agent = run.header.get("agent")
+    return isinstance(agent, dict) and agent.get("kind") == "human"
+
+
+def _human_row(name: str, tier: str, records: Sequence[dict[str, Any]]) -> list[Any]:
+    won = [r for r in records if r.get("success")]
+    lo, hi = wilson(len(won), len(records))
+    times = [float(r["solve_seconds"]) for r in won if r.get("solve_seconds") is not None]
+    shares = [
+        sum(1 for t in times if a <= t < b) / len(times) if times else None for a, b in TIME_TIERS
+    ]
+    return [
+        name,
+        tier,
+        len(records),
+        len(won) / len(records) if records else None,
+        f"{100 * lo:.1f}-{100 * hi:.1f}",
+        _mean_se([float(r["steps_used"]) for r in won]),
+        _mean_se(
+            [(r["steps_used"] - r["optimal_steps"]) / max(1, r["optimal_steps"]) for r in won]
+        ),
+        statistics.median(times) if times else None,
+        *shares,
+    ]
+
+
+def human_table(runs: Sequence[Run]) -> Table:
+    """Each human study's episodes by tier (family and difficulty, then all): Pass@1 with its
+    95% Wilson interval, AvgSteps and NormDist of the solved (mean ± standard error), the
+    median solve time, and the share of solves under 5, 5-15 and over 15 minutes."""
+    rows: list[list[Any]] = []
+    for run in (r for r in runs if is_human(r)):
+        records = list(RunLog(run.path).latest().values())
+        for f, d in ((f, d) for f in FAMILIES for d in DIFFICULTIES):
+            tier = [r for r in records if r["family"] == f and r["difficulty"] == d]
+            if tier:
+                rows.append(_human_row(run.name, f"{f} {d}", tier))
+        rows.append(_human_row(run.name, "all", records))
+    return Table(
+        "Human baseline: success and solve times by tier (Pass@1 %, 95% Wilson interval)",
+        ["Study", "Tier", "Episodes", "Pass@1", "95% CI", "AvgSteps", "NormDist",
+         "Median solve s", "< 5 min", "5-15 min", "> 15 min"],
+        rows,
+        [_text, _text, _int, _pct, _text, _text, _text, _num(1), _pct, _pct, _pct],
+    )  # fmt: skip
+
+
 def tables(runs: Sequence[Run]) -> list[tuple[str, Table]]:
     out = [("table1", table1(runs)), ("difficulty", difficulty_table(runs))]
+    if any(is_human(r) for r in runs):
+        out.append(("human", human_table(runs)))
     proto = protocol_table(runs)
     if proto.rows:
         out.append(("interactive_vs_oneshot", proto))
