@@ -315,47 +315,32 @@ def cost_plot(runs: Sequence[Run], path: str | Path) -> Path:
 TIME_TIERS: Final = ((0.0, 300.0), (300.0, 900.0), (900.0, math.inf))
 
 
-def wilson(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
-    """The Wilson score interval of a rate (95% by default); (0, 1) with no trials."""
-    if n == 0:
-        return 0.0, 1.0
-    p = successes / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
-
-
-def _mean_se(values: Sequence[float]) -> str:
-    if not values:
-        return "—"
-    mean = statistics.fmean(values)
-    se = statistics.stdev(values) / math.sqrt(len(values)) if len(values) > 1 else 0.0
-    return f"{mean:.2f} ± {se:.2f}"
-
-
 def is_human(run: Run) -> bool:
     agent = run.header.get("agent")
     return isinstance(agent, dict) and agent.get("kind") == "human"
 
 
+#: The human table's columns that are no registered metric: the median solve time and the
+#: shares of solves in each time tier (shown by kind: a number, rates with their interval).
+_SECONDS = Metric(
+    "median_solve_seconds", "Median solve s", "lower", "ratio", lambda o, k: Estimate(None), "", 1
+)
+
+
 def _human_row(name: str, tier: str, records: Sequence[dict[str, Any]]) -> list[Any]:
     won = [r for r in records if r.get("success")]
-    lo, hi = wilson(len(won), len(records))
     times = [float(r["solve_seconds"]) for r in won if r.get("solve_seconds") is not None]
-    shares = [
-        sum(1 for t in times if a <= t < b) / len(times) if times else None for a, b in TIME_TIERS
-    ]
+    shares = [stats.rate(sum(1 for t in times if a <= t < b), len(times)) for a, b in TIME_TIERS]
     return [
         name,
         tier,
-        len(records),
-        len(won) / len(records) if records else None,
-        f"{100 * lo:.1f}-{100 * hi:.1f}",
-        _mean_se([float(r["steps_used"]) for r in won]),
-        _mean_se(
+        Estimate(float(len(records))),
+        stats.rate(len(won), len(records)),
+        stats.mean([float(r["steps_used"]) for r in won]),
+        stats.mean(
             [(r["steps_used"] - r["optimal_steps"]) / max(1, r["optimal_steps"]) for r in won]
         ),
-        statistics.median(times) if times else None,
+        Estimate(statistics.median(times) if times else None),
         *shares,
     ]
 
@@ -363,7 +348,8 @@ def _human_row(name: str, tier: str, records: Sequence[dict[str, Any]]) -> list[
 def human_table(runs: Sequence[Run]) -> Table:
     """Each human study's episodes by tier (family and difficulty, then all): Pass@1 with its
     95% Wilson interval, AvgSteps and NormDist of the solved (mean ± standard error), the
-    median solve time, and the share of solves under 5, 5-15 and over 15 minutes."""
+    median solve time, and the share of solves under 5, 5-15 and over 15 minutes (each with
+    its Wilson interval)."""
     rows: list[list[Any]] = []
     for run in (r for r in runs if is_human(r)):
         records = list(RunLog(run.path).latest().values())
@@ -372,12 +358,14 @@ def human_table(runs: Sequence[Run]) -> Table:
             if tier:
                 rows.append(_human_row(run.name, f"{f} {d}", tier))
         rows.append(_human_row(run.name, "all", records))
+    rate = METRICS["pass@1"]
     return Table(
-        "Human baseline: success and solve times by tier (Pass@1 %, 95% Wilson interval)",
-        ["Study", "Tier", "Episodes", "Pass@1", "95% CI", "AvgSteps", "NormDist",
+        "Human baseline: success and solve times by tier (Pass@1 %)",
+        ["Study", "Tier", "Episodes", "Pass@1", "AvgSteps", "NormDist",
          "Median solve s", "< 5 min", "5-15 min", "> 15 min"],
         rows,
-        [_text, _text, _int, _pct, _text, _text, _text, _num(1), _pct, _pct, _pct],
+        [None, None, METRICS["episodes"], rate, METRICS["avg_steps"], METRICS["normdist"],
+         _SECONDS, rate, rate, rate],
     )  # fmt: skip
 
 
