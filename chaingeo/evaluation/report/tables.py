@@ -320,36 +320,26 @@ def is_human(run: Run) -> bool:
     return isinstance(agent, dict) and agent.get("kind") == "human"
 
 
-#: The human table's columns that are no registered metric: the median solve time and the
-#: shares of solves in each time tier (shown by kind: a number, rates with their interval).
-_SECONDS = Metric(
-    "median_solve_seconds", "Median solve s", "lower", "ratio", lambda o, k: Estimate(None), "", 1
-)
-
-
 def _human_row(name: str, tier: str, records: Sequence[dict[str, Any]]) -> list[Any]:
     won = [r for r in records if r.get("success")]
     times = [float(r["solve_seconds"]) for r in won if r.get("solve_seconds") is not None]
+    # each time tier's share of the solves: a rate, with its Wilson interval
     shares = [stats.rate(sum(1 for t in times if a <= t < b), len(times)) for a, b in TIME_TIERS]
-    return [
-        name,
-        tier,
-        Estimate(float(len(records))),
-        stats.rate(len(won), len(records)),
-        stats.mean([float(r["steps_used"]) for r in won]),
-        stats.mean(
-            [(r["steps_used"] - r["optimal_steps"]) / max(1, r["optimal_steps"]) for r in won]
-        ),
-        Estimate(statistics.median(times) if times else None),
-        *shares,
-    ]
+    outcomes = [Outcome.from_record(r) for r in records]
+    figures = [METRICS[m].compute(outcomes, 1) for m in _HUMAN_METRICS]
+    median = f"{statistics.median(times):.0f}" if times else "—"
+    return [name, tier, *figures, median, *shares]
+
+
+#: The registered metrics of the human table, after the study and the tier.
+_HUMAN_METRICS: Final = ("episodes", "pass@1", "avg_steps", "normdist")
 
 
 def human_table(runs: Sequence[Run]) -> Table:
     """Each human study's episodes by tier (family and difficulty, then all): Pass@1 with its
-    95% Wilson interval, AvgSteps and NormDist of the solved (mean ± standard error), the
-    median solve time, and the share of solves under 5, 5-15 and over 15 minutes (each with
-    its Wilson interval)."""
+    95% interval, AvgSteps and NormDist of the solved (mean ± standard error), the median
+    solve time, and the share (%) of solves under 5, 5-15 and over 15 minutes (each with its
+    95% Wilson interval)."""
     rows: list[list[Any]] = []
     for run in (r for r in runs if is_human(r)):
         records = list(RunLog(run.path).latest().values())
@@ -358,15 +348,13 @@ def human_table(runs: Sequence[Run]) -> Table:
             if tier:
                 rows.append(_human_row(run.name, f"{f} {d}", tier))
         rows.append(_human_row(run.name, "all", records))
-    rate = METRICS["pass@1"]
+    titles = [METRICS[m].title for m in _HUMAN_METRICS]
     return Table(
-        "Human baseline: success and solve times by tier (Pass@1 %)",
-        ["Study", "Tier", "Episodes", "Pass@1", "AvgSteps", "NormDist",
-         "Median solve s", "< 5 min", "5-15 min", "> 15 min"],
+        "Human baseline: success and solve times by tier (Pass@1, %)",
+        ["Study", "Tier", *titles, "Median solve s", "< 5 min %", "5-15 min %", "> 15 min %"],
         rows,
-        [None, None, METRICS["episodes"], rate, METRICS["avg_steps"], METRICS["normdist"],
-         _SECONDS, rate, rate, rate],
-    )  # fmt: skip
+        [None, None, *(METRICS[m] for m in _HUMAN_METRICS), None, *[METRICS["pass@1"]] * 3],
+    )
 
 
 def tables(runs: Sequence[Run]) -> list[tuple[str, Table]]:
