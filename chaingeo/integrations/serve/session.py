@@ -17,6 +17,7 @@ from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.base import Reply, StepResultLike
 from chaingeo.evaluation.agents.dialects import DIALECTS, read_reply, tool_call
+from chaingeo.evaluation.agents.prompt import observation_text
 from chaingeo.evaluation.agents.tools import tool_specs
 from chaingeo.evaluation.episode import Episode, Outcome, ProtocolConfig
 from chaingeo.integrations.game import total_reward
@@ -157,7 +158,7 @@ class Play:
             level_id=level.id,
             family=level.family,
             instruction=obs.instruction,
-            text=obs.to_text(),
+            text=observation_text(obs, ep.note),
             feedback=None if self.last is None else self.last.feedback,
             last=last,
             success=bool(s.is_success()),

@@ -156,6 +156,17 @@ def test_an_illegal_action_costs_a_step_like_an_agents(url: str) -> None:
     obs = asyncio.run(go())
     assert obs["steps"] == 1 and not obs["last"]["legal"] and obs["feedback"]
 
+    async def untagged() -> dict[str, Any]:
+        async with _client(url) as env:
+            await env.reset(level=PUZZLE, dialect="text")
+            r = await env.step({"text": "move red -y inf"})  # no <action> tags
+            obs: dict[str, Any] = r.observation
+            return obs
+
+    obs = asyncio.run(untagged())
+    assert obs["steps"] == 1 and obs["last"]["error"] == "unparseable"
+    assert "no <action>...</action> found" in obs["text"]
+
 
 def test_32_sessions_at_once_all_finish(url: str) -> None:
     """32 WebSocket sessions over five levels, interleaved; each reaches success on its own."""
