@@ -205,3 +205,23 @@ def test_http_routes_answer_4xx_to_bad_input(url: str) -> None:
     assert post(f"{url}/step", json={"action": {"bad": 1}}).status_code == 422
     levels = get(f"{url}/levels").json()
     assert [lv["id"] for lv in levels] == sorted(IDS)
+
+
+@pytest.mark.slow
+def test_every_shipped_levels_oracle_plan_succeeds_over_the_wire() -> None:
+    """All shipped levels, 8 sessions at a time, each plan played step by step to success."""
+    from chaingeo.core.suite import shipped_levels
+
+    ids = shipped_levels()
+    with running(Catalog({i: shipped_level(i) for i in ids}), max_sessions=8) as base:
+
+        async def share(part: list[str]) -> list[tuple[str, dict[str, Any]]]:
+            return [(i, (await _play_plan(base, i))[-2]) for i in part]
+
+        async def all_of() -> list[list[tuple[str, dict[str, Any]]]]:
+            return await asyncio.gather(*(share(ids[k::8]) for k in range(8)))
+
+        results = [r for part in asyncio.run(all_of()) for r in part]
+    assert len(results) == len(ids) > 100
+    for level_id, last in results:
+        assert last["success"] and last["steps"] == shipped_level(level_id).optimal_steps, level_id
