@@ -45,7 +45,7 @@ def url() -> Iterator[str]:
 
 
 def _client(url: str) -> GenericEnvClient:
-    return GenericEnvClient(base_url=url, message_timeout_s=60)
+    return GenericEnvClient(base_url=url, message_timeout_s=180)
 
 
 async def _play_plan(url: str, level_id: str, **options: Any) -> list[dict[str, Any]]:
