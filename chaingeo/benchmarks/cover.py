@@ -35,7 +35,7 @@ EXTRA = "bench"
 
 
 @dataclass(frozen=True)
-class Instance:
+class CoverInstance:
     name: str
     pieces: dict[str, Shape]
     box: tuple[int, int, int]
@@ -45,13 +45,15 @@ class Instance:
 
 
 INSTANCES = (
-    Instance("soma 3x3x3", SOMA.pieces, (3, 3, 3), 11520, 240),
-    Instance("pentominoes 6x10x1", PENTOMINOES.pieces, (6, 10, 1), 9356, 2339),
-    Instance("pentominoes 5x12x1", PENTOMINOES.pieces, (5, 12, 1), 4040, 1010),
-    Instance("solid pentominoes 2x5x6", PENTOMINOES.pieces, (2, 5, 6), 2112, 264),
-    Instance("solid pentominoes 3x4x5", PENTOMINOES.pieces, (3, 4, 5), 31520, 3940),
+    CoverInstance("soma 3x3x3", SOMA.pieces, (3, 3, 3), 11520, 240),
+    CoverInstance("pentominoes 6x10x1", PENTOMINOES.pieces, (6, 10, 1), 9356, 2339),
+    CoverInstance("pentominoes 5x12x1", PENTOMINOES.pieces, (5, 12, 1), 4040, 1010),
+    CoverInstance("solid pentominoes 2x5x6", PENTOMINOES.pieces, (2, 5, 6), 2112, 264),
+    CoverInstance("solid pentominoes 3x4x5", PENTOMINOES.pieces, (3, 4, 5), 31520, 3940),
 )
-BEDLAM_INSTANCE = Instance("bedlam 4x4x4", BEDLAM.pieces, (4, 4, 4), None, 19186, compare=False)
+BEDLAM_INSTANCE = CoverInstance(
+    "bedlam 4x4x4", BEDLAM.pieces, (4, 4, 4), None, 19186, compare=False
+)
 QUICK = ("soma 3x3x3", "pentominoes 5x12x1")
 
 
@@ -134,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
     rows = []
     for inst in instances:
 
-        def ours(inst: Instance = inst) -> int:
+        def ours(inst: CoverInstance = inst) -> int:
             _clear_caches()
             r = count_packings(inst.pieces, inst.box)
             if inst.solutions is not None and r.solutions != inst.solutions:

@@ -272,7 +272,7 @@ def count_packings(
     problem = _problem(pieces, target, optional, reflections)
     syms, _ = problem.symmetry
     plan = anchor_plan(problem, anchor) if symmetry else None
-    budget = _Budget(node_limit, deadline, jobs, engine)
+    budget = _CoverBudget(node_limit, deadline, jobs, engine)
     if plan is None:
         search = budget.search(problem, None, engine)
         if not distinct:
@@ -315,7 +315,7 @@ def count_packings(
     return CoverResult(total, n_distinct if distinct else None, budget.stats, len(syms), plan.label)
 
 
-class _Budget:
+class _CoverBudget:
     """Shares one node limit (and the deadline) across the several searches of a count."""
 
     def __init__(

@@ -3,7 +3,7 @@ resumable loop.
 
 A whole state is one ``int16`` row of ``4 n``: ``row[i]`` is the label of piece ``i``'s part
 (its smallest piece index), ``row[n + 3 i + t]`` its offset relative to that piece. The loop
-(:func:`run_astar`) keeps everything in arrays owned by :class:`Run` and returns a status when
+(:func:`run_astar`) keeps everything in arrays owned by :class:`AStarRun` and returns a status when
 a buffer is full, a pattern-database entry is missing, a batch is done (so Python can check
 the deadline) or the search ends; the next call resumes where it stopped (a node whose
 expansion was cut short is expanded again from scratch; its children already stored are found
@@ -77,7 +77,7 @@ def pdb_view(pdb: PatternDB, miss: I16) -> PDBView:
 
 
 class Nodes(NamedTuple):
-    """The stored states (:class:`Run`'s arrays): ``rows`` and their hash ``table``; per node
+    """The stored states (:class:`AStarRun`'s arrays): ``rows`` and their hash ``table``; per node
     ``g``, ``h``, the active part's ``h``, ``f``, the parent and the move from it (group mask,
     direction, ``k``; 0 for a removal), and whether it is closed."""
 
@@ -462,7 +462,7 @@ def run_astar(
     regs: I64, nodes: Nodes, heap: Heap, pieces: Pieces, pdb: PDBView, max_expansions: int,
     batch: int,
 ) -> int:  # fmt: skip
-    """A* from the stored states until a status (module docstring); see :class:`Run`."""
+    """A* from the stored states until a status (module docstring); see :class:`AStarRun`."""
     n = pieces.lo.shape[0]
     work = (
         np.empty(nodes.rows.shape[1], dtype=np.int16),
@@ -486,7 +486,7 @@ def run_astar(
         done += 1
 
 
-class Run:
+class AStarRun:
     """One A* search's arrays, and the Python loop that serves the kernel's requests."""
 
     def __init__(
