@@ -18,8 +18,8 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I32, I64
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import njit
@@ -46,9 +46,6 @@ from chaingeo.solvers.motion import btsearch as bt
 from chaingeo.solvers.motion import levelsearch as ls
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.disassemble import KERNEL_NODES, Analysis, Separations
-
-I64 = npt.NDArray[np.int64]
-Int32Array = npt.NDArray[np.int32]
 
 #: Placement keys ``(transformation, x, y, z)`` packed into one ordered integer.
 _BIAS = 1 << 15
@@ -192,7 +189,7 @@ class RowVerdicts:
                 image[seg] = image[seg][np.argsort(self._key(image[seg]), kind="stable")]
         return image
 
-    def verdict(self, rows: Int32Array) -> bool | None:
+    def verdict(self, rows: I32) -> bool | None:
         """Whether BurrTools takes the assembly ``rows`` apart (None: not decided here)."""
         self.level = None
         pieces = rows[self.piece[rows]].astype(np.int64)
@@ -232,7 +229,7 @@ class StuckCheck:
         self.cells = problem.flat_cells
         self.piece = problem.row_type != packing.hole_type
 
-    def __call__(self, rows: Int32Array) -> bool:
+    def __call__(self, rows: I32) -> bool:
         return bool(mv.stuck(self.pos, self.box, self.row_ptr, self.cells, rows[self.piece[rows]]))
 
 

@@ -19,7 +19,7 @@ from collections.abc import Callable, Generator, Iterable, Iterator
 from multiprocessing.pool import AsyncResult, Pool
 from typing import Final, Protocol
 
-from chaingeo.solvers.cover.placements import Int32Array
+from chaingeo.core.arrays import I32
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.jobs import check_jobs, default_jobs, fork_pool
 
@@ -29,7 +29,7 @@ __all__ = ["check_jobs", "default_jobs", "verdicts"]
 class StuckTest(Protocol):
     """Whether nothing can move in an assembly (its rows)."""
 
-    def __call__(self, rows: Int32Array) -> bool: ...
+    def __call__(self, rows: I32) -> bool: ...
 
 
 class VerdictSource(Protocol):
@@ -37,7 +37,7 @@ class VerdictSource(Protocol):
 
     level: str | None
 
-    def verdict(self, rows: Int32Array) -> bool | None: ...
+    def verdict(self, rows: I32) -> bool | None: ...
 
 
 #: What is known of one assembly: nothing can move, BurrTools' disassembler does not take it
@@ -55,13 +55,13 @@ IN_FLIGHT: Final = 3
 #: Seconds between two looks at the deadline while waiting for a worker.
 POLL_SECONDS: Final = 0.05
 
-Verdict = tuple[Int32Array, int, str | None]
+Verdict = tuple[I32, int, str | None]
 #: How a worker builds its checks of the packing
 #: (:class:`chaingeo.solvers.assembly.btcount.WorkerChecks`).
 WorkerFactory = Callable[[], tuple[StuckTest, VerdictSource]]
 
 
-def judge(rows: Int32Array, stuck: StuckTest | None, on_rows: VerdictSource | None) -> Verdict:
+def judge(rows: I32, stuck: StuckTest | None, on_rows: VerdictSource | None) -> Verdict:
     """One assembly's verdict in this process (``stuck`` None: piece groups, where a part may
     be done without moving)."""
     if stuck is not None and stuck(rows):
@@ -73,7 +73,7 @@ def judge(rows: Int32Array, stuck: StuckTest | None, on_rows: VerdictSource | No
 
 
 def verdicts(
-    classes: Iterable[Int32Array],
+    classes: Iterable[I32],
     stuck: StuckTest | None,
     on_rows: VerdictSource | None,
     *,
@@ -96,14 +96,14 @@ def verdicts(
 
 
 def _on_workers(
-    it: Iterator[Int32Array],
+    it: Iterator[I32],
     jobs: int,
     deadline: Deadline | None,
     worker: WorkerFactory,
 ) -> Generator[Verdict, None, None]:
     """The rest of ``it`` on ``jobs`` worker processes, answers in order."""
     pool = _pool(jobs, worker)
-    pending: deque[tuple[list[Int32Array], AsyncResult[list[tuple[int, str | None]]]]] = deque()
+    pending: deque[tuple[list[I32], AsyncResult[list[tuple[int, str | None]]]]] = deque()
     try:
         done = False
         while not done or pending:
@@ -126,8 +126,8 @@ def _on_workers(
         pool.join()
 
 
-def _take(it: Iterator[Int32Array], n: int) -> list[Int32Array]:
-    out: list[Int32Array] = []
+def _take(it: Iterator[I32], n: int) -> list[I32]:
+    out: list[I32] = []
     for rows in it:
         out.append(rows)
         if len(out) == n:
@@ -148,6 +148,6 @@ def _start(worker: WorkerFactory) -> None:
     _CHECKS[:] = [worker()]
 
 
-def _answer(batch: list[Int32Array]) -> list[tuple[int, str | None]]:
+def _answer(batch: list[I32]) -> list[tuple[int, str | None]]:
     stuck, on_rows = _CHECKS[0]
     return [judge(rows, stuck, on_rows)[1:] for rows in batch]

@@ -50,8 +50,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from chaingeo.core.arrays import I32
 from chaingeo.core.geometry import Shape
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import (
     CoverError,
     CoverProblem,
@@ -104,7 +104,7 @@ class Solution:
         return [s for _, s in self.placements]
 
 
-def make_solution(problem: CoverProblem, rows: Int32Array) -> Solution:
+def make_solution(problem: CoverProblem, rows: I32) -> Solution:
     ids = sorted(int(r) for r in rows if r >= 0)
     per_type: dict[int, list[int]] = {}
     for r in ids:
@@ -133,17 +133,15 @@ class AnchorPlan:
     """
 
     label: str  # the anchor piece's name, or "cell [x, y, z]"
-    rows: Int32Array  # every anchored row
-    group: Int32Array  # the subgroup used (indices into the problem's row maps)
+    rows: I32  # every anchored row
+    group: I32  # the subgroup used (indices into the problem's row maps)
     exact: bool  # a unique piece under the whole group: free-rep solutions are all distinct
-    free_reps: Int32Array  # reps whose stabiliser is trivial (orbit size len(group))
-    fixed_reps: Int32Array  # reps with a non-trivial stabiliser
-    fixed_orbit: Int32Array  # orbit size of each fixed rep
+    free_reps: I32  # reps whose stabiliser is trivial (orbit size len(group))
+    fixed_reps: I32  # reps with a non-trivial stabiliser
+    fixed_orbit: I32  # orbit size of each fixed rep
 
 
-def _orbits(
-    maps: Int32Array, group: Int32Array, rows: Int32Array
-) -> tuple[Int32Array, Int32Array, Int32Array]:
+def _orbits(maps: I32, group: I32, rows: I32) -> tuple[I32, I32, I32]:
     """Orbit representatives of ``rows`` under ``group``: free, fixed, and fixed orbit sizes."""
     sub = maps[group]
     reps = np.unique(sub[:, rows].min(axis=0))
@@ -213,7 +211,7 @@ def _cell_anchor(problem: CoverProblem) -> AnchorPlan | None:
     return None if best is None else best[1]
 
 
-def canonical_forms(problem: CoverProblem, solutions: Int32Array, chunk: int = 4096) -> Int32Array:
+def canonical_forms(problem: CoverProblem, solutions: I32, chunk: int = 4096) -> I32:
     """Lexicographically least sorted row set of each solution over the symmetry group.
 
     ``solutions`` is ``(n, k)`` row ids, ``-1`` padded; the result is ``(n, k)`` (padding last).
@@ -234,7 +232,7 @@ def canonical_forms(problem: CoverProblem, solutions: Int32Array, chunk: int = 4
     return np.where(out == big, -1, out)
 
 
-def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> int:
+def _count_distinct_forms(problem: CoverProblem, blocks: list[I32]) -> int:
     if not blocks:
         return 0
     width = max(b.shape[1] for b in blocks)
@@ -244,7 +242,7 @@ def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> in
     return len(np.unique(canonical_forms(problem, sols), axis=0))
 
 
-def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, reps: Int32Array) -> Int32Array:
+def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, reps: I32) -> I32:
     keep = np.ones(problem.n_rows, dtype=bool)
     keep[plan.rows] = False
     keep[reps] = True
@@ -289,7 +287,7 @@ def count_packings(
     h = len(plan.group)
     total = 0
     n_distinct = 0
-    blocks: list[Int32Array] = []
+    blocks: list[I32] = []
     if len(plan.free_reps):
         search = budget.search(problem, _restricted_rows(problem, plan, plan.free_reps), engine)
         if distinct and not plan.exact:
@@ -337,7 +335,7 @@ class _CoverBudget:
         self.jobs = jobs if node_limit is None and not bounded else 1
         self.engine = engine
 
-    def _parallel(self, search: CoverSearch, collect: bool) -> list[Int32Array]:
+    def _parallel(self, search: CoverSearch, collect: bool) -> list[I32]:
         """The search's subtrees on the workers (its own kernel never runs)."""
         from chaingeo.solvers.cover import parallel
 
@@ -363,12 +361,12 @@ class _CoverBudget:
 
         return self.jobs > 1 and len(search.rows) >= MIN_ROWS
 
-    def search(self, problem: CoverProblem, rows: Int32Array | None, engine: Engine) -> CoverSearch:
+    def search(self, problem: CoverProblem, rows: I32 | None, engine: Engine) -> CoverSearch:
         left = None if self.limit is None else max(self.limit - self.stats.nodes, 0)
         return CoverSearch(problem, rows, engine=engine, node_limit=left, deadline=self.deadline)
 
-    def _run(self, search: CoverSearch, collect: bool) -> list[Int32Array]:
-        blocks: list[Int32Array] = []
+    def _run(self, search: CoverSearch, collect: bool) -> list[I32]:
+        blocks: list[I32] = []
         try:
             if collect:
                 blocks.extend(search.batches(4096))
@@ -388,7 +386,7 @@ class _CoverBudget:
         self._run(search, False)
         return search.found
 
-    def collect(self, search: CoverSearch) -> list[Int32Array]:
+    def collect(self, search: CoverSearch) -> list[I32]:
         if self._worth_workers(search):
             return self._parallel(search, True)
         return self._run(search, True)

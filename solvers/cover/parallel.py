@@ -17,8 +17,8 @@ from typing import Final
 
 import numpy as np
 
+from chaingeo.core.arrays import I32
 from chaingeo.solvers.cover.bitboard import scan_order
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
 from chaingeo.solvers.cover.search import CoverSearch, Engine, choose_kernel
 from chaingeo.solvers.jobs import fork_pool
@@ -32,7 +32,7 @@ MAX_DEPTH: Final = 3
 MIN_ROWS: Final = 1500
 
 
-def split_rows(problem: CoverProblem, rows: Int32Array, engine: Engine) -> list[Int32Array]:
+def split_rows(problem: CoverProblem, rows: I32, engine: Engine) -> list[I32]:
     """The subtrees of the search over ``rows`` (see the module's docstring), in order."""
     first_cell = choose_kernel(problem, engine) == "bitboard-first"
     scan = scan_order(problem) if first_cell else np.arange(problem.n_cells, dtype=np.int32)
@@ -40,7 +40,7 @@ def split_rows(problem: CoverProblem, rows: Int32Array, engine: Engine) -> list[
     for _ in range(MAX_DEPTH):
         if len(parts) >= PARTS:
             break
-        cut: list[Int32Array] = []
+        cut: list[I32] = []
         for i, part in enumerate(parts):
             if len(cut) + len(parts) - i >= PARTS:
                 cut.append(part)  # enough subtrees: the rest stay whole
@@ -52,9 +52,7 @@ def split_rows(problem: CoverProblem, rows: Int32Array, engine: Engine) -> list[
     return parts
 
 
-def _cut(
-    problem: CoverProblem, rows: Int32Array, scan: Int32Array, first_cell: bool
-) -> list[Int32Array]:
+def _cut(problem: CoverProblem, rows: I32, scan: I32, first_cell: bool) -> list[I32]:
     """One subtree per row of the column the kernel would branch on (as near as it can be
     told from outside): an exact-once piece or a mandatory cell, of two rows or more. The
     first-cell kernel takes the first open cell in its scan order unless a piece has fewer
@@ -87,7 +85,7 @@ def _cut(
         chosen = np.flatnonzero(types == piece)
     else:
         chosen = np.unique(owner[cells == cell])
-    out: list[Int32Array] = []
+    out: list[I32] = []
     for i in chosen.tolist():
         taken = np.zeros(problem.n_cells, dtype=bool)
         taken[cells[starts[i] : starts[i] + sizes[i]]] = True
@@ -100,9 +98,7 @@ def _cut(
     return out
 
 
-def count_parallel(
-    problem: CoverProblem, rows: Int32Array, engine: Engine, jobs: int
-) -> tuple[int, int]:
+def count_parallel(problem: CoverProblem, rows: I32, engine: Engine, jobs: int) -> tuple[int, int]:
     """``(covers, nodes)`` of the search over ``rows``, its subtrees on ``jobs`` workers."""
     parts = split_rows(problem, rows, engine)
     results = _map(problem, engine, jobs, parts, collect=False)
@@ -110,8 +106,8 @@ def count_parallel(
 
 
 def collect_parallel(
-    problem: CoverProblem, rows: Int32Array, engine: Engine, jobs: int
-) -> tuple[list[Int32Array], int]:
+    problem: CoverProblem, rows: I32, engine: Engine, jobs: int
+) -> tuple[list[I32], int]:
     """Every cover of the search over ``rows`` (blocks in subtree order) and the nodes."""
     parts = split_rows(problem, rows, engine)
     results = _map(problem, engine, jobs, parts, collect=True)
@@ -126,7 +122,7 @@ def _start(problem: CoverProblem, engine: Engine) -> None:
     _WORK[:] = [(problem, engine)]
 
 
-def _search(args: tuple[Int32Array, bool]) -> tuple[int, int, list[Int32Array]]:
+def _search(args: tuple[I32, bool]) -> tuple[int, int, list[I32]]:
     rows, collect = args
     problem, engine = _WORK[0]
     search = CoverSearch(problem, rows, engine=engine)
@@ -137,8 +133,8 @@ def _search(args: tuple[Int32Array, bool]) -> tuple[int, int, list[Int32Array]]:
 
 
 def _map(
-    problem: CoverProblem, engine: Engine, jobs: int, parts: Sequence[Int32Array], collect: bool
-) -> list[tuple[int, int, list[Int32Array]]]:
+    problem: CoverProblem, engine: Engine, jobs: int, parts: Sequence[I32], collect: bool
+) -> list[tuple[int, int, list[I32]]]:
     """Each part searched (on ``jobs`` workers when more than one), results in part order."""
     work = [(p, collect) for p in parts]
     if jobs <= 1:

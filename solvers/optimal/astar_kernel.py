@@ -16,8 +16,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I32, I64, U8
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import entry, njit
 from chaingeo.solvers.motion import movement as mv
@@ -27,9 +27,6 @@ if TYPE_CHECKING:
     from chaingeo.solvers.deadline import Deadline
     from chaingeo.solvers.motion.partsearch import PieceTable
     from chaingeo.solvers.optimal.pattern_db import PatternDB
-
-I64 = npt.NDArray[np.int64]
-I32 = npt.NDArray[np.int32]
 
 
 @dataclass(frozen=True)
@@ -45,10 +42,6 @@ class AStarLimits:
     seconds: float | None = 300.0
     group_limit: int = 4096
 
-
-I16 = npt.NDArray[np.int16]
-U8 = npt.NDArray[np.uint8]
-U64 = npt.NDArray[np.uint64]
 
 FOUND, EXHAUSTED, NEED_STATES, NEED_HEAP, NEED_PDB, NEED_MOVES, YIELD, LIMIT, GROUPS = range(9)
 # Registers shared with Python.
