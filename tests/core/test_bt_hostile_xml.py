@@ -54,7 +54,7 @@ def test_chain_analyze_names_the_file_of_a_deep_solution(
 ) -> None:
     path = tmp_path / "deep.xmpuzzle"
     path.write_bytes(gzip.compress(_with_solution_extra(b"<s>" * 5000 + b"</s>" * 5000)))
-    assert main(["analyze", "--jit", "python", str(path)]) == 2
+    assert main(["analyze", str(path)]) == 2
     err = capsys.readouterr().err
     assert str(path) in err and "nested" in err and "recursion" not in err
 
