@@ -52,12 +52,12 @@ def trajectories(tmp: Path) -> Surface:
     from chaingeo.core.files import UnreadableFile, read_bounded
     from chaingeo.core.limits import MAX_TRAJECTORY_BYTES
     from chaingeo.core.suite import load_level
-    from chaingeo.envs.worldmodel.trajectory import (
+    from chaingeo.worldmodel.trajectory import (
         parse_trajectory,
         puzzle_trajectory,
         trajectory_json,
     )
-    from chaingeo.envs.worldmodel.trajectory_verdict import check_trajectory
+    from chaingeo.worldmodel.trajectory_verdict import check_trajectory
 
     level = load_level("puzzle-easy-07-burr3")
     doc = trajectory_json(level.id, puzzle_trajectory(level, None))
@@ -93,12 +93,12 @@ def trajectories(tmp: Path) -> Surface:
 
 def kernel_store(tmp: Path) -> Surface:
     """A store whose manifest records its module, damaged one way per case; each must be
-    refused by :func:`chaingeo.core.aot.status` before the module is imported."""
+    refused by :func:`chaingeo.kernels.aot.status` before the module is imported."""
     import importlib.util
 
     import numpy as np
 
-    from chaingeo.core import aot
+    from chaingeo.kernels import aot
 
     s = Surface("precompiled-kernel store")
     module = b"\x7fELF" + bytes(range(256)) * 32
@@ -447,7 +447,7 @@ def video_limits(tmp: Path) -> Surface:
     import subprocess
 
     from chaingeo.core import limits
-    from chaingeo.envs.worldmodel.judge_video import read_clip
+    from chaingeo.worldmodel.judge_video import read_clip
 
     s = Surface("judge-video decoding")
     try:

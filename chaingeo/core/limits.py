@@ -292,9 +292,28 @@ MAX_TRAJECTORY_POSES: Final = 1_000_000
 MAX_TRAJECTORY_COORD: Final = 1e6
 
 # ---------------------------------------------------------------------------------------------
-# The precompiled-kernel store (chaingeo/core/aot.py, issue #37, item 2)
+# The precompiled-kernel store (chaingeo/kernels/aot.py, issue #37, item 2)
 # ---------------------------------------------------------------------------------------------
 
 #: Bytes of a store's manifest and of any file it hashes (the extension module, a source).
 MAX_KERNEL_MANIFEST_BYTES: Final = 16 * 1024 * 1024
 MAX_KERNEL_FILE_BYTES: Final = 256 * 1024 * 1024
+
+# ---------------------------------------------------------------------------------------------
+# chain serve: the environment server's sessions (chaingeo/integrations/serve)
+# ---------------------------------------------------------------------------------------------
+# Every client of the server is untrusted: a session is one WebSocket connection, and each is
+# bounded here, checked before the work (a frame's size and nesting before it is parsed).
+
+#: Sessions open at once (WebSocket connections with an environment); one more is refused.
+MAX_SESSIONS: Final = 64
+#: Seconds a session may stay silent before the server closes it.
+SESSION_IDLE_SECONDS: Final = 900.0
+#: Bytes of one request: a WebSocket frame or an HTTP body (a reply of MAX_REPLY_CHARS fits).
+MAX_REQUEST_BYTES: Final = 1024 * 1024
+#: Bytes one session may send in all, and messages (resets, steps, states) it may send in all:
+#: a client that wants more opens a new session.
+MAX_SESSION_BYTES: Final = 256 * 1024 * 1024
+MAX_SESSION_MESSAGES: Final = 100_000
+#: Characters of a study's participant id and of a study's name.
+MAX_PARTICIPANT_CHARS: Final = 64

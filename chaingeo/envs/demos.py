@@ -79,7 +79,7 @@ def _pngs(frames: dict[str, Any]) -> dict[str, bytes]:
     """PNG bytes of the environment's pixel arrays (pixel-equal to ``render_state``'s PNGs)."""
     from PIL import Image
 
-    from chaingeo.envs.render.raster import png_bytes
+    from chaingeo.pictures.raster import png_bytes
 
     return {name: png_bytes(Image.fromarray(frame)) for name, frame in frames.items()}
 

@@ -58,7 +58,7 @@ from chaingeo.envs.frames import Frame, FrameCache, picture_names
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.machines.state import BaseState
 from chaingeo.envs.observation import DEFAULT_HISTORY, VIEWS, observe
-from chaingeo.envs.render.scene import MIN_SIZE
+from chaingeo.pictures.scene import MIN_SIZE
 
 #: Characters of text actions and observations: printable ASCII and newline.
 CHARSET: Final = frozenset(c for c in string.printable if c not in "\x0b\x0c\r")

@@ -81,7 +81,7 @@ def test_one_bad_file_is_an_error_with_no_json(
 def test_kernels_cannot_change_in_a_process_that_has_them(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    from chaingeo.core.jit import mode
+    from chaingeo.kernels.jit import mode
 
     assert mode() == "numba"  # the test process compiles its kernels
     assert main(["analyze", "puzzle-easy-07-burr3", "--jit", "python"]) == 2

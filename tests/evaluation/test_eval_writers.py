@@ -175,7 +175,7 @@ def test_a_video_cut_short_is_an_error_not_a_success(
 ) -> None:
     """A writer that stops early without an error (ffmpeg on a full disk) leaves a file that
     is not whole: the command says so (exit 2) and leaves no file."""
-    import chaingeo.envs.worldmodel.video as video
+    import chaingeo.worldmodel.video as video
 
     def short(v: Any, path: Path) -> Path:
         path.write_bytes((b"GIF89a" if suffix == ".gif" else b"\0\0\0\x20ftypisom") + b"\0" * 4000)

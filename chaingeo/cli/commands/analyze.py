@@ -17,7 +17,7 @@ optimal search alone is reported as ``optimal_error``).
 match the installed sources (loading them takes milliseconds, starting numba ~0.5 s); a call
 they were not compiled for makes the command start again with numba for the files not yet
 printed. Without them, a single small file runs with interpreted kernels: starting numba costs
-more than the work (:mod:`chaingeo.core.jit`); if the work takes more than
+more than the work (:mod:`chaingeo.kernels.jit`); if the work takes more than
 :data:`INTERPRETED_SECONDS` of CPU time, the command starts again with numba.
 
 When a cap (``--seconds``, ``--max-states``) stops the counting of assemblies, nothing finished
@@ -204,8 +204,8 @@ def analyze_file(spec: str, args: argparse.Namespace, end: float | None = None) 
     problems of a BurrTools file are analysed one by one, each with the time left."""
     from chaingeo.core.errors import ChainGeoError
     from chaingeo.core.formats.burrtools import BTPuzzle
-    from chaingeo.core.jit import mode
     from chaingeo.core.kinematics import SearchLimitError
+    from chaingeo.kernels.jit import mode
     from chaingeo.solvers.figures import PuzzleFigures
 
     end = time.monotonic() + args.seconds if end is None else end
@@ -301,7 +301,7 @@ def _ahead_of_time_first(args: argparse.Namespace) -> bool:
     """Whether to use the precompiled kernels: ``--jit aot``, or ``--jit auto`` when they match
     the sources, no mode is forced by ``CHAINGEO_JIT`` and the command can start itself again
     (not a call of ``main``)."""
-    from chaingeo.core import aot, jit
+    from chaingeo.kernels import aot, jit
 
     if _aot_forced(args):
         return True
@@ -316,7 +316,7 @@ def _ahead_of_time_first(args: argparse.Namespace) -> bool:
 
 
 def _aot_forced(args: argparse.Namespace) -> bool:
-    from chaingeo.core.jit import ENV
+    from chaingeo.kernels.jit import ENV
 
     return bool(args.jit == "aot" or (args.jit == "auto" and os.environ.get(ENV) == "aot"))
 
@@ -324,7 +324,7 @@ def _aot_forced(args: argparse.Namespace) -> bool:
 def _run_ahead_of_time(args: argparse.Namespace) -> int:
     """Analyse with the precompiled kernels; on a call they do not cover, start again with
     numba for the files not yet printed (``--jit aot``: report the miss instead)."""
-    from chaingeo.core.aot import KernelMiss
+    from chaingeo.kernels.aot import KernelMiss
 
     _set_mode("aot")
     try:
@@ -345,7 +345,7 @@ class _TooLong(BaseException):
 
 
 def _set_mode(wanted: str) -> None:
-    from chaingeo.core.jit import set_mode
+    from chaingeo.kernels.jit import set_mode
 
     try:
         set_mode("python" if wanted == "python" else "aot" if wanted == "aot" else "numba")
@@ -356,7 +356,7 @@ def _set_mode(wanted: str) -> None:
 def _interpreted_first(args: argparse.Namespace) -> bool:
     """Whether to try the one file interpreted: ``--jit auto``, one small file, no mode forced
     by ``CHAINGEO_JIT``, and a command line to start again with (not a call of ``main``)."""
-    from chaingeo.core import jit
+    from chaingeo.kernels import jit
 
     argv = getattr(args, "command_line", None)
     if args.jit != "auto" or len(args.files) != 1 or argv is None or jit.ENV in os.environ:
@@ -432,7 +432,7 @@ def _run_interpreted(args: argparse.Namespace) -> int:
 
 def _restart_with_numba(argv: list[str], done: int = 0, status: int = 0) -> None:
     """Start the command again with numba's kernels, skipping the ``done`` files printed."""
-    from chaingeo.core.jit import ENV
+    from chaingeo.kernels.jit import ENV
 
     env = dict(os.environ, **{ENV: "numba", RESUME_ENV: f"{done}:{status}"})
     sys.stdout.flush()

@@ -29,8 +29,8 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.level_arg import find_level
     from chaingeo.cli.out_arg import out_folder
     from chaingeo.core.files import atomic_write
-    from chaingeo.envs.render.pictures import render_exploded
-    from chaingeo.envs.render.scene import render_level_tray, render_solution_views
+    from chaingeo.pictures.pictures import render_exploded
+    from chaingeo.pictures.scene import render_level_tray, render_solution_views
 
     level = find_level(args.level)
     pictures = dict(render_solution_views(level, size=args.size))

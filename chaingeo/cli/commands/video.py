@@ -1,5 +1,5 @@
 """``chain video LEVEL [--plan optimal|FILE] --out FILE.mp4|.gif``: a plan as continuous motion
-from one fixed camera (see :mod:`chaingeo.envs.worldmodel.video`)."""
+from one fixed camera (see :mod:`chaingeo.worldmodel.video`)."""
 
 from __future__ import annotations
 
@@ -37,8 +37,8 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
     from chaingeo.cli.level_arg import find_level
-    from chaingeo.envs.worldmodel.trajectory import write_trajectory
-    from chaingeo.envs.worldmodel.video import VideoError, plan_video, write_video
+    from chaingeo.worldmodel.trajectory import write_trajectory
+    from chaingeo.worldmodel.video import VideoError, plan_video, write_video
 
     if args.out.suffix.lower() not in (".mp4", ".gif"):
         raise CommandError(f"--out must end in .mp4 or .gif, got {str(args.out)!r}")

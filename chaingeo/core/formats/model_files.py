@@ -130,14 +130,14 @@ def _materials(root: ET.Element, at: _Where) -> dict[str, tuple[float, float, fl
 
 
 @dataclass
-class _Budget:
+class _ReadBudget:
     """Vertices and triangles a part may still have (all its meshes together)."""
 
     vertices: int = limits.MAX_PART_VERTICES
     triangles: int = limits.MAX_PART_TRIANGLES
 
 
-def _check_obj_text(text: str, what: str, budget: _Budget, at: _Where) -> None:
+def _check_obj_text(text: str, what: str, budget: _ReadBudget, at: _Where) -> None:
     """Count vertices and triangles, check the vertices are finite numbers of magnitude at most
     :data:`limits.MAX_MODEL_NUMBER` and that every face corner names one, before trimesh parses
     anything (it would drop a non-finite vertex, and the faces on it, without a word)."""
@@ -172,7 +172,7 @@ def _check_obj_text(text: str, what: str, budget: _Budget, at: _Where) -> None:
                 )
 
 
-def _load_obj(path: Path, what: str, budget: _Budget, at: _Where) -> trimesh.Trimesh:
+def _load_obj(path: Path, what: str, budget: _ReadBudget, at: _Where) -> trimesh.Trimesh:
     """One OBJ file, bounded and checked (see the module doc), as a processed trimesh mesh."""
     data = _read_bounded(path, limits.MAX_MESH_BYTES, what, at)
     try:
@@ -213,7 +213,7 @@ def load_urdf_part(urdf: Path, model_dir: Path) -> PartMesh:
     rgba: tuple[float, float, float, float] | None = None
     material: str | None = None
     offset = 0
-    budget = _Budget()
+    budget = _ReadBudget()
     for i, vis in enumerate(visuals):
         at = _Where(str(model_dir), f"{urdf_field} visual[{i}]")
         origin = vis.find("origin")

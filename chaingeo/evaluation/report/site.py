@@ -47,7 +47,7 @@ from typing import Any, Final
 from chaingeo.core import limits
 from chaingeo.core.files import UnreadableFile, atomic_write, folder_locked, read_bounded
 from chaingeo.evaluation.logs import IMAGES, RunError, RunLog
-from chaingeo.evaluation.report.tables import Run, Table, tables, write_report
+from chaingeo.evaluation.report.tables import Run, Table, sort_value, tables, write_report
 from chaingeo.evaluation.usage import PriceTable, Usage
 
 MARKER: Final = ".chain-site"
@@ -64,7 +64,7 @@ _VIEW_ORDER = ("front", "side", "top", "iso", "tray", "target")
 
 
 @dataclass(frozen=True)
-class Episode:
+class EpisodePage:
     """One episode record of one run, and where its page goes."""
 
     run: Run
@@ -103,7 +103,7 @@ class _Builder:
     def __init__(self, runs: Sequence[Run], root: Path, prices: PriceTable) -> None:
         self.runs, self.root, self.prices = list(runs), root, prices
         self.run_slugs = _unique([_slug(r.path.name) for r in runs])
-        self.episodes: list[Episode] = []
+        self.episodes: list[EpisodePage] = []
         for i, run in enumerate(self.runs):
             records = sorted(
                 RunLog(run.path).latest().values(),
@@ -114,7 +114,7 @@ class _Builder:
             )
             for rec, page in zip(records, pages, strict=True):
                 self.episodes.append(
-                    Episode(run, i, rec, f"episodes/{self.run_slugs[i]}/{page}.html")
+                    EpisodePage(run, i, rec, f"episodes/{self.run_slugs[i]}/{page}.html")
                 )
         level_ids = sorted({str(e.record.get("level_id")) for e in self.episodes})
         level_slugs = _unique([_slug(i) for i in level_ids])
@@ -179,6 +179,8 @@ class _Builder:
         )
         for name, table in tables(self.runs):
             parts.append(f"<h2>{escape(table.title)}</h2>")
+            if table.caption:
+                parts.append(f'<p class="note">Uncertainty: {escape(table.caption)}.</p>')
             parts.append(_report_table(name, table))
         parts.append("<h2>Cost versus success</h2>")
         parts.append(
@@ -191,7 +193,7 @@ class _Builder:
 
     def level_matrix(self) -> str:
         """Rows: levels; columns: runs; a cell: solved samples of the run on that level."""
-        by_cell: dict[tuple[str, int], list[Episode]] = {}
+        by_cell: dict[tuple[str, int], list[EpisodePage]] = {}
         facts: dict[str, dict[str, Any]] = {}
         for ep in self.episodes:
             level_id = str(ep.record.get("level_id"))
@@ -258,7 +260,7 @@ class _Builder:
         parts.append(_sortable("episodes", head, rows))
         return _page(level_id, "\n".join(parts), up="../")
 
-    def episode_page(self, ep: Episode) -> str:
+    def episode_page(self, ep: EpisodePage) -> str:
         r, up = ep.record, "../../"
         level_id = str(r.get("level_id"))
         text, cls = _result(r)
@@ -340,7 +342,7 @@ class _Builder:
             return None
         return costs
 
-    def frames(self, ep: Episode, up: str) -> list[str]:
+    def frames(self, ep: EpisodePage, up: str) -> list[str]:
         r = ep.record
         costs = self.turn_costs(r)
         out: list[str] = []
@@ -460,11 +462,11 @@ def _sortable(table_id: str, head: Sequence[tuple[str, bool]], rows: Iterable[li
 def _report_table(name: str, table: Table) -> str:
     """A report table with its own formatters for the text and the raw values for sorting."""
     numeric = [
-        all(isinstance(row[j], int | float) or row[j] is None for row in table.rows) and j > 0
+        all(isinstance(sort_value(row[j]), int | float | None) for row in table.rows) and j > 0
         for j in range(len(table.columns))
     ]
     rows = [
-        [_Cell(fmt(v), _sort_key(v)) for fmt, v in zip(table.formats, row, strict=True)]
+        [_Cell(fmt(v), _sort_key(sort_value(v))) for fmt, v in zip(table.formats, row, strict=True)]
         for row in table.rows
     ]
     return _sortable(name, list(zip(table.columns, numeric, strict=True)), rows)
@@ -567,7 +569,7 @@ def _result(r: Mapping[str, Any]) -> tuple[str, str]:
     return ("out of steps" if r.get("truncated") else "unsolved"), "unsolved"
 
 
-def _errored(eps: Sequence[Episode]) -> bool:
+def _errored(eps: Sequence[EpisodePage]) -> bool:
     return any(e.record.get("status") == "error" for e in eps)
 
 
