@@ -292,14 +292,6 @@ MAX_TRAJECTORY_POSES: Final = 1_000_000
 MAX_TRAJECTORY_COORD: Final = 1e6
 
 # ---------------------------------------------------------------------------------------------
-# The precompiled-kernel store (chaingeo/kernels/aot.py, issue #37, item 2)
-# ---------------------------------------------------------------------------------------------
-
-#: Bytes of a store's manifest and of any file it hashes (the extension module, a source).
-MAX_KERNEL_MANIFEST_BYTES: Final = 16 * 1024 * 1024
-MAX_KERNEL_FILE_BYTES: Final = 256 * 1024 * 1024
-
-# ---------------------------------------------------------------------------------------------
 # chain serve: the environment server's sessions (chaingeo/integrations/serve)
 # ---------------------------------------------------------------------------------------------
 # Every client of the server is untrusted: a session is one WebSocket connection, and each is
@@ -317,3 +309,11 @@ MAX_SESSION_BYTES: Final = 256 * 1024 * 1024
 MAX_SESSION_MESSAGES: Final = 100_000
 #: Characters of a study's participant id and of a study's name.
 MAX_PARTICIPANT_CHARS: Final = 64
+
+# ---------------------------------------------------------------------------------------------
+# The precompiled-kernel store (chaingeo/kernels/aot.py, issue #37, item 2)
+# ---------------------------------------------------------------------------------------------
+
+#: Bytes of a store's manifest and of any file it hashes (the extension module, a source).
+MAX_KERNEL_MANIFEST_BYTES: Final = 16 * 1024 * 1024
+MAX_KERNEL_FILE_BYTES: Final = 256 * 1024 * 1024

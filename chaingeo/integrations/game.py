@@ -25,7 +25,13 @@ from chaingeo.evaluation.agents.base import ToolCall
 from chaingeo.evaluation.agents.dialects import DIALECTS, read_reply, tool_call
 from chaingeo.evaluation.agents.prompt import user_content
 from chaingeo.evaluation.agents.tools import skipped_result, tool_specs
-from chaingeo.evaluation.episode import PROTOCOLS, Episode, Outcome, ProtocolConfig
+from chaingeo.evaluation.episode import (
+    PROTOCOLS,
+    Episode,
+    EpisodeOverError,
+    Outcome,
+    ProtocolConfig,
+)
 
 Protocol = Literal["interactive", "oneshot"]
 Message = dict[str, Any]
@@ -139,9 +145,12 @@ class Game:
     def answer(self, reply: str, calls: Sequence[Call] = ()) -> list[Message] | None:
         """Play ``reply`` (its tool calls, when tools are offered and it made any, else its
         text); the next user turn's messages, or None once the episode is over."""
-        reply = reply_text(reply)  # a list of content parts, or anything else, read as text
-        made = tuple(tool_call(*_triple(call), self.tools) for call in _calls_of(calls))
         ep = self.episode
+        if ep.done:
+            raise EpisodeOverError(f"{self.level.id}: the episode is over")
+        reply = reply_text(reply)
+        given = list(calls) if isinstance(calls, list | tuple) else []
+        made = tuple(tool_call(_call_id(c), *_name_args(c), self.tools) for c in given)
         results = ep.play(
             read_reply(self.dialect, reply, made if self.tools else (), oneshot=ep.oneshot)
         )
@@ -184,13 +193,14 @@ def reply_text(reply: Any) -> str:
     return ""
 
 
-def _calls_of(calls: Any) -> list[Any]:
-    return list(calls) if isinstance(calls, list | tuple) else []
-
-
-def _triple(call: Any) -> tuple[str, Any, Any]:
-    """(id, name, arguments) of a call; one that is not such a triple reads as malformed."""
+def _name_args(call: Any) -> tuple[Any, Any]:
+    """A call's function name and arguments; a call that is not an (id, name, arguments)
+    triple reads as one with neither (translated as malformed: an unparseable step)."""
     if isinstance(call, list | tuple) and len(call) == 3:
-        cid = call[0] if isinstance(call[0], str) else ""
-        return cid, call[1], call[2]
-    return "", None, None
+        return call[1], call[2]
+    return None, None
+
+
+def _call_id(call: Any) -> str:
+    found = call[0] if isinstance(call, list | tuple) and call else ""
+    return found if isinstance(found, str) else ""

@@ -239,13 +239,13 @@ def _within(
     from chaingeo.solvers.deadline import Deadline
     from chaingeo.solvers.limits import SearchLimits
 
-    if end - time.monotonic() <= 0:
+    left = end - time.monotonic()
+    if left <= 0:
         return None
     limits = SearchLimits(
-        max_states=args.max_states, seconds=args.seconds, optimal_seconds=args.optimal_seconds
+        max_states=args.max_states, seconds=left, optimal_seconds=args.optimal_seconds
     )
-    deadline = Deadline(limits.seconds)  # its messages name --seconds; it ends with the command
-    deadline.end = min(end, deadline.end if deadline.end is not None else end)
+    deadline = Deadline(limits.seconds, stated=args.seconds)
     with ProgressLines(f"chain analyze: {spec}", deadline.progress):
         return analyze(
             source,

@@ -62,7 +62,7 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
     from chaingeo.core.piecesets import get_pieceset
 
     path = Path(source)
-    if not path.is_file():
+    if not (path.exists() or path.is_symlink()):  # a name: a piece set or a level id
         try:
             return dict(get_pieceset(source).pieces), None
         except KeyError as e:

@@ -108,7 +108,11 @@ def serve(catalog: Catalog, options: ServeOptions) -> None:
         ),
         flush=True,
     )
-    server.run()
+    try:
+        server.run()
+    finally:
+        if catalog.study is not None:
+            catalog.study.close()
     print(json.dumps({"stopped": f"http://{options.host}:{options.port}/"}), flush=True)
 
 

@@ -51,6 +51,11 @@ class Study:
     samples: dict[str, int] = field(default_factory=dict)  # participant -> record sample
     lock: threading.Lock = field(default_factory=threading.Lock)
 
+    def close(self) -> None:
+        """Release the study's run folder (its writer's lock) for another server."""
+        with self.lock:
+            self.log.close()
+
     @classmethod
     def create(cls, name: str, folder: Path, levels: Sequence[Level], seed: int) -> Study:
         if not NAME_RE.fullmatch(name):

@@ -72,10 +72,12 @@ def test_two_participants_make_a_human_row(
     for r in records:
         times = [s["t"] for s in r["steps"]]
         assert times == sorted(times) and len(times) == r["steps_used"]
+    study.close()  # the server stopped: its folder is free
     again = Study.create("pilot", tmp_path, levels, seed=7)  # a restarted server resumes
     with pytest.raises(Exception, match="every level"):
         again.next_level("alice")
     assert again.next_level("carol").id == again.order("carol")[0].id
+    again.close()
 
     assert main(["report", str(tmp_path / "pilot"), "--out", str(tmp_path / "report")]) == 0
     out = capsys.readouterr().out
