@@ -21,19 +21,7 @@ import zlib
 
 from chaingeo.core import limits
 from chaingeo.core.files import UnreadableFile, read_bounded
-from chaingeo.core.formats.bt_model import (
-    MAX_COLORS,
-    RGB,
-    TRANSFORMS_BT,
-    BTPart,
-    BTPlacement,
-    BTProblem,
-    BTPuzzle,
-    BTShape,
-    BTSolution,
-    BurrToolsError,
-    Cell,
-)
+from chaingeo.core.formats import bt_model as bm
 from chaingeo.core.formats.xml_read import XmlRefused, parse_bounded, to_text
 from chaingeo.core.geometry import Shape
 
@@ -42,18 +30,18 @@ def _int(
     src: str, where: str, value: str | None, lo: int | None = None, hi: int | None = None
 ) -> int:
     if value is None:
-        raise BurrToolsError(src, where, "missing number")
+        raise bm.BurrToolsError(src, where, "missing number")
     text = value.strip()
     if len(text.lstrip("+-")) > limits.MAX_INT_DIGITS:
-        raise BurrToolsError(src, where, f"{value[:24]!r}... is too long a number")
+        raise bm.BurrToolsError(src, where, f"{value[:24]!r}... is too long a number")
     try:
         out = int(text)
     except ValueError:
-        raise BurrToolsError(src, where, f"{value!r} is not an integer") from None
+        raise bm.BurrToolsError(src, where, f"{value!r} is not an integer") from None
     if lo is not None and out < lo:
-        raise BurrToolsError(src, where, f"{out} is below {lo}")
+        raise bm.BurrToolsError(src, where, f"{out} is below {lo}")
     if hi is not None and out > hi:
-        raise BurrToolsError(src, where, f"{out} is above {hi}")
+        raise bm.BurrToolsError(src, where, f"{out} is above {hi}")
     return out
 
 
@@ -68,33 +56,33 @@ def _gunzip(data: bytes, source: str) -> bytes:
         try:
             out.append(d.decompress(rest, budget))
         except zlib.error as e:
-            raise BurrToolsError(source, "(file)", f"not a readable gzip stream: {e}") from None
+            raise bm.BurrToolsError(source, "(file)", f"not a readable gzip stream: {e}") from None
         budget -= len(out[-1])
         if not d.eof:
             if budget > 0:
-                raise BurrToolsError(source, "(file)", "not a readable gzip stream: truncated")
+                raise bm.BurrToolsError(source, "(file)", "not a readable gzip stream: truncated")
             break
         rest = d.unused_data
     if rest.strip(b"\0") and budget > 0:
-        raise BurrToolsError(source, "(file)", "not a readable gzip stream: data after it")
+        raise bm.BurrToolsError(source, "(file)", "not a readable gzip stream: data after it")
     return b"".join(out)
 
 
 def _decompress(data: bytes, source: str) -> bytes:
     raw = _gunzip(data, source) if data[:2] == b"\x1f\x8b" else data
     if len(raw) > limits.MAX_XMPUZZLE_XML_BYTES:
-        raise BurrToolsError(
+        raise bm.BurrToolsError(
             source, "(file)", f"more than {limits.MAX_XMPUZZLE_XML_BYTES} bytes of XML"
         )
     return raw
 
 
-def _parse_voxels(src: str, where: str, node: ET.Element, n_colors: int) -> BTShape:
+def _parse_voxels(src: str, where: str, node: ET.Element, n_colors: int) -> bm.BTShape:
     if node.get("type", "0") != "0":
-        raise BurrToolsError(src, where, f"voxel type {node.get('type')} is not the cube grid")
+        raise bm.BurrToolsError(src, where, f"voxel type {node.get('type')} is not the cube grid")
     sx, sy, sz = (_int(src, f"{where}.{k}", node.get(k), 0, limits.MAX_COORD) for k in "xyz")
     if sx * sy * sz > limits.MAX_BT_GRID_CELLS:
-        raise BurrToolsError(
+        raise bm.BurrToolsError(
             src, where, f"a {sx}x{sy}x{sz} grid; at most {limits.MAX_BT_GRID_CELLS} cells"
         )
     hotspot = tuple(
@@ -103,30 +91,30 @@ def _parse_voxels(src: str, where: str, node: ET.Element, n_colors: int) -> BTSh
     )
     weight = _int(src, f"{where}.weight", node.get("weight", "1"), 0, 1 << 31)
     text = "".join((node.text or "").split())
-    filled: list[Cell] = []
-    variable: list[Cell] = []
-    colors: list[tuple[Cell, int]] = []
+    filled: list[bm.Cell] = []
+    variable: list[bm.Cell] = []
+    colors: list[tuple[bm.Cell, int]] = []
     idx = 0
     i = 0
     while i < len(text):
         ch = text[i]
         if ch not in "#+_":
             what = "colour digits before the first voxel" if ch.isdigit() else repr(ch)
-            raise BurrToolsError(src, where, f"unexpected {what} in the voxel string")
+            raise bm.BurrToolsError(src, where, f"unexpected {what} in the voxel string")
         j = i + 1
         while j < len(text) and text[j].isdigit():
             j += 1
         if idx >= sx * sy * sz:
-            raise BurrToolsError(src, where, f"more than {sx * sy * sz} voxels for the grid")
+            raise bm.BurrToolsError(src, where, f"more than {sx * sy * sz} voxels for the grid")
         cell = (idx % sx, (idx // sx) % sy, idx // (sx * sy))
         if j > i + 1:
-            color = _int(src, f"{where} voxel {cell}", text[i + 1 : j], 0, MAX_COLORS)
+            color = _int(src, f"{where} voxel {cell}", text[i + 1 : j], 0, bm.MAX_COLORS)
             if color > n_colors:
-                raise BurrToolsError(
+                raise bm.BurrToolsError(
                     src, where, f"voxel {cell} has colour {color}; {n_colors} colours are defined"
                 )
             if color and ch == "_":
-                raise BurrToolsError(src, where, f"empty voxel {cell} carries colour {color}")
+                raise bm.BurrToolsError(src, where, f"empty voxel {cell} carries colour {color}")
             if color:
                 colors.append((cell, color))
         if ch == "#":
@@ -136,12 +124,12 @@ def _parse_voxels(src: str, where: str, node: ET.Element, n_colors: int) -> BTSh
         idx += 1
         i = j
     if idx != sx * sy * sz:
-        raise BurrToolsError(src, where, f"{idx} voxels given for a {sx}x{sy}x{sz} grid")
+        raise bm.BurrToolsError(src, where, f"{idx} voxels given for a {sx}x{sy}x{sz} grid")
     if len(filled) + len(variable) > limits.MAX_LEVEL_VOXELS:
-        raise BurrToolsError(
+        raise bm.BurrToolsError(
             src, where, f"{len(filled) + len(variable)} voxels; at most {limits.MAX_LEVEL_VOXELS}"
         )
-    return BTShape(
+    return bm.BTShape(
         node.get("name"),
         (sx, sy, sz),
         Shape(filled),
@@ -154,31 +142,31 @@ def _parse_voxels(src: str, where: str, node: ET.Element, n_colors: int) -> BTSh
 
 def _parse_assembly(
     src: str, where: str, text: str, slots: tuple[int, ...], n_shapes: int
-) -> tuple[BTPlacement | None, ...]:
+) -> tuple[bm.BTPlacement | None, ...]:
     toks = text.split()
-    out: list[BTPlacement | None] = []
+    out: list[bm.BTPlacement | None] = []
     i = 0
     for slot, shape in enumerate(slots):
         if i >= len(toks):
-            raise BurrToolsError(src, where, f"ends before piece {slot}")
+            raise bm.BurrToolsError(src, where, f"ends before piece {slot}")
         if toks[i] == "x":
             out.append(None)
             i += 1
             continue
         if i + 4 > len(toks):
-            raise BurrToolsError(src, where, f"piece {slot} needs x y z transform")
+            raise bm.BurrToolsError(src, where, f"piece {slot} needs x y z transform")
         x, y, z, t = _four_ints(src, where, toks[i : i + 4])
         i += 4
         if t == 255:  # older files: an unused piece
             out.append(None)
             continue
-        if not 0 <= t < len(TRANSFORMS_BT):
-            raise BurrToolsError(src, where, f"transform {t} of piece {slot} is not a cube one")
+        if not 0 <= t < len(bm.TRANSFORMS_BT):
+            raise bm.BurrToolsError(src, where, f"transform {t} of piece {slot} is not a cube one")
         if not 0 <= shape < n_shapes:
-            raise BurrToolsError(src, where, f"shape {shape} does not exist")
-        out.append(BTPlacement(shape, (x, y, z), t))
+            raise bm.BurrToolsError(src, where, f"shape {shape} does not exist")
+        out.append(bm.BTPlacement(shape, (x, y, z), t))
     if i != len(toks):
-        raise BurrToolsError(src, where, f"{len(toks) - i} tokens left over")
+        raise bm.BurrToolsError(src, where, f"{len(toks) - i} tokens left over")
     return tuple(out)
 
 
@@ -195,18 +183,18 @@ def _four_ints(src: str, where: str, toks: list[str]) -> tuple[int, int, int, in
     return x, y, z, t
 
 
-def _parse_part(src: str, where: str, node: ET.Element, n_shapes: int) -> BTPart:
+def _parse_part(src: str, where: str, node: ET.Element, n_shapes: int) -> bm.BTPart:
     cap = limits.MAX_PIECES
     sid = _int(src, f"{where}.id", node.get("id"), 0)
     if sid >= n_shapes:
-        raise BurrToolsError(src, f"{where}.id", f"shape {sid} does not exist")
+        raise bm.BurrToolsError(src, f"{where}.id", f"shape {sid} does not exist")
     if node.get("count") is not None:
         lo = hi = _int(src, f"{where}.count", node.get("count"), 0, cap)
     elif node.get("min") is not None and node.get("max") is not None:
         lo = _int(src, f"{where}.min", node.get("min"), 0, cap)
         hi = _int(src, f"{where}.max", node.get("max"), 0, cap)
         if lo > hi:
-            raise BurrToolsError(src, where, f"min {lo} is above max {hi}")
+            raise bm.BurrToolsError(src, where, f"min {lo} is above max {hi}")
     else:
         lo = hi = 1  # BurrTools' default
     groups: list[tuple[int, int]] = []
@@ -219,32 +207,32 @@ def _parse_part(src: str, where: str, node: ET.Element, n_shapes: int) -> BTPart
             cnt = _int(src, f"{where}.group[{k}].count", g.get("count"), 0, cap)
             if gid and cnt:  # group 0 is "no group", as BurrTools saves it
                 groups.append((gid, cnt))
-    return BTPart(sid, lo, hi, tuple(groups))
+    return bm.BTPart(sid, lo, hi, tuple(groups))
 
 
 def _parse_problem(
-    src: str, where: str, prob: ET.Element, shapes: tuple[BTShape, ...], n_colors: int
-) -> BTProblem:
+    src: str, where: str, prob: ET.Element, shapes: tuple[bm.BTShape, ...], n_colors: int
+) -> bm.BTProblem:
     parts = tuple(
         _parse_part(src, f"{where}.shapes[{k}]", s, len(shapes))
         for k, s in enumerate(prob.findall("shapes/shape"))
     )
     n_pieces = sum(p.max for p in parts)
     if n_pieces > limits.MAX_PIECES:
-        raise BurrToolsError(src, where, f"{n_pieces} pieces; at most {limits.MAX_PIECES}")
+        raise bm.BurrToolsError(src, where, f"{n_pieces} pieces; at most {limits.MAX_PIECES}")
     res = prob.find("result")
     if res is None:
-        raise BurrToolsError(src, where, "no <result> shape")
+        raise bm.BurrToolsError(src, where, "no <result> shape")
     result = _int(src, f"{where}.result", res.get("id"), 0)
     if result >= len(shapes):
-        raise BurrToolsError(src, f"{where}.result", f"shape {result} does not exist")
+        raise bm.BurrToolsError(src, f"{where}.result", f"shape {result} does not exist")
     pairs: set[tuple[int, int]] = set()
     for k, pair in enumerate(prob.findall("bitmap/pair")):
         w = f"{where}.bitmap[{k}]"
-        pc = _int(src, f"{w}.piece", pair.get("piece"), 0, MAX_COLORS - 1)
-        rc = _int(src, f"{w}.result", pair.get("result"), 0, MAX_COLORS - 1)
+        pc = _int(src, f"{w}.piece", pair.get("piece"), 0, bm.MAX_COLORS - 1)
+        rc = _int(src, f"{w}.result", pair.get("result"), 0, bm.MAX_COLORS - 1)
         if max(pc, rc) >= n_colors:
-            raise BurrToolsError(src, w, f"colour {max(pc, rc) + 1} of {n_colors} defined")
+            raise bm.BurrToolsError(src, w, f"colour {max(pc, rc) + 1} of {n_colors} defined")
         pairs.add((pc + 1, rc + 1))  # the file numbers colours from 0, voxels from 1
     max_holes = None
     if prob.get("maxHoles") is not None:
@@ -258,14 +246,14 @@ def _parse_problem(
         w = f"{where}.solutions[{si}]"
         placements = _parse_assembly(src, w, asm.text or "", slots, len(shapes))
         extra = tuple(_compact_xml(e) for e in sol if e.tag != "assembly")
-        sols.append(BTSolution(placements, tuple(sorted(sol.attrib.items())), extra))
+        sols.append(bm.BTSolution(placements, tuple(sorted(sol.attrib.items())), extra))
     state = _int(src, f"{where}.state", prob.get("state", "0"), 0, 2)
     recorded = {
         k: _int(src, f"{where}.{k}", prob.get(k), 0)
         for k in ("assemblies", "solutions", "time")
         if prob.get(k)
     }
-    return BTProblem(
+    return bm.BTProblem(
         prob.get("name"),
         parts,
         result,
@@ -293,15 +281,17 @@ def _compact_xml(node: ET.Element) -> str:
         node.tail = tail
 
 
-def _parse_colors(src: str, root: ET.Element) -> tuple[RGB, ...]:
-    out: list[RGB] = []
+def _parse_colors(src: str, root: ET.Element) -> tuple[bm.RGB, ...]:
+    out: list[bm.RGB] = []
     for k, c in enumerate(root.findall("colors/color")):
         rgb = tuple(
             _int(src, f"colors[{k}].{a}", c.get(a, "0"), 0, 255) for a in ("red", "green", "blue")
         )
         out.append((rgb[0], rgb[1], rgb[2]))
-    if len(out) > MAX_COLORS:
-        raise BurrToolsError(src, "colors", f"{len(out)} colours; BurrTools allows {MAX_COLORS}")
+    if len(out) > bm.MAX_COLORS:
+        raise bm.BurrToolsError(
+            src, "colors", f"{len(out)} colours; BurrTools allows {bm.MAX_COLORS}"
+        )
     return tuple(out)
 
 
@@ -313,32 +303,32 @@ def _check_total_cells(source: str, voxels: list[ET.Element]) -> None:
         sizes = [_int(source, f"shapes[{i}].{k}", v.get(k), 0, limits.MAX_COORD) for k in "xyz"]
         total += sizes[0] * sizes[1] * sizes[2]
         if total > limits.MAX_BT_TOTAL_GRID_CELLS:
-            raise BurrToolsError(
+            raise bm.BurrToolsError(
                 source, "shapes", f"more than {limits.MAX_BT_TOTAL_GRID_CELLS} grid cells in all"
             )
 
 
-def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
+def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> bm.BTPuzzle:
     """Decode the bytes of a ``.xmpuzzle`` file (gzip or plain XML)."""
     if len(data) > limits.MAX_FILE_BYTES:
-        raise BurrToolsError(source, "(file)", f"more than {limits.MAX_FILE_BYTES} bytes")
+        raise bm.BurrToolsError(source, "(file)", f"more than {limits.MAX_FILE_BYTES} bytes")
     raw = _decompress(data, source)
     try:  # DOCTYPE refused, depth and element count bounded as the tree is built
         root = parse_bounded(raw, limits.MAX_BT_XML_DEPTH, limits.MAX_BT_XML_ELEMENTS)
     except XmlRefused as e:
-        raise BurrToolsError(source, "(file)", e.reason) from None
+        raise bm.BurrToolsError(source, "(file)", e.reason) from None
     if root.tag != "puzzle":
-        raise BurrToolsError(source, "(file)", f"root element is <{root.tag}>, not <puzzle>")
+        raise bm.BurrToolsError(source, "(file)", f"root element is <{root.tag}>, not <puzzle>")
     grid = root.find("gridType")
     gtype = "0" if grid is None else grid.get("type", "0")
     if gtype != "0":
-        raise BurrToolsError(
+        raise bm.BurrToolsError(
             source, "gridType", f"grid type {gtype} is not supported; only the cube grid (0)"
         )
     colors = _parse_colors(source, root)
     voxels = root.findall("shapes/voxel")
     if len(voxels) > limits.MAX_BT_SHAPES:
-        raise BurrToolsError(
+        raise bm.BurrToolsError(
             source, "shapes", f"{len(voxels)} shapes; at most {limits.MAX_BT_SHAPES}"
         )
     _check_total_cells(source, voxels)
@@ -347,7 +337,7 @@ def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
     )
     probs = root.findall("problems/problem")
     if len(probs) > limits.MAX_BT_PROBLEMS:
-        raise BurrToolsError(
+        raise bm.BurrToolsError(
             source, "problems", f"{len(probs)} problems; at most {limits.MAX_BT_PROBLEMS}"
         )
     problems = tuple(
@@ -357,13 +347,13 @@ def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
     comment_node = root.find("comment")
     comment = "" if comment_node is None else (comment_node.text or "")
     popup = comment_node is not None and "popup" in comment_node.attrib
-    return BTPuzzle(shapes, problems, comment, colors, popup)
+    return bm.BTPuzzle(shapes, problems, comment, colors, popup)
 
 
-def read_xmpuzzle(path: str | os.PathLike[str]) -> BTPuzzle:
+def read_xmpuzzle(path: str | os.PathLike[str]) -> bm.BTPuzzle:
     source = str(path)
     try:
         data = read_bounded(path, limits.MAX_FILE_BYTES)
     except UnreadableFile as e:
-        raise BurrToolsError(source, "(file)", e.reason) from None
+        raise bm.BurrToolsError(source, "(file)", e.reason) from None
     return parse_xmpuzzle(data, source)

@@ -16,20 +16,13 @@ from pathlib import Path
 import numpy as np
 
 from chaingeo.core.files import atomic_write
-from chaingeo.core.formats.bt_model import (
-    BTPart,
-    BTPlacement,
-    BTProblem,
-    BTPuzzle,
-    BTShape,
-    BTSolution,
-)
+from chaingeo.core.formats import bt_model as bm
 from chaingeo.core.geometry import Shape
 
 _EMPTY_TAG = re.compile(rb'(<[A-Za-z]+(?:\s+[A-Za-z]+="[^"]*")*) />')
 
 
-def voxel_string(shape: BTShape) -> str:
+def voxel_string(shape: bm.BTShape) -> str:
     """``#``/``+``/``_`` per grid cell, x fastest, each coloured voxel followed by its colour."""
     sx, sy, sz = shape.size
     chars = ["_"] * (sx * sy * sz)
@@ -41,7 +34,7 @@ def voxel_string(shape: BTShape) -> str:
     return "".join(chars)
 
 
-def _shape_node(parent: ET.Element, s: BTShape) -> None:
+def _shape_node(parent: ET.Element, s: bm.BTShape) -> None:
     attrs = {"x": str(s.size[0]), "y": str(s.size[1]), "z": str(s.size[2])}
     for axis, h in zip("xyz", s.hotspot, strict=True):
         if h:
@@ -54,7 +47,7 @@ def _shape_node(parent: ET.Element, s: BTShape) -> None:
     ET.SubElement(parent, "voxel", attrs).text = voxel_string(s)
 
 
-def _part_node(parent: ET.Element, p: BTPart) -> None:
+def _part_node(parent: ET.Element, p: bm.BTPart) -> None:
     attrs = {"id": str(p.shape)}
     if p.min == p.max:
         attrs["count"] = str(p.min)
@@ -71,13 +64,13 @@ def _part_node(parent: ET.Element, p: BTPart) -> None:
             ET.SubElement(node, "group", group=str(gid), count=str(count))
 
 
-def _placement_text(pl: BTPlacement | None) -> str:
+def _placement_text(pl: bm.BTPlacement | None) -> str:
     if pl is None:
         return "x"
     return f"{pl.position[0]} {pl.position[1]} {pl.position[2]} {pl.transform}"
 
 
-def _problem_node(parent: ET.Element, p: BTProblem) -> None:
+def _problem_node(parent: ET.Element, p: bm.BTProblem) -> None:
     attrs: dict[str, str] = {}
     if p.name:
         attrs["name"] = p.name
@@ -104,7 +97,7 @@ def _problem_node(parent: ET.Element, p: BTProblem) -> None:
                 node.append(ET.fromstring(extra))
 
 
-def xmpuzzle_xml(puzzle: BTPuzzle) -> bytes:
+def xmpuzzle_xml(puzzle: bm.BTPuzzle) -> bytes:
     """The XML document (uncompressed)."""
     root = ET.Element("puzzle", version="2")
     ET.SubElement(root, "gridType", type="0")
@@ -126,39 +119,39 @@ def xmpuzzle_xml(puzzle: BTPuzzle) -> bytes:
     return b'<?xml version="1.0"?>\n' + body
 
 
-def xmpuzzle_bytes(puzzle: BTPuzzle) -> bytes:
+def xmpuzzle_bytes(puzzle: bm.BTPuzzle) -> bytes:
     """Canonical gzip bytes (fixed mtime, so the same puzzle is the same file)."""
     return gzip.compress(xmpuzzle_xml(puzzle), mtime=0)
 
 
-def write_xmpuzzle(puzzle: BTPuzzle, path: str | os.PathLike[str]) -> Path:
+def write_xmpuzzle(puzzle: bm.BTPuzzle, path: str | os.PathLike[str]) -> Path:
     return atomic_write(path, xmpuzzle_bytes(puzzle))
 
 
 def assembled_puzzle(
     pieces: Mapping[str, Shape], *, name: str = "CHAIN-geo puzzle", comment: str = ""
-) -> BTPuzzle:
+) -> bm.BTPuzzle:
     """A one-problem puzzle: each piece its own shape (count 1), the union as the result, and
     the assembly itself stored as the one solution (so BurrTools shows it and can disassemble
     it)."""
     names = sorted(pieces)
     allv = np.concatenate([pieces[n].voxels for n in names])
     base = allv.min(axis=0)
-    shapes: list[BTShape] = []
-    placements: list[BTPlacement | None] = []
+    shapes: list[bm.BTShape] = []
+    placements: list[bm.BTPlacement | None] = []
     for i, n in enumerate(names):
         s = pieces[n]
         norm = s.normalized()
-        shapes.append(BTShape(n, norm.extent, norm, Shape([])))
+        shapes.append(bm.BTShape(n, norm.extent, norm, Shape([])))
         pos = s.min_corner - base
-        placements.append(BTPlacement(i, (int(pos[0]), int(pos[1]), int(pos[2])), 0))
+        placements.append(bm.BTPlacement(i, (int(pos[0]), int(pos[1]), int(pos[2])), 0))
     union = Shape(allv - base)
-    shapes.append(BTShape("result", union.extent, union, Shape([])))
-    problem = BTProblem(
+    shapes.append(bm.BTShape("result", union.extent, union, Shape([])))
+    problem = bm.BTProblem(
         name,
-        tuple(BTPart(i, 1, 1) for i in range(len(names))),
+        tuple(bm.BTPart(i, 1, 1) for i in range(len(names))),
         len(names),
-        (BTSolution(tuple(placements)),),
+        (bm.BTSolution(tuple(placements)),),
         {"assemblies": 1},
     )
-    return BTPuzzle(tuple(shapes), (problem,), comment)
+    return bm.BTPuzzle(tuple(shapes), (problem,), comment)
