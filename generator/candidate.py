@@ -11,11 +11,15 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+import numpy as np
+
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.generator.config import PuzzleConfig
+from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
+from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable
 
 Score = tuple[int, int]
 
@@ -39,6 +43,20 @@ def probe_limits(config: PuzzleConfig) -> SearchLimits:
         max_states=config.probe_states,
         seconds=config.seconds,
         max_total_states=10 * config.probe_states,
+    )
+
+
+def probe_search(table: PieceTable, pieces: int, config: PuzzleConfig) -> PartSearch:
+    """The breadth-first search of the whole assembly's configurations (every piece one part,
+    at rest) under the probe caps, as the climbing generators score a design."""
+    limits = probe_limits(config)
+    return PartSearch(
+        table,
+        tuple(range(pieces)),
+        np.zeros((pieces, 3), dtype=np.int64),
+        max_group=config.max_group,
+        limits=limits,
+        deadline=Deadline(limits.seconds),
     )
 
 

@@ -32,12 +32,16 @@ import numpy as np
 from chaingeo.core.arrays import I16, I64
 from chaingeo.core.geometry import NEIGHBOURS, Shape
 from chaingeo.core.kinematics import Assembly, SearchLimitError
-from chaingeo.generator.candidate import Candidate, evaluate, piece_names, probe_limits
+from chaingeo.generator.candidate import (
+    Candidate,
+    evaluate,
+    piece_names,
+    probe_search,
+)
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.kernels.jit import njit
-from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.motion.disassemble import fast_legal_moves
-from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable, Removal
+from chaingeo.solvers.motion.partsearch import PieceTable, Removal
 
 #: Progress of a candidate: (levels still missing, closeness within that); (0, 0) is reached.
 Progress = tuple[int, int]
@@ -237,15 +241,7 @@ def progress(
     named = piece_names(shapes)
     table = PieceTable(named)
     k = len(shapes)
-    limits = probe_limits(config)
-    search = PartSearch(
-        table,
-        tuple(range(k)),
-        np.zeros((k, 3), dtype=np.int64),
-        max_group=config.max_group,
-        limits=limits,
-        deadline=Deadline(limits.seconds),
-    )
+    search = probe_search(table, k, config)
     try:
         for depth in range(target):
             removals = search.expand_layer()

@@ -36,15 +36,20 @@ import numpy as np
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.piecesets.burrs import SLOTS
-from chaingeo.generator.candidate import Candidate, Score, evaluate, piece_names, probe_limits
+from chaingeo.generator.candidate import (
+    Candidate,
+    Score,
+    evaluate,
+    piece_names,
+    probe_search,
+)
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.layouts import Layout
 from chaingeo.solvers.assembly.assemble import iter_assemblies
 from chaingeo.solvers.cover.problem import PieceSpec
-from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
-from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable
+from chaingeo.solvers.motion.partsearch import PieceTable
 
 #: Stick length of Cutler's standard six-piece burr.
 STICK_LENGTH = 8
@@ -265,16 +270,8 @@ def _graph_depth(shapes: Sequence[Shape], config: PuzzleConfig) -> int | None:
     from a high level, so the walk may cross it; None past the probe's state cap."""
     table = PieceTable(piece_names(shapes))
     n = len(shapes)
-    limits = probe_limits(config)
     try:
-        search = PartSearch(
-            table,
-            tuple(range(n)),
-            np.zeros((n, 3), dtype=np.int64),
-            max_group=config.max_group,
-            limits=limits,
-            deadline=Deadline(limits.seconds),
-        )
+        search = probe_search(table, n, config)
         while not search.exhausted:
             search.expand_layer()
     except SearchLimitError:
