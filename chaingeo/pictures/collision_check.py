@@ -34,7 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from functools import lru_cache
-from typing import Final
+from typing import Any, Final
 
 import fcl
 import numpy as np
@@ -83,17 +83,25 @@ def swept_collision(
     meet ``rest``? (Meshes eroded as explained above; touching faces do not count.)"""
     if not rest:
         return False
+    samples = math.ceil(distance * SAMPLES_PER_UNIT) + 1
+    end = fcl.Transform(np.asarray(direction, dtype=np.float64) * distance)
+    return _sweep_collides(group, rest, end, samples, fcl.CCDMotionType.CCDM_TRANS)
+
+
+def _sweep_collides(
+    group: Sequence[Shape], rest: Sequence[Shape], end: Any, samples: int, motion: Any
+) -> bool:
+    """python-fcl's continuous check of the group moving from rest to ``end`` (a translation
+    or a screw motion) against the fixed rest, with ``samples`` steps."""
     moving = fcl.CollisionObject(_bvh(group, GROUP_EPS), fcl.Transform())
     fixed = fcl.CollisionObject(_bvh(rest, REST_EPS), fcl.Transform())
-    samples = math.ceil(distance * SAMPLES_PER_UNIT) + 1
     request = fcl.ContinuousCollisionRequest(
         num_max_iterations=samples,
         toc_err=1.0 / (4 * samples),
-        ccd_motion_type=fcl.CCDMotionType.CCDM_TRANS,
+        ccd_motion_type=motion,
         ccd_solver_type=fcl.CCDSolverType.CCDC_NAIVE,
     )
     result = fcl.ContinuousCollisionResult()
-    end = fcl.Transform(np.asarray(direction, dtype=np.float64) * distance)
     fcl.continuousCollide(moving, end, fixed, fcl.Transform(), request, result)
     return bool(result.is_collide)
 
@@ -112,8 +120,6 @@ def turning_collision(
     centres at whole numbers: :mod:`chaingeo.core.turns`), ever meet ``rest``?"""
     if not rest:
         return False
-    moving = fcl.CollisionObject(_bvh(group, GROUP_EPS), fcl.Transform())
-    fixed = fcl.CollisionObject(_bvh(rest, REST_EPS), fcl.Transform())
     # mesh coordinates put cell (i, j, k) at [i, i+1] x ..., its centre at i + 1/2
     point = np.asarray(centre2, dtype=np.float64) / 2 + 0.5
     angle = quarter * math.pi / 2
@@ -122,15 +128,7 @@ def turning_collision(
     rot = np.eye(3)
     rot[u, u], rot[u, v], rot[v, u], rot[v, v] = c, -s, s, c
     end = fcl.Transform(rot, point - rot @ point)
-    request = fcl.ContinuousCollisionRequest(
-        num_max_iterations=TURN_SAMPLES,
-        toc_err=1.0 / (4 * TURN_SAMPLES),
-        ccd_motion_type=fcl.CCDMotionType.CCDM_SCREW,
-        ccd_solver_type=fcl.CCDSolverType.CCDC_NAIVE,
-    )
-    result = fcl.ContinuousCollisionResult()
-    fcl.continuousCollide(moving, end, fixed, fcl.Transform(), request, result)
-    return bool(result.is_collide)
+    return _sweep_collides(group, rest, end, TURN_SAMPLES, fcl.CCDMotionType.CCDM_SCREW)
 
 
 def sweep_to_clear(group: Sequence[Shape], rest: Sequence[Shape], direction: Cell) -> float:
