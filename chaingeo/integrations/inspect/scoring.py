@@ -13,6 +13,7 @@ epochs, so a fixed-k reducer could not).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 from inspect_ai.scorer import (
@@ -134,37 +135,35 @@ def _successes(scores: list[Score]) -> tuple[int, int]:
     return len(scores), sum(1 for s in scores if float(s.as_float()) >= 1.0)
 
 
+def _over_epochs(rate: Callable[[int, int], float]) -> ScoreReducer:
+    """A reducer of a level's epochs: ``rate(n, c)`` of its ``n`` epochs, ``c`` solved."""
+
+    def reduce(scores: list[Score]) -> Score:
+        n, c = _successes(scores)
+        return _reduced(rate(n, c) if n else math.nan, scores)
+
+    return reduce
+
+
 @score_reducer(name="mean")
 def mean_epochs() -> ScoreReducer:
     """The share of a level's epochs solved."""
 
-    def reduce(scores: list[Score]) -> Score:
-        n, c = _successes(scores)
-        return _reduced(c / n if n else math.nan, scores)
-
-    return reduce
+    return _over_epochs(lambda n, c: c / n)
 
 
 @score_reducer(name="pass_at_k")
 def pass_at_epochs() -> ScoreReducer:
     """Pass@k with k the level's epochs (unbiased; at least one of k succeeds)."""
 
-    def reduce(scores: list[Score]) -> Score:
-        n, c = _successes(scores)
-        return _reduced(pass_at_k_unbiased(n, c, n) if n else math.nan, scores)
-
-    return reduce
+    return _over_epochs(lambda n, c: pass_at_k_unbiased(n, c, n))
 
 
 @score_reducer(name="pass_hat_k")
 def pass_all_epochs() -> ScoreReducer:
     """Pass^k with k the level's epochs (all k succeed)."""
 
-    def reduce(scores: list[Score]) -> Score:
-        n, c = _successes(scores)
-        return _reduced(pass_hat_k_unbiased(n, c, n) if n else math.nan, scores)
-
-    return reduce
+    return _over_epochs(lambda n, c: pass_hat_k_unbiased(n, c, n))
 
 
 #: The task's metrics: accuracy with its standard error, and the step figures.
