@@ -4,6 +4,7 @@ under a short name for readers who want the graphs alone."""
 
 from __future__ import annotations
 
+from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.graphs import (
     FLOOR,
     MAX_STATES,
@@ -19,6 +20,7 @@ from chaingeo.solvers.graphs import (
     group_can_slide,
     minimal_groups,
     piece_free,
+    shortest_to,
     state_graph,
     support_graph,
 )
@@ -26,6 +28,7 @@ from chaingeo.solvers.graphs import (
 __all__ = [
     "FLOOR",
     "MAX_STATES",
+    "SearchLimitError",
     "bfs_layers",
     "blocking_graph",
     "blocking_graphs",
@@ -38,6 +41,7 @@ __all__ = [
     "group_can_slide",
     "minimal_groups",
     "piece_free",
+    "shortest_to",
     "state_graph",
     "support_graph",
 ]
