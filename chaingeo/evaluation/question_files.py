@@ -275,6 +275,9 @@ def write_lmms_task(shown: Iterable[Shown], images: Path, folder: Path) -> int:
         rows.append(_line(row) + "\n")
     data = folder / "chaingeo_questions.jsonl"
     atomic_write(data, "".join(rows).encode("utf-8"))
-    atomic_write(folder / "chaingeo_questions.yaml", LMMS_YAML.format(data=data.name).encode())
+    # lmms-eval hands data_files to datasets.load_dataset, which reads them from the working
+    # directory: the file is named by its absolute path
+    yaml = LMMS_YAML.format(data=json.dumps(str(data.resolve())))
+    atomic_write(folder / "chaingeo_questions.yaml", yaml.encode())
     atomic_write(folder / "utils.py", LMMS_UTILS.encode())
     return len(rows)

@@ -24,7 +24,7 @@ def register(sub: Any) -> None:
         metavar="DIR",
         help="folder for questions.jsonl, images/, questions.tsv and lmms-eval/",
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument(
         "--category",
         action="append",
