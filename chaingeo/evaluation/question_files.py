@@ -281,3 +281,55 @@ def write_lmms_task(shown: Iterable[Shown], images: Path, folder: Path) -> int:
     atomic_write(folder / "chaingeo_questions.yaml", yaml.encode())
     atomic_write(folder / "utils.py", LMMS_UTILS.encode())
     return len(rows)
+
+
+#: Bytes per Parquet shard of the ``questions`` configuration.
+HF_SHARD_BYTES: Final = 256 * 1024 * 1024
+HF_CARD: Final = """---
+pretty_name: "CHAIN-geo questions"
+task_categories:
+- visual-question-answering
+configs:
+- config_name: questions
+  data_files:
+{files}---
+
+# CHAIN-geo questions
+
+Multiple-choice questions about interlocking puzzles and 3D packing, every answer proven by
+exact solvers (`chain questions`); `proof` holds the facts that make it right. Train and test
+are split by level signature.
+"""
+
+
+def write_hf_questions(shown: Sequence[Shown], images: Path, folder: Path) -> dict[str, int]:
+    """The ``questions`` configuration of the Hugging Face dataset export, one Parquet set per
+    split (:func:`chaingeo.envs.dataset.write_config`), and a card when the folder has none
+    (`chain export-dataset` into the same folder writes the full card, listing it)."""
+    from chaingeo.envs.dataset import QUESTIONS, write_config
+
+    counts: dict[str, int] = {}
+    for split in ("train", "test"):
+        rows = (_hf_row(s, images) for s in shown if s.split == split)
+        counts[split], _ = write_config(rows, folder, QUESTIONS, split, HF_SHARD_BYTES)
+    card = folder / "README.md"
+    if not card.exists():
+        files = "".join(
+            f"  - split: {k}\n    path: {QUESTIONS}/{k}-*.parquet\n" for k, n in counts.items() if n
+        )
+        atomic_write(card, HF_CARD.format(files=files).encode("utf-8"))
+    return counts
+
+
+def _hf_row(s: Shown, images: Path) -> dict[str, Any]:
+    return {
+        "id": s.id,
+        "category": s.category,
+        "level": s.level,
+        "question": s.question,
+        **dict(zip(LETTERS, s.options, strict=True)),
+        "answer": s.answer,
+        "state": list(s.state),
+        "proof": _line(dict(s.proof)),
+        "images": [{"bytes": (images / s.image).read_bytes(), "path": s.image}],
+    }

@@ -34,7 +34,7 @@ needs_suite = pytest.mark.skipif(not shipped(), reason="the shipped suite is not
 @pytest.fixture(scope="module")
 def written(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("q") / "out"
-    assert main(["questions", *IDS, "--out", str(out), "--seed", "5"]) == 0
+    assert main(["questions", *IDS, "--out", str(out), "--seed", "5", "--hf", str(out / "hf")]) == 0
     return out
 
 
@@ -199,3 +199,19 @@ def test_model_asked_with_and_without_pictures(written: Path, server: str) -> No
     sent = _Chat.seen[-2]["messages"][0]["content"]
     assert sent[1]["image_url"]["url"].startswith("data:image/png;base64,")
     assert text_only.label == "m (text only)"
+
+
+@needs_suite
+def test_hf_questions_config_loads(written: Path, tmp_path: Path) -> None:
+    """The Hub's loader reads the ``questions`` configuration; splits follow the signatures."""
+    datasets = pytest.importorskip("datasets")
+    got = datasets.load_dataset(str(written / "hf"), "questions", cache_dir=str(tmp_path))
+    shown = {q.id: q for q in read_questions(written / "questions.jsonl")}
+    assert sum(len(got[k]) for k in got) == len(shown)
+    for split in got:
+        for row in got[split]:
+            q = shown[row["id"]]
+            assert q.split == split and row["answer"] == q.answer
+            assert row["images"][0].size[0] > 100 and json.loads(row["proof"]) == q.proof
+    levels = {split: {row["level"] for row in got[split]} for split in got}
+    assert not (levels.get("train", set()) & levels.get("test", set()))

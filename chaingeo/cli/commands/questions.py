@@ -37,12 +37,19 @@ def register(sub: Any) -> None:
         action="store_true",
         help="write questions.jsonl only (no images, TSV or lmms-eval task)",
     )
+    p.add_argument(
+        "--hf",
+        type=Path,
+        metavar="DIR",
+        help="also write the questions configuration of the Hugging Face dataset export there",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.level_arg import levels_of
     from chaingeo.evaluation.question_files import (
+        write_hf_questions,
         write_lmms_task,
         write_questions,
         write_vlmeval_tsv,
@@ -59,6 +66,8 @@ def run(args: argparse.Namespace) -> int:
     if not args.no_pictures:
         write_vlmeval_tsv(shown, args.out / "images", args.out / "questions.tsv")
         write_lmms_task(shown, args.out / "images", args.out / "lmms-eval")
+        if args.hf is not None:
+            write_hf_questions(shown, args.out / "images", args.hf)
     t2 = time.perf_counter()
     per = Counter(q.category for q in questions)
     letters = Counter(q.letter for q in questions)
