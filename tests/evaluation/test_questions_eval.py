@@ -215,3 +215,22 @@ def test_hf_questions_config_loads(written: Path, tmp_path: Path) -> None:
             assert row["images"][0].size[0] > 100 and json.loads(row["proof"]) == q.proof
     levels = {split: {row["level"] for row in got[split]} for split in got}
     assert not (levels.get("train", set()) & levels.get("test", set()))
+
+
+@needs_suite
+@pytest.mark.slow
+def test_same_bytes_under_any_hash_seed(tmp_path: Path) -> None:
+    """Two processes with different PYTHONHASHSEED write the same questions and TSV."""
+    import os
+    import subprocess
+    import sys
+
+    outs = []
+    for seed in ("1", "2"):
+        out = tmp_path / seed
+        env = {**os.environ, "PYTHONHASHSEED": seed}
+        cmd = [sys.executable, "-m", "chaingeo.cli.main", "questions", *IDS, "--out", str(out)]
+        subprocess.run(cmd, check=True, env=env, capture_output=True)
+        outs.append(out)
+    for name in ("questions.jsonl", "questions.tsv"):
+        assert (outs[0] / name).read_bytes() == (outs[1] / name).read_bytes()
