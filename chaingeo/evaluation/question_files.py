@@ -26,11 +26,13 @@ from chaingeo.envs.actions.types import cells_text
 from chaingeo.envs.demos import plan_texts
 from chaingeo.generator.questions import LETTERS, Question
 from chaingeo.generator.questions.model import CELLS_FIELD
+from chaingeo.generator.questions.views import recipe_pieces, recipes, solved
 
 #: One view's size in the question picture (3 x 2 views).
 VIEW_SIZE: Final = 256
 #: Levels whose signature hashes below this share of the range are the test split.
 TEST_SHARE: Final = 0.3
+SAME: Final = "same-assembly"
 HINT: Final = "Answer with the option's letter only."
 TSV_COLUMNS: Final = (
     "index",
@@ -119,8 +121,14 @@ def image_name(level: str, step: int) -> str:
 
 
 def present(q: Question, level: Level) -> Shown:
-    """The question's final texts (cells 1-based) and the state as action texts."""
+    """The question's final texts (cells 1-based) and the state as action texts; a
+    same-assembly question's options name its pictures by letter."""
     prompt = _fill(q.prompt, q.prompt_cells)
+    options = tuple(_fill(o.text, o.cells) for o in q.options)
+    image = image_name(q.level, q.step)
+    if q.category == SAME:
+        options = tuple(f"picture {k}" for k in LETTERS)
+        image = f"{q.level}-{q.id}.png"
     return Shown(
         id=q.id,
         category=q.category,
@@ -128,11 +136,34 @@ def present(q: Question, level: Level) -> Shown:
         split=split_of(q.signature),
         state=tuple(plan_texts(level)[: q.step]),
         question=prompt,
-        options=tuple(_fill(o.text, o.cells) for o in q.options),
+        options=options,
         answer=q.letter,
         proof=q.proof,
-        image=image_name(q.level, q.step),
+        image=image,
     )
+
+
+def assembly_picture(q: Question, level: Level, size: int = VIEW_SIZE) -> bytes:
+    """A same-assembly question's picture: the solved level on top, its four options (each
+    drawn from its recipe, labelled A-D) below, every one from the iso corner."""
+    from PIL import Image
+
+    from chaingeo.envs.render.fastview import render_images
+    from chaingeo.envs.render.raster import png_bytes
+
+    rgb = {p.name: p.rgb for p in level.pieces}
+
+    def draw(pieces: Mapping[str, Any], title: str) -> Any:
+        every = [c for s in pieces.values() for c in s.cells]
+        lo = [-min(c[i] for c in every) for i in range(3)]
+        scene = {n: (s.translate(lo), rgb[n]) for n, s in pieces.items()}
+        return render_images(scene, None, ("iso",), size, title)["iso"].convert("RGB")
+
+    sheet = Image.new("RGB", (4 * size, 2 * size), (255, 255, 255))
+    sheet.paste(draw(solved(level), "THE SOLVED LEVEL"), (3 * size // 2, 0))
+    for i, recipe in enumerate(recipes(q)):
+        sheet.paste(draw(recipe_pieces(level, recipe), f"PICTURE {LETTERS[i]}"), (i * size, size))
+    return png_bytes(sheet)
 
 
 def state_picture(level: Level, step: int, size: int = VIEW_SIZE) -> bytes:
@@ -165,8 +196,12 @@ def write_questions(
     atomic_write(out / "questions.jsonl", lines.encode("utf-8"))
     if pictures:
         (out / "images").mkdir(exist_ok=True)
-        for q in sorted({(q.level, q.step) for q in questions}):
-            atomic_write(out / "images" / image_name(*q), state_picture(levels[q[0]], q[1]))
+        states = sorted({(q.level, q.step) for q in questions if q.category != SAME})
+        for lv, step in states:
+            atomic_write(out / "images" / image_name(lv, step), state_picture(levels[lv], step))
+        for q, s in zip(questions, shown, strict=True):
+            if q.category == SAME:
+                atomic_write(out / "images" / s.image, assembly_picture(q, levels[q.level]))
     return shown
 
 

@@ -13,7 +13,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from chaingeo.core.level import Level
-from chaingeo.generator.questions import counting, puzzle, stacking
+from chaingeo.generator.questions import counting, puzzle, stacking, views
 from chaingeo.generator.questions.common import CATEGORIES
 from chaingeo.generator.questions.model import LETTERS, Option, Question, QuestionError, balance
 
@@ -26,7 +26,7 @@ __all__ = [
     "generate_questions",
     "level_questions",
 ]
-_FAMILIES = (puzzle, counting, stacking)  # imported for their registrations
+_FAMILIES = (puzzle, counting, stacking, views)  # imported for their registrations
 
 
 def level_questions(

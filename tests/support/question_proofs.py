@@ -11,10 +11,13 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
+from typing import Any
 
-from chaingeo.core.geometry import box_cells
+import numpy as np
+
+from chaingeo.core.geometry import SYMMETRIES, Cell, box_cells
 from chaingeo.core.kinematics import Assembly, legal_steps, state_key
-from chaingeo.core.level import Level
+from chaingeo.core.level import Level, StackingSolution
 from chaingeo.envs.actions.types import PlaceAction
 from chaingeo.envs.demos import plan_texts
 from chaingeo.envs.machines import new_state
@@ -67,8 +70,12 @@ def truth_blocks(q: Question, asm: Assembly) -> Truth:
             out.append(not blocked)
             continue
         rest = {n: asm.shapes[n] for n in asm.part_of(x) if n != o.text}
-        without = Assembly(rest, {n: asm.offsets[n] for n in rest}, (frozenset(rest),),
-                           {n: r for n, r in asm.rotations.items() if n in rest})  # fmt: skip
+        without = Assembly(
+            rest,
+            {n: asm.offsets[n] for n in rest},
+            (frozenset(rest),),
+            {n: r for n, r in asm.rotations.items() if n in rest},
+        )
         out.append(blocked and without.free_distance([x], d) != 0)
     return out
 
@@ -157,8 +164,48 @@ def truth_count(q: Question, level: Level, state: PuzzleState | StackingState) -
     return [int(o.text.split()[0]) == value for o in q.options]
 
 
+def _coloured(level: Level, recipe: dict[str, Any]) -> frozenset[tuple[str, Cell]]:
+    """The recipe applied to the solved level by hand: matrices on cell arrays, normalised."""
+    sol = level.solution
+    where = {
+        p.name: np.array(
+            sol.placements[p.name].cells if isinstance(sol, StackingSolution) else p.shape.cells
+        )
+        for p in level.pieces
+    }
+    if recipe.get("mirror"):
+        where = {n: a * np.array([-1, 1, 1]) for n, a in where.items()}
+    if "shift" in recipe:
+        name, shift = recipe["shift"]
+        where[name] = where[name] + np.array(shift)
+    if "swap" in recipe:
+        first, second = recipe["swap"]
+        where[first], where[second] = where[second], where[first]
+    r = SYMMETRIES[int(recipe["rotation"])]
+    where = {n: a @ r.T for n, a in where.items()}
+    lo = np.min(np.concatenate(list(where.values())), axis=0)
+    out: set[tuple[str, Cell]] = set()
+    for n, arr in where.items():
+        for c in arr - lo:
+            out.add((n, (int(c[0]), int(c[1]), int(c[2]))))
+    return frozenset(out)
+
+
+def truth_same_assembly(q: Question, level: Level) -> Truth:
+    """Right: some proper rotation of the solved level gives exactly the option's cells."""
+    from chaingeo.generator.questions.views import recipes
+
+    out = []
+    for recipe in recipes(q):
+        target = _coloured(level, dict(recipe))
+        out.append(any(_coloured(level, {"rotation": r}) == target for r in range(24)))
+    return out
+
+
 def truth(q: Question, level: Level) -> Truth:
     """Which options are right, decided without the generator."""
+    if q.category == "same-assembly":
+        return truth_same_assembly(q, level)
     state = replayed(level, q.step)
     if isinstance(state, StackingState):
         if q.category in ("fits", "supported"):
