@@ -2,9 +2,9 @@
 
 The right picture is the solved assembly turned by one of the 23 other rotations; the wrong
 ones are near copies seen the same way: its mirror image (when the assembly is chiral), one
-piece shifted by a cell, two pieces' colours swapped (when their shapes differ). Each option
-carries its recipe in ``extra`` (the presentation draws it); the proof says, per option, whether
-its coloured cells are a rotation of the solved level's.
+piece shifted by a cell, two pieces' colours swapped. The proof lists each option's recipe (the
+presentation draws it, :func:`recipes` finds it from the option) and whether its coloured cells
+are a rotation of the solved level's.
 """
 
 from __future__ import annotations
