@@ -1,10 +1,11 @@
 """Generate levels of any family at scale: serially, with joblib locally, or on a Dask cluster.
 
-Underneath is one pure function per family, ``make(config, seed, index) -> Level | Rejection``;
-a worker runs it (and draws the pictures) and sends back bytes. The runner, the only writer,
-takes the results strictly in index order, reserves each signature (:mod:`chaingeo.generator.dedup`)
-and writes the accepted ones, until ``count`` levels are accepted or ``max_items`` indices
-were tried. So which levels come out, and their bytes, do not depend on the backend or the
+Underneath is one pure function per family,
+``make(config, seed, index) -> Level | GenerationRejection``; a worker runs it (and draws the
+pictures) and sends back bytes. The runner, the only writer, takes the results strictly in index
+order, reserves each signature (:mod:`chaingeo.generator.dedup`) and writes the accepted ones,
+until ``count`` levels are accepted or ``max_items`` indices were tried. So which levels come
+out, and their bytes, do not depend on the backend or the
 number of workers. Output folder::
 
     OUT/<level id>.json                  chain-level/1 files (``chain validate OUT`` reads them)
@@ -30,10 +31,10 @@ from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.files import atomic_write
 from chaingeo.core.level import Level, level_bytes
 from chaingeo.generator.dedup import Reservation, SignatureStore
-from chaingeo.generator.result import ATTEMPTS_KEY, Rejection
+from chaingeo.generator.result import ATTEMPTS_KEY, GenerationRejection
 from chaingeo.generator.signature import level_signature
 
-MakeFn = Callable[[Any, int, int], "Level | Rejection"]
+MakeFn = Callable[[Any, int, int], "Level | GenerationRejection"]
 PictureFn = Callable[[Level], dict[str, bytes]]
 SUMMARY_FILE = "summary.jsonl"
 PICTURES_DIR = "pictures"
@@ -103,7 +104,7 @@ def run_item(
     """Make item ``index`` (and its pictures); runs on a worker."""
     t0 = time.perf_counter()
     out = make(config, seed, index)
-    if isinstance(out, Rejection):
+    if isinstance(out, GenerationRejection):
         return ItemResult(
             index,
             reason=out.reason,
@@ -227,7 +228,7 @@ def _distributed() -> Any:
 
 
 @dataclass
-class Summary:
+class BatchSummary:
     family: str
     config: Any
     seed: int
@@ -294,7 +295,7 @@ def run(
     dask: str | None = None,
     progress: bool = True,
     write_summary: bool = True,
-) -> Summary:
+) -> BatchSummary:
     """Generate ``job.count`` levels into ``out``; returns (and appends to
     ``OUT/summary.jsonl``) the summary, with a count for every outcome and attempt reason."""
     if jobs < 1:
@@ -308,7 +309,7 @@ def run(
         backend, workers, results = "joblib", jobs, _joblib(job, jobs)
     else:
         backend, workers, results = "serial", 1, _serial(job)
-    summary = Summary(job.family, job.config, job.seed, job.count, backend, workers)
+    summary = BatchSummary(job.family, job.config, job.seed, job.count, backend, workers)
     from tqdm import tqdm
 
     bar = tqdm(

@@ -31,10 +31,10 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.geometry import NEIGHBOURS, Shape
-from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Assembly, SearchLimitError
 from chaingeo.generator.candidate import Candidate, evaluate, piece_names, probe_limits
 from chaingeo.generator.config import PuzzleConfig
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.motion.disassemble import fast_legal_moves
 from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable, Removal

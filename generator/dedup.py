@@ -25,7 +25,7 @@ from enum import Enum
 from pathlib import Path
 from typing import Final
 
-_SIGNATURE_RE: Final = re.compile(r"^[0-9a-f]{8,128}$")
+_SIGNATURE_RE: Final = re.compile(r"[0-9a-f]{8,128}")
 SIGNATURES_DIR: Final = "signatures"
 
 
@@ -43,7 +43,7 @@ class SignatureStore:
         self.folder.mkdir(parents=True, exist_ok=True)
 
     def _path(self, signature: str) -> Path:
-        if not _SIGNATURE_RE.match(signature):
+        if not _SIGNATURE_RE.fullmatch(signature):
             raise ValueError(f"signature {signature!r} is not a lowercase hex digest")
         return self.folder / signature
 
@@ -67,7 +67,7 @@ class SignatureStore:
             self._path(signature).unlink()
 
     def signatures(self) -> list[str]:
-        return sorted(p.name for p in self.folder.iterdir() if _SIGNATURE_RE.match(p.name))
+        return sorted(p.name for p in self.folder.iterdir() if _SIGNATURE_RE.fullmatch(p.name))
 
 
 def _create_exclusive(target: Path, content: str) -> bool:

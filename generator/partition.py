@@ -220,7 +220,7 @@ def _duplicates(keys: Counter[tuple[Cell, ...]]) -> int:
     return sum(c - 1 for c in keys.values() if c > 1)
 
 
-class _Evaluator:
+class _PartitionEvaluator:
     """Memoised piece cost and canonical form per cell set (repair revisits the same sets)."""
 
     def __init__(self, grid: BoxGrid, rules: PieceRules) -> None:
@@ -240,7 +240,7 @@ class _Evaluator:
 
 def partition_cost(grid: BoxGrid, labels: Labels, rules: PieceRules) -> int:
     """Total rule violations of a partition: per-piece costs plus repeated shapes if distinct."""
-    ev = _Evaluator(grid, rules)
+    ev = _PartitionEvaluator(grid, rules)
     evals = [ev(frozenset(cells)) for cells in pieces_of(labels)]
     dup = _duplicates(Counter(k for _, k in evals)) if rules.distinct else 0
     return sum(c for c, _ in evals) + dup
@@ -264,7 +264,7 @@ def repair(
     Returns ``(labels, remaining cost, moves made)``; cost 0 means repaired.
     """
     labels = list(labels)
-    ev = _Evaluator(grid, rules)
+    ev = _PartitionEvaluator(grid, rules)
     members = [set(cells) for cells in pieces_of(labels)]
     evals = [ev(frozenset(m)) for m in members]
     keys: Counter[tuple[Cell, ...]] = Counter(k for _, k in evals)

@@ -37,7 +37,7 @@ from chaingeo.generator.cubes import cube_search, interlocking_target
 from chaingeo.generator.deep import TOWERS, maze_candidate, tower_candidate
 from chaingeo.generator.layouts import Layout, get_layout
 from chaingeo.generator.maze import parse_maze_shape
-from chaingeo.generator.result import Rejection
+from chaingeo.generator.result import GenerationRejection
 from chaingeo.generator.standard_burr import standard_burr_search
 from chaingeo.solvers.analysis import BLOCKS_KEY, analyze_puzzle
 from chaingeo.solvers.limits import SearchLimits
@@ -274,7 +274,7 @@ def shape_family(config: PuzzleConfig) -> ShapeFamily:
     return next(family for _, family in SHAPES.items() if family.matches(config))
 
 
-def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
+def make(config: PuzzleConfig, seed: int, index: int) -> Level | GenerationRejection:
     """Item ``index`` of ``seed``: a verified level, or why the candidate was rejected."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
     family = shape_family(config)
@@ -282,9 +282,9 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
     best, blocks = built.best, built.blocks
     extra: dict[str, object] = {"shape": config.shape, **built.stats}
     if best is None:
-        return Rejection(family.failure(config), seed, index)
+        return GenerationRejection(family.failure(config), seed, index)
     if best.score[0] < config.min_level:
-        return Rejection(f"level {best.score[0]} below {config.min_level}", seed, index)
+        return GenerationRejection(f"level {best.score[0]} below {config.min_level}", seed, index)
     limits = SearchLimits(
         max_states=config.max_states,
         seconds=config.seconds,
@@ -304,4 +304,4 @@ def make(config: PuzzleConfig, seed: int, index: int) -> Level | Rejection:
             blocks=blocks,
         )
     except SearchLimitError as e:
-        return Rejection(f"optimal plan not found within limits: {e}", seed, index)
+        return GenerationRejection(f"optimal plan not found within limits: {e}", seed, index)

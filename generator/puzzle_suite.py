@@ -7,7 +7,7 @@ entry, listed in :data:`SUITE`:
   ``chain import``), imported by :func:`chaingeo.generator.imported.imported_puzzle_level` exactly
   as ``chain import`` does; its tier is what the solver's figures give, and the build stops when
   that is not the entry's tier.
-* :class:`SuiteEntry`: a generator configuration and seed; items ``0, 1, 2, ...`` of the seed
+* :class:`PuzzleSuiteEntry`: a generator configuration and seed; items ``0, 1, 2, ...`` of the seed
   are made with :func:`chaingeo.generator.puzzle.make` and the first ones whose tier (from the
   solver's figures, :func:`chaingeo.generator.puzzle.difficulty_of`) is the entry's and whose
   signature is new within the entry are kept. A puzzle made by two entries stops the build (change a
@@ -31,14 +31,14 @@ from chaingeo.core.level import Difficulty, Level, revalidate, save_level
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.imported import imported_puzzle_level
 from chaingeo.generator.puzzle import make
-from chaingeo.generator.result import Rejection
+from chaingeo.generator.result import GenerationRejection
 from chaingeo.solvers.limits import SearchLimits
 
 Goal = Literal["disassemble", "assemble"]
 
 
 @dataclass(frozen=True)
-class SuiteEntry:
+class PuzzleSuiteEntry:
     """``count`` generated levels of one configuration and seed."""
 
     difficulty: Difficulty
@@ -88,29 +88,29 @@ A: Goal = "assemble"
 #: 7 and up in the hard tier), three-piece and three-plate burrs, interlocking cubes, a
 #: 12-piece tower and two 36-piece towers. Both goals in every tier; most generated levels ask
 #: for assembly, which neither baseline manages (docs/benchmarks/baselines.md, 'The puzzle suite').
-SUITE: tuple[SuiteEntry | ModelEntry, ...] = (
+SUITE: tuple[PuzzleSuiteEntry | ModelEntry, ...] = (
     ModelEntry("easy", "luban-3-piece", (D,), turns=True),
     ModelEntry("easy", "luban-6-piece", (D, A)),
-    SuiteEntry("easy", _EASY6, 101, 3, (D, A, A)),
-    SuiteEntry("easy", _BURR3E, 401, 1, (A,)),
-    SuiteEntry("easy", _PLATE3E, 411, 1, (A,)),
-    SuiteEntry("easy", _CUBE3, 102, 2, (A, A)),
+    PuzzleSuiteEntry("easy", _EASY6, 101, 3, (D, A, A)),
+    PuzzleSuiteEntry("easy", _BURR3E, 401, 1, (A,)),
+    PuzzleSuiteEntry("easy", _PLATE3E, 411, 1, (A,)),
+    PuzzleSuiteEntry("easy", _CUBE3, 102, 2, (A, A)),
     ModelEntry("mid", "interlocking-cube-puzzle", (D, A)),
     # disassembly only: the reverse of its optimal plan joins sticks that do not touch, which
     # the assembly rules forbid (parts join only where their bounding boxes touch)
     ModelEntry("mid", "luban-15-piece", (D,)),
-    SuiteEntry("mid", _TOWER, 303, 1, (D,)),
-    SuiteEntry("mid", _HOLEY, 201, 1, (A,)),
-    SuiteEntry("mid", _HOLEY4, 301, 2, (A, A)),
-    SuiteEntry("mid", _BURR3M, 402, 1, (A,)),
-    SuiteEntry("mid", _PLATE3M, 412, 1, (A,)),
-    SuiteEntry("mid", _CUBE4, 202, 3, (A, A, A)),
+    PuzzleSuiteEntry("mid", _TOWER, 303, 1, (D,)),
+    PuzzleSuiteEntry("mid", _HOLEY, 201, 1, (A,)),
+    PuzzleSuiteEntry("mid", _HOLEY4, 301, 2, (A, A)),
+    PuzzleSuiteEntry("mid", _BURR3M, 402, 1, (A,)),
+    PuzzleSuiteEntry("mid", _PLATE3M, 412, 1, (A,)),
+    PuzzleSuiteEntry("mid", _CUBE4, 202, 3, (A, A, A)),
     ModelEntry("hard", "liliput", (A,)),
     ModelEntry("hard", "three-plate-burr-puzzle", (A,)),
     ModelEntry("hard", "luban-separate-pieces", (A,)),
-    SuiteEntry("hard", _STANDARD, 2026, 4, (D, A, A, A)),
-    SuiteEntry("hard", _TOWER36, 401, 2, (D, A)),
-    SuiteEntry("hard", _CUBE4H, 302, 1, (A,)),
+    PuzzleSuiteEntry("hard", _STANDARD, 2026, 4, (D, A, A, A)),
+    PuzzleSuiteEntry("hard", _TOWER36, 401, 2, (D, A)),
+    PuzzleSuiteEntry("hard", _CUBE4H, 302, 1, (A,)),
 )
 
 
@@ -133,7 +133,7 @@ def model_items(entry: ModelEntry, models: Path) -> list[Level]:
     return made
 
 
-def entry_items(entry: SuiteEntry, max_items: int = 400) -> list[Level]:
+def entry_items(entry: PuzzleSuiteEntry, max_items: int = 400) -> list[Level]:
     """The first ``entry.count`` items of the entry's seed with its difficulty and distinct
     signatures (ids not yet given). Entries are independent, so they can run in parallel."""
     seen: set[str] = set()
@@ -143,7 +143,7 @@ def entry_items(entry: SuiteEntry, max_items: int = 400) -> list[Level]:
             break
         goal = entry.goals[len(made)]
         item = make(dataclasses.replace(entry.config, goal=goal), entry.seed, index)
-        if isinstance(item, Rejection):
+        if isinstance(item, GenerationRejection):
             continue
         if item.difficulty != entry.difficulty or item.provenance.signature in seen:
             continue
@@ -157,13 +157,13 @@ def entry_items(entry: SuiteEntry, max_items: int = 400) -> list[Level]:
     return made
 
 
-def _items(entry: SuiteEntry | ModelEntry, models: Path, max_items: int) -> list[Level]:
+def _items(entry: PuzzleSuiteEntry | ModelEntry, models: Path, max_items: int) -> list[Level]:
     if isinstance(entry, ModelEntry):
         return model_items(entry, models)
     return entry_items(entry, max_items)
 
 
-def _shape_of(entry: SuiteEntry | ModelEntry) -> str:
+def _shape_of(entry: PuzzleSuiteEntry | ModelEntry) -> str:
     return entry.name if isinstance(entry, ModelEntry) else entry.config.shape
 
 

@@ -1,7 +1,7 @@
 """What one generation item gives back when it gives no level: the family-neutral rejection.
 
 Every family's ``make(config, seed, index)`` returns a :class:`~chaingeo.core.level.Level` or a
-:class:`Rejection`; the batch runner needs nothing else to count outcomes.
+:class:`GenerationRejection`; the batch runner needs nothing else to count outcomes.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ ATTEMPTS_KEY: Final = "rejected_attempts"
 
 
 @dataclass(frozen=True)
-class Rejection:
+class GenerationRejection:
     """No level for this (config, seed, index): the last reason, and every attempt's reason."""
 
     reason: str

@@ -2,7 +2,8 @@
 
 ``make(config, seed, index)`` is a pure function: it draws everything from its own
 ``numpy.random.Generator`` seeded by ``SeedSequence([seed, index])`` and returns a verified
-:class:`~chaingeo.core.level.Level` or a :class:`Rejection` saying why no level came out. Modes:
+:class:`~chaingeo.core.level.Level` or a :class:`GenerationRejection` saying why no level came
+out. Modes:
 
 - **easy**: cuboid pieces with at least two equal sides (rods, 2x2 plates, 2x2x2 cubes), a
   random multiset that fills the volume, packed (and so verified packable) by the exact-cover
@@ -52,7 +53,7 @@ from chaingeo.generator.partition import (
     random_sizes,
     repair,
 )
-from chaingeo.generator.result import ATTEMPTS_KEY, Rejection
+from chaingeo.generator.result import ATTEMPTS_KEY, GenerationRejection
 
 GENERATOR: Final = "chaingeo.generator.stacking"
 #: Bump when a change to the algorithm changes what a (config, seed, index) produces.
@@ -71,7 +72,7 @@ def level_id(config: StackingConfig, seed: int, index: int) -> str:
     return f"stacking-{box_text(config.box)}-{config.mode}-s{seed}-{index:06d}"
 
 
-def make(config: StackingConfig, seed: int, index: int) -> Level | Rejection:
+def make(config: StackingConfig, seed: int, index: int) -> Level | GenerationRejection:
     """One stacking level for item ``index`` of ``seed``, or why there is none."""
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
     tally: Counter[str] = Counter()
@@ -89,7 +90,9 @@ def make(config: StackingConfig, seed: int, index: int) -> Level | Rejection:
                 last = outcome
                 continue
             return _build(config, seed, index, min_piece, outcome, tally, rng)
-    return Rejection(reason=last, seed=seed, index=index, attempts=dict(sorted(tally.items())))
+    return GenerationRejection(
+        reason=last, seed=seed, index=index, attempts=dict(sorted(tally.items()))
+    )
 
 
 def stage_problem(config: StackingConfig, min_piece: int) -> str | None:

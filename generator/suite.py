@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Final
 
-from chaingeo.generator.batch import GenerationJob, PictureFn, Summary, run
+from chaingeo.generator.batch import BatchSummary, GenerationJob, PictureFn, run
 from chaingeo.generator.config import StackingConfig, get_config
 from chaingeo.generator.stacking import GENERATOR, make
 
@@ -80,7 +80,7 @@ def build_suite(
     progress: bool = True,
     pictures: str | os.PathLike[str] | None = None,
     picture_maker: PictureFn | None = None,
-) -> list[Summary]:
+) -> list[BatchSummary]:
     """Generate the whole suite and write its level files into ``out``.
 
     Earlier suite files in ``out`` (levels made by this generator) are replaced; other files
@@ -91,7 +91,7 @@ def build_suite(
         raise ValueError("pictures and picture_maker go together")
 
     target = Path(out)
-    summaries: list[Summary] = []
+    summaries: list[BatchSummary] = []
     with tempfile.TemporaryDirectory(prefix="chain-suite-") as scratch:
         for entry in SUITE:
             job = entry.job()

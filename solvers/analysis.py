@@ -384,7 +384,7 @@ def analyze(
     ``optimal`` / ``assemble``: search o_i / count assemblies. ``mirrors``: see
     :mod:`chaingeo.solvers.assembly.btassemble`. Everything runs within ``deadline`` (default:
     one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`)."""
-    from chaingeo.core.jit import mode
+    from chaingeo.kernels.jit import mode
 
     limits = DEFAULT_LIMITS if limits is None else limits
     deadline = Deadline(limits.seconds) if deadline is None else deadline

@@ -33,12 +33,16 @@ class Progress:
 class Deadline:
     """The wall-clock budget shared by every search of one analysis (None: no time limit),
     with the analysis' :class:`Progress`. ``ValueError`` for a negative or NaN number of
-    seconds (NaN would never expire)."""
+    seconds (NaN would never expire). ``stated`` is the limit its error names when this
+    deadline is what is left of a longer one (a whole command's ``--seconds``)."""
 
-    def __init__(self, seconds: float | None, cap: str = "seconds") -> None:
+    def __init__(
+        self, seconds: float | None, cap: str = "seconds", stated: float | None = None
+    ) -> None:
         if seconds is not None and (math.isnan(seconds) or seconds < 0):
             raise ValueError(f"seconds: a time limit must be >= 0, got {seconds}")
         self.seconds = seconds
+        self.stated = seconds if stated is None else stated
         self.cap = cap  # the field of SearchLimits this time limit is
         self.start = time.monotonic()
         self.end = None if seconds is None else self.start + seconds
@@ -66,7 +70,7 @@ class Deadline:
     def error(self, where: str = "") -> SearchLimitError:
         """The error that names this cap (``where``: what was running, for the message)."""
         at = f" in {where}" if where else ""
-        return SearchLimitError(f"time limit of {self.seconds:g} s reached{at}", self.cap)
+        return SearchLimitError(f"time limit of {self.stated:g} s reached{at}", self.cap)
 
     def check(self) -> None:
         if self.expired():

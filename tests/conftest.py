@@ -13,12 +13,12 @@ from typing import Any
 import pytest
 from hypothesis import settings
 
-from chaingeo.core import aot
+from chaingeo.kernels import aot
 
 settings.register_profile("ci", derandomize=True, deadline=None, max_examples=100)
 settings.load_profile("ci")
 
-#: The kernels ``chain precompile`` stored for this user (what tests/core/test_aot.py checks).
+#: The kernels ``chain precompile`` stored for this user (what tests/kernels/test_aot.py checks).
 #: Every other test, and every ``chain`` it starts, sees an empty store, so that what
 #: ``--jit auto`` chooses does not depend on whether this machine has precompiled.
 USER_KERNELS = aot.store_dir()

@@ -23,8 +23,8 @@ import numpy as np
 
 from chaingeo.core.level import Level, StackingSolution, stacking_level
 from chaingeo.core.piecesets import BEDLAM_SOLUTION
-from chaingeo.envs.render.raster import parse_color
-from chaingeo.envs.render.scene import VIEWS, PieceMap, render_tray, render_views
+from chaingeo.pictures.raster import parse_color
+from chaingeo.pictures.scene import VIEWS, PieceMap, render_tray, render_views
 
 SIZE = 512
 GOAL_RATIO = 20.0
@@ -149,8 +149,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"scene: Bedlam 4x4x4, {len(boxed)} pieces placed, {len(tray)} in the tray, {SIZE} px")
     print("                                    CPU ms   wall ms   (best of runs)")
     for label, (wall, cpu) in (
-        ("chaingeo.envs.render.scene   4 views", views_only),
-        ("chaingeo.envs.render.scene   4 views + tray", t_ours),
+        ("chaingeo.pictures.scene   4 views", views_only),
+        ("chaingeo.pictures.scene   4 views + tray", t_ours),
         ("matplotlib voxels 4 views + tray", t_ref),
     ):
         print(f"{label:34s} {cpu * 1e3:8.1f}  {wall * 1e3:8.1f}")

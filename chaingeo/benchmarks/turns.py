@@ -26,7 +26,7 @@ from chaingeo.core.suite import suite_folder
 from chaingeo.envs.machines.puzzle import PuzzleState
 from chaingeo.envs.machines.puzzle_actions import turn_actions
 from chaingeo.evaluation.agents.base import AgentSpec
-from chaingeo.evaluation.episode import EpisodeTask, run_episode
+from chaingeo.evaluation.play import EpisodeTask, run_episode
 from chaingeo.solvers.motion.turnmoves import TurnTable
 
 

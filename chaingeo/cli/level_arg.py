@@ -1,11 +1,11 @@
 """A level named on the command line: a level file, or the id of a level in a folder (by
-default the shipped suite). One resolver, so every command that takes a level takes both, and
-one error naming both possibilities when neither fits."""
+default the shipped suite), through the library's one resolver
+(:func:`chaingeo.core.suite.resolve_level`), so every command takes both, and one error names
+both possibilities (and the nearest ids) when neither fits."""
 
 from __future__ import annotations
 
 import argparse
-import itertools
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -27,46 +27,23 @@ def add_level(p: argparse.ArgumentParser, name: str = "level", **kwargs: Any) ->
 
 
 def find_level(spec: str | Path, folder: Path | None = None) -> Level:
-    """The level in file ``spec``, else the level whose id is ``spec`` under ``folder``."""
-    from chaingeo.core.level import load_level
-
-    path = Path(spec)
-    if path.is_file():
-        return load_level(path)
-    return _by_id(str(spec), folder)[1]
+    """The level in file ``spec``, else the level whose id is ``spec`` under ``folder``
+    (:func:`chaingeo.core.suite.resolve_level`)."""
+    return _resolve(spec, folder)[1]
 
 
 def level_file(spec: str | Path, folder: Path | None = None) -> Path:
     """The file of :func:`find_level`'s level (for commands that report files)."""
-    path = Path(spec)
-    return path if path.is_file() else _by_id(str(spec), folder)[0]
+    return _resolve(spec, folder)[0]
 
 
-def _by_id(spec: str, folder: Path | None) -> tuple[Path, Level]:
-    """The file and level of id ``spec`` under ``folder`` (default: the shipped suite); the
-    one error naming both readings of ``spec`` when there is none."""
-    from chaingeo.core.suite import suite_folder
+def _resolve(spec: str | Path, folder: Path | None) -> tuple[Path, Level]:
+    from chaingeo.core.suite import UnknownLevelError, resolve_level
 
-    root = folder if folder is not None else suite_folder()
-    found = _search(spec, root) if root.is_dir() else None
-    if found is None:
-        where = f"none in {root}" if root.is_dir() else f"{root} is no folder"
-        raise CommandError(f"no level file or level id {spec!r} (no such file; {where})")
-    return found
-
-
-def _search(spec: str, root: Path) -> tuple[Path, Level] | None:
-    """Files are named by id, so those are read first; then every file of ``root``."""
-    from chaingeo.core.level import load_level
-
-    if "/" in spec or "\\" in spec:  # a path, never an id
-        return None
-    named = sorted(root.rglob(f"{spec}.json"))
-    for path in itertools.chain(named, sorted(root.rglob("*.json"))):
-        level = load_level(path)
-        if level.id == spec:
-            return path, level
-    return None
+    try:
+        return resolve_level(spec, folder)
+    except UnknownLevelError as e:
+        raise CommandError(str(e)) from None
 
 
 def add_level_list(p: argparse.ArgumentParser) -> None:

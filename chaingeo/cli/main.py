@@ -78,6 +78,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ChainGeoError, FileNotFoundError, ValueError) as e:
         print(f"chain {args.command}: error: {e}", file=sys.stderr)
         return 2
+    except OSError as e:  # a full disk, a folder not ours: one line naming the path
+        print(f"chain {args.command}: error: {os_error(e)}", file=sys.stderr)
+        return 2
+
+
+def os_error(e: OSError) -> str:
+    """``PATH: reason`` of an ``OSError`` (both paths of a rename), without a traceback."""
+    where = " -> ".join(str(f) for f in (e.filename, e.filename2) if f is not None)
+    reason = e.strerror or str(e)
+    return f"{where}: {reason}" if where else reason
 
 
 if __name__ == "__main__":

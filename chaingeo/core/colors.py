@@ -4,7 +4,7 @@ The order is fixed and is the assignment order, chosen so that the first pieces 
 the most distinct hues (after Kelly's and Trubetskoy's lists of maximally distinct colours).
 
 Any two colours of the palette differ by at least :data:`MIN_DELTA_E00` in CIEDE2000, so every
-level, whichever of them it uses, passes the same check (``tests/envs/render/test_colors.py``
+level, whichever of them it uses, passes the same check (``tests/pictures/test_colors.py``
 holds it for the palette and for every shipped level). The first 13 colours are Trubetskoy's;
 the later ones were moved (each by at most 11 ΔE00 from its named shade, so the name still fits,
 and so that the materials of CHAIN's models still import as the same names) until the whole

@@ -44,11 +44,11 @@ FORMAT: Final = "chain-level/1"
 FAMILIES: Final = ("stacking", "puzzle")
 DIFFICULTIES: Final = ("easy", "mid", "hard")
 GOALS: Final = {"stacking": ("pack",), "puzzle": ("disassemble", "assemble")}
-_NAME_RE: Final = re.compile(r"^[a-z][a-z0-9_-]{0,31}$")
-_ID_RE: Final = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,127}$")
-_HEX_RE: Final = re.compile(r"^#[0-9a-f]{6}$")
+_NAME_RE: Final = re.compile(r"[a-z][a-z0-9_-]{0,31}")
+_ID_RE: Final = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,127}")
+_HEX_RE: Final = re.compile(r"#[0-9a-f]{6}")
 #: CHAIN's piece ids: the piece's index in CHAIN's level file, in decimal.
-_CHAIN_ID_RE: Final = re.compile(r"^(?:0|[1-9][0-9]{0,5})$")
+_CHAIN_ID_RE: Final = re.compile(r"0|[1-9][0-9]{0,5}")
 
 Family = Literal["stacking", "puzzle"]
 Difficulty = Literal["easy", "mid", "hard"]
@@ -199,6 +199,11 @@ def default_step_budget(optimal_steps: int) -> int:
 # ---------------------------------------------------------------------------------------------
 
 
+def is_level_id(text: object) -> bool:
+    """Whether ``text`` is a level id as a level file may write it (matched whole)."""
+    return isinstance(text, str) and _ID_RE.fullmatch(text) is not None
+
+
 def parse_level(data: Any, source: str = "<level>") -> Level:
     """Validate a decoded JSON value and build the level; :class:`LevelError` if anything is off."""
     r = Reader(source)
@@ -207,7 +212,7 @@ def parse_level(data: Any, source: str = "<level>") -> Level:
     if fmt != FORMAT:
         raise r.fail("format", f"expected {FORMAT!r}, got {fmt!r}")
     level_id = r.string(r.get(top, "id", "id"), "id")
-    if not _ID_RE.match(level_id):
+    if not _ID_RE.fullmatch(level_id):
         raise r.fail("id", f"{level_id!r} must be letters, digits, '.', '_' or '-'")
     family = r.string(r.get(top, "family", "family"), "family", FAMILIES)
     difficulty = r.string(r.get(top, "difficulty", "difficulty"), "difficulty", DIFFICULTIES)
@@ -327,12 +332,12 @@ def _parse_pieces(
         f = f"pieces[{i}]"
         obj = r.obj(item, f)
         name = r.string(r.get(obj, "name", f"{f}.name"), f"{f}.name")
-        if not _NAME_RE.match(name):
+        if not _NAME_RE.fullmatch(name):
             raise r.fail(f"{f}.name", f"{name!r} must be one lowercase word a model can type")
         if name in seen_names:
             raise r.fail(f"{f}.name", f"duplicate piece name {name!r}")
         rgb = r.string(r.get(obj, "rgb", f"{f}.rgb"), f"{f}.rgb")
-        if not _HEX_RE.match(rgb):
+        if not _HEX_RE.fullmatch(rgb):
             raise r.fail(f"{f}.rgb", f"{rgb!r} is not a lowercase #rrggbb colour")
         if rgb in seen_rgb:
             raise r.fail(f"{f}.rgb", f"duplicate colour {rgb} (also {seen_rgb[rgb]})")
@@ -341,7 +346,7 @@ def _parse_pieces(
         chain_id = None
         if "chain_id" in obj:
             chain_id = r.string(obj["chain_id"], f"{f}.chain_id")
-            if not _CHAIN_ID_RE.match(chain_id):
+            if not _CHAIN_ID_RE.fullmatch(chain_id):
                 raise r.fail(f"{f}.chain_id", f"{short(chain_id)} is not a piece index")
         total += len(shape)
         if total > limits.MAX_LEVEL_VOXELS:

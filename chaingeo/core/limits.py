@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Callable
 from typing import Any, Final
 
 import numpy as np
@@ -53,6 +54,13 @@ MAX_XMPUZZLE_XML_BYTES: Final = 32 * 1024 * 1024
 MAX_BT_GRID_CELLS: Final = 1_000_000
 MAX_BT_SHAPES: Final = 4096
 MAX_BT_PROBLEMS: Final = 1024
+#: The XML tree of an ``.xmpuzzle``: nesting and elements, checked as it is built (issue #37,
+#: item 4: a deep stored solution broke the recursion limit; millions of elements cost a
+#: gigabyte), and the grid cells of all shapes together, before any voxel string is read.
+#: BurrTools' examples: depth 19, 1,004 elements, 27 grids of 216 cells.
+MAX_BT_XML_DEPTH: Final = 256
+MAX_BT_XML_ELEMENTS: Final = 100_000
+MAX_BT_TOTAL_GRID_CELLS: Final = 2_000_000
 
 #: The ``optimal_steps`` re-check of ``chain validate``: a search capped at this many states
 #: (the same cap the tests use); larger puzzles are reported as not re-checked.
@@ -83,6 +91,13 @@ MAX_RETRY_AFTER_SECONDS: Final = 60.0
 MAX_RETRY_SECONDS: Final = 900.0
 #: Same-origin HTTP 307/308 redirects followed per request (other redirects never are).
 MAX_REDIRECTS: Final = 3
+#: Run folders read back (``chain report``, ``--resume``): bytes of ``header.json``, of
+#: ``episodes.jsonl`` and of one stored picture, and the samples per level a record may name
+#: (each checked before the work; records are checked field by field as they are read).
+MAX_RUN_HEADER_BYTES: Final = 1024 * 1024
+MAX_RUN_LOG_BYTES: Final = 1024 * 1024 * 1024
+MAX_RUN_IMAGE_BYTES: Final = 64 * 1024 * 1024
+MAX_SAMPLES: Final = 10_000
 #: Run logs: characters of one logged string (longer ones keep a head and their length and
 #: SHA-256), bytes of one reply's record (a step, a plan, a candidate) and of one episode's
 #: record; past the episode budget later steps keep only their outcome.
@@ -128,7 +143,7 @@ def _bounded_int(text: str) -> int:
     return int(text)
 
 
-def loads_bounded(text: str) -> Any:
+def loads_bounded(text: str, object_pairs_hook: Callable[[Any], Any] | None = None) -> Any:
     """``json.loads`` with the nesting depth checked first (the decoder recurses), integer
     literals of at most :data:`MAX_INT_DIGITS` digits and finite numbers only; :class:`LimitError`
     past any of them. ``NaN``, ``Infinity`` and overflowing literals (``1e999``) are caught by
@@ -148,7 +163,11 @@ def loads_bounded(text: str) -> Any:
         return value if math.isfinite(value) else non_finite(literal)
 
     data = json.loads(
-        text, parse_int=_bounded_int, parse_float=finite_float, parse_constant=non_finite
+        text,
+        parse_int=_bounded_int,
+        parse_float=finite_float,
+        parse_constant=non_finite,
+        object_pairs_hook=object_pairs_hook,
     )
     if found:
         literal = found[0].literal
@@ -252,11 +271,13 @@ MAX_DATASET_SHARD_BYTES: Final = 256 * 1024 * 1024
 #: Bytes of one video file (stat before opening; CHAIN's clips are at most 4 MB).
 MAX_VIDEO_BYTES: Final = 512 * 1024 * 1024
 #: Pixels of one frame (4K UHD), frames of one video (10 minutes at 30 fps) and pixels of all
-#: frames together, checked from the container's header before decoding and again while
-#: decoding (a header can lie). CHAIN's clips: 2.1 Mpx frames, 150 frames, 3.1e8 pixels.
+#: frames together, checked from the container's header before decoding and on every decoded
+#: frame as it arrives (a header can lie, and a raw H.264 stream or a streamed MKV has no
+#: frame count: issue #37, item 5). CHAIN's clips: 2.1 Mpx frames, 150 frames, 3.1e8 pixels;
+#: the total is five times that (decoding it takes seconds, not half a minute).
 MAX_VIDEO_FRAME_PIXELS: Final = 3840 * 2160
 MAX_VIDEO_FRAMES: Final = 18_000
-MAX_VIDEO_TOTAL_PIXELS: Final = 4_000_000_000
+MAX_VIDEO_TOTAL_PIXELS: Final = 1_600_000_000
 
 # ---------------------------------------------------------------------------------------------
 # chain check-trajectory: pose trajectory files (issue #22)
@@ -269,3 +290,30 @@ MAX_TRAJECTORY_BYTES: Final = 64 * 1024 * 1024
 MAX_TRAJECTORY_FRAMES: Final = 50_000
 MAX_TRAJECTORY_POSES: Final = 1_000_000
 MAX_TRAJECTORY_COORD: Final = 1e6
+
+# ---------------------------------------------------------------------------------------------
+# chain serve: the environment server's sessions (chaingeo/integrations/serve)
+# ---------------------------------------------------------------------------------------------
+# Every client of the server is untrusted: a session is one WebSocket connection, and each is
+# bounded here, checked before the work (a frame's size and nesting before it is parsed).
+
+#: Sessions open at once (WebSocket connections with an environment); one more is refused.
+MAX_SESSIONS: Final = 64
+#: Seconds a session may stay silent before the server closes it.
+SESSION_IDLE_SECONDS: Final = 900.0
+#: Bytes of one request: a WebSocket frame or an HTTP body (a reply of MAX_REPLY_CHARS fits).
+MAX_REQUEST_BYTES: Final = 1024 * 1024
+#: Bytes one session may send in all, and messages (resets, steps, states) it may send in all:
+#: a client that wants more opens a new session.
+MAX_SESSION_BYTES: Final = 256 * 1024 * 1024
+MAX_SESSION_MESSAGES: Final = 100_000
+#: Characters of a study's participant id and of a study's name.
+MAX_PARTICIPANT_CHARS: Final = 64
+
+# ---------------------------------------------------------------------------------------------
+# The precompiled-kernel store (chaingeo/kernels/aot.py, issue #37, item 2)
+# ---------------------------------------------------------------------------------------------
+
+#: Bytes of a store's manifest and of any file it hashes (the extension module, a source).
+MAX_KERNEL_MANIFEST_BYTES: Final = 16 * 1024 * 1024
+MAX_KERNEL_FILE_BYTES: Final = 256 * 1024 * 1024

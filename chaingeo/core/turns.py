@@ -1,7 +1,7 @@
 """Quarter turns: the centre convention, the turn move, and the exact sweep test.
 
 **Centre convention.** A piece is a set of unit cubes; voxel ``(i, j, k)`` is the cube
-``[i, i+1] x [j, j+1] x [k, k+1]`` (:mod:`chaingeo.envs.render.mesh`). A quarter turn about a line
+``[i, i+1] x [j, j+1] x [k, k+1]`` (:mod:`chaingeo.pictures.mesh`). A quarter turn about a line
 parallel to z through ``(px, py)`` maps a cube's centre ``(i+1/2, j+1/2)`` to
 ``(px - (j+1/2-py), py + (i+1/2-px))``, a cube centre again for every ``i, j`` exactly when
 ``px + py`` and ``px - py`` are whole numbers: ``px, py`` are both whole (the line runs along cube

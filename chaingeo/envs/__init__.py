@@ -1,8 +1,10 @@
 """The environments, in rooms: actions and the text parser (:mod:`.actions`), the two state
-machines (:mod:`.machines`), pictures and meshes (:mod:`.render`), video models
-(:mod:`.worldmodel`); observations, the Gymnasium wrappers and the dataset export beside them.
+machines (:mod:`.machines`); observations, the Gymnasium wrappers and the dataset export beside
+them.
 
-Built on :mod:`chaingeo.core` and :mod:`chaingeo.solvers`; the evaluation harness sits above.
+Built on :mod:`chaingeo.core`, :mod:`chaingeo.solvers` and the pictures
+(:mod:`chaingeo.pictures`); the evaluation harness and the video-model checks
+(:mod:`chaingeo.worldmodel`) sit above.
 
 Its entry points are exported here and imported on first use: ``new_state``, ``observe``,
 ``render_state``, ``parse_action``, the action types, and the Gymnasium environments

@@ -32,7 +32,7 @@ from chaingeo.core.limits import LimitError
 from chaingeo.envs.demos import demonstration, plan_texts
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.observation import render_state
-from chaingeo.envs.render.pictures import level_pictures
+from chaingeo.pictures.pictures import level_pictures
 
 LEVELS: Final = "levels"
 DEMONSTRATIONS: Final = "demonstrations"

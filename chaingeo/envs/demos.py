@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from chaingeo.core.errors import ChainGeoError
+from chaingeo.core.files import atomic_path
 from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
 from chaingeo.envs.actions.types import PlaceAction, action_of_move
 
@@ -78,7 +79,7 @@ def _pngs(frames: dict[str, Any]) -> dict[str, bytes]:
     """PNG bytes of the environment's pixel arrays (pixel-equal to ``render_state``'s PNGs)."""
     from PIL import Image
 
-    from chaingeo.envs.render.raster import png_bytes
+    from chaingeo.pictures.raster import png_bytes
 
     return {name: png_bytes(Image.fromarray(frame)) for name, frame in frames.items()}
 
@@ -93,7 +94,7 @@ def demonstration_lines(levels: Iterable[Level], **env_kwargs: Any) -> Iterator[
 def write_demonstrations(levels: Iterable[Level], path: Path, **env_kwargs: Any) -> int:
     """Write :func:`demonstration_lines` to ``path`` (JSONL); returns the number of records."""
     count = 0
-    with path.open("w", encoding="ascii", newline="\n") as out:
+    with atomic_path(path) as tmp, tmp.open("w", encoding="ascii", newline="\n") as out:
         for line in demonstration_lines(levels, **env_kwargs):
             out.write(line + "\n")
             count += 1

@@ -3,7 +3,7 @@
 The Gymnasium environments hand out pixels, not files: encoding every picture to PNG and
 decoding it back cost about a third of the time spent on an observation's pictures.
 :func:`render_frames` takes the images :func:`chaingeo.envs.observation.render_state` encodes
-(drawn by :mod:`chaingeo.envs.render.fastview`, byte-equal to :mod:`chaingeo.envs.render.scene`) as
+(drawn by :mod:`chaingeo.pictures.fastview`, byte-equal to :mod:`chaingeo.pictures.scene`) as
 arrays; PNG is lossless, so they are pixel-equal to decoding the PNG (tested).
 PNG stays where bytes are wanted (the harness' logs and agents call ``render_state``);
 :func:`png_frames` keeps the round trip callable as the reference of ``chain bench env``.
@@ -59,7 +59,7 @@ def _views(state: BaseState, size: int) -> dict[str, Frame]:
 
 
 def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
-    import chaingeo.envs.render.fastview as fastview
+    import chaingeo.pictures.fastview as fastview
 
     return fastview.render_arrays(pieces, box, VIEWS, size)
 
@@ -68,7 +68,7 @@ def _extra(state: BaseState, size: int, tray: PieceMap | None = None) -> Frame:
     """The tray (stacking: ``tray``, else the state's) or the target (puzzles), as
     :func:`render_state` draws it."""
     if isinstance(state, StackingState):
-        from chaingeo.envs.render.sheet import tray_pixels
+        from chaingeo.pictures.sheet import tray_pixels
 
         return tray_pixels(scene(state)[2] if tray is None else tray, size)
     return _array(extra_image(state, size))
@@ -89,8 +89,8 @@ def decode_png(data: bytes) -> Frame:
 
 
 def reference_frames(state: BaseState, size: int) -> dict[str, Frame]:
-    """:func:`render_frames` drawn by :mod:`chaingeo.envs.render.scene` itself (the reference of
-    :mod:`chaingeo.envs.render.fastview`: the same pixels, slower), no PNG."""
+    """:func:`render_frames` drawn by :mod:`chaingeo.pictures.scene` itself (the reference of
+    :mod:`chaingeo.pictures.fastview`: the same pixels, slower), no PNG."""
     return {v: _array(img) for v, img in state_images(state, size, reference=True).items()}
 
 
@@ -151,8 +151,8 @@ class FrameCache:
 
     def clear(self) -> None:
         """Forget every picture (levels were replaced under the same ids), and the layouts
-        :mod:`chaingeo.envs.render.fastview` keeps in this process."""
-        import chaingeo.envs.render.fastview as fastview
+        :mod:`chaingeo.pictures.fastview` keeps in this process."""
+        import chaingeo.pictures.fastview as fastview
 
         self._store.clear()
         self._pictures = 0

@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import re
 import string
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, ClassVar, Final
 
@@ -48,6 +48,7 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level, load_levels
 from chaingeo.core.limits import MAX_OBSERVATION_CHARS, MAX_STACKING_ACTIONS, LimitError
 from chaingeo.core.suite import suite_folder
@@ -57,13 +58,28 @@ from chaingeo.envs.frames import Frame, FrameCache, picture_names
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.machines.state import BaseState
 from chaingeo.envs.observation import DEFAULT_HISTORY, VIEWS, observe
-from chaingeo.envs.render.scene import MIN_SIZE
+from chaingeo.pictures.scene import MIN_SIZE
 
 #: Characters of text actions and observations: printable ASCII and newline.
 CHARSET: Final = frozenset(c for c in string.printable if c not in "\x0b\x0c\r")
 ACTION_MAX_LENGTH: Final = 1024
 OBSERVATION_MAX_LENGTH: Final = MAX_OBSERVATION_CHARS
 DEFAULT_LEVELS: Final = suite_folder()
+
+
+#: The longest history window (turns echoed in the observation): with actions of at most
+#: :data:`ACTION_MAX_LENGTH` characters, the text observation stays under its limit.
+MAX_HISTORY_WINDOW: Final = 16
+
+
+class EnvError(ChainGeoError, ValueError):
+    """A call the environment cannot take as made: an unknown level, options that are not a
+    mapping, a history window past its bound (the agent's own actions are never refused this
+    way: see :meth:`ChainEnv.step`)."""
+
+
+class EpisodeOver(ChainGeoError, RuntimeError):
+    """A step before :meth:`ChainEnv.reset` or after the episode ended."""
 
 
 #: Every character outside :data:`CHARSET` (printable ASCII less \x0b \x0c \r), one at a time.
@@ -93,6 +109,10 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
         list_legal_actions: bool = False,
     ) -> None:
         super().__init__()
+        if not 0 <= history_window <= MAX_HISTORY_WINDOW:
+            raise EnvError(
+                f"history_window must be 0 to {MAX_HISTORY_WINDOW}, got {history_window}"
+            )
         source = DEFAULT_LEVELS if levels is None else levels
         loaded = load_levels(source) if isinstance(source, str | Path) else list(source)
         self.levels: dict[str, Level] = {
@@ -150,7 +170,7 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
     @property
     def state(self) -> BaseState:
         if self._state is None:
-            raise RuntimeError("call reset() first")
+            raise EpisodeOver("call reset() first")
         return self._state
 
     def action_catalogue(self) -> list[str]:
@@ -216,26 +236,53 @@ class ChainEnv(gymnasium.Env[dict[str, Any], str]):
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, Any], dict[str, Any]]:
         super().reset(seed=seed)
+        if options is not None and not isinstance(options, Mapping):
+            raise EnvError(
+                f"options must be a mapping (e.g. {{'level': id}}), got {_kind(options)}"
+            )
         wanted = (options or {}).get("level")
         ids = list(self.levels)
         if wanted is None:
             level_id = ids[int(self.np_random.integers(len(ids)))]
-        elif wanted in self.levels:
+        elif isinstance(wanted, str) and wanted in self.levels:
             level_id = str(wanted)
         else:
-            raise ValueError(f"unknown {self.family} level {wanted!r}")
+            raise EnvError(f"unknown {self.family} level {str(wanted)[:80]!r}")
         self._state = self._start(level_id)
         return self._observation(), self._info(None)
 
     def step(self, action: str) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
+        """Apply ``action`` (one step, legal or not, as the state machine counts it), or refuse
+        it without consuming the step when it is not in the action space (not text, or longer
+        than :data:`ACTION_MAX_LENGTH`): the agent's text is bounded before the observation
+        echoes it, so no action makes a later observation too long."""
         state = self.state
         if state.is_success() or state.finished:
-            raise RuntimeError("the episode has ended; call reset()")
-        result = state.step_text(str(action))
+            raise EpisodeOver("the episode has ended; call reset()")
+        if not isinstance(action, str) or len(action) > ACTION_MAX_LENGTH:
+            return self._refuse(action)
+        result = state.step_text(action)
         terminated = state.is_success() or state.finished
         truncated = state.is_truncated() and not terminated
         reward = 1.0 if result.success and result.legal else 0.0
         return self._observation(), reward, terminated, truncated, self._info(result)
+
+    def _refuse(self, action: Any) -> tuple[dict[str, Any], float, bool, bool, dict[str, Any]]:
+        what = f"{len(action)} characters" if isinstance(action, str) else _kind(action)
+        info = self._info(None)
+        info.update(
+            legal=False,
+            error="refused",
+            feedback=f"Action refused ({what}; at most {ACTION_MAX_LENGTH} characters of text); "
+            "no step was used.",
+        )
+        state = self.state
+        truncated = state.is_truncated() and not state.is_success()
+        return self._observation(), 0.0, False, truncated, info
+
+
+def _kind(value: Any) -> str:
+    return "null" if value is None else type(value).__name__
 
 
 class StackingEnv(ChainEnv):

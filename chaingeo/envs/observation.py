@@ -1,7 +1,7 @@
 """What an agent is shown each turn: the task, the pieces, recent turns, the budget, pictures.
 
 Text follows the agent convention: cells are 1-based (converted by
-:mod:`chaingeo.envs.actions.types`). The pictures come from :mod:`chaingeo.envs.render.scene`,
+:mod:`chaingeo.envs.actions.types`). The pictures come from :mod:`chaingeo.pictures.scene`,
 called from :func:`render_state` only. Stacking shows the box (placed pieces where they are) and the
 tray of unplaced pieces; a puzzle shows its largest part where it is and every other part laid out
 beside it along +x (parts apart never interact, so only their shapes matter), and its goal as
@@ -12,7 +12,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from types import ModuleType
 from typing import TYPE_CHECKING, Final
 
 from chaingeo.core.geometry import Cell, Shape
@@ -256,7 +255,7 @@ def render_state(
     state: BaseState, size: int = DEFAULT_IMAGE_SIZE, reference: bool = False
 ) -> dict[str, bytes]:
     """PNG bytes per view: the four views, then ``tray`` (stacking) or ``target`` (puzzles)."""
-    from chaingeo.envs.render.raster import png_bytes
+    from chaingeo.pictures.raster import png_bytes
 
     images = state_images(state, size, reference)
     return {name: png_bytes(img) for name, img in images.items()}
@@ -267,22 +266,33 @@ def state_images(
 ) -> dict[str, Image.Image]:
     """The pictures of an observation as images (:func:`render_state` encodes them; the
     Gymnasium environments take their pixels): the four views, then the extra picture.
-    ``reference`` draws them with :mod:`chaingeo.envs.render.scene` itself, the slower reference
-    of :mod:`chaingeo.envs.render.fastview` (the same pixels)."""
+    ``reference`` draws them with :mod:`chaingeo.pictures.scene` itself, the slower reference
+    of :mod:`chaingeo.pictures.fastview` (the same pixels)."""
     pieces, box, _ = scene(state)
-    images = dict(_drawer(reference).render_images(pieces, box, VIEWS, size))
+    images = _views(pieces, box, VIEWS, size, None, reference)
     images[extra_picture(state)] = extra_image(state, size, reference)
     return images
 
 
-def _drawer(reference: bool) -> ModuleType:
+def _views(
+    pieces: PieceMap,
+    box: Sequence[int] | None,
+    views: Sequence[str],
+    size: int,
+    title: str | None,
+    reference: bool,
+) -> dict[str, Image.Image]:
+    """The views drawn by the reference renderer or by its kernels (the same pixels)."""
     if reference:
-        import chaingeo.envs.render.scene as render
+        from chaingeo.pictures.scene import render_images
 
-        return render
-    import chaingeo.envs.render.fastview as fastview
+        return render_images(pieces, box, views, size, title)
+    from PIL import Image as PILImage
 
-    return fastview
+    from chaingeo.pictures.fastview import render_arrays
+
+    arrays = render_arrays(pieces, box, views, size, title)
+    return {v: PILImage.fromarray(a) for v, a in arrays.items()}
 
 
 def extra_picture(state: BaseState) -> str:
@@ -298,15 +308,18 @@ def extra_image(
     state: BaseState, size: int = DEFAULT_IMAGE_SIZE, reference: bool = False
 ) -> Image.Image:
     """The tray (stacking: the pieces not yet placed) or the target (puzzles: the goal)."""
-    draw = _drawer(reference)
     if state.level.family == "stacking":
-        image: Image.Image = draw.render_tray_image(scene(state)[2], size)
-        return image
+        from PIL import Image as PILImage
+
+        from chaingeo.pictures.scene import render_tray_image
+        from chaingeo.pictures.sheet import tray_pixels
+
+        tray = scene(state)[2]
+        if reference:
+            return render_tray_image(tray, size)
+        return PILImage.fromarray(tray_pixels(tray, size))
     title = TARGET_TITLES[state.level.goal]
-    images: dict[str, Image.Image] = draw.render_images(
-        target_scene(state), None, ("iso",), size, title
-    )
-    return images["iso"]
+    return _views(target_scene(state), None, ("iso",), size, title, reference)["iso"]
 
 
 #: The first title line of a puzzle's ``target`` picture (not the current view's title).

@@ -16,10 +16,10 @@ from chaingeo.core.lazy import lazy_exports
 if TYPE_CHECKING:  # the real types for mypy and editors; at run time see _LAZY
     from chaingeo.evaluation.agents.base import Agent, AgentSpec
     from chaingeo.evaluation.agents.registry import make_agent, register_agent
-    from chaingeo.evaluation.episode import ProtocolConfig
+    from chaingeo.evaluation.episode import Outcome, ProtocolConfig
     from chaingeo.evaluation.judges.registry import make_judge, register_judge
     from chaingeo.evaluation.judges.selection import Judge
-    from chaingeo.evaluation.metrics import Outcome, Summary, summarize
+    from chaingeo.evaluation.metrics import Summary, summarize
     from chaingeo.evaluation.report.tables import load_run, write_report
     from chaingeo.evaluation.runner import RunConfig, evaluate
     from chaingeo.evaluation.usage import PriceTable
@@ -29,7 +29,7 @@ _LAZY: Final = {
     "Agent": "chaingeo.evaluation.agents.base:Agent",
     "AgentSpec": "chaingeo.evaluation.agents.base:AgentSpec",
     "Judge": "chaingeo.evaluation.judges.selection:Judge",
-    "Outcome": "chaingeo.evaluation.metrics:Outcome",
+    "Outcome": "chaingeo.evaluation.episode:Outcome",
     "PriceTable": "chaingeo.evaluation.usage:PriceTable",
     "ProtocolConfig": "chaingeo.evaluation.episode:ProtocolConfig",
     "RunConfig": "chaingeo.evaluation.runner:RunConfig",

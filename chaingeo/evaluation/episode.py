@@ -1,8 +1,12 @@
-"""One episode: an agent plays one level under one protocol; the result is a log record.
+"""The one episode: a level played under a protocol, one agent turn at a time.
 
-This is a pure function of its :class:`EpisodeTask` (level, agent spec, protocol, seeds), so it
-runs the same in this process, a worker process or on a Dask worker. Images never go into the
-record: they come back beside it, keyed by SHA-256, for the writer to store as files.
+Every door drives this class: ``chain eval`` (:mod:`chaingeo.evaluation.play` asks an agent for
+each turn), the chat game behind verifiers (:mod:`chaingeo.integrations.game`), and any door
+that receives replies from outside (a server, another harness). A driver asks for the
+:meth:`Episode.observation`, gets a reply from somewhere, reads it into a :class:`Reply` (the
+dialects of :mod:`chaingeo.evaluation.dialects`) and hands it to :meth:`Episode.play`, until
+:attr:`Episode.done`; then :meth:`Episode.outcome` is the one :class:`Outcome` every metric
+reads, and :meth:`Episode.record` the run-format record ``chain report`` reads.
 
 Protocols:
 
@@ -11,50 +15,40 @@ Protocols:
   applies it or explains why not (an unparseable, illegal or ambiguous action changes nothing
   but costs a step) until the level is solved, the agent says ``finish`` or the step budget is
   spent. A reply may hold several actions (a model's native tool calls): they are taken in
-  order, each a step with its own record, stopping at the first one rejected; the next turn
-  hands the agent that reply and what each executed action did. With ``candidates > 1`` each
-  turn asks the agent that many times and commits the candidate the judge ranks first after
-  every one was checked in a cloned state (its first action: the verifier tries that one).
+  order, each a step with its own record, stopping at the first one rejected.
 - ``oneshot`` (open loop): the agent sees one fixed view once (plus the tray of pieces, or the
   assembly target, where the level has one: they say what there is to place, not where things
-  are) and writes its whole plan, which
-  is executed action by action with no feedback (a failed action costs its step and the plan
-  goes on) until solved, finished, out of budget or out of actions.
+  are) and writes its whole plan, which is executed action by action with no feedback (a failed
+  action costs its step and the plan goes on) until solved, finished, out of budget or out of
+  actions.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import importlib
-import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-import numpy as np
-
+from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.level import Level, content_hash
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.observation import observe
 from chaingeo.evaluation.agents.base import (
     TRANSPORT,
-    Agent,
-    AgentError,
-    AgentSpec,
-    AuthenticationError,
     ObservationLike,
     Reply,
     StateLike,
     StepResultLike,
-    Turn,
 )
-from chaingeo.evaluation.agents.registry import make_agent
 from chaingeo.evaluation.judges.registry import make_judge
-from chaingeo.evaluation.judges.selection import Judge, verify
 from chaingeo.evaluation.logs import episode_key
 from chaingeo.evaluation.usage import Usage
 
 ProtocolName = Literal["interactive", "oneshot"]
+PROTOCOLS: tuple[ProtocolName, ...] = ("interactive", "oneshot")
 #: Pictures that show what the pieces or the goal are rather than the scene (kept in one-shot).
 AUXILIARY_VIEWS = ("tray", "target")
 
@@ -72,7 +66,7 @@ class ProtocolConfig:
     env: str = "chaingeo"
 
     def __post_init__(self) -> None:
-        if self.name not in ("interactive", "oneshot"):
+        if self.name not in PROTOCOLS:
             raise ValueError(f"unknown protocol {self.name!r}; use interactive or oneshot")
         if self.candidates < 1 or self.history_window < 0:
             raise ValueError("candidates must be >= 1 and history_window >= 0")
@@ -94,31 +88,69 @@ class ProtocolConfig:
         return out
 
 
+class EpisodeOverError(ChainGeoError, RuntimeError):
+    """A driver played a turn after the episode ended (a driver's mistake, not an agent's)."""
+
+
 @dataclass(frozen=True)
-class EpisodeTask:
-    level: Level
-    sample: int
-    seed: int  # the run's seed
-    agent: AgentSpec
-    protocol: ProtocolConfig = field(default_factory=ProtocolConfig)
+class Outcome:
+    """What every metric and reward needs of one episode (JSON-able: it rides on a framework's
+    trace). ``actions`` counts the agent's action attempts, ``readable`` those the environment
+    could read (parsed, legal or not)."""
 
-    @property
-    def key(self) -> str:
-        return episode_key(self.level.id, self.sample)
+    level_id: str
+    family: str
+    difficulty: str
+    optimal_steps: int
+    success: bool
+    steps: int
+    sample: int = 0
+    usage: Usage = Usage()
+    cost_usd: float | None = 0.0
+    actions: int = 0
+    readable: int = 0
+    finished: bool = False
+    truncated: bool = False
 
+    def to_json(self) -> dict[str, Any]:
+        out = dataclasses.asdict(self)
+        out["usage"] = self.usage.to_json()
+        return out
 
-@dataclass
-class EpisodeResult:
-    record: dict[str, Any]
-    images: dict[str, bytes]  # file name (sha256.png) -> PNG bytes
+    @classmethod
+    def from_json(cls, data: Any) -> Outcome | None:
+        """The outcome a trace carries; None when the episode never got one (it errored)."""
+        if not isinstance(data, dict):
+            return None
+        try:
+            usage = Usage.from_json(data.get("usage") or {})
+            return cls(**{**data, "usage": usage})
+        except (TypeError, ValueError, AttributeError):
+            return None
 
-
-def episode_seed(run_seed: int, level: Level, sample: int) -> int:
-    """Seed of one episode, from the run seed, the level's content and the sample number: an
-    episode draws the same randomness whichever other levels share the run."""
-    level_part = int(content_hash(level)[:15], 16)
-    ss = np.random.SeedSequence([run_seed, level_part, sample])
-    return int(ss.generate_state(1, dtype=np.uint64)[0] >> np.uint64(1))
+    @classmethod
+    def from_record(cls, record: Mapping[str, Any]) -> Outcome:
+        """The outcome of a run record (:meth:`Episode.record`); a model judge's tokens count
+        with the agent's."""
+        usage = Usage.from_json(record.get("usage", {}))
+        if record.get("judge"):
+            usage = usage + Usage.from_json(record["judge"]["usage"])
+        steps = record.get("steps") or []
+        return cls(
+            level_id=str(record["level_id"]),
+            family=str(record["family"]),
+            difficulty=str(record["difficulty"]),
+            optimal_steps=int(record["optimal_steps"]),
+            success=bool(record["success"]),
+            steps=int(record["steps_used"]),
+            sample=int(record.get("sample", 0)),
+            actions=len(steps),
+            readable=sum(1 for s in steps if s.get("error") != "unparseable"),
+            finished=bool(record.get("finished", False)),
+            truncated=bool(record.get("truncated", False)),
+            usage=usage,
+            cost_usd=record.get("cost_usd"),
+        )
 
 
 def _environment(module: str) -> tuple[Callable[[Level], StateLike], Callable[..., Any]]:
@@ -130,22 +162,25 @@ def _environment(module: str) -> tuple[Callable[[Level], StateLike], Callable[..
     return mod.new_state, mod.observe
 
 
-class _Images:
-    def __init__(self) -> None:
-        self.files: dict[str, bytes] = {}
+def header(level: Level, sample: int, seed: int, protocol: str, agent: str) -> dict[str, Any]:
+    """The fields every run record of ``level`` starts with."""
+    return {
+        "key": episode_key(level.id, sample),
+        "level_id": level.id,
+        "level_hash": content_hash(level),
+        "family": level.family,
+        "difficulty": level.difficulty,
+        "goal": level.goal,
+        "optimal_steps": level.optimal_steps,
+        "max_steps": level.max_steps,
+        "sample": sample,
+        "seed": seed,
+        "protocol": protocol,
+        "agent": agent,
+    }
 
-    def names(self, obs: ObservationLike | None) -> dict[str, str]:
-        out: dict[str, str] = {}
-        if obs is None:
-            return out
-        for view, png in obs.images.items():
-            name = hashlib.sha256(png).hexdigest() + ".png"
-            self.files[name] = png
-            out[view] = name
-        return out
 
-
-def _step_record(
+def step_record(
     turn: int, reply: Reply, sent: str, result: StepResultLike, call: int = 0
 ) -> dict[str, Any]:
     """One step. Of a reply with several actions, the first step holds the reply, its usage,
@@ -173,219 +208,107 @@ def _step_record(
     return rec
 
 
-def _header(task: EpisodeTask, seed: int) -> dict[str, Any]:
-    level = task.level
-    return {
-        "key": task.key,
-        "level_id": level.id,
-        "level_hash": content_hash(level),
-        "family": level.family,
-        "difficulty": level.difficulty,
-        "goal": level.goal,
-        "optimal_steps": level.optimal_steps,
-        "max_steps": level.max_steps,
-        "sample": task.sample,
-        "seed": seed,
-        "protocol": task.protocol.name,
-        "agent": task.agent.label,
-    }
+class Episode:
+    """A level's state machine, one protocol, and what has been played so far.
 
+    ``images`` says whether observations carry pictures; ``keep_images`` whether their PNG bytes
+    are kept for :attr:`images` (a run stores them as files; a training game need not)."""
 
-#: The longest exception message an errored record keeps.
-MAX_ERROR_CHARS = 500
-
-
-def describe_error(exc: BaseException) -> str:
-    """``Class: message`` of an exception, one line, bounded, with no traceback; an agent error
-    is the harness's own wording and keeps just its message."""
-    message = " ".join(str(exc).split())
-    if len(message) > MAX_ERROR_CHARS:
-        message = message[: MAX_ERROR_CHARS - 3] + "..."
-    if isinstance(exc, AgentError):
-        return message
-    return f"{type(exc).__name__}: {message}" if message else type(exc).__name__
-
-
-def error_record(task: EpisodeTask, exc: BaseException) -> EpisodeResult:
-    """The record of an episode that never produced one (its worker died, its result could not
-    come back): status ``error``, nothing played."""
-    record = _header(task, episode_seed(task.seed, task.level, task.sample))
-    record.update(
-        model=None,
-        status="error",
-        error=describe_error(exc),
-        error_type=type(exc).__name__,
-        success=False,
-        steps_used=0,
-        invalid=0,
-        unparseable=0,
-        illegal=0,
-        ambiguous=0,
-        finished=False,
-        truncated=False,
-        usage=Usage().to_json(),
-        wall_seconds=0.0,
-        steps=[],
-    )
-    return EpisodeResult(record, {})
-
-
-def run_episode(task: EpisodeTask) -> EpisodeResult:
-    """Play one episode. Whatever an agent or the environment raises becomes an errored record
-    (class and message, never a traceback), except :class:`AuthenticationError`, which no
-    other episode would survive either: it propagates so the run stops at once."""
-    return _Episode(task).run()
-
-
-class _Episode:
-    """One episode's play: the state, the agent, what has been recorded so far."""
-
-    def __init__(self, task: EpisodeTask) -> None:
-        self.task = task
-        self.seed = episode_seed(task.seed, task.level, task.sample)
-        self.started = time.monotonic()
-        self.images = _Images()
-        self.steps: list[dict[str, Any]] = []
-        self.usage = Usage()
-        self.record = _header(task, self.seed)
-        self.record["model"] = None
-        self.state: StateLike | None = None
-        self.agent: Agent | None = None
-        self.judge: Judge | None = None
-        self.finished = False
-        self.status: str = "done"
-        self.error: str | None = None
-        self.error_type: str | None = None
-
-    def _fail(self, e: BaseException) -> None:
-        """Record the first error only: later ones are consequences."""
-        if self.status == "done":
-            self.status, self.error, self.error_type = "error", describe_error(e), type(e).__name__
-
-    def run(self) -> EpisodeResult:
-        proto = self.task.protocol
-        try:
-            make_state, observe_state = _environment(proto.env)
-            state = self.state = make_state(self.task.level)
-            agent = self.agent = make_agent(self.task.agent)
-            self.record["model"] = agent.model
-            agent.start(self.task.level, self.seed)
-
-            def see(window: int) -> ObservationLike:
-                obs: ObservationLike = observe_state(
-                    state, history_window=window, text_state=proto.text_state,
-                    images=agent.uses_images,
-                )  # fmt: skip
-                return obs
-
-            if proto.name == "interactive":
-                self._interactive(state, agent, see)
-            else:
-                self._oneshot(state, agent, see(0))
-        except AuthenticationError:
-            raise
-        except Exception as e:  # one bad episode must never stop a run
-            self._fail(e)
-        finally:
-            self._close_agent()
-        return self._result()
-
-    def _close_agent(self) -> None:
-        if self.agent is None:
-            return
-        try:
-            notes = self.agent.notes()
-            if notes:
-                self.record["agent_notes"] = notes
-            self.agent.close()
-        except Exception as e:
-            self._fail(e)
-
-    def _interactive(
-        self, state: StateLike, agent: Agent, see: Callable[[int], ObservationLike]
+    def __init__(
+        self,
+        level: Level,
+        protocol: ProtocolConfig | None = None,
+        *,
+        images: bool = True,
+        sample: int = 0,
+        seed: int = 0,
+        agent: str = "agent",
+        keep_images: bool = True,
     ) -> None:
-        """Turn after turn until success, truncation or the agent finishes."""
-        task, proto = self.task, self.task.protocol
-        judge = self.judge = make_judge(proto.judge, proto.judge_options)
-        judge.start(self.seed)
-        note: str | None = None
-        previous: Reply | None = None
-        results: tuple[StepResultLike, ...] = ()
-        turn = 0
-        while not (state.is_success() or state.is_truncated()):
-            if turn >= state.max_steps:
-                raise RuntimeError(f"{task.level.id}: the environment stopped counting steps")
-            obs = see(proto.history_window)
-            shown = self.images.names(obs)
-            replies = [
-                agent.act(
-                    Turn(
-                        task.level,
-                        obs,
-                        state.clone() if agent.needs_state else None,
-                        turn,
-                        task.sample,
-                        c,
-                        note,
-                        previous,
-                        results,
-                    )
-                )
-                for c in range(proto.candidates)
-            ]
-            for r in replies:
-                self.usage = self.usage + r.usage
-            chosen, extra = self._choose(state, judge, replies, obs)
-            done = self._take(state, turn, chosen, {"images": shown, **extra})
-            note = chosen.note if chosen.action is None else None
-            previous, results = chosen, tuple(done)
-            turn += 1
-            if state.finished:
-                self.finished = True
-                return
+        self.level = level
+        self.protocol = protocol or ProtocolConfig()
+        self.sample, self.seed = sample, seed
+        self.uses_images, self.keep_images = images, keep_images
+        make_state, self._observe = _environment(self.protocol.env)
+        self.state: StateLike = make_state(level)
+        self.steps: list[dict[str, Any]] = []
+        self.images: dict[str, bytes] = {}  # file name (sha256.png) -> PNG bytes
+        self.usage = Usage()
+        self.turn = 0
+        self.note: str | None = None  # why the last reply could not be read
+        self.previous: Reply | None = None
+        self.results: tuple[StepResultLike, ...] = ()
+        self.plan: dict[str, Any] | None = None  # one-shot: the plan as the agent gave it
+        self._shown: dict[str, str] = {}
+        self._over = False
+        self.agent = agent
 
-    def _choose(
-        self, state: StateLike, judge: Judge, replies: list[Reply], obs: ObservationLike
-    ) -> tuple[Reply, dict[str, Any]]:
-        """The reply to play (the judge ranks several candidates) and what the turn's first
-        step record gets besides (the candidates, their usage, the judge's)."""
-        if len(replies) <= 1:
-            return replies[0], {}
-        checked = verify(state, replies)
-        spent = judge.usage
-        best = judge.rank(state, checked, obs)[0]
-        cands = [
-            {
-                "reply": c.reply.text,
-                "action": c.reply.action,
-                **({"actions": list(c.reply.actions)} if c.reply.actions else {}),
-                "legal": c.legal,
-                "error": c.result.error if c.result else None,
-                "usage": c.reply.usage.to_json(),
-                "chosen": c.index == best,
-            }
-            for c in checked
-        ]
-        extra: dict[str, Any] = {
-            "candidates": cands,
-            "usage": sum((r.usage for r in replies), Usage()).to_json(),
-        }
-        if judge.usage != spent:
-            extra["judge_usage"] = _spent(judge.usage, spent).to_json()
-        return replies[best], extra
+    # -- what the agent sees -------------------------------------------------------------------
 
-    def _take(
-        self, state: StateLike, turn: int, chosen: Reply, first: dict[str, Any]
+    @property
+    def oneshot(self) -> bool:
+        return self.protocol.name == "oneshot"
+
+    def observation(self) -> ObservationLike:
+        """What the agent sees now (in one-shot: the one view, and the tray or target)."""
+        proto = self.protocol
+        window = 0 if self.oneshot else proto.history_window
+        obs: ObservationLike = self._observe(
+            self.state, history_window=window, text_state=proto.text_state,
+            images=self.uses_images,
+        )  # fmt: skip
+        if self.oneshot:
+            keep = (proto.oneshot_view, *AUXILIARY_VIEWS)
+            obs = _with_images(obs, {k: v for k, v in obs.images.items() if k in keep})
+        self._shown = self._names(obs)
+        return obs
+
+    def _names(self, obs: ObservationLike) -> dict[str, str]:
+        out: dict[str, str] = {}
+        for view, png in obs.images.items():
+            name = hashlib.sha256(png).hexdigest() + ".png"
+            if self.keep_images:
+                self.images[name] = png
+            out[view] = name
+        return out
+
+    # -- playing -------------------------------------------------------------------------------
+
+    @property
+    def done(self) -> bool:
+        s = self.state
+        return self._over or bool(s.is_success() or s.is_truncated() or s.finished)
+
+    def play(
+        self, reply: Reply, *, spent: Usage | None = None, extra: Mapping[str, Any] | None = None
     ) -> list[StepResultLike]:
-        """Play the chosen reply's actions, one step record each; stop at a rejected one."""
-        todo = chosen.actions or (chosen.action if chosen.action is not None else "",)
+        """Play one agent turn and return what each step it took did. ``spent`` is the turn's
+        usage when it differs from the reply's (several candidates were asked); ``extra`` goes
+        into the turn's first step record. An unreadable reply costs one step; nothing an agent
+        writes raises here."""
+        if self.done:
+            raise EpisodeOverError(f"{self.level.id}: the episode is over")
+        self.usage = self.usage + (reply.usage if spent is None else spent)
+        if self.oneshot:
+            return self._play_plan(reply)
+        done = self._take(reply, {"images": self._shown, **(extra or {})})
+        self.note = reply.note if reply.action is None else None
+        self.previous, self.results = reply, tuple(done)
+        self.turn += 1
+        if self.turn >= self.state.max_steps and not self.done:
+            raise RuntimeError(f"{self.level.id}: the environment stopped counting steps")
+        return done
+
+    def _take(self, reply: Reply, first: Mapping[str, Any]) -> list[StepResultLike]:
+        """The reply's actions, one step record each; stop at a rejected one."""
+        todo = reply.actions or (reply.action if reply.action is not None else "",)
         done: list[StepResultLike] = []
         for i, sent in enumerate(todo):
-            if i and (state.finished or state.is_success() or state.is_truncated()):
+            if i and self.done:
                 break
-            result = state.step_text(sent)
+            result = self.state.step_text(sent)
             done.append(result)
-            rec = _step_record(turn, chosen, sent, result, i)
+            rec = step_record(self.turn, reply, sent, result, i)
             if i == 0:
                 rec.update(first)
             self.steps.append(rec)
@@ -393,87 +316,73 @@ class _Episode:
                 break  # the actions after a rejected one are not taken
         return done
 
-    def _oneshot(self, state: StateLike, agent: Agent, obs: ObservationLike) -> None:
-        """One plan from the first observation, its actions played in order."""
-        task, proto = self.task, self.task.protocol
-        keep = (proto.oneshot_view, *AUXILIARY_VIEWS)
-        view = {k: v for k, v in obs.images.items() if k in keep}
-        obs = _with_images(obs, view)
-        shown = self.images.names(obs)
-        plan = agent.plan(
-            Turn(task.level, obs, state.clone() if agent.needs_state else None, 0, task.sample)
-        )
-        self.usage = self.usage + plan.usage
-        self.record["plan"] = {
+    def _play_plan(self, plan: Reply) -> list[StepResultLike]:
+        """A one-shot plan's actions in order, with no feedback; then the episode is over."""
+        self.plan = {
             "reply": plan.text,
             "actions": list(plan.actions),
             "note": plan.note,
             "usage": plan.usage.to_json(),
-            "images": shown,
+            "images": self._shown,
         }
         if plan.calls:
-            self.record["plan"]["calls"] = [c.to_json() for c in plan.calls]
+            self.plan["calls"] = [c.to_json() for c in plan.calls]
+        done: list[StepResultLike] = []
         for i, text in enumerate(plan.actions):
-            if state.is_success() or state.is_truncated():
+            if self.done:
                 break
-            result = state.step_text(text)
-            self.steps.append(_step_record(i, Reply(text, text), text, result))
-            if state.finished:
-                self.finished = True
-                break
+            result = self.state.step_text(text)
+            done.append(result)
+            self.steps.append(step_record(i, Reply(text, text), text, result))
+        self._over = True
+        return done
 
-    def _result(self) -> EpisodeResult:
-        record, steps, judge = self.record, self.steps, self.judge
-        if judge is not None and judge.usage.calls:
-            record["judge"] = {"model": judge.model, "usage": judge.usage.to_json()}
-        try:
-            ended = _ending(self.state)
-        except Exception as e:  # a state that cannot report its end
-            ended = _ending(None)
-            self._fail(e)
-        record.update(status=self.status, error=self.error)
-        if self.error_type is not None:
-            record["error_type"] = self.error_type
-        record.update(
-            success=ended["success"],
-            steps_used=ended["steps_used"],
+    # -- the end -------------------------------------------------------------------------------
+
+    def outcome(self) -> Outcome:
+        s, level = self.state, self.level
+        success = bool(s.is_success())
+        actions = len(self.steps)
+        readable = sum(1 for r in self.steps if r["error"] != "unparseable")
+        return Outcome(
+            level_id=level.id,
+            family=level.family,
+            difficulty=level.difficulty,
+            optimal_steps=level.optimal_steps,
+            success=success,
+            steps=int(s.steps_used),
+            sample=self.sample,
+            actions=max(actions, 1) if self.oneshot and self._over else actions,
+            readable=readable,
+            finished=bool(s.finished),
+            truncated=bool(s.is_truncated()) and not success,
+            usage=self.usage,
+        )
+
+    def record(self) -> dict[str, Any]:
+        """The run-format record of what was played (``chain eval`` adds status, timing, the
+        model and the agent's notes)."""
+        o = self.outcome()
+        steps = self.steps
+        rec = header(self.level, self.sample, self.seed, self.protocol.name, self.agent)
+        if self.plan is not None:
+            rec["plan"] = self.plan
+        rec.update(
+            success=o.success,
+            steps_used=o.steps,
             invalid=sum(1 for s in steps if not s["legal"]),
             unparseable=sum(1 for s in steps if s["error"] == "unparseable"),
             illegal=sum(1 for s in steps if s["error"] == "illegal"),
             ambiguous=sum(1 for s in steps if s["error"] == "ambiguous"),
-            finished=self.finished,
-            truncated=ended["truncated"],
+            finished=o.finished,
+            truncated=o.truncated,
             usage=self.usage.to_json(),
-            wall_seconds=round(time.monotonic() - self.started, 3),
             steps=steps,
         )
-        return EpisodeResult(record, self.images.files)
-
-
-def _ending(state: StateLike | None) -> dict[str, Any]:
-    if state is None:
-        return {"success": False, "steps_used": 0, "truncated": False}
-    success = bool(state.is_success())
-    return {
-        "success": success,
-        "steps_used": int(state.steps_used),
-        "truncated": bool(state.is_truncated()) and not success,
-    }
-
-
-def _spent(now: Usage, before: Usage) -> Usage:
-    return Usage(
-        now.input_tokens - before.input_tokens,
-        now.output_tokens - before.output_tokens,
-        now.reasoning_tokens - before.reasoning_tokens,
-        now.cached_tokens - before.cached_tokens,
-        now.calls - before.calls,
-    )
+        return rec
 
 
 def _with_images(obs: ObservationLike, images: Mapping[str, bytes]) -> ObservationLike:
-    import dataclasses
-
     if dataclasses.is_dataclass(obs) and not isinstance(obs, type):
         out: ObservationLike = dataclasses.replace(obs, images=dict(images))
         return out

@@ -23,15 +23,26 @@ import hashlib
 import json
 import os
 import platform
+import shutil
 import subprocess
+import tempfile
 from collections.abc import Iterable, Mapping
 from importlib import metadata
 from pathlib import Path
 from typing import Any, Final
 
-from chaingeo.core import canonical_json
+from chaingeo.core import canonical_json, limits
 from chaingeo.core.errors import ChainGeoError
-from chaingeo.core.files import atomic_write
+from chaingeo.core.files import (
+    UnreadableFile,
+    atomic_write,
+    lock_folder,
+    parse_json,
+    read_bounded,
+    read_json,
+    unlock_folder,
+)
+from chaingeo.evaluation.records import header_problem, record_problem
 from chaingeo.evaluation.sanitize import clean, dumps_line
 
 RUN_FORMAT: Final = "chain-run/1"
@@ -125,6 +136,7 @@ class RunLog:
     def __init__(self, path: str | os.PathLike[str], secrets: Iterable[str] = ()) -> None:
         self.path = Path(path)
         self._secrets = sorted({s for s in secrets if s}, key=len, reverse=True)
+        self._lock: int | None = None
 
     # -- opening ---------------------------------------------------------------------------
 
@@ -136,41 +148,64 @@ class RunLog:
         resume: bool = False,
         secrets: Iterable[str] = (),
     ) -> RunLog:
-        """Start a new run, or with ``resume`` continue one whose header agrees."""
+        """Start a new run, or with ``resume`` continue one whose header agrees. The folder's
+        lock is held until :meth:`close` (a second writer is refused: two resumes at once
+        recorded episodes twice); a new run is made whole in a temporary folder and renamed
+        into place, so a full disk leaves no half run that ``--resume`` would refuse."""
         log = RunLog(path, secrets)
-        head = log.path / HEADER
-        if head.exists():
+        log._lock = lock_folder(log.path)
+        try:
+            log._open(header, resume)
+        except BaseException:
+            log.close()
+            raise
+        return log
+
+    def _open(self, header: Mapping[str, Any], resume: bool) -> None:
+        if (self.path / HEADER).exists():
             if not resume:
-                raise RunError(f"{log.path}: a run is already there; pass --resume to continue it")
-            old = log.header()
+                raise RunError(f"{self.path}: a run is already there; pass --resume to continue it")
+            old = self.header()
             for key in IDENTITY_FIELDS:
                 if old.get(key) != header.get(key):
                     raise RunError(
-                        f"{log.path}: cannot resume: {key} differs from the recorded run "
+                        f"{self.path}: cannot resume: {key} differs from the recorded run "
                         f"({_short(old.get(key))} there, {_short(header.get(key))} now)"
                     )
-            log._drop_partial_tail()
-            return log
-        if log.path.exists() and any(log.path.iterdir()):
-            raise RunError(f"{log.path}: exists and is not a run directory")
-        (log.path / IMAGES).mkdir(parents=True, exist_ok=True)
-        atomic_write(
-            head,
-            log.redact(canonical_json.dumps(clean(dict(header), redact=log.redact))).encode(
-                "utf-8"
-            ),
-            durable=True,
-        )
-        (log.path / EPISODES).touch()
-        return log
+            self._drop_partial_tail()
+            return
+        if self.path.exists() and (not self.path.is_dir() or any(self.path.iterdir())):
+            raise RunError(f"{self.path}: exists and is not a run directory")
+        text = canonical_json.dumps(clean(dict(header), redact=self.redact))
+        fresh = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.", dir=self.path.parent))
+        try:
+            fresh.chmod(0o755)
+            (fresh / IMAGES).mkdir()
+            atomic_write(fresh / HEADER, self.redact(text).encode("utf-8"), durable=True)
+            (fresh / EPISODES).touch()
+            if self.path.exists():
+                self.path.rmdir()  # empty, checked above
+            fresh.rename(self.path)
+        finally:
+            shutil.rmtree(fresh, ignore_errors=True)
+
+    def close(self) -> None:
+        """Release the folder's lock (a writer's; readers never take it)."""
+        if self._lock is not None:
+            unlock_folder(self._lock)
+            self._lock = None
 
     def header(self) -> dict[str, Any]:
+        """The header, read with the bounded JSON reader and checked (:func:`header_problem`)."""
         try:
-            data = json.loads((self.path / HEADER).read_text("utf-8"))
-        except (OSError, json.JSONDecodeError) as e:
-            raise RunError(f"{self.path}: no readable {HEADER}: {e}") from None
+            data = read_json(self.path / HEADER, limits.MAX_RUN_HEADER_BYTES)
+        except UnreadableFile as e:
+            raise RunError(f"{self.path}: no readable {HEADER}: {e.reason}") from None
         if not isinstance(data, dict) or data.get("format") != RUN_FORMAT:
             raise RunError(f"{self.path}/{HEADER}: not a {RUN_FORMAT} header")
+        problem = header_problem(data)
+        if problem:
+            raise RunError(f"{self.path}/{HEADER}: {problem}")
         return data
 
     # -- writing ---------------------------------------------------------------------------
@@ -208,7 +243,10 @@ class RunLog:
         if not file.exists():
             file.touch()
             return
-        data = file.read_bytes()
+        try:
+            data = read_bounded(file, limits.MAX_RUN_LOG_BYTES)
+        except UnreadableFile as e:
+            raise RunError(f"{file}: {e.reason}") from None
         keep = data.rfind(b"\n") + 1
         if keep != len(data):
             with open(file, "r+b") as fh:
@@ -236,23 +274,26 @@ class RunLog:
 
 
 def read_records(file: Path) -> list[dict[str, Any]]:
+    """The records of ``episodes.jsonl``, each line through the bounded JSON reader and checked
+    field by field (:func:`record_problem`); RunError naming the line otherwise."""
     try:
-        data = file.read_bytes()
-    except OSError as e:
-        raise RunError(f"{file}: cannot read: {e.strerror or e}") from None
+        data = read_bounded(file, limits.MAX_RUN_LOG_BYTES)
+    except UnreadableFile as e:
+        raise RunError(f"{file}: {e.reason}") from None
     lines = data.split(b"\n")
     out: list[dict[str, Any]] = []
     for i, raw in enumerate(lines):
         if not raw.strip():
             continue
         try:
-            rec = json.loads(raw)
-        except json.JSONDecodeError:
+            rec = parse_json(raw)
+        except UnreadableFile as e:
             if i == len(lines) - 1:  # unfinished last line of a killed run
                 break
-            raise RunError(f"{file}: line {i + 1} is not JSON") from None
-        if not isinstance(rec, dict) or "key" not in rec:
-            raise RunError(f"{file}: line {i + 1} is not an episode record")
+            raise RunError(f"{file}: line {i + 1}: {e.reason}") from None
+        problem = record_problem(rec)
+        if problem:
+            raise RunError(f"{file}: line {i + 1} is not an episode record: {problem}")
         out.append(rec)
     return out
 

@@ -148,8 +148,8 @@ def assembly_picture(q: Question, level: Level, size: int = VIEW_SIZE) -> bytes:
     drawn from its recipe, labelled A-D) below, every one from the iso corner."""
     from PIL import Image
 
-    from chaingeo.envs.render.fastview import render_images
-    from chaingeo.envs.render.raster import png_bytes
+    from chaingeo.pictures.fastview import render_images
+    from chaingeo.pictures.raster import png_bytes
 
     rgb = {p.name: p.rgb for p in level.pieces}
 
@@ -173,7 +173,7 @@ def state_picture(level: Level, step: int, size: int = VIEW_SIZE) -> bytes:
 
     from chaingeo.envs.machines import new_state
     from chaingeo.envs.observation import state_images
-    from chaingeo.envs.render.raster import png_bytes
+    from chaingeo.pictures.raster import png_bytes
 
     state = new_state(level)
     for text in plan_texts(level)[:step]:

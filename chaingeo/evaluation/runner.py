@@ -1,6 +1,6 @@
 """Running an agent over a level suite: episodes in parallel, logged as they finish, resumable.
 
-:func:`evaluate` plans one :class:`~chaingeo.evaluation.episode.EpisodeTask` per (level, sample),
+:func:`evaluate` plans one :class:`~chaingeo.evaluation.play.EpisodeTask` per (level, sample),
 skips those a resumed run already recorded, runs the rest (in this process, ``jobs`` worker
 processes, or on a Dask cluster) and writes each finished episode (images first, then its
 record, fsynced) from this process only, so records never interleave. Killing the run at any
@@ -37,15 +37,9 @@ from chaingeo.core.level import Level, level_set_hash
 from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
 from chaingeo.evaluation.agents.http import api_key
 from chaingeo.evaluation.agents.registry import make_agent
-from chaingeo.evaluation.episode import (
-    EpisodeResult,
-    EpisodeTask,
-    ProtocolConfig,
-    error_record,
-    run_episode,
-)
+from chaingeo.evaluation.episode import Outcome, ProtocolConfig
 from chaingeo.evaluation.logs import RunLog, make_header
-from chaingeo.evaluation.metrics import Outcome
+from chaingeo.evaluation.play import EpisodeResult, EpisodeTask, error_record, run_episode
 from chaingeo.evaluation.usage import PriceTable, Usage
 
 
@@ -58,24 +52,6 @@ class RunConfig:
     resume: bool = False
     retry_errors: bool = False
     progress: bool = True
-
-
-def outcome_of(record: dict[str, Any]) -> Outcome:
-    """The metrics' view of a record; a model judge's tokens count with the agent's."""
-    usage = Usage.from_json(record.get("usage", {}))
-    if record.get("judge"):
-        usage = usage + Usage.from_json(record["judge"]["usage"])
-    return Outcome(
-        level_id=str(record["level_id"]),
-        family=str(record["family"]),
-        difficulty=str(record["difficulty"]),
-        optimal_steps=int(record["optimal_steps"]),
-        success=bool(record["success"]),
-        steps=int(record["steps_used"]),
-        sample=int(record.get("sample", 0)),
-        usage=usage,
-        cost_usd=record.get("cost_usd"),
-    )
 
 
 class ProgressBar:
@@ -301,4 +277,5 @@ def evaluate(
             bar.add(rec)
     finally:
         bar.close()
-    return [outcome_of(r) for r in log.latest().values()]
+        log.close()
+    return [Outcome.from_record(r) for r in log.latest().values()]

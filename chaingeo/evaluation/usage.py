@@ -22,6 +22,7 @@ from typing import Any, Final
 
 from chaingeo.core import limits
 from chaingeo.core.errors import ChainGeoError
+from chaingeo.core.files import UnreadableFile, read_json
 
 #: The largest count a cost multiplies (int64, what any real counter holds): with prices at
 #: most :data:`~chaingeo.core.limits.MAX_PRICE_USD` every cost is a finite float.
@@ -49,6 +50,16 @@ class Usage:
             self.reasoning_tokens + other.reasoning_tokens,
             self.cached_tokens + other.cached_tokens,
             self.calls + other.calls,
+        )
+
+    def __sub__(self, other: Usage) -> Usage:
+        """What was spent since ``other`` (an earlier reading of the same counter)."""
+        return Usage(
+            self.input_tokens - other.input_tokens,
+            self.output_tokens - other.output_tokens,
+            self.reasoning_tokens - other.reasoning_tokens,
+            self.cached_tokens - other.cached_tokens,
+            self.calls - other.calls,
         )
 
     @property
@@ -172,10 +183,10 @@ class PriceTable:
         text = resources.files("chaingeo.evaluation").joinpath("prices.json").read_text("utf-8")
         prices = _parse_prices(json.loads(text), "chaingeo/evaluation/prices.json")
         for path in extra:
-            try:
-                data = json.loads(Path(path).read_text("utf-8"))
-            except (OSError, ValueError) as e:  # ValueError: not JSON, or a 5,000-digit number
-                raise PriceError(f"{path}: cannot read price table: {e}") from None
+            try:  # the one bounded JSON reader: a regular file, size, depth and digits first
+                data = read_json(path, limits.MAX_FILE_BYTES)
+            except UnreadableFile as e:
+                raise PriceError(f"{path}: cannot read price table: {e.reason}") from None
             prices.update(_parse_prices(data, str(path)))
         return PriceTable(prices)
 

@@ -1,82 +1,45 @@
 """One level played in chat turns: the part of a training environment that is ours.
 
-A :class:`Game` holds a level's state machine and speaks chat messages (OpenAI wire dicts): it
-opens with the observation (text, and the views as base64 PNG parts when ``images``), reads each
-assistant reply in the harness's text dialect (:mod:`chaingeo.evaluation.agents.prompt`) and
-answers with the next observation, until the level is solved, the agent says ``finish`` or the
-step budget is spent. It never sees a framework, so it is tested without one and a framework
-adapter (:mod:`chaingeo.integrations.verifiers`) only moves its messages.
+A :class:`Game` is the one :class:`~chaingeo.evaluation.episode.Episode` spoken in chat
+messages (OpenAI wire dicts): it opens with the observation (text, and the views as base64 PNG
+parts when ``images``), reads each assistant reply in its dialect
+(:mod:`chaingeo.evaluation.agents.dialects`: ``text``, or ``tools`` for native tool calls with
+text as a fallback) and answers with the next observation, until the episode is done. It never
+sees a framework, so it is tested without one and a framework adapter
+(:mod:`chaingeo.integrations.verifiers`) only moves its messages. A reply's tool calls each get
+their ``tool`` result before the next observation.
 
-Protocols, as in :mod:`chaingeo.evaluation.episode`: ``interactive`` takes one action per reply
-(an unreadable reply still costs its step); ``oneshot`` shows one view once and runs the whole
-``<plan>`` of the first reply with no feedback. With ``tools`` the agent may also act by native
-tool calls (:mod:`chaingeo.evaluation.agents.tools`: one function per action kind, translated to
-action text): a reply's calls are played in order, each a step, stopping at the first one
-rejected, and each gets its ``tool`` result before the next observation.
-
-Rewards (each in [0, 1], computed from :class:`Outcome` as :mod:`chaingeo.evaluation.metrics`
-does for a run): :func:`success_reward`, :func:`efficiency_reward` (``1 - NormDist`` of this
+Rewards (each in [0, 1], computed from the episode's
+:class:`~chaingeo.evaluation.episode.Outcome` as :mod:`chaingeo.evaluation.metrics` does for a
+run): :func:`success_reward`, :func:`efficiency_reward` (``1 - NormDist`` of this
 episode when solved) and :func:`format_reward` (the share of replies the environment could read).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
 from typing import Any, Final, Literal
 
-from chaingeo.core import limits
 from chaingeo.core.level import Level
-from chaingeo.envs.machines import new_state
-from chaingeo.envs.machines.state import StepResult
-from chaingeo.envs.observation import observe
-from chaingeo.evaluation.agents.prompt import (
-    ONESHOT_PROMPT,
-    ONESHOT_TOOLS_PROMPT,
-    SYSTEM_PROMPT,
-    TOOLS_PROMPT,
-    extract_action,
-    extract_plan,
-    user_content,
+from chaingeo.evaluation.agents.base import ToolCall
+from chaingeo.evaluation.agents.dialects import DIALECTS, read_reply, tool_call
+from chaingeo.evaluation.agents.prompt import user_content
+from chaingeo.evaluation.agents.tools import skipped_result, tool_specs
+from chaingeo.evaluation.episode import (
+    PROTOCOLS,
+    Episode,
+    EpisodeOverError,
+    Outcome,
+    ProtocolConfig,
 )
-from chaingeo.evaluation.agents.tools import skipped_result, tool_specs, translate
-from chaingeo.evaluation.episode import AUXILIARY_VIEWS
 
 Protocol = Literal["interactive", "oneshot"]
-PROTOCOLS: Final[tuple[Protocol, ...]] = ("interactive", "oneshot")
 Message = dict[str, Any]
 #: A native tool call as a model made it: id, function name, arguments (JSON text).
 Call = tuple[str, str, str]
 
 #: Default reward weights: an optimal, well-formed episode sums to 1, a nonsense one to 0.
 DEFAULT_WEIGHTS: Final[dict[str, float]] = {"success": 0.5, "efficiency": 0.4, "format": 0.1}
-
-
-@dataclass(frozen=True)
-class Outcome:
-    """What the rewards need of one episode (JSON-able: it rides on a framework's trace)."""
-
-    level_id: str
-    optimal_steps: int
-    success: bool
-    steps: int
-    actions: int
-    readable: int
-    finished: bool
-    truncated: bool
-
-    def to_json(self) -> dict[str, Any]:
-        return asdict(self)
-
-    @classmethod
-    def from_json(cls, data: Any) -> Outcome | None:
-        """The outcome a trace carries; None when the episode never got one (it errored)."""
-        if not isinstance(data, dict):
-            return None
-        try:
-            return cls(**data)
-        except TypeError:
-            return None
 
 
 def success_reward(o: Outcome | None) -> float:
@@ -103,9 +66,7 @@ def format_reward(o: Outcome | None) -> float:
 def system_prompt(protocol: Protocol, tools: bool = False) -> str:
     """The harness's system prompt for ``protocol`` (text dialect, or tools with text as a
     fallback)."""
-    if protocol == "interactive":
-        return TOOLS_PROMPT if tools else SYSTEM_PROMPT
-    return ONESHOT_TOOLS_PROMPT if tools else ONESHOT_PROMPT
+    return DIALECTS.get("tools" if tools else "text").system_prompt(protocol == "oneshot")
 
 
 def offered_tools(level: Level, protocol: Protocol) -> list[dict[str, Any]]:
@@ -150,7 +111,7 @@ def _text_only(message: Message) -> Message:
 
 
 class Game:
-    """A level's state machine behind a chat: :meth:`opening`, then :meth:`answer` per reply."""
+    """A level's episode behind a chat: :meth:`opening`, then :meth:`answer` per reply."""
 
     def __init__(
         self,
@@ -163,95 +124,83 @@ class Game:
     ) -> None:
         if protocol not in PROTOCOLS:
             raise ValueError(f"unknown protocol {protocol!r}; use interactive or oneshot")
-        self.level, self.protocol, self.images = level, protocol, images
-        self.history_window, self.oneshot_view = history_window, oneshot_view
+        config = ProtocolConfig(protocol, history_window=history_window, oneshot_view=oneshot_view)
+        self.episode = Episode(level, config, images=images, keep_images=False)
+        self.level, self.protocol = level, protocol
         self.tools = offered_tools(level, protocol) if tools else []
-        self.state = new_state(level)
-        self.actions = 0
-        self.readable = 0
-        self.over = False
+        self.dialect = "tools" if tools else "text"
 
-    def _user(self, note: str | None = None) -> Message:
-        oneshot = self.protocol == "oneshot"
-        obs = observe(self.state, 0 if oneshot else self.history_window, images=self.images)
-        views = (self.oneshot_view, *AUXILIARY_VIEWS) if oneshot else None
-        return {"role": "user", "content": user_content(obs, note, views=views)}
+    @property
+    def state(self) -> Any:
+        return self.episode.state
+
+    def _user(self) -> Message:
+        obs = self.episode.observation()
+        return {"role": "user", "content": user_content(obs, self.episode.note)}
 
     def opening(self) -> Message:
         """The first user turn: the task, the pieces, the budget and (with images) the views."""
         return self._user()
 
-    def _ended(self) -> bool:
-        s = self.state
-        return bool(s.is_success() or s.is_truncated() or s.finished)
-
-    def _step(self, text: str) -> StepResult:
-        """Play one action text (one step, whatever it was)."""
-        result = self.state.step_text(text)
-        self.actions += 1
-        self.readable += int(result.error != "unparseable")
-        return result
-
-    def _calls(self, calls: Sequence[Call]) -> list[str]:
-        """The action text of each call (a malformed one reads as unparseable)."""
-        return [translate(name, args, self.tools).action for _, name, args in calls]
-
     def answer(self, reply: str, calls: Sequence[Call] = ()) -> list[Message] | None:
         """Play ``reply`` (its tool calls, when tools are offered and it made any, else its
         text); the next user turn's messages, or None once the episode is over."""
-        if self.over:
-            raise RuntimeError("the episode is over")
-        calls = calls if self.tools else ()
-        if self.protocol == "oneshot":
-            plan = self._calls(calls[: limits.MAX_TOOL_CALLS]) if calls else extract_plan(reply)[0]
-            for text in plan:
-                if self._ended():
-                    break
-                self._step(text)
-            self.actions = max(1, self.actions)  # no plan at all is one unreadable action
-            self.over = True
+        ep = self.episode
+        if ep.done:
+            raise EpisodeOverError(f"{self.level.id}: the episode is over")
+        reply = reply_text(reply)
+        given = list(calls) if isinstance(calls, list | tuple) else []
+        made = tuple(tool_call(_call_id(c), *_name_args(c), self.tools) for c in given)
+        results = ep.play(
+            read_reply(self.dialect, reply, made if self.tools else (), oneshot=ep.oneshot)
+        )
+        answers: list[Message] = []
+        if self.tools and made and not ep.oneshot:
+            answers = _tool_messages(made, [r.feedback for r in results], results)
+        if ep.done:
             return None
-        if calls:
-            return self._play_calls(calls)
-        action, note = extract_action(reply)
-        self._step(action or "")
-        return self._next([], note)
-
-    def _play_calls(self, calls: Sequence[Call]) -> list[Message] | None:
-        """Each call in order until one is rejected (or the game ends; at most
-        :data:`~chaingeo.core.limits.MAX_TOOL_CALLS`); one ``tool`` message per call, played or
-        not (the chat protocol wants every call answered), then the next observation."""
-        feedback: list[str] = []
-        legal = True
-        for text in self._calls(calls[: limits.MAX_TOOL_CALLS]):
-            if self._ended() or not legal:
-                break
-            result = self._step(text)
-            feedback.append(result.feedback)
-            legal = result.legal
-        rejected = None if legal else len(feedback) - 1
-        skipped = "Not executed. Nothing changed." if rejected is None else skipped_result(rejected)
-        answers = [
-            {"role": "tool", "tool_call_id": cid, "content": (feedback + [skipped] * len(calls))[i]}
-            for i, (cid, _, _) in enumerate(calls)
-        ]
-        return self._next(answers, None)
-
-    def _next(self, before: list[Message], note: str | None) -> list[Message] | None:
-        if self._ended():
-            self.over = True
-            return None
-        return [*before, self._user(note)]
+        return [*answers, self._user()]
 
     def outcome(self) -> Outcome:
-        s = self.state
-        return Outcome(
-            level_id=self.level.id,
-            optimal_steps=self.level.optimal_steps,
-            success=bool(s.is_success()),
-            steps=int(s.steps_used),
-            actions=self.actions,
-            readable=self.readable,
-            finished=bool(s.finished),
-            truncated=bool(s.is_truncated()) and not s.is_success(),
-        )
+        return self.episode.outcome()
+
+
+def _tool_messages(
+    calls: Sequence[ToolCall], feedback: list[str], results: Sequence[Any]
+) -> list[Message]:
+    """One ``tool`` message per call, played or not (the chat protocol wants every call
+    answered): the played ones their feedback, the rest why they were skipped."""
+    rejected = next((i for i, r in enumerate(results) if not r.legal), None)
+    skipped = "Not executed. Nothing changed." if rejected is None else skipped_result(rejected)
+    return [
+        {"role": "tool", "tool_call_id": c.id, "content": (feedback + [skipped] * len(calls))[i]}
+        for i, c in enumerate(calls)
+    ]
+
+
+def reply_text(reply: Any) -> str:
+    """A reply's text: a string, or the text parts of OpenAI content parts (a list of
+    ``{"type": "text", "text": ...}``); anything else reads as no text (an unreadable reply)."""
+    if isinstance(reply, str):
+        return reply
+    if isinstance(reply, list):
+        parts = [
+            p["text"]
+            for p in reply
+            if isinstance(p, dict) and p.get("type") == "text" and isinstance(p.get("text"), str)
+        ]
+        return "\n".join(parts)
+    return ""
+
+
+def _name_args(call: Any) -> tuple[Any, Any]:
+    """A call's function name and arguments; a call that is not an (id, name, arguments)
+    triple reads as one with neither (translated as malformed: an unparseable step)."""
+    if isinstance(call, list | tuple) and len(call) == 3:
+        return call[1], call[2]
+    return None, None
+
+
+def _call_id(call: Any) -> str:
+    found = call[0] if isinstance(call, list | tuple) and call else ""
+    return found if isinstance(found, str) else ""

@@ -21,8 +21,8 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.geometry import Shape
-from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import SearchLimitError
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.assembly.btassemble import (
     BTFrame,
     Mirrors,

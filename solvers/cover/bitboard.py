@@ -21,7 +21,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover import kernels as kn
 from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem

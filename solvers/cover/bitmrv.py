@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover import kernels as kn
 from chaingeo.solvers.cover.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
 from chaingeo.solvers.cover.placements import Int32Array

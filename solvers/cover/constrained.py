@@ -27,7 +27,7 @@ from functools import cached_property
 import numpy as np
 
 from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
-from chaingeo.core.jit import njit
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover.placements import (
     Int32Array,
     IntArray,

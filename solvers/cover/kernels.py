@@ -13,7 +13,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.kernels.jit import njit
 
 # Status codes (REG_STATUS).
 FRESH = 0

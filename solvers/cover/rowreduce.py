@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import mode, njit
+from chaingeo.kernels.jit import mode, njit
 from chaingeo.solvers.cover.problem import CoverProblem
 
 I64 = npt.NDArray[np.int64]

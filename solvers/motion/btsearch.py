@@ -27,8 +27,8 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import Move, SearchLimitError
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs

@@ -16,7 +16,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
-from chaingeo.core.jit import Pinned
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
+from chaingeo.kernels.jit import Pinned
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs

@@ -25,7 +25,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import njit
+from chaingeo.kernels.jit import njit
 
 I64 = npt.NDArray[np.int64]
 

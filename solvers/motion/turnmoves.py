@@ -30,8 +30,8 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
-from chaingeo.core.jit import njit
 from chaingeo.core.turns import quarter_index
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.sweep import FAR_LIMIT, StencilArrays, rmax2, rmin2, turn_hit

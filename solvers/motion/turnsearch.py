@@ -24,9 +24,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from chaingeo.core.geometry import ROTATIONS, rotation_index
-from chaingeo.core.jit import Pinned
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
+from chaingeo.kernels.jit import Pinned
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs

@@ -18,8 +18,8 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import entry, njit
 from chaingeo.core.kinematics import SearchLimitError
+from chaingeo.kernels.jit import entry, njit
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.optimal.pattern_db import DEAD, KEY_WIDTH, lookup
 

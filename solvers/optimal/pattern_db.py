@@ -25,8 +25,8 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from chaingeo.core.jit import entry, njit
 from chaingeo.core.kinematics import SearchLimitError
+from chaingeo.kernels.jit import entry, njit
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.partsearch import PieceTable

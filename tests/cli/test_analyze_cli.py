@@ -81,7 +81,7 @@ def test_one_bad_file_is_an_error_with_no_json(
 def test_kernels_cannot_change_in_a_process_that_has_them(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    from chaingeo.core.jit import mode
+    from chaingeo.kernels.jit import mode
 
     assert mode() == "numba"  # the test process compiles its kernels
     assert main(["analyze", "puzzle-easy-07-burr3", "--jit", "python"]) == 2
@@ -239,3 +239,28 @@ def test_the_interpreted_try_counts_the_assemblers_placements(seed: int) -> None
     )
     assert placements_within(puzzle, puzzle.problems, rows)
     assert not placements_within(puzzle, puzzle.problems, rows - 1)
+
+
+# Issue #37, item 3: --seconds bounds the command, not each problem; the problems and files it
+# does not reach are reported as not reached.
+
+
+def test_seconds_bounds_the_whole_command(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import gzip
+
+    from tests.support.paths import DATA
+
+    xml = gzip.decompress((DATA / "burrtools" / "solid_burrs.xmpuzzle").read_bytes())
+    a, b = xml.index(b"<problem "), xml.index(b"</problem>") + len(b"</problem>")
+    many = tmp_path / "many.xmpuzzle"
+    many.write_bytes(gzip.compress(xml[:a] + xml[a:b] * 1024 + xml[b:]))
+    t0 = time.monotonic()
+    code = main(["analyze", "--jit", "numba", "--seconds", "2", str(many), str(many)])
+    assert time.monotonic() - t0 < 2 + 10 + 5  # one grace period at most past the deadline
+    rows = [json.loads(x) for x in capsys.readouterr().out.splitlines()]
+    assert code == 1 and len(rows) == 2
+    missed = [p for p in rows[0]["problems"] if "not reached" in (p.get("limit") or "")]
+    assert len(rows[0]["problems"]) == 1024 and len(missed) > 900
+    assert "not reached" in rows[1]["limit"] and "--seconds" in rows[1]["limit"]

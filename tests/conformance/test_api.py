@@ -118,6 +118,42 @@ def test_an_unknown_level_is_a_typed_error_saying_where_ids_are(spec: str) -> No
     assert "chaingeo.shipped_levels()" in str(caught.value) and repr(spec) in str(caught.value)
 
 
+@settings(max_examples=20, deadline=None)
+@given(st.sampled_from(chaingeo.shipped_levels()), st.data())
+def test_a_near_miss_names_the_level_meant(level_id: str, data: st.DataObject) -> None:
+    """One character dropped, doubled or changed: the error says "did you mean" the id, in the
+    library and in every command (one resolver)."""
+    from chaingeo.cli.errors import CommandError
+    from chaingeo.cli.level_arg import find_level
+    from chaingeo.core.suite import MAX_SUGGESTIONS, nearest
+
+    i = data.draw(st.integers(0, len(level_id) - 1))
+    typo = data.draw(st.sampled_from([
+        level_id[:i] + level_id[i + 1 :],
+        level_id[:i] + level_id[i] + level_id[i:],
+        level_id[:i] + ("x" if level_id[i] != "x" else "y") + level_id[i + 1 :],
+    ]))  # fmt: skip
+    with pytest.raises(chaingeo.UnknownLevelError) as caught:
+        chaingeo.load_level(typo)
+    near = caught.value.near
+    assert "did you mean" in str(caught.value) and near == tuple(sorted(near))
+    ties = [i for i in chaingeo.shipped_levels() if nearest(typo, [i]) == [i]]
+    assert level_id in near or len(ties) > MAX_SUGGESTIONS
+    with pytest.raises(CommandError, match="did you mean"):
+        find_level(typo)
+
+
+def test_ids_are_looked_up_in_the_folder_given(tmp_path: Path) -> None:
+    from chaingeo.core.suite import resolve_level, suite_folder
+
+    (src,) = suite_folder().rglob("puzzle-easy-07-burr3.json")
+    (tmp_path / "mine.json").write_bytes(src.read_bytes())
+    path, level = resolve_level("puzzle-easy-07-burr3", tmp_path)
+    assert path == tmp_path / "mine.json" and level.id == "puzzle-easy-07-burr3"
+    with pytest.raises(chaingeo.UnknownLevelError, match=str(tmp_path)):
+        resolve_level("puzzle-easy-01-luban-3-piece", tmp_path)
+
+
 def _without_timing(row: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in row.items() if k not in ("seconds", "kernels", "file", "plan")}
 

@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, MoveError
-from chaingeo.envs.render.collision_check import move_is_legal, swept_collision
-from chaingeo.envs.render.mesh import mesh_arrays, piece_mesh
+from chaingeo.pictures.collision_check import move_is_legal, swept_collision
+from chaingeo.pictures.mesh import mesh_arrays, piece_mesh
 from tests.support.puzzle_strategies import scenes
 
 DISTANCES = (1, 2, 3, None)

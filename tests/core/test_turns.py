@@ -26,7 +26,7 @@ from chaingeo.core.turns import (
     turn_cells,
     turn_from_json,
 )
-from chaingeo.envs.render.collision_check import turn_is_legal, turning_collision
+from chaingeo.pictures.collision_check import turn_is_legal, turning_collision
 from tests.support.puzzle_strategies import scenes, small_scenes
 
 Sq = tuple[int, int]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -29,7 +30,8 @@ from chaingeo.core.level import (
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.agents.baselines import oracle_plan
-from chaingeo.evaluation.episode import EpisodeTask, ProtocolConfig, run_episode
+from chaingeo.evaluation.episode import ProtocolConfig
+from chaingeo.evaluation.play import EpisodeTask, run_episode
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from tests.support.fake_openai import Script, fake_openai, reply
 
@@ -152,8 +154,10 @@ def test_chain_eval_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str
     out = tmp_path / "runs"
     assert main(["eval", "--levels", str(suite), "--out", str(out), "--no-progress"]) == 0
     text = capsys.readouterr().out
-    assert "| oracle | 100.0 | 100.0 | 100.0 | 4 | 4 | " in text
-    assert sorted(p.name for p in out.iterdir()) == [
+    full = r"100\.0 \[\d+\.\d, 100\.0\]"  # all solved, with its 95% interval
+    assert re.search(rf"\| oracle \| {full} \| {full} \| {full} \| 4 \| 4 \| ", text)
+    # (and each run's lock file, .NAME.lock, beside it)
+    assert sorted(p.name for p in out.iterdir() if not p.name.endswith(".lock")) == [
         "greedy-interactive",
         "oracle-interactive",
         "random-interactive",
@@ -182,4 +186,4 @@ def test_chain_eval_end_to_end(tmp_path: Path, capsys: pytest.CaptureFixture[str
         args += ["--protocol", "both"]
         assert main(args) == 0
     assert script.problems == []
-    assert "| fake | 100.0 | — | 100.0 | 1 |" in capsys.readouterr().out
+    assert "| fake | 100.0 [20.7, 100.0] | — | 100.0 [20.7, 100.0] | 1 |" in capsys.readouterr().out

@@ -31,6 +31,24 @@ def _header(**over: object) -> dict[str, object]:
     return h
 
 
+def _rec(key: str, **over: object) -> dict[str, object]:
+    """A complete episode record (readers check every field they use) for ``key``."""
+    level_id, sample = key.split("#")
+    rec: dict[str, object] = {
+        "key": key,
+        "level_id": level_id,
+        "sample": int(sample),
+        "family": "stacking",
+        "difficulty": "easy",
+        "optimal_steps": 2,
+        "steps_used": 2,
+        "success": True,
+        "status": "done",
+    }
+    rec.update(over)
+    return rec
+
+
 def test_header_names_commit_versions_and_level_set(tmp_path: Path) -> None:
     log = RunLog.create(tmp_path / "run", _header())
     head = log.header()
@@ -49,25 +67,26 @@ def test_records_append_images_by_hash_and_partial_tail(tmp_path: Path) -> None:
     assert name == hashlib.sha256(png).hexdigest() + ".png"
     assert (log.path / "images" / name).read_bytes() == png
     assert log.put_image(png) == name
-    log.append({"key": episode_key("a", 0), "status": "done", "images": [name]})
-    log.append({"key": episode_key("b", 0), "status": "error"})
+    log.append(_rec(episode_key("a", 0), images=[name]))
+    log.append(_rec(episode_key("b", 0), status="error"))
     # A killed writer leaves half a line behind.
     with open(log.path / EPISODES, "ab") as fh:
         fh.write(b'{"key": "c#0", "sta')
     assert [r["key"] for r in log.records()] == ["a#0", "b#0"]
     assert log.finished_keys() == {"a#0", "b#0"}
     assert log.finished_keys(retry_errors=True) == {"a#0"}
+    log.close()  # one writer at a time: the folder's lock
     again = RunLog.create(log.path, _header(), resume=True)
-    again.append({"key": "c#0", "status": "done"})
+    again.append(_rec("c#0"))
     lines = (log.path / EPISODES).read_text().splitlines()
     assert [json.loads(x)["key"] for x in lines] == ["a#0", "b#0", "c#0"]
     # A retried episode: the later record wins.
-    again.append({"key": "b#0", "status": "done"})
+    again.append(_rec("b#0"))
     assert again.latest()["b#0"]["status"] == "done"
 
 
 def test_resume_refuses_a_different_run_and_new_refuses_existing(tmp_path: Path) -> None:
-    RunLog.create(tmp_path / "run", _header())
+    RunLog.create(tmp_path / "run", _header()).close()
     with pytest.raises(RunError, match="--resume"):
         RunLog.create(tmp_path / "run", _header())
     with pytest.raises(RunError, match="level_set_hash differs"):
@@ -92,6 +111,7 @@ def test_secrets_never_reach_the_files(tmp_path: Path) -> None:
 
 def test_a_corrupt_middle_line_is_an_error(tmp_path: Path) -> None:
     log = RunLog.create(tmp_path / "run", _header())
-    (log.path / EPISODES).write_text('{"key": "a#0"}\nnot json\n{"key": "b#0"}\n')
+    good = [json.dumps(_rec(k)) for k in ("a#0", "b#0")]
+    (log.path / EPISODES).write_text(f"{good[0]}\nnot json\n{good[1]}\n")
     with pytest.raises(RunError, match="line 2"):
         log.records()

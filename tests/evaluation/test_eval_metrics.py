@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import statistics
 from pathlib import Path
 
 import pytest
@@ -11,13 +12,15 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from chaingeo.evaluation import metrics as m
+from chaingeo.evaluation.episode import Outcome
+from chaingeo.evaluation.stats import Estimate
 from chaingeo.evaluation.usage import Price, PriceError, PriceTable, Usage, UsageError, total_usage
 
 U = Usage(input_tokens=1000, output_tokens=500, calls=1)
 
 
-def _o(level: str, fam: str, diff: str, opt: int, ok: bool, steps: int, sample: int) -> m.Outcome:
-    return m.Outcome(level, fam, diff, opt, ok, steps, sample, U, 0.01)
+def _o(level: str, fam: str, diff: str, opt: int, ok: bool, steps: int, sample: int) -> Outcome:
+    return Outcome(level, fam, diff, opt, ok, steps, sample, U, 0.01)
 
 
 # Level A (stacking easy, o=4): solved in 6, then failed at the 30-step budget.
@@ -59,10 +62,10 @@ def test_efficiency_metrics_by_hand() -> None:
     # 6 episodes x 1500 tokens = 9000 tokens; 6 x $0.01 = $0.06; 3 solved.
     assert m.solved_per_million_tokens(RUN) == pytest.approx(3 / 0.009)
     assert m.solved_per_usd(RUN) == pytest.approx(3 / 0.06)
-    free = [m.Outcome("A", "stacking", "easy", 4, True, 4)]
+    free = [Outcome("A", "stacking", "easy", 4, True, 4)]
     assert m.solved_per_million_tokens(free) is None
     assert m.solved_per_usd(free) is None
-    unknown = [*RUN[:1], m.Outcome("B", "puzzle", "mid", 5, False, 30, 0, U, None)]
+    unknown = [*RUN[:1], Outcome("B", "puzzle", "mid", 5, False, 30, 0, U, None)]
     assert m.run_cost(unknown) is None and m.solved_per_usd(unknown) is None
 
 
@@ -76,14 +79,42 @@ def test_nothing_solved_gives_none_not_zero() -> None:
 
 def test_summary_row() -> None:
     s = m.summarize(RUN)
-    assert (s.episodes, s.levels, s.samples, s.succ_task) == (6, 3, 2, 3)
-    assert s.by_difficulty["stacking/easy"] == pytest.approx(0.5)
-    assert s.by_difficulty["stacking/hard"] == 1.0
-    assert s.by_difficulty["puzzle/mid"] == 0.0
-    assert s.by_difficulty["puzzle/hard"] is None
-    assert sorted(s.pass_at) == [1, 2] and s.pass_at[2] == pytest.approx(2 / 3)
+    assert (s.episodes, s.levels, s.samples, s.value("succ_task")) == (6, 3, 2, 3)
+    assert s.value("pass@1", "stacking", "easy") == pytest.approx(0.5)
+    assert s.value("pass@1", "stacking", "hard") == 1.0
+    assert s.value("pass@1", "puzzle", "mid") == 0.0
+    assert s.value("pass@1", "puzzle", "hard") is None
+    assert s.ks == [1, 2] and s.value("pass@k", k=2) == pytest.approx(2 / 3)
+    assert s.value("pass^k", k=2) == pytest.approx(1 / 3)  # only C solves both samples
     assert s.usage == Usage(6000, 3000, 0, 0, 6)
-    assert s.cost_usd == pytest.approx(0.06)
+    assert s.value("cost_usd") == pytest.approx(0.06)
+    # Two samples per level: Pass@1's interval is a bootstrap over the three levels, so it
+    # lies within the smallest and largest level's rate; the step means carry a stderr.
+    p1 = s.estimate("pass@1")
+    assert p1.method == "bootstrap" and 0.0 <= p1.low <= p1.value <= p1.high <= 1.0  # type: ignore[operator]
+    steps = s.estimate("avg_steps")
+    assert steps.stderr == pytest.approx(statistics.stdev([6, 8, 10]) / 3**0.5)
+
+
+def test_registry_gives_every_metric_once_with_a_direction() -> None:
+    assert {"pass@1", "avg_steps", "dist2opt", "normdist", "pass@k", "pass^k", "avg@k"} <= set(
+        m.METRICS
+    )
+    assert m.METRICS["normdist"].better == "lower" and m.METRICS["pass@1"].better == "higher"
+    with pytest.raises(ValueError, match="twice"):
+        m.register_metric("pass@1", "again", "rate", "higher")(lambda o, k: Estimate(None))
+
+
+@given(st.integers(1, 8).flatmap(lambda n: st.tuples(st.just(n), st.integers(0, n))), st.data())
+def test_unbiased_pass_hat_k_equals_exhaustive_subsets(
+    nc: tuple[int, int], data: st.DataObject
+) -> None:
+    n, c = nc
+    k = data.draw(st.integers(1, n))
+    outcomes = [True] * c + [False] * (n - c)
+    subsets = list(itertools.combinations(range(n), k))
+    exact = sum(all(outcomes[i] for i in s) for s in subsets) / len(subsets)
+    assert m.pass_hat_k_unbiased(n, c, k) == pytest.approx(exact)
 
 
 def test_duplicate_samples_and_short_levels_are_errors() -> None:

@@ -12,7 +12,7 @@ import pytest
 from chaingeo.cli.main import main
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.episode import ProtocolConfig
-from chaingeo.evaluation.report.tables import find_runs, load_run, table1
+from chaingeo.evaluation.report.tables import find_runs, load_run, sort_value, table1
 from chaingeo.evaluation.runner import RunConfig, evaluate
 from tests.support.harness import FAKE, fake_levels
 
@@ -36,7 +36,8 @@ def runs(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_table1_numbers(runs: Path) -> None:
     loaded = [load_run(p) for p in find_runs([runs / "runs"])]
-    rows = {r[0]: r for r in table1(loaded).rows}
+    table = table1(loaded)
+    rows = {r[0]: [sort_value(v) for v in r] for r in table.rows}
     scripted = rows["scripted"]
     # Puzzle (none), Stacking, All, Succ.Task, Episodes, AvgSteps, Dist2Opt, NormDist
     assert scripted[1] is None
@@ -44,6 +45,10 @@ def test_table1_numbers(runs: Path) -> None:
     assert scripted[4:9] == [1, 3, 3.0, 1.0, 0.5]
     assert rows["random"][3] == 1.0 and rows["random"][7] == 0.0
     assert "scripted (one-shot)" in rows
+    # One sample per level: Wilson intervals for the rates, and the caption says so.
+    stacking = next(r for r in table.rows if r[0] == "scripted")[2]
+    assert (stacking.low, stacking.high) == pytest.approx((0.0615, 0.7923), abs=1e-4)
+    assert "Wilson" in table.caption and "standard error" in table.caption
 
 
 def test_chain_report_writes_tables_csv_and_plot(
@@ -51,10 +56,18 @@ def test_chain_report_writes_tables_csv_and_plot(
 ) -> None:
     assert main(["report", str(runs / "runs"), "--out", str(tmp_path / "rep")]) == 0
     out = capsys.readouterr().out
-    assert "### Table 1" in out and "| scripted | — | 33.3 | 33.3 | 1 |" in out
+    assert "### Table 1" in out
+    assert "| scripted | — | 33.3 [6.1, 79.2] | 33.3 [6.1, 79.2] | 1 |" in out
+    # one solved episode: its steps have no standard error; random solves all three
+    assert "| 3.00 ± — | 1.00 ± — | 0.500 ± — |" in out
+    assert "Uncertainty: 95% Wilson score interval" in out
     assert "Interactive vs one-shot" in out and "Stacking Easy" in out
     table = list(csv.reader(io.StringIO((tmp_path / "rep" / "table1.csv").read_text())))
-    assert table[0][:4] == ["Agent", "Puzzle", "Stacking", "All"]
+    assert table[0][:5] == ["Agent", "Puzzle", "Puzzle low", "Puzzle high", "Puzzle stderr"]
+    assert "NormDist stderr" in table[0] and "Solved/USD low" in table[0]
+    row = dict(zip(table[0], next(r for r in table if r[0] == "scripted"), strict=True))
+    assert float(row["Stacking low"]) == pytest.approx(0.0615, abs=1e-4)
+    assert row["Puzzle"] == row["Puzzle low"] == "" and row["AvgSteps stderr"] == ""
     assert len(table) == 4
     png = (tmp_path / "rep" / "cost_success.png").read_bytes()
     assert png.startswith(b"\x89PNG") and len(png) > 5000

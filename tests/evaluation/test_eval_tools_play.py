@@ -123,7 +123,7 @@ def test_a_model_plays_whole_levels_with_tool_calls_only(
         )
     assert script.problems == []  # every request answered the last calls, by id and in order
     assert code == 0
-    assert "| fake | 100.0 |" in capsys.readouterr().out
+    assert "| fake | 100.0 [" in capsys.readouterr().out
     bodies = [r["body"] for r in script.requests]
     assert len(bodies) == 5
     assert all(b["reasoning_effort"] == "high" and b["top_k"] == 20 for b in bodies)

@@ -28,7 +28,7 @@ from chaingeo.generator.cubes import (
     void_sites,
 )
 from chaingeo.generator.puzzle import make
-from chaingeo.generator.result import Rejection
+from chaingeo.generator.result import GenerationRejection
 from chaingeo.solvers.motion.partsearch import PieceTable
 
 EASY = PuzzleConfig(shape="cube3", pieces=3, min_level=2, hole_rate=0.3, hill_steps=10)
@@ -103,4 +103,4 @@ def test_generated_four_cubes_reach_level_three(index: int) -> None:
 @pytest.mark.slow
 def test_a_cube_that_misses_its_level_is_rejected_with_the_reason() -> None:
     item = make(dataclasses.replace(EASY, min_level=9), 5, 0)
-    assert isinstance(item, Rejection) and "level 9 or more" in item.reason
+    assert isinstance(item, GenerationRejection) and "level 9 or more" in item.reason

@@ -9,11 +9,11 @@ import pytest
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.level import Level, load_levels, stacking_level
-from chaingeo.envs.render.pictures import level_pictures
 from chaingeo.generator.batch import SUMMARY_FILE, GenerationError, GenerationJob, run
 from chaingeo.generator.config import get_config
-from chaingeo.generator.result import Rejection
+from chaingeo.generator.result import GenerationRejection
 from chaingeo.generator.stacking import make
+from chaingeo.pictures.pictures import level_pictures
 
 PLATES = [
     Shape([(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)]),
@@ -25,10 +25,10 @@ TRIPODS = [
 ]
 
 
-def fake_make(config: object, seed: int, index: int) -> Level | Rejection:
+def fake_make(config: object, seed: int, index: int) -> Level | GenerationRejection:
     """A family of its own: plates, a rejection, tripods, a rejection, plates again..."""
     if index % 2:
-        return Rejection("odd-index", seed, index, {"odd-index": 1, "tried-twice": 1})
+        return GenerationRejection("odd-index", seed, index, {"odd-index": 1, "tried-twice": 1})
     packing = PLATES if index % 4 == 0 else TRIPODS
     return stacking_level(f"fake-{index}", "easy", (2, 2, 2), packing, generator="fake")
 

@@ -17,7 +17,7 @@ from chaingeo.generator.config import (
     register_config,
     stacking_config,
 )
-from chaingeo.generator.result import ATTEMPTS_KEY, Rejection
+from chaingeo.generator.result import ATTEMPTS_KEY, GenerationRejection
 from chaingeo.generator.stacking import easy_cuboids, make, random_multiset, stage_problem
 
 
@@ -147,12 +147,12 @@ def test_no_level_gives_a_rejection_with_every_reason() -> None:
     # Two 4-cell pieces in a 2x2x2 box are always congruent: hard mode cannot succeed.
     cfg = stacking_config((2, 2, 2), "hard", min_piece=4, fallback_min_piece=None, attempts=5)
     out = make(cfg, 0, 7)
-    assert isinstance(out, Rejection)
+    assert isinstance(out, GenerationRejection)
     assert out.reason == "repair-failed:repeated-shape"
     assert out.attempts == {"repair-failed:repeated-shape": 5}
     assert (out.seed, out.index) == (0, 7)
     impossible = make(stacking_config((3, 3, 3), "hard", max_pieces=5, attempts=3), 0, 0)
-    assert isinstance(impossible, Rejection)
+    assert isinstance(impossible, GenerationRejection)
     assert impossible.attempts == {"no-feasible-piece-count": 2}
 
 
@@ -173,7 +173,7 @@ def test_every_outcome_is_a_sound_level_or_a_counted_rejection(
 ) -> None:
     cfg = get_config(name).replace(attempts=40)
     out = make(cfg, seed, index)
-    if isinstance(out, Rejection):
+    if isinstance(out, GenerationRejection):
         assert out.reason in out.attempts and sum(out.attempts.values()) <= cfg.attempts
     else:
         assert level_problems(out, cfg) == []

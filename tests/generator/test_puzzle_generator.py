@@ -16,7 +16,7 @@ from chaingeo.core.level import Level, level_bytes, load_level
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.layouts import get_layout
 from chaingeo.generator.puzzle import difficulty_of, make
-from chaingeo.generator.result import Rejection
+from chaingeo.generator.result import GenerationRejection
 
 SMALL = PuzzleConfig(shape="cube3", pieces=3, hill_steps=20, hole_rate=0.3)
 
@@ -57,7 +57,7 @@ def test_assemble_goal_stores_the_reversed_plan() -> None:
 
 def test_rejections_say_why() -> None:
     item = make(PuzzleConfig(shape="burr6", hill_steps=0, min_level=9), 5, 0)
-    assert isinstance(item, Rejection) and "below 9" in item.reason
+    assert isinstance(item, GenerationRejection) and "below 9" in item.reason
 
 
 def test_chain_generate_puzzle(tmp_path: Path, capsys: object) -> None:

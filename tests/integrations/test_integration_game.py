@@ -15,7 +15,8 @@ from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.baselines import oracle_plan
 from chaingeo.evaluation.agents.tools import skipped_result, translate
-from chaingeo.integrations.game import Game, Outcome, Protocol, efficiency_reward, recent
+from chaingeo.evaluation.episode import Outcome
+from chaingeo.integrations.game import Game, Protocol, efficiency_reward, recent
 from chaingeo.integrations.game import total_reward as total
 from tests.support.plans import place_calls
 from tests.support.shipped import shipped

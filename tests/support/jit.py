@@ -4,7 +4,7 @@ never in the compiled mode (results and memory bounds are checked the same in bo
 
 from __future__ import annotations
 
-from chaingeo.core import jit
+from chaingeo.kernels import jit
 
 #: Kernels are numba's in this process (read from ``CHAINGEO_JIT``, fixed for the process).
 COMPILED = jit.mode() == "numba"

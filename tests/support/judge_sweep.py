@@ -16,8 +16,8 @@ from typing import Any
 
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import suite_folder
-from chaingeo.envs.worldmodel.judge_video import judge_video
-from chaingeo.envs.worldmodel.video import plan_video, write_gif
+from chaingeo.worldmodel.judge_video import judge_video
+from chaingeo.worldmodel.video import plan_video, write_gif
 
 SIZE = 256
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from chaingeo.core.colors import PALETTE
 from chaingeo.core.piecesets import BEDLAM_SOLUTION
-from chaingeo.envs.render.scene import PieceMap
+from chaingeo.pictures.scene import PieceMap
 
 
 def bedlam_half() -> tuple[PieceMap, PieceMap]:

@@ -17,7 +17,7 @@ optimal search alone is reported as ``optimal_error``).
 match the installed sources (loading them takes milliseconds, starting numba ~0.5 s); a call
 they were not compiled for makes the command start again with numba for the files not yet
 printed. Without them, a single small file runs with interpreted kernels: starting numba costs
-more than the work (:mod:`chaingeo.core.jit`); if the work takes more than
+more than the work (:mod:`chaingeo.kernels.jit`); if the work takes more than
 :data:`INTERPRETED_SECONDS` of CPU time, the command starts again with numba.
 
 When a cap (``--seconds``, ``--max-states``) stops the counting of assemblies, nothing finished
@@ -40,6 +40,7 @@ import signal
 import sys
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 from functools import lru_cache
 from pathlib import Path
 from types import FrameType
@@ -146,13 +147,19 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_all(args: argparse.Namespace, done: int = 0, status: int = 0) -> int:
     """Analyse the files after the first ``done`` (printed by an earlier start of the command
-    whose exit status so far was ``status``), one JSON line each."""
+    whose exit status so far was ``status``), one JSON line each, all within the command's one
+    ``--seconds``: a file (or problem) the deadline does not reach is reported as not reached."""
+    end = time.monotonic() + args.seconds
     for i, spec in enumerate(args.files):
         if i < done:
             continue
         _printed[:] = [i, status]
+        if end - time.monotonic() <= 0:
+            print(replace(_not_reached(args), file=str(spec)).to_json(LIMIT_FLAGS), flush=True)
+            status = max(status, 1)
+            continue
         try:
-            figures = analyze_file(spec, args)
+            figures = analyze_file(spec, args, end)
             status = max(status, _cut_short(spec, figures))
             line = figures.to_json(LIMIT_FLAGS)
         except CommandError as e:
@@ -167,7 +174,13 @@ def _run_all(args: argparse.Namespace, done: int = 0, status: int = 0) -> int:
 def _cut_short(spec: str, figures: PuzzleFigures) -> int:
     """Say on stderr which cap cut counting short, naming its flag, and return the exit
     status: 1 when some count is a lower bound, else 0."""
+    missed = [r for r in figures.cut_short() if (r.limit or "").startswith("not reached")]
+    if missed:
+        limit = with_flag(missed[0].limit or "", missed[0].limit_cap)
+        print(f"chain analyze: {spec}: {len(missed)} not analysed ({limit})", file=sys.stderr)
     for row in figures.cut_short():
+        if row in missed:
+            continue
         limit = with_flag(row.limit or "", row.limit_cap)
         print(
             f"chain analyze: {spec}: counting stopped ({limit}); the counts are lower "
@@ -177,33 +190,37 @@ def _cut_short(spec: str, figures: PuzzleFigures) -> int:
     return 1 if figures.cut_short() else 0
 
 
-def analyze_file(spec: str, args: argparse.Namespace) -> PuzzleFigures:
-    """The figures of one file (``CommandError`` for any failure, with the reason)."""
-    from dataclasses import replace
+def _not_reached(args: argparse.Namespace, **known: Any) -> PuzzleFigures:
+    """The figures of a file or problem the command's deadline did not reach."""
+    from chaingeo.solvers.figures import PuzzleFigures
 
+    reason = f"not reached: the command's time limit ({args.seconds:g} s) was spent"
+    return PuzzleFigures(counts_complete=False, limit=reason, limit_cap="seconds", **known)
+
+
+def analyze_file(spec: str, args: argparse.Namespace, end: float | None = None) -> PuzzleFigures:
+    """The figures of one file within the command's deadline ``end`` (``time.monotonic``;
+    default ``--seconds`` from now); ``CommandError`` for any failure, with the reason. The
+    problems of a BurrTools file are analysed one by one, each with the time left."""
     from chaingeo.core.errors import ChainGeoError
+    from chaingeo.core.formats.burrtools import BTPuzzle
     from chaingeo.core.kinematics import SearchLimitError
-    from chaingeo.solvers.analysis import analyze
-    from chaingeo.solvers.deadline import Deadline
-    from chaingeo.solvers.limits import SearchLimits
+    from chaingeo.kernels.jit import mode
+    from chaingeo.solvers.figures import PuzzleFigures
 
-    limits = SearchLimits(
-        max_states=args.max_states, seconds=args.seconds, optimal_seconds=args.optimal_seconds
-    )
-    deadline = Deadline(limits.seconds)
+    end = time.monotonic() + args.seconds if end is None else end
     start = time.perf_counter()
     try:
-        with ProgressLines(f"chain analyze: {spec}", deadline.progress):
-            source = read_puzzle(spec) if Path(spec).suffix == ".xmpuzzle" else find_level(spec)
-            figures = analyze(
-                source,
-                limits=limits,
-                problem=args.problem,
-                optimal=not args.no_optimal,
-                assemble=not args.no_assemble,
-                mirrors=args.mirrors,
-                deadline=deadline,
-            )
+        source = read_puzzle(spec) if Path(spec).suffix == ".xmpuzzle" else find_level(spec)
+        if isinstance(source, BTPuzzle) and args.problem is None and len(source.problems) > 1:
+            rows = [
+                _within(source, k, args, end, spec) or _not_reached(args, problem=k, name=p.name)
+                for k, p in enumerate(source.problems)
+            ]
+            rows = [replace(r, file=None, kernels=None, seconds=None) for r in rows]
+            figures = PuzzleFigures(problems=tuple(rows), several=True, kernels=mode())
+        else:
+            figures = _within(source, args.problem, args, end, spec) or _not_reached(args)
     except SearchLimitError as e:
         raise CommandError(limit_message(e)) from None
     except (ChainGeoError, FileNotFoundError) as e:
@@ -211,6 +228,34 @@ def analyze_file(spec: str, args: argparse.Namespace) -> PuzzleFigures:
     except (IndexError, RuntimeError, ValueError) as e:
         raise CommandError(str(e)) from None
     return replace(figures, file=str(spec), seconds=round(time.perf_counter() - start, 3))
+
+
+def _within(
+    source: Any, problem: int | None, args: argparse.Namespace, end: float, spec: str
+) -> PuzzleFigures | None:
+    """``analyze`` of ``source`` (one problem) with the time left before ``end``; None when
+    none is left."""
+    from chaingeo.solvers.analysis import analyze
+    from chaingeo.solvers.deadline import Deadline
+    from chaingeo.solvers.limits import SearchLimits
+
+    left = end - time.monotonic()
+    if left <= 0:
+        return None
+    limits = SearchLimits(
+        max_states=args.max_states, seconds=left, optimal_seconds=args.optimal_seconds
+    )
+    deadline = Deadline(limits.seconds, stated=args.seconds)
+    with ProgressLines(f"chain analyze: {spec}", deadline.progress):
+        return analyze(
+            source,
+            limits=limits,
+            problem=problem,
+            optimal=not args.no_optimal,
+            assemble=not args.no_assemble,
+            mirrors=args.mirrors,
+            deadline=deadline,
+        )
 
 
 @lru_cache(maxsize=1)
@@ -256,18 +301,22 @@ def _ahead_of_time_first(args: argparse.Namespace) -> bool:
     """Whether to use the precompiled kernels: ``--jit aot``, or ``--jit auto`` when they match
     the sources, no mode is forced by ``CHAINGEO_JIT`` and the command can start itself again
     (not a call of ``main``)."""
-    from chaingeo.core import aot, jit
+    from chaingeo.kernels import aot, jit
 
     if _aot_forced(args):
         return True
     argv = getattr(args, "command_line", None)
     if args.jit != "auto" or argv is None or jit.ENV in os.environ or RESUME_ENV in os.environ:
         return False
-    return aot.load() is not None  # checked once: setting the mode finds it loaded
+    if aot.load() is not None:  # checked once: setting the mode finds it loaded
+        return True
+    if aot.refused:  # a store is there but fails its checks: one line, then numba
+        print(f"chain analyze: precompiled kernels {aot.refused}; using numba", file=sys.stderr)
+    return False
 
 
 def _aot_forced(args: argparse.Namespace) -> bool:
-    from chaingeo.core.jit import ENV
+    from chaingeo.kernels.jit import ENV
 
     return bool(args.jit == "aot" or (args.jit == "auto" and os.environ.get(ENV) == "aot"))
 
@@ -275,7 +324,7 @@ def _aot_forced(args: argparse.Namespace) -> bool:
 def _run_ahead_of_time(args: argparse.Namespace) -> int:
     """Analyse with the precompiled kernels; on a call they do not cover, start again with
     numba for the files not yet printed (``--jit aot``: report the miss instead)."""
-    from chaingeo.core.aot import KernelMiss
+    from chaingeo.kernels.aot import KernelMiss
 
     _set_mode("aot")
     try:
@@ -296,7 +345,7 @@ class _TooLong(BaseException):
 
 
 def _set_mode(wanted: str) -> None:
-    from chaingeo.core.jit import set_mode
+    from chaingeo.kernels.jit import set_mode
 
     try:
         set_mode("python" if wanted == "python" else "aot" if wanted == "aot" else "numba")
@@ -307,7 +356,7 @@ def _set_mode(wanted: str) -> None:
 def _interpreted_first(args: argparse.Namespace) -> bool:
     """Whether to try the one file interpreted: ``--jit auto``, one small file, no mode forced
     by ``CHAINGEO_JIT``, and a command line to start again with (not a call of ``main``)."""
-    from chaingeo.core import jit
+    from chaingeo.kernels import jit
 
     argv = getattr(args, "command_line", None)
     if args.jit != "auto" or len(args.files) != 1 or argv is None or jit.ENV in os.environ:
@@ -383,7 +432,7 @@ def _run_interpreted(args: argparse.Namespace) -> int:
 
 def _restart_with_numba(argv: list[str], done: int = 0, status: int = 0) -> None:
     """Start the command again with numba's kernels, skipping the ``done`` files printed."""
-    from chaingeo.core.jit import ENV
+    from chaingeo.kernels.jit import ENV
 
     env = dict(os.environ, **{ENV: "numba", RESUME_ENV: f"{done}:{status}"})
     sys.stdout.flush()

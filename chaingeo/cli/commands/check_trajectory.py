@@ -1,5 +1,5 @@
 """``chain check-trajectory LEVEL TRAJ.json``: the exact verdict on a pose trajectory
-(``chain-trajectory/1``, see :mod:`chaingeo.envs.worldmodel.trajectory`): exit 0 valid, 1 invalid, 2
+(``chain-trajectory/1``, see :mod:`chaingeo.worldmodel.trajectory`): exit 0 valid, 1 invalid, 2
 unreadable; the last line printed is one JSON object."""
 
 from __future__ import annotations
@@ -39,19 +39,17 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.level_arg import find_level
     from chaingeo.core.files import UnreadableFile, read_bounded
     from chaingeo.core.limits import MAX_TRAJECTORY_BYTES
-    from chaingeo.envs.worldmodel.trajectory import TrajectoryError, parse_trajectory
-    from chaingeo.envs.worldmodel.trajectory_verdict import check_trajectory
+    from chaingeo.worldmodel.trajectory import TrajectoryError, parse_trajectory
+    from chaingeo.worldmodel.trajectory_verdict import check_trajectory
 
     if args.max_jump is not None and not args.max_jump > 0:
         raise CommandError(f"--max-jump must be a positive number, got {args.max_jump}")
     level = find_level(args.level)
     try:
         raw = read_bounded(args.trajectory, MAX_TRAJECTORY_BYTES)
-        traj = parse_trajectory(raw.decode("utf-8"))
+        traj = parse_trajectory(raw)
     except UnreadableFile as e:
         raise CommandError(f"{args.trajectory}: {e.reason}") from None
-    except UnicodeDecodeError:
-        raise CommandError(f"{args.trajectory}: not UTF-8 text") from None
     except TrajectoryError as e:
         raise CommandError(f"{args.trajectory}: {e}") from None
     verdict = check_trajectory(level, traj, args.max_jump)

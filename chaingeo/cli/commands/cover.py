@@ -62,7 +62,7 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
     from chaingeo.core.piecesets import get_pieceset
 
     path = Path(source)
-    if not path.is_file():
+    if not (path.exists() or path.is_symlink()):  # a name: a piece set or a level id
         try:
             return dict(get_pieceset(source).pieces), None
         except KeyError as e:
@@ -70,10 +70,13 @@ def load_pieces(source: str) -> tuple[dict[str, Any], tuple[int, int, int] | Non
             if level is None:
                 raise CommandError(f"--pieces: no such file or level id, and {e.args[0]}") from None
             return dict(level.shapes), level.box
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
-        raise CommandError(f"--pieces: cannot read {source}: {e}") from None
+    from chaingeo.core import limits
+    from chaingeo.core.files import UnreadableFile, read_json
+
+    try:  # the one bounded JSON reader
+        data = read_json(path, limits.MAX_FILE_BYTES)
+    except UnreadableFile as e:
+        raise CommandError(f"--pieces: cannot read {source}: {e.reason}") from None
     if isinstance(data, dict) and "format" in data:
         level = parse_level(data, source)
         return dict(level.shapes), level.box

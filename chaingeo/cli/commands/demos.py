@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
-from pathlib import Path
 from typing import Any
 
 from chaingeo.cli.out_arg import add_out
@@ -31,6 +30,7 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
     from chaingeo.cli.level_arg import levels_of
+    from chaingeo.core.files import atomic_path
     from chaingeo.envs.demos import DemonstrationError, demonstration_lines
 
     levels = levels_of(args)
@@ -40,7 +40,9 @@ def run(args: argparse.Namespace) -> int:
         out = (
             sys.stdout
             if args.out == "-"
-            else files.enter_context(Path(args.out).open("w", encoding="ascii", newline="\n"))
+            else files.enter_context(
+                files.enter_context(atomic_path(args.out)).open("w", encoding="ascii", newline="\n")
+            )
         )
         try:
             for line in demonstration_lines(levels, **options):

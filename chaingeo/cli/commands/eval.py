@@ -83,12 +83,22 @@ def register(sub: Any) -> None:
         " reasoning_effort=high or extra_body='{\"top_k\": 20}', repeatable",
     )
     p.add_argument(
+        "--config",
+        metavar="NAME|FILE",
+        help="an evaluation protocol as a file: sampling, history, budgets, pictures, protocols"
+        f" (shipped: {', '.join(_config_names())}; or a .toml path); flags given explicitly"
+        " override it",
+    )
+    p.add_argument(
         "--protocol",
         choices=("interactive", "oneshot", "both"),
-        default="interactive",
-        help="turn by turn with feedback, or the whole plan at once",
+        default=None,
+        help="turn by turn with feedback, or the whole plan at once (default: interactive, or"
+        " the config's)",
     )
-    p.add_argument("--samples", type=int, default=1, help="episodes per level (Pass@k, Avg@k)")
+    p.add_argument(
+        "--samples", type=int, default=None, help="episodes per level (Pass@k, Pass^k, Avg@k)"
+    )
     p.add_argument("--candidates", type=int, default=1, help="candidates per turn (verifier)")
     p.add_argument(
         "--judge",
@@ -102,7 +112,12 @@ def register(sub: Any) -> None:
         metavar="KEY=VALUE",
         help="judge option, e.g. model=NAME base_url=URL (for --judge model), repeatable",
     )
-    p.add_argument("--history-window", type=int, default=5, help="recent turns shown")
+    p.add_argument(
+        "--history-window",
+        type=int,
+        default=None,
+        help="recent turns shown (5 unless the config says)",
+    )
     p.add_argument("--text-state", action="store_true", help="add every piece's cells as text")
     p.add_argument("--seed", type=int, default=0, help="seed of the agents' randomness")
     p.add_argument("--jobs", type=int, default=1, help="episodes in parallel (processes)")
@@ -137,6 +152,12 @@ def register(sub: Any) -> None:
     p.set_defaults(func=run)
 
 
+def _config_names() -> list[str]:
+    from chaingeo.evaluation.eval_config import config_names
+
+    return config_names()
+
+
 def _option(text: str, flag: str = "--agent-option") -> tuple[str, Any]:
     if "=" not in text:
         raise CommandError(f"{flag} {text!r}: expected KEY=VALUE")
@@ -148,7 +169,17 @@ def _option(text: str, flag: str = "--agent-option") -> tuple[str, Any]:
 
 
 #: Options only a model agent takes; the built-in baselines are run without them.
-MODEL_ONLY = ("model", "base_url", "api_key_env", "tools", "model_options")
+MODEL_ONLY = (
+    "model",
+    "base_url",
+    "api_key_env",
+    "tools",
+    "model_options",
+    "temperature",
+    "top_p",
+    "max_tokens",
+    "images",
+)
 
 
 def _slug(text: str) -> str:
@@ -197,7 +228,7 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.evaluation.agents.base import AgentSpec, AuthenticationError
     from chaingeo.evaluation.agents.openai_chat import provider_fields
     from chaingeo.evaluation.agents.registry import BASELINES
-    from chaingeo.evaluation.episode import ProtocolConfig
+    from chaingeo.evaluation.eval_config import ConfigError, EvalConfig, load_config
     from chaingeo.evaluation.logs import RunLog
     from chaingeo.evaluation.report.tables import Run, load_run, table1
     from chaingeo.evaluation.runner import RunConfig, evaluate
@@ -214,6 +245,11 @@ def run(args: argparse.Namespace) -> int:
         levels = levels[: args.limit]
     if not levels:
         raise CommandError(f"{source}: no levels to evaluate")
+    try:
+        config = load_config(args.config) if args.config else EvalConfig()
+    except ConfigError as e:
+        raise CommandError(str(e)) from None
+    levels = config.budgeted(levels)
 
     names = args.agent or list(BASELINES)
     options = dict(_option(o) for o in args.agent_option)
@@ -225,6 +261,10 @@ def run(args: argparse.Namespace) -> int:
         options["api_key_env"] = args.api_key_env
     if args.label:
         options["label"] = args.label
+    for key, value in config.sampling().items():  # the config's sampling; options win
+        options.setdefault(key, value)
+    if not config.images:
+        options.setdefault("images", False)
     if args.tools:
         options["tools"] = args.tools
     if args.model_option:
@@ -235,7 +275,10 @@ def run(args: argparse.Namespace) -> int:
         except ValueError as e:
             raise CommandError(f"--model-option: {e}") from None
         options["model_options"] = model_options
-    protocols = ["interactive", "oneshot"] if args.protocol == "both" else [args.protocol]
+    if args.protocol is None:
+        protocols: list[str] = list(config.protocols)
+    else:
+        protocols = ["interactive", "oneshot"] if args.protocol == "both" else [args.protocol]
     if args.out is None:
         if args.resume:
             raise CommandError("--resume needs --out (the folder of the runs to continue)")
@@ -243,7 +286,7 @@ def run(args: argparse.Namespace) -> int:
         args.out = Path("runs") / stamp
     prices = PriceTable.load(*args.prices)
     cfg = RunConfig(
-        samples=args.samples,
+        samples=config.samples if args.samples is None else args.samples,
         seed=args.seed,
         jobs=args.jobs,
         dask=args.dask,
@@ -264,10 +307,11 @@ def run(args: argparse.Namespace) -> int:
         spec = AgentSpec(name, opts)
         for proto_name in protocols:
             try:
-                proto = ProtocolConfig(
-                    name=proto_name,  # type: ignore[arg-type]
-                    history_window=args.history_window,
-                    text_state=args.text_state,
+                window = args.history_window
+                proto = config.protocol(
+                    proto_name,  # type: ignore[arg-type]
+                    history_window=config.history_window if window is None else window,
+                    text_state=args.text_state or config.text_state,
                     candidates=args.candidates,
                     judge=args.judge,
                     judge_options=dict(_option(o) for o in args.judge_option),

@@ -10,7 +10,7 @@ from typing import Any
 from chaingeo.cli.level_arg import add_level
 from chaingeo.cli.out_arg import add_out
 
-#: The same as :data:`chaingeo.envs.render.mesh.FORMATS` (kept here so ``chain --help`` loads no
+#: The same as :data:`chaingeo.pictures.mesh.FORMATS` (kept here so ``chain --help`` loads no
 #: mesh code).
 FORMATS = ("glb", "stl", "obj")
 
@@ -25,7 +25,7 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.level_arg import find_level
-    from chaingeo.envs.render.mesh import export_level
+    from chaingeo.pictures.mesh import export_level
 
     level = find_level(args.level)
     target: Path = args.out or Path(f"{level.id}.{args.format}")

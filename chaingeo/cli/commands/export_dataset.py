@@ -37,7 +37,8 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
     from chaingeo.cli.level_arg import levels_of
-    from chaingeo.core.files import atomic_write
+    from chaingeo.cli.out_arg import out_folder
+    from chaingeo.core.files import atomic_write, folder_locked
     from chaingeo.envs.dataset import DatasetError, export_dataset
     from chaingeo.envs.dataset_card import dataset_card
     from chaingeo.envs.demos import DemonstrationError
@@ -45,14 +46,20 @@ def run(args: argparse.Namespace) -> int:
 
     levels = levels_of(args)
     signatures = {lv.id: level_signature(lv) for lv in levels}
-    try:
-        summary = export_dataset(
-            levels, args.out, split=args.split, image_size=args.image_size, signatures=signatures
-        )
-    except (DatasetError, DemonstrationError) as e:
-        raise CommandError(str(e)) from e
-    card = dataset_card(args.out, levels, args.split, summary.rows)
-    atomic_write(args.out / "README.md", card.encode("utf-8"))
+    out_folder(args.out)  # an existing file is one error line (it was NotADirectoryError)
+    with folder_locked(args.out):  # a second writer of the same folder is refused
+        try:
+            summary = export_dataset(
+                levels,
+                args.out,
+                split=args.split,
+                image_size=args.image_size,
+                signatures=signatures,
+            )
+        except (DatasetError, DemonstrationError) as e:
+            raise CommandError(str(e)) from e
+        card = dataset_card(args.out, levels, args.split, summary.rows)
+        atomic_write(args.out / "README.md", card.encode("utf-8"))
     files = sorted(str(f.relative_to(args.out)) for fs in summary.files.values() for f in fs)
     print(json.dumps({"split": args.split, "rows": summary.rows, "bytes": summary.bytes,
                       "files": files}, sort_keys=True))  # fmt: skip

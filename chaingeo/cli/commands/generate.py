@@ -74,9 +74,9 @@ def add_curriculum_option(p: argparse._ActionsContainer, family: str) -> None:
 
 def run_job(args: argparse.Namespace, family: str, make: Any, config: Any) -> int:
     """Run one generation job from parsed options; print the summary as one JSON line."""
-    from chaingeo.envs.render.pictures import level_pictures
     from chaingeo.generator.batch import HELD_OUT, GenerationError, GenerationJob, run
     from chaingeo.generator.signature import shipped_signatures
+    from chaingeo.pictures.pictures import level_pictures
 
     held_out = shipped_signatures() if args.split == "train" else frozenset()
     try:
@@ -174,8 +174,8 @@ def _register_suite(fam: Any) -> None:
 
 
 def _run_suite(args: argparse.Namespace) -> int:
-    from chaingeo.envs.render.pictures import level_pictures
     from chaingeo.generator.suite import build_suite
+    from chaingeo.pictures.pictures import level_pictures
 
     try:
         summaries = build_suite(

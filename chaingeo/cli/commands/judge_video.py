@@ -1,5 +1,5 @@
 """``chain judge-video VIDEO [--level LEVEL] [--evidence DIR]``: is a generated video of a
-puzzle coming apart physically valid? (see :mod:`chaingeo.envs.worldmodel.judge_video`). Exit 0
+puzzle coming apart physically valid? (see :mod:`chaingeo.worldmodel.judge_video`). Exit 0
 valid, 1 invalid, 2 unreadable input; the last line printed is the JSON report."""
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
     from chaingeo.cli.level_arg import find_level
-    from chaingeo.envs.worldmodel.judge_video import VideoJudgeError, judge_video
+    from chaingeo.worldmodel.judge_video import VideoJudgeError, judge_video
 
     level = find_level(args.level) if args.level is not None else None
     try:

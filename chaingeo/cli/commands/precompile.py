@@ -6,7 +6,7 @@ puzzle; the BurrTools feature examples of :mod:`chaingeo.generator.bt_examples`:
 piece groups, ranges, several problems; any ``FILE``: levels or ``.xmpuzzle`` files; BurrTools
 puzzles with mirrors kept and dropped; each analysis capped at ``--seconds``), then compiles
 every kernel signature that work used into one extension module in the user cache
-(:mod:`chaingeo.core.aot_build`). ``chain analyze`` uses it while it matches the installed
+(:mod:`chaingeo.kernels.aot_build`). ``chain analyze`` uses it while it matches the installed
 sources and numpy, and falls back to numba for a call the workload did not cover. Needs a C
 compiler (numba's ``pycc`` links the module with it).
 """
@@ -46,7 +46,7 @@ def register(sub: Any) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.core import aot
+    from chaingeo.kernels import aot
 
     if args.status:
         print(f"{aot.store_dir()}: {aot.status().sentence}")
@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.seconds > 0:
         raise CommandError(f"--seconds: expected a positive number, got {args.seconds}")
     _numba_mode()
-    from chaingeo.core import aot_build, jit
+    from chaingeo.kernels import aot_build, jit
 
     start = time.perf_counter()
     for label, run_one in _workload(args.files, args.seconds):
@@ -75,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _numba_mode() -> None:
-    from chaingeo.core.jit import ENV, set_mode
+    from chaingeo.kernels.jit import ENV, set_mode
 
     if os.environ.get(ENV, "numba") != "numba":
         raise CommandError(f"{ENV}={os.environ[ENV]}: precompiling needs numba's kernels")

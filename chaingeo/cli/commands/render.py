@@ -28,8 +28,9 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.level_arg import find_level
     from chaingeo.cli.out_arg import out_folder
-    from chaingeo.envs.render.pictures import render_exploded
-    from chaingeo.envs.render.scene import render_level_tray, render_solution_views
+    from chaingeo.core.files import atomic_write
+    from chaingeo.pictures.pictures import render_exploded
+    from chaingeo.pictures.scene import render_level_tray, render_solution_views
 
     level = find_level(args.level)
     pictures = dict(render_solution_views(level, size=args.size))
@@ -39,6 +40,6 @@ def run(args: argparse.Namespace) -> int:
     out_folder(args.out)
     for view, data in pictures.items():
         target = args.out / f"{level.id}-{view}.png"
-        target.write_bytes(data)
+        atomic_write(target, data)
         print(target)
     return 0

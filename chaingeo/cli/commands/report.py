@@ -41,7 +41,11 @@ def run(args: argparse.Namespace) -> int:
     runs = [load_run(p) for p in find_runs(args.runs)]
     for _, table in tables(runs):
         print(table.markdown())
-    for path in write_report(runs, args.out):
+    from chaingeo.core.files import folder_locked
+
+    with folder_locked(args.out):  # a second writer of the same folder is refused
+        written = write_report(runs, args.out)
+    for path in written:
         print(f"wrote {path}")
     if args.html is not None:
         from chaingeo.evaluation.report.site import write_site

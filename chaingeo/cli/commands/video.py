@@ -1,5 +1,5 @@
 """``chain video LEVEL [--plan optimal|FILE] --out FILE.mp4|.gif``: a plan as continuous motion
-from one fixed camera (see :mod:`chaingeo.envs.worldmodel.video`)."""
+from one fixed camera (see :mod:`chaingeo.worldmodel.video`)."""
 
 from __future__ import annotations
 
@@ -37,8 +37,8 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
     from chaingeo.cli.level_arg import find_level
-    from chaingeo.envs.worldmodel.trajectory import write_trajectory
-    from chaingeo.envs.worldmodel.video import VideoError, plan_video, write_video
+    from chaingeo.worldmodel.trajectory import write_trajectory
+    from chaingeo.worldmodel.video import VideoError, plan_video, write_video
 
     if args.out.suffix.lower() not in (".mp4", ".gif"):
         raise CommandError(f"--out must end in .mp4 or .gif, got {str(args.out)!r}")
@@ -56,10 +56,7 @@ def run(args: argparse.Namespace) -> int:
         video = plan_video(level, text, args.size)
         if args.trajectory_out is not None:
             write_trajectory(level, text, args.trajectory_out)
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = args.out.with_name(f".{args.out.stem}.tmp{args.out.suffix}")
-        write_video(video, tmp)
-        tmp.replace(args.out)
+        write_video(video, args.out)
     except VideoError as e:
         raise CommandError(str(e)) from None
     seconds = time.perf_counter() - start

@@ -1,6 +1,6 @@
 """``chain worldmodel LEVEL --out DIR``: what a video model is given for a level (reference
 image and prompt) and the ground-truth video of its optimal plan (see
-:mod:`chaingeo.envs.worldmodel.prompt`)."""
+:mod:`chaingeo.worldmodel.prompt`)."""
 
 from __future__ import annotations
 
@@ -31,8 +31,8 @@ def register(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.errors import CommandError
     from chaingeo.cli.level_arg import find_level
-    from chaingeo.envs.worldmodel.prompt import write_worldmodel
-    from chaingeo.envs.worldmodel.video import VideoError, mp4_available
+    from chaingeo.worldmodel.prompt import write_worldmodel
+    from chaingeo.worldmodel.video import VideoError, mp4_available
 
     if args.size < 128 or args.size % 16:
         raise CommandError(f"--size must be a multiple of 16, at least 128; got {args.size}")

@@ -34,7 +34,7 @@ from chaingeo.core.formats.bt_model import (
     BurrToolsError,
     Cell,
 )
-from chaingeo.core.formats.xml_guard import doctype_problem
+from chaingeo.core.formats.xml_read import XmlRefused, parse_bounded, to_text
 from chaingeo.core.geometry import Shape
 
 
@@ -57,24 +57,35 @@ def _int(
     return out
 
 
-def _decompress(data: bytes, source: str) -> bytes:
-    if data[:2] != b"\x1f\x8b":
-        raw = data
-    else:
+def _gunzip(data: bytes, source: str) -> bytes:
+    """Every member of a gzip stream (BurrTools writes one; ``cat a.gz b.gz`` makes two, and
+    gzip reads them all), decompressed up to one byte past the XML limit."""
+    budget = limits.MAX_XMPUZZLE_XML_BYTES + 1
+    out: list[bytes] = []
+    rest = data
+    while rest[:2] == b"\x1f\x8b" and budget > 0:
         d = zlib.decompressobj(wbits=16 + zlib.MAX_WBITS)
         try:
-            raw = d.decompress(data, limits.MAX_XMPUZZLE_XML_BYTES + 1)
+            out.append(d.decompress(rest, budget))
         except zlib.error as e:
             raise BurrToolsError(source, "(file)", f"not a readable gzip stream: {e}") from None
-        if not d.eof and len(raw) <= limits.MAX_XMPUZZLE_XML_BYTES:
-            raise BurrToolsError(source, "(file)", "not a readable gzip stream: truncated")
+        budget -= len(out[-1])
+        if not d.eof:
+            if budget > 0:
+                raise BurrToolsError(source, "(file)", "not a readable gzip stream: truncated")
+            break
+        rest = d.unused_data
+    if rest.strip(b"\0") and budget > 0:
+        raise BurrToolsError(source, "(file)", "not a readable gzip stream: data after it")
+    return b"".join(out)
+
+
+def _decompress(data: bytes, source: str) -> bytes:
+    raw = _gunzip(data, source) if data[:2] == b"\x1f\x8b" else data
     if len(raw) > limits.MAX_XMPUZZLE_XML_BYTES:
         raise BurrToolsError(
             source, "(file)", f"more than {limits.MAX_XMPUZZLE_XML_BYTES} bytes of XML"
         )
-    problem = doctype_problem(raw)  # after decoding, in whatever encoding the XML declares
-    if problem is not None:
-        raise BurrToolsError(source, "(file)", problem)
     return raw
 
 
@@ -277,7 +288,7 @@ def _compact_xml(node: ET.Element) -> str:
             el.tail = None
     tail, node.tail = node.tail, None
     try:
-        return ET.tostring(node, encoding="unicode")
+        return to_text(node)  # no recursion: the depth is bounded, but so is the stack
     finally:
         node.tail = tail
 
@@ -294,15 +305,28 @@ def _parse_colors(src: str, root: ET.Element) -> tuple[RGB, ...]:
     return tuple(out)
 
 
+def _check_total_cells(source: str, voxels: list[ET.Element]) -> None:
+    """The grid cells of all shapes together, before any voxel string is read (each costs its
+    cells in Python work)."""
+    total = 0
+    for i, v in enumerate(voxels):
+        sizes = [_int(source, f"shapes[{i}].{k}", v.get(k), 0, limits.MAX_COORD) for k in "xyz"]
+        total += sizes[0] * sizes[1] * sizes[2]
+        if total > limits.MAX_BT_TOTAL_GRID_CELLS:
+            raise BurrToolsError(
+                source, "shapes", f"more than {limits.MAX_BT_TOTAL_GRID_CELLS} grid cells in all"
+            )
+
+
 def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
     """Decode the bytes of a ``.xmpuzzle`` file (gzip or plain XML)."""
     if len(data) > limits.MAX_FILE_BYTES:
         raise BurrToolsError(source, "(file)", f"more than {limits.MAX_FILE_BYTES} bytes")
     raw = _decompress(data, source)
-    try:
-        root = ET.fromstring(raw)
-    except ET.ParseError as e:
-        raise BurrToolsError(source, "(file)", f"invalid XML: {e}") from None
+    try:  # DOCTYPE refused, depth and element count bounded as the tree is built
+        root = parse_bounded(raw, limits.MAX_BT_XML_DEPTH, limits.MAX_BT_XML_ELEMENTS)
+    except XmlRefused as e:
+        raise BurrToolsError(source, "(file)", e.reason) from None
     if root.tag != "puzzle":
         raise BurrToolsError(source, "(file)", f"root element is <{root.tag}>, not <puzzle>")
     grid = root.find("gridType")
@@ -317,6 +341,7 @@ def parse_xmpuzzle(data: bytes, source: str = "<xmpuzzle>") -> BTPuzzle:
         raise BurrToolsError(
             source, "shapes", f"{len(voxels)} shapes; at most {limits.MAX_BT_SHAPES}"
         )
+    _check_total_cells(source, voxels)
     shapes = tuple(
         _parse_voxels(source, f"shapes[{i}]", v, len(colors)) for i, v in enumerate(voxels)
     )

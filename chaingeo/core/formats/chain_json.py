@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from chaingeo.core import canonical_json, limits
-from chaingeo.core.files import UnreadableFile, read_bounded
+from chaingeo.core.files import UnreadableFile, atomic_write, read_bounded
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.core.level import (
     Difficulty,
@@ -198,4 +198,4 @@ def read_chain_stacking(
 
 
 def write_chain_stacking(level: Level, path: str | os.PathLike[str]) -> None:
-    Path(path).write_text(canonical_json.dumps(export_chain_stacking(level)), encoding="utf-8")
+    atomic_write(path, canonical_json.dumps(export_chain_stacking(level)).encode("utf-8"))

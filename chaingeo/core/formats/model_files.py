@@ -38,7 +38,7 @@ from chaingeo.core.formats.mesh_lattice import (
     PartMesh,
     rpy_matrix,
 )
-from chaingeo.core.formats.xml_guard import doctype_problem
+from chaingeo.core.formats.xml_read import XmlRefused, parse_bounded
 from chaingeo.core.level_reader import short
 
 _VERTEX_RE: Final = re.compile(r"^[ \t]*v[ \t]([^\n]*)", re.MULTILINE)
@@ -130,14 +130,14 @@ def _materials(root: ET.Element, at: _Where) -> dict[str, tuple[float, float, fl
 
 
 @dataclass
-class _Budget:
+class _ReadBudget:
     """Vertices and triangles a part may still have (all its meshes together)."""
 
     vertices: int = limits.MAX_PART_VERTICES
     triangles: int = limits.MAX_PART_TRIANGLES
 
 
-def _check_obj_text(text: str, what: str, budget: _Budget, at: _Where) -> None:
+def _check_obj_text(text: str, what: str, budget: _ReadBudget, at: _Where) -> None:
     """Count vertices and triangles, check the vertices are finite numbers of magnitude at most
     :data:`limits.MAX_MODEL_NUMBER` and that every face corner names one, before trimesh parses
     anything (it would drop a non-finite vertex, and the faces on it, without a word)."""
@@ -172,7 +172,7 @@ def _check_obj_text(text: str, what: str, budget: _Budget, at: _Where) -> None:
                 )
 
 
-def _load_obj(path: Path, what: str, budget: _Budget, at: _Where) -> trimesh.Trimesh:
+def _load_obj(path: Path, what: str, budget: _ReadBudget, at: _Where) -> trimesh.Trimesh:
     """One OBJ file, bounded and checked (see the module doc), as a processed trimesh mesh."""
     data = _read_bounded(path, limits.MAX_MESH_BYTES, what, at)
     try:
@@ -199,13 +199,10 @@ def load_urdf_part(urdf: Path, model_dir: Path) -> PartMesh:
     at = _Where(str(model_dir), urdf_field)
     path = _inside(root_dir, urdf, "the URDF", at)
     data = _read_bounded(path, limits.MAX_URDF_BYTES, "the URDF", at)
-    problem = doctype_problem(data)
-    if problem is not None:
-        raise at.fail(problem)
-    try:
-        root = ET.fromstring(data)
-    except ET.ParseError as e:
-        raise at.fail(f"not readable XML: {e}") from None
+    try:  # the one bounded XML reader: no DOCTYPE, depth and elements bounded as it is built
+        root = parse_bounded(data, limits.MAX_BT_XML_DEPTH, limits.MAX_BT_XML_ELEMENTS)
+    except XmlRefused as e:
+        raise at.fail(e.reason) from None
     named = _materials(root, at)
     visuals = list(root.iter("visual"))
     if len(visuals) > limits.MAX_PART_MESHES:
@@ -216,7 +213,7 @@ def load_urdf_part(urdf: Path, model_dir: Path) -> PartMesh:
     rgba: tuple[float, float, float, float] | None = None
     material: str | None = None
     offset = 0
-    budget = _Budget()
+    budget = _ReadBudget()
     for i, vis in enumerate(visuals):
         at = _Where(str(model_dir), f"{urdf_field} visual[{i}]")
         origin = vis.find("origin")

@@ -5,8 +5,10 @@ Forgiving in syntax where that is unambiguous (case, spaces, commas, brackets, `
 meaning. Cells are read through :func:`chaingeo.envs.actions.types.cell_from_agent` (1-based text ->
 0-based code), the only place that converts.
 
-Two dialects: ours (``place red (1,1,1) ...``) and CHAIN's JSON tool calls
-(:mod:`chaingeo.envs.actions.chain_dialect`), chosen by whether the text is a JSON object. In both a
+Action syntaxes are plug-ins (:data:`SYNTAXES`, tried in order): CHAIN's JSON tool calls
+(:mod:`chaingeo.envs.actions.chain_dialect`, a JSON object) and turn words
+(:mod:`chaingeo.envs.actions.turn_text`); a text neither claims is read as ours
+(``place red (1,1,1) ...``). In both a
 stacking piece may be named by its colour or, on levels converted from CHAIN, by CHAIN's id
 (``place 2 (1,1,1) ...``); ``state`` shows every piece's cells.
 """
@@ -14,13 +16,15 @@ stacking piece may be named by its colour or, on levels converted from CHAIN, by
 from __future__ import annotations
 
 import re
-from collections.abc import Hashable, Iterable, Sequence
+from collections.abc import Callable, Hashable, Iterable, Sequence
+from dataclasses import dataclass
 from typing import Final, Protocol
 
 from chaingeo.core import limits
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.kinematics import Move
 from chaingeo.core.level import Level
+from chaingeo.core.registry import Registry
 from chaingeo.core.rules import Rejection, StackingRules
 from chaingeo.core.turns import TurnMove
 from chaingeo.envs.actions import chain_dialect
@@ -128,7 +132,27 @@ def _turn_text(text: str, normalised: str) -> TurnRequest:
         raise UnparseableActionError(text, f"{e.hint}") from None
 
 
-def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest | TurnRequest:
+#: What a syntax reads: an action, or a move whose distance or destination is left open.
+Parsed = Action | MoveRequest | TurnRequest
+
+
+@dataclass(frozen=True)
+class ActionSyntax:
+    """One way an agent may write an action (our words, CHAIN's JSON calls, turn words): whether
+    it claims a text (given the text and its body without ``<action>`` tags or a code fence)
+    and how it reads one. The first registered syntax that claims a text reads it; a text no
+    syntax claims is read as our words."""
+
+    name: str
+    claims: Callable[[str, str], bool]
+    read: Callable[[str, str], Parsed]
+
+
+#: Action syntaxes in the order they are tried; a name already taken is refused.
+SYNTAXES: Registry[ActionSyntax] = Registry("action syntax")
+
+
+def parse_text(text: str, family: str = "stacking") -> Parsed:
     """Parse agent text without a state: an action, or a move whose distance or (in assembly)
     destination is left open. :class:`UnparseableActionError` if it is not in the grammar.
 
@@ -143,35 +167,55 @@ def parse_text(text: str, family: str = "stacking") -> Action | MoveRequest | Tu
             f"{limits.MAX_TEXT_CHARS}; {hint_all}",
         )
     body = chain_dialect.unwrap(text)
-    if chain_dialect.is_tool_call(body):
-        return chain_dialect.parse_tool_call(text, body)
-    if is_turn_text(_normalise(text)):
-        return _turn_text(text, _normalise(text))
     try:
-        tokens = _tokenise(_normalise(body))
-        if not tokens:
-            raise _Unparseable("the text is empty")
-        if tokens[0] == ("word", "pick") and len(tokens) > 1 and tokens[1] == ("word", "up"):
-            tokens = [("word", "pickup"), *tokens[2:]]
-        if tokens[0][0] != "word" or tokens[0][1] not in _VERBS:
-            raise _Unparseable(f"unknown command {tokens[0][1]!r}")
-        verb = _VERBS[tokens[0][1]]
-        rest = tokens[1:]
-        if verb in ("finish", "state"):
-            if rest:
-                raise _Unparseable(f"'{verb}' takes nothing after it")
-            return FinishAction() if verb == "finish" else StateAction()
-        if verb == "pickup":
-            if len(rest) != 1 or rest[0][0] not in ("word", "num"):
-                raise _Unparseable("'pickup' takes exactly one colour name")
-            return PickupAction(rest[0][1])
-        if verb == "place":
-            return _parse_place(rest)
-        return _parse_move(rest)
+        for _, syntax in SYNTAXES.items():
+            if syntax.claims(text, body):
+                return syntax.read(text, body)
+        return _read_words(text, body)
     except _Unparseable as e:
         raise UnparseableActionError(text, f"{e.hint}; {hint_all}") from None
     except _Meaningless as e:
         raise IllegalActionError(e.reason, text=text) from None
+
+
+def _read_words(text: str, body: str) -> Parsed:
+    """Our words: ``place red (1,1,1) ...``, ``move red +x 2``, ``pickup red``, ``finish``."""
+    tokens = _tokenise(_normalise(body))
+    if not tokens:
+        raise _Unparseable("the text is empty")
+    if tokens[0] == ("word", "pick") and len(tokens) > 1 and tokens[1] == ("word", "up"):
+        tokens = [("word", "pickup"), *tokens[2:]]
+    if tokens[0][0] != "word" or tokens[0][1] not in _VERBS:
+        raise _Unparseable(f"unknown command {tokens[0][1]!r}")
+    verb = _VERBS[tokens[0][1]]
+    rest = tokens[1:]
+    if verb in ("finish", "state"):
+        if rest:
+            raise _Unparseable(f"'{verb}' takes nothing after it")
+        return FinishAction() if verb == "finish" else StateAction()
+    if verb == "pickup":
+        if len(rest) != 1 or rest[0][0] not in ("word", "num"):
+            raise _Unparseable("'pickup' takes exactly one colour name")
+        return PickupAction(rest[0][1])
+    if verb == "place":
+        return _parse_place(rest)
+    return _parse_move(rest)
+
+
+SYNTAXES.register(
+    "chain",
+    ActionSyntax(
+        "chain",
+        lambda t, b: chain_dialect.is_tool_call(b),
+        lambda t, b: chain_dialect.parse_tool_call(t, b),
+    ),
+)
+SYNTAXES.register(
+    "turn",
+    ActionSyntax(
+        "turn", lambda t, b: is_turn_text(_normalise(t)), lambda t, b: _turn_text(t, _normalise(t))
+    ),
+)
 
 
 def _leading_id(rest: Sequence[Token]) -> bool:

@@ -22,10 +22,10 @@ from typing import Protocol, overload
 
 import numpy as np
 
-from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import DIRECTIONS, Move
 from chaingeo.core.limits import MAX_PIECES
 from chaingeo.envs.actions.types import MoveAction
+from chaingeo.kernels.jit import njit
 
 _DIRS = tuple(DIRECTIONS)
 #: the rank of each direction index's text (the actions sort directions as text)

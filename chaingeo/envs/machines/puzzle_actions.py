@@ -28,7 +28,6 @@ from collections.abc import Mapping
 import numpy as np
 
 from chaingeo.core.geometry import Cell
-from chaingeo.core.jit import njit
 from chaingeo.core.kinematics import (
     DIRECTIONS,
     OPPOSITE,
@@ -44,6 +43,7 @@ from chaingeo.core.turns import AXES, TurnMove
 from chaingeo.envs.actions.lists import ActionList
 from chaingeo.envs.actions.types import Action, FinishAction, MoveAction, TurnAction
 from chaingeo.envs.machines.move_table import LazyBlock, MoveRange, MoveTable
+from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion.disassemble import move_rows
 from chaingeo.solvers.motion.partsearch import PieceTable
 from chaingeo.solvers.motion.turnmoves import TurnTable

@@ -61,7 +61,7 @@ class StepResult:
 
 
 @dataclass(frozen=True)
-class Turn:
+class LoggedTurn:
     """One entry of the turn log: the step number (1-based), what the agent wrote, the reply."""
 
     step: int
@@ -83,7 +83,7 @@ class GameState(Protocol):
     @property
     def finished(self) -> bool: ...
     @property
-    def history(self) -> list[Turn]: ...
+    def history(self) -> list[LoggedTurn]: ...
     def legal_actions(self) -> Sequence[Action]: ...
     def resolve(self, action: Action | MoveRequest | TurnRequest) -> Action: ...
     def problem(self, action: Action) -> str | None: ...
@@ -113,7 +113,7 @@ class BaseState(ABC):
         self._steps_used = 0
         self._finished = False
         self._stack: list[tuple[Action, Any, bool]] = []  # action, position, finished before
-        self._history: list[Turn] = []
+        self._history: list[LoggedTurn] = []
 
     # -- family hooks -------------------------------------------------------------------------
     @property
@@ -177,7 +177,7 @@ class BaseState(ABC):
         return self._finished
 
     @property
-    def history(self) -> list[Turn]:
+    def history(self) -> list[LoggedTurn]:
         return self._history
 
     def is_truncated(self) -> bool:
@@ -249,7 +249,7 @@ class BaseState(ABC):
             self.push(action)
         except ActionError as e:
             self._steps_used += 1
-            self._history.append(Turn(self._steps_used, text, e.feedback, False))
+            self._history.append(LoggedTurn(self._steps_used, text, e.feedback, False))
             return StepResult(
                 None, False, e.kind, e.feedback, self.is_success(), self.is_truncated(), e.code
             )
@@ -259,5 +259,5 @@ class BaseState(ABC):
             feedback = self.describe(action)
             if self.is_success():
                 feedback += " Solved!"
-        self._history.append(Turn(self._steps_used, text, feedback, True))
+        self._history.append(LoggedTurn(self._steps_used, text, feedback, True))
         return StepResult(action, True, None, feedback, self.is_success(), self.is_truncated())

@@ -35,20 +35,18 @@ import json
 from collections.abc import Mapping, Sequence
 from typing import Any, Final
 
-from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.base import Agent, AgentError, Reply, ToolCall, Turn
+from chaingeo.evaluation.agents.dialects import read_reply, wire_tool_calls
 from chaingeo.evaluation.agents.http import ChatClient, RequestRejected, ServerSettings
 from chaingeo.evaluation.agents.prompt import (
     ONESHOT_PROMPT,
     ONESHOT_TOOLS_PROMPT,
     SYSTEM_PROMPT,
     TOOLS_PROMPT,
-    extract_action,
-    extract_plan,
     user_content,
 )
-from chaingeo.evaluation.agents.tools import skipped_result, tool_specs, translate
+from chaingeo.evaluation.agents.tools import skipped_result, tool_specs
 from chaingeo.evaluation.usage import Usage
 
 TOOL_SETTINGS: Final = ("auto", "on", "off")
@@ -212,7 +210,8 @@ class OpenAIAgent(Agent):
         message = answer["choices"][0]["message"]
         text = _content_text(message.get("content"))
         reasoning = message.get("reasoning_content") or message.get("reasoning")
-        calls = _tool_calls(message.get("tool_calls"), tools, turn) if self._native else ()
+        prefix = f"call_{turn.index}_{turn.candidate}"
+        calls = wire_tool_calls(message.get("tool_calls"), tools, prefix) if self._native else ()
         usage = Usage.from_openai(answer.get("usage"))
         return text, reasoning if isinstance(reasoning, str) else None, calls, usage
 
@@ -220,23 +219,18 @@ class OpenAIAgent(Agent):
 
     def act(self, turn: Turn) -> Reply:
         answer = self._complete(turn, (SYSTEM_PROMPT, TOOLS_PROMPT), self._act_tools)
-        text, reasoning, calls, usage = self._read(answer, turn, self._act_tools)
-        if calls:
-            actions = tuple(c.action for c in calls)
-            return Reply(text, actions[0], usage, actions=actions, reasoning=reasoning, calls=calls)
-        action, note = extract_action(text)
-        if action is None and self._native and note and note.startswith("no <action>"):
-            note = "your reply called no tool and had no <action>...</action>"
-        return Reply(text, action, usage, note=note, reasoning=reasoning)
+        return self._reply(answer, turn, self._act_tools, oneshot=False)
 
     def plan(self, turn: Turn) -> Reply:
         answer = self._complete(turn, (ONESHOT_PROMPT, ONESHOT_TOOLS_PROMPT), self._plan_tools)
-        text, reasoning, calls, usage = self._read(answer, turn, self._plan_tools)
-        if calls:
-            actions = tuple(c.action for c in calls)
-            return Reply(text, None, usage, actions=actions, reasoning=reasoning, calls=calls)
-        actions, note = extract_plan(text)
-        return Reply(text, None, usage, actions=actions, note=note, reasoning=reasoning)
+        return self._reply(answer, turn, self._plan_tools, oneshot=True)
+
+    def _reply(
+        self, answer: Mapping[str, Any], turn: Turn, tools: Sequence[dict[str, Any]], oneshot: bool
+    ) -> Reply:
+        text, reasoning, calls, usage = self._read(answer, turn, tools)
+        dialect = "tools" if self._native else "text"
+        return read_reply(dialect, text, calls, oneshot=oneshot, usage=usage, reasoning=reasoning)
 
 
 def _content_text(content: Any) -> str:
@@ -249,32 +243,6 @@ def _content_text(content: Any) -> str:
             if isinstance(p, dict) and p.get("type") == "text"
         )
     return ""
-
-
-def _tool_calls(raw: Any, tools: Sequence[dict[str, Any]], turn: Turn) -> tuple[ToolCall, ...]:
-    """The calls of an assistant message, each translated (a call without an id gets one); at
-    most :data:`~chaingeo.core.limits.MAX_TOOL_CALLS`, the rest dropped unplayed."""
-    if not isinstance(raw, list):
-        return ()
-    out: list[ToolCall] = []
-    for i, call in enumerate(raw[: limits.MAX_TOOL_CALLS]):
-        call = call if isinstance(call, dict) else {}
-        fn = call.get("function")
-        fn = fn if isinstance(fn, dict) else {}
-        name, args = fn.get("name"), fn.get("arguments")
-        cid = call.get("id")
-        if not isinstance(cid, str) or not cid:
-            cid = f"call_{turn.index}_{turn.candidate}_{i}"
-        if isinstance(args, str):
-            shown = args
-        else:
-            try:
-                shown = json.dumps(args if args is not None else {})
-            except (TypeError, ValueError):
-                shown = "{}"
-        action = translate(name, args, tools).action
-        out.append(ToolCall(cid, name if isinstance(name, str) else str(name), shown, action))
-    return tuple(out)
 
 
 def _assistant_message(reply: Reply) -> dict[str, Any]:

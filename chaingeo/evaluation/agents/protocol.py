@@ -30,13 +30,13 @@ class ProtocolError(AgentError):
     """The server's answer broke the chat-completions protocol (shape, types, bounds)."""
 
 
-class _TooLong(ChainGeoError, ValueError):
+class _ReplyTooLong(ChainGeoError, ValueError):
     pass
 
 
 def _int(literal: str) -> int:
     if len(literal.lstrip("-")) > limits.MAX_ANSWER_INT_DIGITS:
-        raise _TooLong(literal)
+        raise _ReplyTooLong(literal)
     return int(literal)
 
 
@@ -65,7 +65,7 @@ def parse_answer(raw: bytes) -> Any:
         raise ProtocolError(f"the answer is JSON nested {depth} deep")
     try:
         return json.loads(text, parse_int=_int, parse_constant=_constant)
-    except _TooLong as e:
+    except _ReplyTooLong as e:
         raise ProtocolError(
             f"the answer holds a number of {len(str(e))} digits; at most"
             f" {limits.MAX_ANSWER_INT_DIGITS}"

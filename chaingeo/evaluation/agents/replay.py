@@ -8,11 +8,12 @@ level and sample, the action text of every step in order. When a plan runs out t
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from chaingeo.core import limits
+from chaingeo.core.files import UnreadableFile, read_json
 from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.base import Agent, Reply, Turn
 from chaingeo.evaluation.logs import EPISODES, RunLog
@@ -31,10 +32,10 @@ def load_plans(source: str | Path) -> dict[tuple[str, int | None], tuple[str, ..
                 str(s.get("sent", "")) for s in steps
             )
         return plans
-    try:
-        data = json.loads(path.read_text("utf-8"))
-    except (OSError, json.JSONDecodeError) as e:
-        raise ValueError(f"{path}: cannot read replay file: {e}") from None
+    try:  # the one bounded JSON reader
+        data = read_json(path, limits.MAX_FILE_BYTES)
+    except UnreadableFile as e:
+        raise ValueError(f"{path}: cannot read replay file: {e.reason}") from None
     if not isinstance(data, dict) or not all(
         isinstance(v, list) and all(isinstance(a, str) for a in v) for v in data.values()
     ):

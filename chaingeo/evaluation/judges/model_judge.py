@@ -17,7 +17,7 @@ from typing import Any, Final
 from chaingeo.evaluation.agents.base import ObservationLike, StateLike
 from chaingeo.evaluation.agents.http import ChatClient, ServerSettings
 from chaingeo.evaluation.agents.prompt import user_content
-from chaingeo.evaluation.judges.selection import Candidate, FirstLegal, Judge
+from chaingeo.evaluation.judges.selection import CheckedReply, Judge, Preference
 from chaingeo.evaluation.usage import Usage
 
 JUDGE_PROMPT: Final = (
@@ -45,21 +45,27 @@ class ModelJudge(Judge):
     def start(self, seed: int) -> None:
         self._client = self.server.client(seed + 1)
 
-    def rank(
+    def preference(
         self,
         state: StateLike,
-        candidates: Sequence[Candidate],
+        candidates: Sequence[CheckedReply],
         observation: ObservationLike | None = None,
-    ) -> list[int]:
-        order = FirstLegal().rank(state, candidates)
-        offered: list[Candidate] = []
+    ) -> Preference:
+        """The candidate the model picks first (when it picks one of two or more distinct
+        legal actions); the rest in sampling order."""
+        offered: list[CheckedReply] = []
         seen: set[str] = set()
-        for c in (candidates[i] for i in order):
+        for c in sorted(candidates, key=lambda c: (not c.legal, c.index)):
             if c.legal and c.reply.action is not None and c.reply.action not in seen:
                 seen.add(c.reply.action)
                 offered.append(c)
         if len(offered) < 2 or observation is None:
-            return order
+            return lambda c: ()
+        best = self._ask(offered, observation)
+        return lambda c: (int(c.index != best),)
+
+    def _ask(self, offered: Sequence[CheckedReply], observation: ObservationLike) -> int | None:
+        """The index of the candidate the model chooses, None when its answer names none."""
         if self._client is None:
             self.start(0)
         assert self._client is not None
@@ -83,6 +89,5 @@ class ModelJudge(Judge):
         self.replies.append(text)
         found = _CHOICE_RE.findall(text)
         if not found or not 1 <= int(found[-1]) <= len(offered):
-            return order
-        best = offered[int(found[-1]) - 1].index
-        return [best, *(i for i in order if i != best)]
+            return None
+        return offered[int(found[-1]) - 1].index

@@ -9,13 +9,13 @@ from typing import Any
 
 from chaingeo.core.registry import Registry
 from chaingeo.evaluation.judges.model_judge import ModelJudge
-from chaingeo.evaluation.judges.selection import FirstLegal, Judge, Progress, Vote
+from chaingeo.evaluation.judges.selection import FirstLegal, Judge, ProgressJudge, Vote
 
 #: Judge factories by name (taking the judge options); a taken name is refused.
 JUDGES: Registry[Callable[[Mapping[str, Any]], Judge]] = Registry("judge")
 JUDGES.register("first", lambda options: FirstLegal())
 JUDGES.register("vote", lambda options: Vote())
-JUDGES.register("progress", lambda options: Progress())
+JUDGES.register("progress", lambda options: ProgressJudge())
 JUDGES.register("model", ModelJudge)
 
 

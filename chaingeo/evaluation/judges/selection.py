@@ -19,7 +19,7 @@ reward model, ...) is registered. A judge that calls a model adds what it spent 
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from chaingeo.evaluation.agents.base import ObservationLike, Reply, StateLike, StepResultLike
@@ -27,7 +27,7 @@ from chaingeo.evaluation.usage import Usage
 
 
 @dataclass(frozen=True)
-class Candidate:
+class CheckedReply:
     index: int
     reply: Reply
     result: StepResultLike | None  # the verifier's verdict in a clone (None: nothing to try)
@@ -36,6 +36,10 @@ class Candidate:
     @property
     def legal(self) -> bool:
         return self.result is not None and self.result.legal
+
+
+#: Orders legal candidates: the key of each (smaller first).
+Preference = Callable[[CheckedReply], tuple[int, ...]]
 
 
 class Judge:
@@ -49,68 +53,68 @@ class Judge:
     def rank(
         self,
         state: StateLike,
-        candidates: Sequence[Candidate],
+        candidates: Sequence[CheckedReply],
         observation: ObservationLike | None = None,
     ) -> list[int]:
-        """Candidate indices, best first (every index exactly once)."""
-        raise NotImplementedError
+        """Candidate indices, best first (every index exactly once): verified-legal ones
+        first, then by :meth:`preference`, then in sampling order."""
+        prefer = self.preference(state, candidates, observation)
+        return [
+            c.index for c in sorted(candidates, key=lambda c: (not c.legal, prefer(c), c.index))
+        ]
+
+    def preference(
+        self,
+        state: StateLike,
+        candidates: Sequence[CheckedReply],
+        observation: ObservationLike | None = None,
+    ) -> Preference:
+        """How this judge orders legal candidates (smaller first); none by default."""
+        return lambda c: ()
 
 
 class FirstLegal(Judge):
     name = "first"
 
-    def rank(
-        self,
-        state: StateLike,
-        candidates: Sequence[Candidate],
-        observation: ObservationLike | None = None,
-    ) -> list[int]:
-        return [c.index for c in sorted(candidates, key=lambda c: (not c.legal, c.index))]
-
 
 class Vote(Judge):
     name = "vote"
 
-    def rank(
+    def preference(
         self,
         state: StateLike,
-        candidates: Sequence[Candidate],
+        candidates: Sequence[CheckedReply],
         observation: ObservationLike | None = None,
-    ) -> list[int]:
+    ) -> Preference:
         votes = Counter(c.result.action.to_text() for c in candidates if c.legal and c.result)
-
-        def key(c: Candidate) -> tuple[bool, int, int]:
-            n = votes[c.result.action.to_text()] if c.legal and c.result else 0
-            return (not c.legal, -n, c.index)
-
-        return [c.index for c in sorted(candidates, key=key)]
+        return lambda c: (-votes[c.result.action.to_text()] if c.legal and c.result else 0,)
 
 
-class Progress(Judge):
+class ProgressJudge(Judge):
     name = "progress"
 
-    def rank(
+    def preference(
         self,
         state: StateLike,
-        candidates: Sequence[Candidate],
+        candidates: Sequence[CheckedReply],
         observation: ObservationLike | None = None,
-    ) -> list[int]:
-        def key(c: Candidate) -> tuple[bool, bool, int, int]:
+    ) -> Preference:
+        def key(c: CheckedReply) -> tuple[int, ...]:
             if c.after is None:
-                return (True, True, 0, c.index)
-            return (False, not c.after.is_success(), -len(c.after.legal_actions()), c.index)
+                return ()
+            return (int(not c.after.is_success()), -len(c.after.legal_actions()))
 
-        return [c.index for c in sorted(candidates, key=key)]
+        return key
 
 
-def verify(state: StateLike, replies: Sequence[Reply]) -> list[Candidate]:
+def verify(state: StateLike, replies: Sequence[Reply]) -> list[CheckedReply]:
     """Try each reply's action in its own clone of ``state``."""
     out = []
     for i, reply in enumerate(replies):
         if reply.action is None:
-            out.append(Candidate(i, reply, None, None))
+            out.append(CheckedReply(i, reply, None, None))
             continue
         probe = state.clone()
         result = probe.step_text(reply.action)
-        out.append(Candidate(i, reply, result, probe if result.legal else None))
+        out.append(CheckedReply(i, reply, result, probe if result.legal else None))
     return out

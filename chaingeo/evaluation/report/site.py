@@ -33,8 +33,10 @@ Why it looks the way it does:
 from __future__ import annotations
 
 import hashlib
+import os
 import re
 import shutil
+import tempfile
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from html import escape
@@ -42,8 +44,10 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Final
 
+from chaingeo.core import limits
+from chaingeo.core.files import UnreadableFile, atomic_write, folder_locked, read_bounded
 from chaingeo.evaluation.logs import IMAGES, RunError, RunLog
-from chaingeo.evaluation.report.tables import Run, Table, tables, write_report
+from chaingeo.evaluation.report.tables import Run, Table, sort_value, tables, write_report
 from chaingeo.evaluation.usage import PriceTable, Usage
 
 MARKER: Final = ".chain-site"
@@ -60,7 +64,7 @@ _VIEW_ORDER = ("front", "side", "top", "iso", "tray", "target")
 
 
 @dataclass(frozen=True)
-class Episode:
+class EpisodePage:
     """One episode record of one run, and where its page goes."""
 
     run: Run
@@ -81,18 +85,17 @@ def write_site(runs: Sequence[Run], out_dir: str | Path, prices: PriceTable | No
         raise RunError(f"{out}: not a folder")
     if out.exists() and not (out / MARKER).exists() and any(out.iterdir()):
         raise RunError(f"{out}: exists and was not written by `chain report --html`; pick another")
-    build = out.parent / f".{out.name}.building"
-    if build.exists():
-        shutil.rmtree(build)
-    build.mkdir(parents=True)
-    try:
-        _Builder(runs, build, prices or PriceTable.load()).build()
-        if out.exists():
-            shutil.rmtree(out)
-        build.rename(out)
-    finally:
-        if build.exists():
-            shutil.rmtree(build)
+    with folder_locked(out):  # a second writer is refused, not raced
+        build = Path(tempfile.mkdtemp(prefix=f".{out.name}.building.", dir=out.parent))
+        try:
+            build.chmod(0o755)
+            _Builder(runs, build, prices or PriceTable.load()).build()
+            if out.exists():
+                shutil.rmtree(out)
+            build.rename(out)
+        finally:
+            if build.exists():
+                shutil.rmtree(build)
     return out
 
 
@@ -100,7 +103,7 @@ class _Builder:
     def __init__(self, runs: Sequence[Run], root: Path, prices: PriceTable) -> None:
         self.runs, self.root, self.prices = list(runs), root, prices
         self.run_slugs = _unique([_slug(r.path.name) for r in runs])
-        self.episodes: list[Episode] = []
+        self.episodes: list[EpisodePage] = []
         for i, run in enumerate(self.runs):
             records = sorted(
                 RunLog(run.path).latest().values(),
@@ -111,7 +114,7 @@ class _Builder:
             )
             for rec, page in zip(records, pages, strict=True):
                 self.episodes.append(
-                    Episode(run, i, rec, f"episodes/{self.run_slugs[i]}/{page}.html")
+                    EpisodePage(run, i, rec, f"episodes/{self.run_slugs[i]}/{page}.html")
                 )
         level_ids = sorted({str(e.record.get("level_id")) for e in self.episodes})
         level_slugs = _unique([_slug(i) for i in level_ids])
@@ -125,7 +128,7 @@ class _Builder:
     def write(self, rel: str, text: str) -> None:
         path = self.root / rel
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(text.encode("utf-8"))
+        atomic_write(path, text.encode("utf-8"))
 
     def build(self) -> None:
         (self.root / MARKER).write_bytes(b"written by chain report --html\n")
@@ -145,13 +148,17 @@ class _Builder:
         name = str(name)
         if name not in self.copied:
             source = run.path / IMAGES / name
-            if not (_IMAGE_NAME.fullmatch(name) and source.is_file()):
+            inside = os.path.realpath(run.path) + os.sep + IMAGES + os.sep + name
+            if not (_IMAGE_NAME.fullmatch(name) and os.path.realpath(source) == inside):
                 return f'<p class="muted">picture missing: {escape(name)}</p>'
-            data = source.read_bytes()
+            try:  # a regular file of the run itself (no link out of it), bounded
+                data = read_bounded(source, limits.MAX_RUN_IMAGE_BYTES)
+            except UnreadableFile:
+                return f'<p class="muted">picture missing: {escape(name)}</p>'
             if hashlib.sha256(data).hexdigest() + ".png" != name:
                 return f'<p class="muted">picture altered: {escape(name)}</p>'
             (self.root / "images").mkdir(exist_ok=True)
-            (self.root / "images" / name).write_bytes(data)
+            atomic_write(self.root / "images" / name, data)
             self.copied.add(name)
         return f'<img src="{up}images/{name}" alt="{escape(alt)}" loading="lazy">'
 
@@ -172,6 +179,8 @@ class _Builder:
         )
         for name, table in tables(self.runs):
             parts.append(f"<h2>{escape(table.title)}</h2>")
+            if table.caption:
+                parts.append(f'<p class="note">Uncertainty: {escape(table.caption)}.</p>')
             parts.append(_report_table(name, table))
         parts.append("<h2>Cost versus success</h2>")
         parts.append(
@@ -184,7 +193,7 @@ class _Builder:
 
     def level_matrix(self) -> str:
         """Rows: levels; columns: runs; a cell: solved samples of the run on that level."""
-        by_cell: dict[tuple[str, int], list[Episode]] = {}
+        by_cell: dict[tuple[str, int], list[EpisodePage]] = {}
         facts: dict[str, dict[str, Any]] = {}
         for ep in self.episodes:
             level_id = str(ep.record.get("level_id"))
@@ -251,7 +260,7 @@ class _Builder:
         parts.append(_sortable("episodes", head, rows))
         return _page(level_id, "\n".join(parts), up="../")
 
-    def episode_page(self, ep: Episode) -> str:
+    def episode_page(self, ep: EpisodePage) -> str:
         r, up = ep.record, "../../"
         level_id = str(r.get("level_id"))
         text, cls = _result(r)
@@ -333,7 +342,7 @@ class _Builder:
             return None
         return costs
 
-    def frames(self, ep: Episode, up: str) -> list[str]:
+    def frames(self, ep: EpisodePage, up: str) -> list[str]:
         r = ep.record
         costs = self.turn_costs(r)
         out: list[str] = []
@@ -453,11 +462,11 @@ def _sortable(table_id: str, head: Sequence[tuple[str, bool]], rows: Iterable[li
 def _report_table(name: str, table: Table) -> str:
     """A report table with its own formatters for the text and the raw values for sorting."""
     numeric = [
-        all(isinstance(row[j], int | float) or row[j] is None for row in table.rows) and j > 0
+        all(isinstance(sort_value(row[j]), int | float | None) for row in table.rows) and j > 0
         for j in range(len(table.columns))
     ]
     rows = [
-        [_Cell(fmt(v), _sort_key(v)) for fmt, v in zip(table.formats, row, strict=True)]
+        [_Cell(fmt(v), _sort_key(sort_value(v))) for fmt, v in zip(table.formats, row, strict=True)]
         for row in table.rows
     ]
     return _sortable(name, list(zip(table.columns, numeric, strict=True)), rows)
@@ -560,7 +569,7 @@ def _result(r: Mapping[str, Any]) -> tuple[str, str]:
     return ("out of steps" if r.get("truncated") else "unsolved"), "unsolved"
 
 
-def _errored(eps: Sequence[Episode]) -> bool:
+def _errored(eps: Sequence[EpisodePage]) -> bool:
     return any(e.record.get("status") == "error" for e in eps)
 
 

@@ -2,10 +2,12 @@
 ``vf-eval`` and training with prime-rl.
 
 ``load_environment(family=..., difficulty=..., split=..., images=True, protocol=..., reward=...)``
-returns the environment. verifiers' command line finds a taskset by the top-level module its id
-names: the plugin module ``chaingeo_env`` (a distribution of its own, ``plugin/`` beside this
-file, so chaingeo's wheel stays one package) exports the same taskset, environment and harness
-under the id ``chaingeo-env`` (``vf-eval chaingeo-env --env.taskset.family puzzle``).
+returns the environment; it needs nothing but this package (the id ``chaingeo-env`` resolves in
+this process, :func:`~chaingeo.integrations.verifiers.plugin_module.install_alias`).
+verifiers' command line finds a taskset by the top-level module its id names: the plugin
+``chaingeo_env`` (a one-file distribution shipped inside this package, so chaingeo's wheel stays
+one top-level package) is installed by ``python -m chaingeo.integrations.verifiers install``,
+then ``vf-eval chaingeo-env --env.taskset.family puzzle`` works.
 Rewards, summing to 1 for an optimal, well-formed episode: ``success`` (0.5), ``efficiency``
 (0.4; ``1 - NormDist`` when solved) and ``format`` (0.1; the share of readable actions).
 """
@@ -25,6 +27,7 @@ from chaingeo.integrations.verifiers.environment import (
     load_environment,
 )
 from chaingeo.integrations.verifiers.harness import ChainGeoHarness, ChainGeoHarnessConfig
+from chaingeo.integrations.verifiers.plugin_module import install_alias
 from chaingeo.integrations.verifiers.taskset import (
     TASKSET_ID,
     ChainGeoConfig,
@@ -32,6 +35,8 @@ from chaingeo.integrations.verifiers.taskset import (
     ChainGeoTask,
     ChainGeoTaskset,
 )
+
+install_alias()
 
 __all__ = [
     "TASKSET_ID",

@@ -3,7 +3,7 @@
 A task is one level (its file, family, difficulty, optimal plan length) and how it is played
 (protocol, images). It carries no prompt: the environment (``ChainGeoEnv``) opens each episode
 with the level's first observation, rendered when the episode starts. The rewards read the
-episode's :class:`~chaingeo.integrations.game.Outcome`, which the environment leaves on the
+episode's :class:`~chaingeo.evaluation.episode.Outcome`, which the environment leaves on the
 trace (``trace.info["chaingeo"]``); their weights are the task config's, so
 ``--env.taskset.task.rewards.efficiency.weight 0`` (or ``load_environment(reward=...)``) changes
 them without code.
@@ -20,10 +20,10 @@ from pydantic import Field
 
 from chaingeo.core.level import Level, LevelError, load_level
 from chaingeo.core.suite import FAMILIES, suite_folder
+from chaingeo.evaluation.episode import Outcome
 from chaingeo.integrations.game import (
     DEFAULT_WEIGHTS,
     Game,
-    Outcome,
     efficiency_reward,
     format_reward,
     offered_tools,

@@ -232,3 +232,23 @@ def test_ambiguous_lists_candidates() -> None:
 def test_bad_json_is_a_typed_error(obj: object) -> None:
     with pytest.raises(ActionFormatError):
         action_from_json(obj)
+
+
+def test_an_action_syntax_is_a_plug_in_and_a_name_is_taken_once() -> None:
+    """A registered syntax reads the texts it claims; the built-in names are refused again."""
+    from chaingeo.core.registry import DuplicateNameError
+    from chaingeo.envs.actions.parse import SYNTAXES, ActionSyntax, parse_text
+
+    def claims(text: str, body: str) -> bool:
+        return body.strip().lower() == "surrender"
+
+    done = ActionSyntax("surrender-word", claims, lambda text, body: FinishAction())
+    with pytest.raises(UnparseableActionError):
+        parse_text("surrender")
+    with SYNTAXES.registered("surrender-word", done):
+        assert parse_text("<action>Surrender</action>") == FinishAction()
+    with pytest.raises(UnparseableActionError):
+        parse_text("surrender")
+    for name in ("chain", "turn"):
+        with pytest.raises(DuplicateNameError):
+            SYNTAXES.register(name, done)

@@ -20,7 +20,7 @@ from chaingeo.core.level import load_level
 from chaingeo.core.turns import AXES, TurnMove, square_hit, swept_squares
 from chaingeo.envs.machines import puzzle_actions
 from chaingeo.evaluation.agents.base import AgentSpec
-from chaingeo.evaluation.episode import EpisodeTask, run_episode
+from chaingeo.evaluation.play import EpisodeTask, run_episode
 from chaingeo.solvers.motion import sweep
 from chaingeo.solvers.motion.turnmoves import TurnTable
 from chaingeo.solvers.motion.turnsearch import fast_legal_turns, turn_problem, turn_rows

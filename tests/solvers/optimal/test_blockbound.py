@@ -14,7 +14,7 @@ from chaingeo.core.level import Level, PuzzleSolution
 from chaingeo.envs.machines import new_state
 from chaingeo.generator.config import PuzzleConfig
 from chaingeo.generator.puzzle import make
-from chaingeo.generator.result import Rejection
+from chaingeo.generator.result import GenerationRejection
 from chaingeo.solvers.motion.disassemble import analyze_assembly
 from chaingeo.solvers.optimal.blockbound import analyze_by_blocks, block_lower_bound
 
@@ -66,7 +66,7 @@ def test_block_bound_refuses_group_moves_and_bad_partitions() -> None:
 def _tower(goal: str) -> Level:
     config = PuzzleConfig(shape="burr12", hill_steps=0, max_group=1)
     item = make(dataclasses.replace(config, goal=goal), 5, 1)  # type: ignore[arg-type]
-    assert not isinstance(item, Rejection), item.reason
+    assert not isinstance(item, GenerationRejection), item.reason
     return item
 
 

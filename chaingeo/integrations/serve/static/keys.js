@@ -1,0 +1,20 @@
+// Which key sends which action: the page shows this table, and player.js follows it.
+export const KEYS = [
+  ["click", "select a piece (shift+click: add or remove it; double-click: its whole part)"],
+  ["] / [", "move the cursor to the next / previous piece (dashed in the list and the labels)"],
+  ["space", "select or unselect the cursor's piece (escape: unselect all)"],
+  ["g", "select the cursor piece's whole part (puzzles)"],
+  ["d / a", "+x / -x: move the selection (puzzles) or the ghost (stacking)"],
+  ["w / s", "+y / -y"],
+  ["e / q", "+z / -z"],
+  ["1-9, 0", "the distance of the next move; 0 = to infinity (out of the puzzle)"],
+  ["x / y / z", "the axis of turns"],
+  ["r / f", "turn +90 / -90 about that axis (puzzles whose rules allow turns; stacking: turn the ghost)"],
+  ["n / b", "stacking: the ghost to the next / previous legal placement"],
+  ["enter", "stacking: place the piece where the ghost is"],
+  ["p", "stacking: pick the selected piece up"],
+  ["shift+f", "finish (end the episode)"],
+  ["u", "undo (free play only)"],
+  ["v", "switch the 3D view and the agent's view (pictures and text)"],
+  ["arrows, + / -", "orbit and zoom the camera (mouse: drag, wheel, right-drag to pan)"],
+];

@@ -1,0 +1,437 @@
+"""Pieces tracked over a video's frames, and the changes no rigid piece can make.
+
+Per frame, each colour class's components are grouped into objects: two components of one
+colour are one piece seen round an occluder when the straight gap between their nearest points
+is mostly covered by other pieces (a beam behind a crossing beam shows as two parts); a gap of
+background between them is a break. Objects are compared frame to frame by the overlap of
+their (slightly grown) masks.
+
+Temporal smoothing: a class's object count is median-filtered over :data:`WINDOW` frames, so a
+single noisy frame changes nothing; an identity change must persist for :data:`PERSIST` frames.
+A piece that enters or leaves through the picture's border is not a violation (our own videos
+carry removed pieces out of the picture), and a piece that disappears behind another, which
+keeps its area, is reported as undecided rather than lost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Final
+
+import numpy as np
+import numpy.typing as npt
+
+from chaingeo.kernels.jit import njit
+from chaingeo.worldmodel.judge_segment import BoolArray, FloatArray, close, components, dilate
+
+#: Frames of the median filter over object counts (odd), and frames an identity change must
+#: hold.
+WINDOW: Final = 5
+PERSIST: Final = 3
+#: Share of the gap between two same-coloured parts that other pieces must cover for the parts
+#: to count as one occluded piece.
+OCCLUDED_GAP: Final = 0.6
+#: Furthest move (share of the frame's longer side) of a piece between two frames.
+FAST_SHARE: Final = 0.25
+#: Pixels from the picture's edge within which a part touches the border.
+BORDER: Final = 3
+#: Growth (share of the frame's longer side) of a mask when matching across one frame.
+MOTION_SHARE: Final = 0.03
+
+
+@dataclass(frozen=True)
+class Obj:
+    """One piece as seen in one frame: its colour class (0-based), pixels and parts."""
+
+    cls: int
+    mask: BoolArray
+    parts: int
+
+    @property
+    def area(self) -> int:
+        return int(self.mask.sum())
+
+    def touches_border(self) -> bool:
+        """Within BORDER pixels of the picture's edge (cleaning may eat the outer column)."""
+        m, b = self.mask, BORDER
+        return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
+
+
+@dataclass(frozen=True)
+class Event:
+    """A change between frames ``frame - 1`` and ``frame``: a violation kind (lost, added,
+    split, merge, recolor), or a note (entered, left, hidden)."""
+
+    kind: str
+    frame: int
+    piece: str
+    other: str | None = None
+    detail: str = ""
+    masks: tuple[BoolArray, ...] = field(default=(), compare=False, repr=False)
+    #: How many of ``masks`` (the first ones) are seen in frame ``frame - 1``; the rest in
+    #: ``frame``.
+    before: int = 1
+
+
+VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "pass_through")
+
+
+def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
+    edge = mask & ~(
+        np.roll(mask, 1, 0) & np.roll(mask, -1, 0) & np.roll(mask, 1, 1) & np.roll(mask, -1, 1)
+    )
+    pts = np.argwhere(edge if edge.any() else mask)
+    step = max(1, len(pts) // limit)
+    return pts[::step]
+
+
+def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
+    """Whether the gap between ``a`` and ``b`` (the pixels within half their distance plus a
+    little of both) lies mostly on other pieces (an occluder) rather than on background."""
+    pa, pb = _boundary_points(a), _boundary_points(b)
+    gap = float(np.sqrt(((pa[:, None, :] - pb[None, :, :]) ** 2).sum(axis=2).min()))
+    if gap <= 4:
+        return True
+    r = int(gap) + 3
+    ys, xs = np.nonzero(a | b)
+    y0, y1 = max(0, int(ys.min()) - r), int(ys.max()) + r + 1
+    x0, x1 = max(0, int(xs.min()) - r), int(xs.max()) + r + 1
+    da, db = _distances(a[y0:y1, x0:x1], r), _distances(b[y0:y1, x0:x1], r)
+    lens = (da > 0) & (db > 0) & (da + db <= int(np.ceil(gap)) + 2)
+    if not lens.any():
+        return False
+    return float((lens & others[y0:y1, x0:x1]).sum()) >= OCCLUDED_GAP * float(lens.sum())
+
+
+def _distances(mask: BoolArray, r: int) -> np.ndarray:
+    """Chessboard distance to ``mask`` (0 on it), capped at r + 1: what growing the mask a
+    pixel at a time within the picture gives (a shortest chessboard path stays within the
+    box of its ends), in two passes instead of r growths."""
+    h, w = mask.shape
+    flat = np.ascontiguousarray(mask, dtype=np.bool_).ravel()
+    return _chessboard_kernel(flat, h, w, r + 1).reshape(h, w)
+
+
+@njit(cache=True)
+def _chessboard_kernel(flat: BoolArray, h: int, w: int, cap: int) -> npt.NDArray[np.int64]:
+    """Two-pass chamfer over the 8 neighbours, all steps 1: exact for the chessboard metric."""
+    out = np.full(h * w, cap, dtype=np.int64)
+    for i in range(h * w):
+        if flat[i]:
+            out[i] = 0
+    for y in range(h):
+        for x in range(w):
+            d = out[y * w + x]
+            if x > 0:
+                d = min(d, out[y * w + x - 1] + 1)
+            if y > 0:
+                for xx in range(max(0, x - 1), min(w, x + 2)):
+                    d = min(d, out[(y - 1) * w + xx] + 1)
+            out[y * w + x] = d
+    for y in range(h - 1, -1, -1):
+        for x in range(w - 1, -1, -1):
+            d = out[y * w + x]
+            if x < w - 1:
+                d = min(d, out[y * w + x + 1] + 1)
+            if y < h - 1:
+                for xx in range(max(0, x - 1), min(w, x + 2)):
+                    d = min(d, out[(y + 1) * w + xx] + 1)
+            out[y * w + x] = d
+    return out
+
+
+def _centroid(mask: BoolArray) -> FloatArray:
+    out: FloatArray = np.argwhere(mask).mean(axis=0)
+    return out
+
+
+def _root(group: list[int], i: int) -> int:
+    while group[i] != i:
+        i = group[i]
+    return i
+
+
+def solid_of(masks: list[BoolArray]) -> BoolArray:
+    """Every piece pixel of a frame, closed so that the drawn edges between two pieces of
+    different colours count as piece, not background."""
+    solid = np.zeros_like(masks[0]) if masks else np.zeros((1, 1), bool)
+    for m in masks:
+        solid |= m
+    return close(solid)
+
+
+def frame_objects(
+    masks: list[BoolArray], min_area: int, occluders: BoolArray | None = None
+) -> tuple[list[Obj], BoolArray]:
+    """Objects of one frame (each class's components grouped across occluders), and the
+    frame's piece pixels (:func:`solid_of`) with ``occluders`` (a box's wire frame drawn over
+    the pieces), which hide pieces as pieces do."""
+    solid = solid_of(masks if occluders is None else [*masks, occluders])
+    out: list[Obj] = []
+    for k, mask in enumerate(masks):
+        comps = components(mask, min_area)
+        group = list(range(len(comps)))
+        others = solid & ~mask
+        for i in range(len(comps)):
+            for j in range(i + 1, len(comps)):
+                ri, rj = _root(group, i), _root(group, j)
+                if ri != rj and _gap_covered(comps[i], comps[j], others):
+                    group[rj] = ri
+        for r in sorted({_root(group, i) for i in range(len(comps))}):
+            members = [c for i, c in enumerate(comps) if _root(group, i) == r]
+            out.append(Obj(k, np.logical_or.reduce(members), len(members)))
+    return out, solid
+
+
+def _counts(frames: list[list[Obj]], classes: int) -> np.ndarray:
+    c = np.zeros((len(frames), classes), dtype=np.int64)
+    for t, objs in enumerate(frames):
+        for o in objs:
+            c[t, o.cls] += 1
+    return c
+
+
+def smoothed_counts(raw: np.ndarray) -> np.ndarray:
+    """Median of each class's count over WINDOW frames (clipped at the ends)."""
+    n = len(raw)
+    half = WINDOW // 2
+    out = np.empty_like(raw)
+    for t in range(n):
+        out[t] = np.median(raw[max(0, t - half) : min(n, t + half + 1)], axis=0).round()
+    return out
+
+
+class Tracker:
+    """Finds the events of a sequence of per-frame objects (see the module docstring)."""
+
+    def __init__(self, frames: list[tuple[list[Obj], BoolArray]], names: tuple[str, ...]) -> None:
+        self.frames = [objs for objs, _ in frames]
+        self.solid = [solid for _, solid in frames]
+        self.names = names
+        shape = self.solid[0].shape if self.solid else (1, 1)
+        self.reach = max(2, round(MOTION_SHARE * max(shape)))
+        self.raw = _counts(self.frames, len(names))
+        self.smooth = smoothed_counts(self.raw)
+
+    def _of(self, t: int, k: int) -> list[Obj]:
+        return [o for o in self.frames[t] if o.cls == k]
+
+    def _change_frame(self, t: int, k: int) -> int:
+        """The raw frame pair nearest ``t`` where class ``k``'s count makes the smoothed step."""
+        old, new = self.smooth[t - 1, k], self.smooth[t, k]
+        for d in (0, -1, 1, -2, 2):
+            b = t + d
+            if 1 <= b < len(self.frames) and self.raw[b - 1, k] == old and self.raw[b, k] == new:
+                return b
+        return t
+
+    def events(self) -> list[Event]:
+        out: list[Event] = []
+        for t in range(1, len(self.frames)):
+            for k in range(len(self.names)):
+                if self.smooth[t, k] == self.smooth[t - 1, k]:
+                    continue
+                b = self._change_frame(t, k)
+                if self.smooth[t, k] > self.smooth[t - 1, k]:
+                    out.extend(self._more(b, k))
+                else:
+                    out.extend(self._fewer(b, k))
+        out.extend(self._swaps())
+        return sorted(out, key=lambda e: (e.frame, e.kind, e.piece))
+
+    def _touching(self, a: Obj, objs: list[Obj]) -> list[Obj]:
+        grown = dilate(a.mask, self.reach)
+        return [o for o in objs if (grown & o.mask).any()]
+
+    def _against_others(self, c: Obj, t: int) -> bool:
+        """Whether a part borders other pieces (so it may have come out from behind one)."""
+        ring = dilate(c.mask, 2) & ~c.mask
+        others = self.solid[t] & ~np.logical_or.reduce([o.mask for o in self._of(t, c.cls)])
+        return float((ring & others).sum()) >= 0.15 * max(1, int(ring.sum()))
+
+    def _more(self, b: int, k: int) -> list[Event]:
+        before, now = self._of(b - 1, k), self._of(b, k)
+        name = self.names[k]
+        for p in before:
+            hit = self._touching(p, now)
+            if len(hit) >= 2:
+                masks = (p.mask, *[h.mask for h in hit])
+                if self._under_others(p.mask, hit, b):
+                    detail = f"part of the {name} piece went behind another piece"
+                    return [Event("hidden", b, name, None, detail, masks)]
+                detail = f"one {name} piece became {len(hit)} separate parts (background between)"
+                return [Event("split", b, name, None, detail, masks)]
+        out: list[Event] = []
+        unmatched = [p for p in before if not self._touching(p, now)]
+        for c in now:
+            if self._touching(c, before):
+                continue
+            fast = [p for p in unmatched if self._fast_move(p, c)]
+            if fast:
+                unmatched.remove(fast[0])
+                out.append(Event("moved", b, name, None, "moved further than one frame's reach"))
+                continue
+            if c.touches_border() or self._from_border(k, b) or self._heading_out(c, b, 1):
+                out.append(Event("entered", b, name, None, "came in through the border"))
+                continue
+            gone = [
+                o
+                for o in self.frames[b - 1]
+                if o.cls != k
+                and (o.mask & c.mask).sum() >= 0.5 * min(o.area, c.area)
+                and not self._touching(o, self._of(b, o.cls))
+            ]
+            if gone:
+                other = self.names[gone[0].cls]
+                detail = f"the {other} piece turned {name}"
+                out.append(Event("recolor", b, other, name, detail, (gone[0].mask, c.mask)))
+            elif self._against_others(c, b):
+                detail = f"a {name} part came into sight beside another piece"
+                out.append(Event("revealed", b, name, None, detail))
+            else:
+                detail = f"a {name} piece appeared in open view, away from the border"
+                out.append(Event("added", b, name, None, detail, (c.mask,), before=0))
+        return out
+
+    def _fast_move(self, p: Obj, c: Obj) -> bool:
+        """Whether ``c`` may be ``p`` moved fast: alike in area, within FAST_SHARE of the
+        frame (a piece matched nowhere before and one matched nowhere now)."""
+        d = _centroid(c.mask) - _centroid(p.mask)
+        far = float(np.hypot(*d)) <= FAST_SHARE * max(p.mask.shape)
+        return far and _alike(p, c)
+
+    def _from_border(self, k: int, b: int) -> bool:
+        """Whether a piece of class ``k`` touched the border a frame or two before ``b``: one
+        carried in at speed (our videos bring pieces in fast) is past the reach of one frame."""
+        return any(o.touches_border() for t in (b - 1, b - 2) if t >= 0 for o in self._of(t, k))
+
+    def _under_others(self, whole: BoolArray, parts: list[Obj], t: int) -> bool:
+        """Whether what ``whole`` has beyond ``parts`` lies, at frame ``t``, mostly on other
+        pieces: the parts are one piece seen round an occluder, not a break or a fusion."""
+        rest = whole & ~dilate(np.logical_or.reduce([o.mask for o in parts]), 1)
+        if not rest.any():
+            return False
+        own = np.zeros_like(rest)
+        for o in self._of(t, parts[0].cls):
+            own |= o.mask
+        return float((rest & self.solid[t] & ~own).sum()) >= 0.5 * float(rest.sum())
+
+    def _fewer(self, b: int, k: int) -> list[Event]:
+        before, now = self._of(b - 1, k), self._of(b, k)
+        name = self.names[k]
+        for c in now:
+            hit = self._touching(c, before)
+            if len(hit) >= 2 and c.parts == 1:
+                masks = (*[h.mask for h in hit], c.mask)
+                if self._under_others(c.mask, hit, b - 1):
+                    detail = f"a hidden part of the {name} piece came into sight"
+                    return [Event("revealed", b, name, None, detail, masks)]
+                detail = f"{len(hit)} separate {name} parts fused into one"
+                return [Event("merge", b, name, name, detail, masks, before=len(hit))]
+        out = [self._vanished(p, b) for p in before if not self._touching(p, now)]
+        return [e for e in out if e.kind != "recolor"]  # a recolour is reported by the new class
+
+    def _vanished(self, p: Obj, b: int) -> Event:
+        name = self.names[p.cls]
+        if p.touches_border() or self._heading_out(p, b - 1):
+            return Event("left", b, name, None, "went out through the border")
+        if self._shrinking(p, b - 1) and self._against_others(p, b - 1):
+            detail = f"the {name} piece shrank out of sight beside another piece"
+            return Event("hidden", b, name, None, detail, (p.mask,))
+        if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
+            return Event(
+                "lost", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
+            )
+        others = [o for o in self.frames[b] if o.cls != p.cls]
+        if not others:
+            return Event("hidden", b, name, None, f"the {name} piece shrank out of sight")
+        cover = max(others, key=lambda o: int((o.mask & p.mask).sum()))
+        other = self.names[cover.cls]
+        was = [o for o in self.frames[b - 1] if o.cls == cover.cls]
+        was_there = [o for o in was if (dilate(o.mask, self.reach) & cover.mask).any()]
+        if not was_there:
+            return Event("recolor", b, name, other, f"the {name} piece turned {other}")
+        grew = cover.area - sum(o.area for o in was_there)
+        if grew >= 0.7 * p.area and not self._of(b, p.cls):
+            detail = f"the {name} piece fused into the {other} piece (its area grew by {grew} px)"
+            return Event("merge", b, name, other, detail, (p.mask, cover.mask))
+        detail = f"the {name} piece went out of sight behind the {other} piece"
+        return Event("hidden", b, name, other, detail, (p.mask, cover.mask))
+
+    def _shrinking(self, p: Obj, t: int) -> bool:
+        """Whether ``p`` (seen at frame ``t``) is under half the area its colour showed near it
+        within WINDOW frames before: it was going behind something, not deleted in view."""
+        near = dilate(p.mask, 2 * self.reach)
+        seen = [
+            o.area
+            for u in range(max(0, t - WINDOW), t)
+            for o in self._of(u, p.cls)
+            if (o.mask & near).any()
+        ]
+        return bool(seen) and p.area < 0.5 * max(seen)
+
+    def _heading_out(self, p: Obj, t: int, step: int = -1) -> bool:
+        """Whether ``p`` (seen at frame ``t``) moves fast enough to be out of the picture two
+        frames later (our videos carry removed pieces out at speed); with ``step`` 1, two
+        frames earlier (carried in at speed)."""
+        if not 0 <= t + step < len(self.frames):
+            return False
+        other = self._of(t + step, p.cls)
+        if not other:
+            return False
+        here = _centroid(p.mask)
+        d = here - min(
+            (_centroid(o.mask) for o in other), key=lambda c: float(((here - c) ** 2).sum())
+        )
+        ys, xs = np.nonzero(p.mask)
+        h, w = p.mask.shape
+        lo = np.array([ys.min(), xs.min()]) + 2 * d
+        hi = np.array([ys.max(), xs.max()]) + 2 * d
+        return bool(hi[0] < 0 or hi[1] < 0 or lo[0] >= h or lo[1] >= w)
+
+    def _swaps(self) -> list[Event]:
+        """Identity changes that keep every count: a colour now where another colour was,
+        nowhere near where it was itself, for PERSIST frames."""
+        out: list[Event] = []
+        for b in range(1, len(self.frames) - PERSIST + 1):
+            if not np.array_equal(self.raw[b - 1], self.raw[b]):
+                continue
+            for k in range(len(self.names)):
+                ev = self._swap_at(b, k)
+                if ev is not None and not any(e.piece == ev.piece for e in out):
+                    out.append(ev)
+        return out
+
+    def _swap_at(self, b: int, k: int) -> Event | None:
+        before, now = self._of(b - 1, k), self._of(b, k)
+        if len(now) != 1 or len(before) != 1:
+            return None
+        c, was = now[0], before[0]
+        if (c.mask & was.mask).sum() >= 0.2 * c.area:
+            return None
+        for o in self.frames[b - 1]:
+            near = dilate(o.mask, self.reach)  # the other piece may be moving
+            if o.cls == k or (near & c.mask).sum() < 0.5 * min(c.area, o.area):
+                continue
+            # mutual: where this piece was now shows the other colour, moved off its own place
+            partner = [x for x in self._of(b, o.cls) if _overlaps(x, was)]
+            if len(partner) != 1 or (partner[0].mask & o.mask).sum() >= 0.2 * partner[0].area:
+                continue
+            if not (_alike(c, o) and _alike(partner[0], was)):
+                continue  # a swap of colours keeps both silhouettes; a reveal changes them
+            later = [self._of(b + d, k) for d in range(1, PERSIST)]
+            if all(len(x) == 1 and (x[0].mask & was.mask).sum() < 0.2 * x[0].area for x in later):
+                other = self.names[o.cls]
+                detail = f"the {other} piece now shows as {self.names[k]} (and the reverse)"
+                return Event("recolor", b, other, self.names[k], detail, (o.mask, c.mask))
+        return None
+
+
+def _alike(a: Obj, b: Obj) -> bool:
+    """Areas within a factor of two (one silhouette seen twice, not a piece and a sliver)."""
+    return min(a.area, b.area) >= 0.5 * max(a.area, b.area)
+
+
+def _overlaps(a: Obj, b: Obj) -> bool:
+    """At least half of the smaller of two objects lies on the other."""
+    return bool((a.mask & b.mask).sum() >= 0.5 * min(a.area, b.area))
