@@ -148,7 +148,7 @@ def assembly_picture(q: Question, level: Level, size: int = VIEW_SIZE) -> bytes:
     drawn from its recipe, labelled A-D) below, every one from the iso corner."""
     from PIL import Image
 
-    from chaingeo.pictures.fastview import render_images
+    from chaingeo.pictures.fastview import render_arrays
     from chaingeo.pictures.raster import png_bytes
 
     rgb = {p.name: p.rgb for p in level.pieces}
@@ -157,7 +157,7 @@ def assembly_picture(q: Question, level: Level, size: int = VIEW_SIZE) -> bytes:
         every = [c for s in pieces.values() for c in s.cells]
         lo = [-min(c[i] for c in every) for i in range(3)]
         scene = {n: (s.translate(lo), rgb[n]) for n, s in pieces.items()}
-        return render_images(scene, None, ("iso",), size, title)["iso"].convert("RGB")
+        return Image.fromarray(render_arrays(scene, None, ("iso",), size, title)["iso"])
 
     sheet = Image.new("RGB", (4 * size, 2 * size), (255, 255, 255))
     sheet.paste(draw(solved(level), "THE SOLVED LEVEL"), (3 * size // 2, 0))
