@@ -28,8 +28,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I64
 from chaingeo.core.geometry import NEIGHBOURS, Shape
 from chaingeo.core.kinematics import Assembly, SearchLimitError
 from chaingeo.generator.candidate import Candidate, evaluate, piece_names, probe_limits
@@ -38,9 +38,6 @@ from chaingeo.kernels.jit import njit
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.motion.disassemble import fast_legal_moves
 from chaingeo.solvers.motion.partsearch import PartSearch, PieceTable, Removal
-
-I64 = npt.NDArray[np.int64]
-I16 = npt.NDArray[np.int16]
 
 #: Progress of a candidate: (levels still missing, closeness within that); (0, 0) is reached.
 Progress = tuple[int, int]

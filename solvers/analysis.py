@@ -29,12 +29,22 @@ from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.solvers.assembly.btassemble import Mirrors, bt_packing_spec, piece_groups
 from chaingeo.solvers.assembly.btcount import BTReport, count_bt
-from chaingeo.solvers.assembly.groups import PieceGroups, analyze_grouped
+from chaingeo.solvers.assembly.groups import (
+    RULE_TWO,
+    PieceGroups,
+    analyze_grouped,
+    optimal_grouped,
+)
 from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.figures import PuzzleFigures
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, Rods, analyze_assembly
+from chaingeo.solvers.motion.disassemble import (
+    Analysis,
+    OptimalLimitError,
+    Rods,
+    analyze_assembly,
+)
 from chaingeo.solvers.motion.movement import MAX_PIECES
 
 if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imports
@@ -180,8 +190,45 @@ def disassembly_figures(
     )
     out.update(level=first.level, moves=first.moves, optimal_steps=None)
     if optimal and first.disassemblable:
-        deadline.progress.stage = "searching for the optimal plan"
-        try:
+        out.update(
+            optimal_figures(
+                shapes,
+                max_group=max_group,
+                limits=limits,
+                deadline=deadline,
+                stage="searching for the optimal plan",
+                blocks=blocks,
+                turns=turns,
+                rods=rods,
+            )
+        )
+    return out
+
+
+def optimal_figures(
+    shapes: Mapping[str, Shape],
+    *,
+    max_group: int | None,
+    limits: SearchLimits,
+    deadline: Deadline,
+    stage: str,
+    blocks: Sequence[Sequence[str]] | None = None,
+    turns: bool = False,
+    rods: Rods | None = None,
+    groups: PieceGroups | None = None,
+) -> dict[str, Any]:
+    """``optimal_steps`` and ``plan`` of an assembly known to come apart (with ``groups``:
+    under BurrTools' group rule, :func:`chaingeo.solvers.assembly.groups.optimal_grouped`),
+    searched within ``limits.optimal_seconds`` of ``deadline``; past a cap,
+    :func:`optimal_error_of`'s entries instead."""
+    deadline.progress.stage = stage
+    within = deadline.within(limits.optimal_seconds, "optimal_seconds")
+    try:
+        if groups is not None:
+            best = optimal_grouped(
+                shapes, groups, max_group=max_group, limits=limits, deadline=within
+            )
+        else:
             best = analyze_puzzle(
                 shapes,
                 max_group=max_group,
@@ -189,12 +236,13 @@ def disassembly_figures(
                 blocks=blocks,
                 turns=turns,
                 rods=rods,
-                deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
+                deadline=within,
             )
-            out.update(optimal_steps=best.optimal_steps, plan=best.plan)
-        except SearchLimitError as e:
-            out.update(optimal_error_of(e))
-    return out
+    except SearchLimitError as e:
+        return optimal_error_of(e)
+    if best.optimal_steps is None:
+        return {"optimal_error": RULE_TWO}
+    return {"optimal_steps": best.optimal_steps, "plan": best.plan}
 
 
 def level_analysis_row(
@@ -202,8 +250,9 @@ def level_analysis_row(
     limits: SearchLimits,
     optimal: bool,
     assemble: bool,
-    mirrors: Mirrors = "keep",
+    mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
+    jobs: int | None = 1,
 ) -> dict[str, Any]:
     """The figures of one of our puzzle levels (a dict, with ``plan``): BurrTools' assemblies and
     solutions of the level written as a BurrTools file (:func:`level_puzzle`: each piece its
@@ -221,7 +270,7 @@ def level_analysis_row(
         from chaingeo.core.formats.bt_level import level_puzzle
 
         packing = compile_packing(bt_packing_spec(level_puzzle(level), 0))
-        rep = count_figures(packing, out, mirrors, max_group, limits, deadline, "")
+        rep = count_figures(packing, out, mirrors, max_group, limits, deadline, "", jobs)
         deadline = deadline if rep.complete else grace_deadline(limits)
     out.update(
         disassembly_figures(
@@ -240,9 +289,13 @@ def level_analysis_row(
 
 def optimal_error_of(e: SearchLimitError) -> dict[str, Any]:
     """The figures' entries for an optimal search stopped by a cap: ``optimal_error`` (the
-    reason) and ``optimal_limit_cap`` (the field of ``SearchLimits`` reached, for a front end
-    to name its own option: ``chain analyze`` names the flag and drops this key)."""
-    return {"optimal_error": e.reason, "optimal_limit_cap": e.cap}
+    reason), ``optimal_limit_cap`` (the field of ``SearchLimits`` reached, for a front end
+    to name its own option: ``chain analyze`` names the flag and drops this key) and, when the
+    search proved them, ``optimal_bounds`` ``(lo, hi)`` with ``lo <= o_i <= hi``."""
+    out: dict[str, Any] = {"optimal_error": e.reason, "optimal_limit_cap": e.cap}
+    if isinstance(e, OptimalLimitError):
+        out["optimal_bounds"] = (e.lo, e.hi)
+    return out
 
 
 #: Seconds the figures of a known assembly get when counting spent the analysis' time.
@@ -256,6 +309,12 @@ def grace_deadline(limits: SearchLimits) -> Deadline:
     return Deadline(seconds)
 
 
+#: The name the figures give each way of counting mirror images (``convention``): burrTxt's
+#: (BurrTools' command-line solver, the default: an assembly and its mirror image are one) or
+#: BurrTools' stored figures (its GUI's "keep mirror solutions").
+CONVENTIONS: Final[dict[str, str]] = {"drop": "burrtxt", "keep": "mirrors-kept"}
+
+
 def count_figures(
     packing: Packing,
     out: dict[str, Any],
@@ -264,6 +323,7 @@ def count_figures(
     limits: SearchLimits,
     deadline: Deadline,
     label: str,
+    jobs: int | None = 1,
 ) -> BTReport:
     """Count BurrTools' assemblies and solutions into ``out``; a cap reached ends the count,
     and ``out`` then says so: ``counts_complete`` false, the counts lower bounds, ``limit``
@@ -276,8 +336,9 @@ def count_figures(
         limits=limits,
         deadline=deadline,
         partial=True,
+        jobs=jobs,
     )
-    out.update(assemblies=rep.assemblies, solutions=rep.solutions)
+    out.update(assemblies=rep.assemblies, solutions=rep.solutions, convention=CONVENTIONS[mirrors])
     if rep.limit is not None:
         out.update(counts_complete=False, limit=rep.limit.reason, limit_cap=rep.limit.cap)
     return rep
@@ -303,13 +364,14 @@ def problem_analysis_row(
     limits: SearchLimits,
     optimal: bool,
     assemble: bool,
-    mirrors: Mirrors = "keep",
+    mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
+    jobs: int | None = 1,
 ) -> dict[str, Any]:
     """The figures of one problem of a BurrTools puzzle (a dict, with ``plan``): BurrTools'
     assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.assembly.btassemble`), then
     level, moves and o_i of the first solution (with ``assemble`` off: of the first stored
-    assembly). With piece groups o_i is not searched (``optimal_error`` says so). Everything runs
+    assembly); with piece groups o_i under BurrTools' group rule. Everything runs
     within ``deadline`` (default: one of ``limits.seconds``)."""
     if deadline is None:
         deadline = Deadline(limits.seconds)
@@ -320,7 +382,9 @@ def problem_analysis_row(
     first: Analysis | None = None
     if assemble:
         packing = compile_packing(bt_packing_spec(puzzle, index))
-        rep = count_figures(packing, out, mirrors, None, limits, deadline, f"problem {index}: ")
+        rep = count_figures(
+            packing, out, mirrors, None, limits, deadline, f"problem {index}: ", jobs
+        )
         if rep.first_packing is not None:
             found, first = (rep.first_packing, piece_groups(packing)), rep.first_analysis
         if not rep.complete:
@@ -336,7 +400,17 @@ def problem_analysis_row(
         result = first or analyze_grouped(shapes, groups, limits=limits, deadline=deadline)
         out.update(level=result.level, moves=result.moves, optimal_steps=None)
         if optimal and result.disassemblable:
-            out["optimal_error"] = "o_i is not searched for problems with piece groups"
+            stage = f"problem {index}: searching for the optimal plan"
+            out.update(
+                optimal_figures(
+                    shapes,
+                    max_group=None,
+                    limits=limits,
+                    deadline=deadline,
+                    stage=stage,
+                    groups=groups,
+                )
+            )
     elif first is None:
         out.update(
             disassembly_figures(
@@ -346,17 +420,12 @@ def problem_analysis_row(
     else:  # the level is known: the assembler's disassembler found it
         out.update(level=first.level, moves=first.moves, optimal_steps=None)
         if optimal:
-            deadline.progress.stage = f"problem {index}: searching for the optimal plan"
-            try:
-                best = analyze_puzzle(
-                    shapes,
-                    max_group=None,
-                    limits=limits,
-                    deadline=deadline.within(limits.optimal_seconds, "optimal_seconds"),
+            stage = f"problem {index}: searching for the optimal plan"
+            out.update(
+                optimal_figures(
+                    shapes, max_group=None, limits=limits, deadline=deadline, stage=stage
                 )
-                out.update(optimal_steps=best.optimal_steps, plan=best.plan)
-            except SearchLimitError as e:
-                out.update(optimal_error_of(e))
+            )
     return out
 
 
@@ -372,8 +441,9 @@ def analyze(
     problem: int | None = None,
     optimal: bool = True,
     assemble: bool = True,
-    mirrors: Mirrors = "keep",
+    mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
+    jobs: int | None = None,
 ) -> PuzzleFigures:
     """Assemblies, solutions, level, moves and o_i of a puzzle, as ``chain analyze`` prints
     them (:meth:`PuzzleFigures.to_json`).
@@ -383,9 +453,12 @@ def analyze(
     puzzle (default: its only one, or every one in ``problems``; ignored for levels).
     ``optimal`` / ``assemble``: search o_i / count assemblies. ``mirrors``: see
     :mod:`chaingeo.solvers.assembly.btassemble`. Everything runs within ``deadline`` (default:
-    one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`)."""
+    one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`). ``jobs``: worker
+    processes for the counts (None: the machine's cores); the figures do not depend on it."""
     from chaingeo.kernels.jit import mode
+    from chaingeo.solvers.jobs import check_jobs
 
+    jobs = check_jobs(jobs)
     limits = DEFAULT_LIMITS if limits is None else limits
     deadline = Deadline(limits.seconds) if deadline is None else deadline
     start = time.perf_counter()
@@ -395,12 +468,12 @@ def analyze(
     several = False
     if isinstance(source, BTPuzzle):
         several = problem is None and len(source.problems) != 1
-        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline)
+        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline, jobs)
     else:
         from chaingeo.core.suite import load_level
 
         level = load_level(source) if isinstance(source, str | os.PathLike) else source
-        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline)]
+        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline, jobs)]
     meta: dict[str, Any] = {"file": file, "kernels": mode()}
     meta["seconds"] = round(time.perf_counter() - start, 3)
     if several:
@@ -416,14 +489,17 @@ def _puzzle_rows(
     assemble: bool,
     mirrors: Mirrors,
     deadline: Deadline,
+    jobs: int | None,
 ) -> list[dict[str, Any]]:
     """The rows of problem ``problem``, or with None of the puzzle's only problem, or of every
     one."""
     if problem is not None or len(puzzle.problems) == 1:
         return [
-            problem_analysis_row(puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline)
+            problem_analysis_row(
+                puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline, jobs
+            )
         ]
     return [
-        problem_analysis_row(puzzle, i, limits, optimal, assemble, mirrors, deadline)
+        problem_analysis_row(puzzle, i, limits, optimal, assemble, mirrors, deadline, jobs)
         for i in range(len(puzzle.problems))
     ]

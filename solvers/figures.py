@@ -22,12 +22,14 @@ __all__ = ["PuzzleFigures"]
 ALWAYS: tuple[str, ...] = ("assemblies", "solutions", "level", "moves", "optimal_steps")
 #: Keys written only when set (``counts_complete`` only when false).
 OPTIONAL: tuple[str, ...] = (
+    "convention",
     "problem",
     "name",
     "limit",
     "limit_cap",
     "optimal_error",
     "optimal_limit_cap",
+    "optimal_bounds",
     "disassembly_error",
 )
 #: What the run adds at the top: the source named, the kernels' mode, the wall time.
@@ -42,8 +44,11 @@ class PuzzleFigures:
 
     ``counts_complete`` false: a cap (``limit``, the field of ``SearchLimits`` in
     ``limit_cap``) cut counting short and the counts are lower bounds. ``optimal_error``: why o_i
-    is unknown (``optimal_limit_cap`` the cap reached). ``plan``: one optimal full disassembly
-    when o_i was searched (not written to JSON)."""
+    is unknown (``optimal_limit_cap`` the cap reached; ``optimal_bounds`` what the search proved
+    by then: ``lo <= o_i <= hi``). ``plan``: one optimal full disassembly
+    when o_i was searched (not written to JSON). ``convention``: how the counts treat mirror
+    images (``burrtxt``: an assembly and its mirror image are one, as burrTxt prints;
+    ``mirrors-kept``: BurrTools' stored figures); None when nothing was counted."""
 
     assemblies: int | None = None
     solutions: int | None = None
@@ -51,10 +56,12 @@ class PuzzleFigures:
     moves: int | None = None
     optimal_steps: int | None = None
     counts_complete: bool = True
+    convention: str | None = None
     limit: str | None = None
     limit_cap: str | None = None
     optimal_error: str | None = None
     optimal_limit_cap: str | None = None
+    optimal_bounds: tuple[int, int] | None = None
     disassembly_error: str | None = None
     problem: int | None = None
     name: str | None = None
@@ -81,6 +88,9 @@ class PuzzleFigures:
         kw["problems"] = tuple(cls.from_dict(p) for p in row.get("problems", ()))
         kw["several"] = "problems" in row
         kw["plan"] = tuple(row.get("plan", ()))
+        if row.get("optimal_bounds") is not None:
+            lo, hi = row["optimal_bounds"]
+            kw["optimal_bounds"] = (int(lo), int(hi))
         return cls(**kw)
 
     @classmethod
@@ -97,6 +107,8 @@ class PuzzleFigures:
             return out
         out.update({k: getattr(self, k) for k in ALWAYS})
         out.update({k: getattr(self, k) for k in OPTIONAL if getattr(self, k) is not None})
+        if self.optimal_bounds is not None:
+            out["optimal_bounds"] = list(self.optimal_bounds)
         if not self.counts_complete:
             out["counts_complete"] = False
         if flags is not None:

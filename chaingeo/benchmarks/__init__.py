@@ -11,4 +11,5 @@ from chaingeo.core.registry import Registry
 #: Benchmark name -> its module (imported only when run: ``chain --help`` stays fast).
 BENCHMARKS: Registry[str] = Registry("benchmark")
 for _module in sorted(m.name for m in pkgutil.iter_modules(__path__)):
-    BENCHMARKS.register(_module, f"{__name__}.{_module}")
+    if not _module.startswith("_"):  # a private module is a part of one (robustness's classes)
+        BENCHMARKS.register(_module, f"{__name__}.{_module}")

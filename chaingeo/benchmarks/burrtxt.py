@@ -118,13 +118,13 @@ SMALL_SECONDS: Final = 0.2
 
 
 @dataclass(frozen=True)
-class Instance:
+class BurrTxtCase:
     name: str
     path: Path
     problem: int
 
 
-def instances(folder: Path, quick: bool) -> list[Instance]:
+def instances(folder: Path, quick: bool) -> list[BurrTxtCase]:
     """BurrTools' own example files (when present), our BurrTools examples, and every shipped
     puzzle level without turns, written as ``.xmpuzzle`` files into ``folder``."""
     from chaingeo.core.formats.bt_level import level_puzzle
@@ -134,21 +134,23 @@ def instances(folder: Path, quick: bool) -> list[Instance]:
     from chaingeo.core.suite import suite_folder
     from chaingeo.generator.bt_examples import EXAMPLES
 
-    out: list[Instance] = []
+    out: list[BurrTxtCase] = []
     shared = Path(__file__).resolve().parents[3] / "shared" / "burrtools"
     for path in sorted(shared.glob("*.xmpuzzle")) if shared.is_dir() else []:
         n = len(read_xmpuzzle(path).problems)
-        out.extend(Instance(f"{path.stem}#{i}" if n > 1 else path.stem, path, i) for i in range(n))
+        out.extend(
+            BurrTxtCase(f"{path.stem}#{i}" if n > 1 else path.stem, path, i) for i in range(n)
+        )
     for name, build in EXAMPLES.items():
         puzzle = build()
         path = write_xmpuzzle(puzzle, folder / f"{name}.xmpuzzle")
         n = len(puzzle.problems)
-        out.extend(Instance(f"{name}#{i}" if n > 1 else name, path, i) for i in range(n))
+        out.extend(BurrTxtCase(f"{name}#{i}" if n > 1 else name, path, i) for i in range(n))
     for level in load_levels(suite_folder("puzzle")):
         if isinstance(level.rules, PuzzleRules) and level.rules.turns:
             continue  # BurrTools has no turns
         path = write_xmpuzzle(level_puzzle(level), folder / f"{level.id}.xmpuzzle")
-        out.append(Instance(level.id, path, 0))
+        out.append(BurrTxtCase(level.id, path, 0))
     if quick:
         out = [i for i in out if i.name in QUICK]
     return out
@@ -157,7 +159,7 @@ def instances(folder: Path, quick: bool) -> list[Instance]:
 QUICK: Final = ("linked_rings", "puzzle-mid-04-burr12", "puzzle-easy-07-burr3", "AlPackino")
 
 
-def run_ours(instance: Instance, seconds: float) -> tuple[float, dict[str, Any]]:
+def run_ours(instance: BurrTxtCase, seconds: float) -> tuple[float, dict[str, Any]]:
     """``chain analyze FILE --mirrors drop --no-optimal`` as a whole process (its own default
     kernels): wall seconds and the JSON it printed (``error`` when it failed)."""
     import json
@@ -177,7 +179,7 @@ def run_ours(instance: Instance, seconds: float) -> tuple[float, dict[str, Any]]
     return wall, dict(json.loads(done.stdout.splitlines()[-1]))
 
 
-def compare(instance: Instance, binary: Path, seconds: float, repeat: int) -> dict[str, Any]:
+def compare(instance: BurrTxtCase, binary: Path, seconds: float, repeat: int) -> dict[str, Any]:
     """One row: both sides' figures and best whole-process wall times, and their ratio."""
     bt: BurrTxtResult | None = None
     bt_s = ours_s = float("inf")

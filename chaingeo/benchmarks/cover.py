@@ -4,7 +4,9 @@ Each instance is counted three ways in the same process: ``reduced`` is ``count_
 ``chain cover`` runs it (symmetry reduction, automatic engine, problem built from scratch);
 ``raw`` is our engine enumerating every solution without symmetry reduction (the same work
 xcover does; the kernel the automatic rule picked, its nodes and work units per second are
-printed); ``xcover`` runs ``xcover.covers`` over the very same rows. JIT compilation is
+printed), also with its subtrees on N worker processes (N: the machine's cores, at least 2;
+``raw_scaling`` is one process' time over theirs, the pool's start included); ``xcover`` runs
+``xcover.covers`` over the very same rows. JIT compilation is
 excluded: every kernel is warmed up on a tiny instance first. Times are the best of
 ``--repeat`` runs (wall clock; a run over 10 s is not repeated); the ratios are xcover's time
 over ours, so above 1 means we are faster. The machines are shared: compare ratios, not seconds.
@@ -33,7 +35,7 @@ EXTRA = "bench"
 
 
 @dataclass(frozen=True)
-class Instance:
+class CoverInstance:
     name: str
     pieces: dict[str, Shape]
     box: tuple[int, int, int]
@@ -43,13 +45,15 @@ class Instance:
 
 
 INSTANCES = (
-    Instance("soma 3x3x3", SOMA.pieces, (3, 3, 3), 11520, 240),
-    Instance("pentominoes 6x10x1", PENTOMINOES.pieces, (6, 10, 1), 9356, 2339),
-    Instance("pentominoes 5x12x1", PENTOMINOES.pieces, (5, 12, 1), 4040, 1010),
-    Instance("solid pentominoes 2x5x6", PENTOMINOES.pieces, (2, 5, 6), 2112, 264),
-    Instance("solid pentominoes 3x4x5", PENTOMINOES.pieces, (3, 4, 5), 31520, 3940),
+    CoverInstance("soma 3x3x3", SOMA.pieces, (3, 3, 3), 11520, 240),
+    CoverInstance("pentominoes 6x10x1", PENTOMINOES.pieces, (6, 10, 1), 9356, 2339),
+    CoverInstance("pentominoes 5x12x1", PENTOMINOES.pieces, (5, 12, 1), 4040, 1010),
+    CoverInstance("solid pentominoes 2x5x6", PENTOMINOES.pieces, (2, 5, 6), 2112, 264),
+    CoverInstance("solid pentominoes 3x4x5", PENTOMINOES.pieces, (3, 4, 5), 31520, 3940),
 )
-BEDLAM_INSTANCE = Instance("bedlam 4x4x4", BEDLAM.pieces, (4, 4, 4), None, 19186, compare=False)
+BEDLAM_INSTANCE = CoverInstance(
+    "bedlam 4x4x4", BEDLAM.pieces, (4, 4, 4), None, 19186, compare=False
+)
 QUICK = ("soma 3x3x3", "pentominoes 5x12x1")
 
 
@@ -94,12 +98,23 @@ def _warm_up() -> None:
     sum(1 for _ in covers([[0, 1], [2]]))
 
 
+def _raw_on_workers(problem: object, jobs: int) -> int:
+    """The unreduced count with its subtrees on ``jobs`` workers (the pool's start timed too)."""
+    import numpy as np
+
+    from chaingeo.solvers.cover.parallel import count_parallel
+
+    rows = np.arange(problem.n_rows, dtype=np.int32)  # type: ignore[attr-defined]
+    return count_parallel(problem, rows, "auto", jobs)[0]  # type: ignore[arg-type]
+
+
 def run(args: argparse.Namespace) -> int:
     from xcover import covers
 
     from chaingeo.solvers.cover.packings import count_packings
     from chaingeo.solvers.cover.problem import cover_problem
     from chaingeo.solvers.cover.search import CoverSearch, CoverStats
+    from chaingeo.solvers.jobs import default_jobs
 
     instances = list(INSTANCES)
     if os.environ.get("CHAIN_BENCH_COVER_BEDLAM") == "1":
@@ -107,6 +122,7 @@ def run(args: argparse.Namespace) -> int:
     if args.quick:
         instances = [i for i in instances if i.name in QUICK]
     repeat = int(args.repeat)
+    jobs = max(2, default_jobs())
     _warm_up()
     print(
         f"chain bench cover: best of {repeat}, wall seconds, JIT warm-up excluded "
@@ -120,7 +136,7 @@ def run(args: argparse.Namespace) -> int:
     rows = []
     for inst in instances:
 
-        def ours(inst: Instance = inst) -> int:
+        def ours(inst: CoverInstance = inst) -> int:
             _clear_caches()
             r = count_packings(inst.pieces, inst.box)
             if inst.solutions is not None and r.solutions != inst.solutions:
@@ -154,6 +170,13 @@ def run(args: argparse.Namespace) -> int:
         t_ref, n_ref = _best(reference, repeat)
         if not n == n_raw == n_ref:
             raise AssertionError(f"{inst.name}: counts differ: {n}, {n_raw}, {n_ref}")
+
+        def on_workers(problem: object = problem) -> int:
+            return _raw_on_workers(problem, jobs)
+
+        t_par, n_par = _best(on_workers, repeat)
+        if n_par != n_raw:
+            raise AssertionError(f"{inst.name}: {n_par} covers on {jobs} workers, {n_raw} in one")
         st = last[0]
         rate = st.updates / st.seconds if st.seconds > 0 else 0.0
         record = {
@@ -165,6 +188,10 @@ def run(args: argparse.Namespace) -> int:
             "xcover_s": round(t_ref, 4),
             "xcover_over_ours": round(t_ref / t_ours, 2),
             "xcover_over_raw": round(t_ref / t_raw, 2),
+            "raw_jobs": jobs,
+            "raw_workers_s": round(t_par, 4),
+            "raw_scaling": round(t_raw / t_par, 2),
+            "xcover_over_raw_workers": round(t_ref / t_par, 2),
             "raw_kernel": st.kernel,
             "raw_nodes": st.nodes,
             "raw_updates": st.updates,
@@ -173,7 +200,8 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"{inst.name:26} {n:>9} {inst.distinct:>8} {t_ours:>8.3f} {t_raw:>8.3f} "
             f"{t_ref:>8.3f} {t_ref / t_ours:>6.1f} {t_ref / t_raw:>6.2f}  {st.kernel:14} "
-            f"{st.nodes:>10} {rate / 1e6:>7.0f}M",
+            f"{st.nodes:>10} {rate / 1e6:>7.0f}M  raw on {jobs} workers {t_par:.3f} s "
+            f"({t_raw / t_par:.2f}x one)",
             flush=True,
         )
     worst = min(r["xcover_over_ours"] for r in rows)  # type: ignore[type-var]

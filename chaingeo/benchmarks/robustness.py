@@ -16,7 +16,7 @@ nesting 100,000 deep, NaN, lone surrogates, wrong types, unknown names) are tran
 played under the same contract. Server faults (:mod:`chaingeo.evaluation.drills`): a hostile
 server plays each attack of issue #21 against a real ``evaluate`` run; the table counts the
 episodes done and errored, run crashes, hangs, key leaks and the largest log (all but the last
-must be 0). Round three (:mod:`chaingeo.benchmarks.surfaces`): the surfaces of issue #37, one
+must be 0). Round three (:mod:`chaingeo.benchmarks._surfaces`): the surfaces of issue #37, one
 class each, printed as its table (cases, tracebacks, hangs, wrong acceptances, files outside
 their folder or left partial; all but the cases must be 0).
 """
@@ -31,7 +31,7 @@ from collections import Counter
 from collections.abc import Iterator
 from typing import Any
 
-from chaingeo.benchmarks.surfaces import surface_table, surfaces
+from chaingeo.benchmarks._surfaces import surface_table, surfaces
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import suite_folder
 from chaingeo.envs.machines import new_state

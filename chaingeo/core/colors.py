@@ -20,6 +20,8 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import F64
+
 #: Least CIEDE2000 difference between any two piece colours of one level (and of the palette).
 #: Blue and cobalt, which people confused on screen, were 11.4 apart.
 MIN_DELTA_E00: Final = 12.0
@@ -104,7 +106,6 @@ def assign_colors(count: int) -> list[NamedColor]:
 # Colour difference: sRGB -> CIELAB (D65) -> CIEDE2000
 # ---------------------------------------------------------------------------------------------
 
-FloatArray = npt.NDArray[np.float64]
 _SRGB_TO_XYZ: Final = np.array(
     [
         [0.4124564, 0.3575761, 0.1804375],
@@ -117,7 +118,7 @@ _EPSILON: Final = 216 / 24389  # CIE's exact constants, not the rounded 0.008856
 _KAPPA: Final = 24389 / 27
 
 
-def srgb_to_lab(rgb: npt.ArrayLike) -> FloatArray:
+def srgb_to_lab(rgb: npt.ArrayLike) -> F64:
     """CIELAB (D65 white) of 8-bit sRGB triples, shape (..., 3) -> (..., 3)."""
     c = np.asarray(rgb, dtype=np.float64) / 255.0
     linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
@@ -129,7 +130,7 @@ def srgb_to_lab(rgb: npt.ArrayLike) -> FloatArray:
     )
 
 
-def ciede2000(lab1: npt.ArrayLike, lab2: npt.ArrayLike) -> FloatArray:
+def ciede2000(lab1: npt.ArrayLike, lab2: npt.ArrayLike) -> F64:
     """CIEDE2000 colour difference (k_L = k_C = k_H = 1) of CIELAB colours, broadcasting over
     leading axes; as published by CIE 142-2001, with the hue conventions of Sharma, Wu and
     Dalal (2005) where a chroma is zero."""
@@ -169,7 +170,7 @@ def ciede2000(lab1: npt.ArrayLike, lab2: npt.ArrayLike) -> FloatArray:
     s_h = 1 + 0.015 * cp_bar * t
     r_t = -np.sin(np.radians(2 * d_theta)) * r_c
     x, y, z = d_l / s_l, d_c / s_c, d_h / s_h
-    out: FloatArray = np.sqrt(x * x + y * y + z * z + r_t * y * z)
+    out: F64 = np.sqrt(x * x + y * y + z * z + r_t * y * z)
     return out
 
 

@@ -111,6 +111,8 @@ class Outcome:
     readable: int = 0
     finished: bool = False
     truncated: bool = False
+    #: Why the episode errored (its record's ``error``, or its class); None when it played.
+    error: str | None = None
 
     def to_json(self) -> dict[str, Any]:
         out = dataclasses.asdict(self)
@@ -150,7 +152,14 @@ class Outcome:
             truncated=bool(record.get("truncated", False)),
             usage=usage,
             cost_usd=record.get("cost_usd"),
+            error=_error_of(record),
         )
+
+
+def _error_of(record: Mapping[str, Any]) -> str | None:
+    if record.get("status") != "error":
+        return None
+    return str(record.get("error") or record.get("error_type") or "?")
 
 
 def _environment(module: str) -> tuple[Callable[[Level], StateLike], Callable[..., Any]]:

@@ -40,18 +40,18 @@ import fcl
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import F64
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.pictures.mesh import eroded_mesh, mesh_arrays
 
 GROUP_EPS: Final = 1e-3
 REST_EPS: Final = 2e-3
 SAMPLES_PER_UNIT: Final = 4
-FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int32]
 
 
 @lru_cache(maxsize=512)
-def _eroded_at_origin(shape: Shape, eps: float) -> tuple[FloatArray, IntArray]:
+def _eroded_at_origin(shape: Shape, eps: float) -> tuple[F64, IntArray]:
     """Eroded mesh arrays of a normalised shape (the Minkowski difference is the slow part, and
     it commutes with translation, so it is computed once per shape)."""
     return mesh_arrays(eroded_mesh(shape, eps))
@@ -59,7 +59,7 @@ def _eroded_at_origin(shape: Shape, eps: float) -> tuple[FloatArray, IntArray]:
 
 def _bvh(shapes: Sequence[Shape], eps: float) -> fcl.BVHModel:
     """One FCL mesh model holding the eroded meshes of several pieces."""
-    vertices: list[FloatArray] = []
+    vertices: list[F64] = []
     triangles: list[IntArray] = []
     base = 0
     for shape in shapes:

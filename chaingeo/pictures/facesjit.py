@@ -17,6 +17,7 @@ from functools import lru_cache
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import F64, I64
 from chaingeo.kernels.jit import njit
 from chaingeo.pictures.raster import (
     FACE_CORNERS,
@@ -24,11 +25,8 @@ from chaingeo.pictures.raster import (
     SHADE,
     Camera,
     Faces,
-    FloatArray,
     no_faces,
 )
-
-I64 = npt.NDArray[np.int64]
 
 
 @njit(cache=True)
@@ -63,7 +61,7 @@ def open_faces(cells: I64, facing: I64, normals: I64) -> tuple[I64, I64]:
 
 
 @njit(cache=True)
-def shaded_fills(colors: FloatArray, ci: I64, tone: FloatArray) -> npt.NDArray[np.uint8]:
+def shaded_fills(colors: F64, ci: I64, tone: F64) -> npt.NDArray[np.uint8]:
     """``clip(rint(colors[ci] * tone[:, None]), 0, 255)`` as bytes (rint: half to even)."""
     out = np.empty((ci.shape[0], 3), np.uint8)
     for j in range(ci.shape[0]):
@@ -74,14 +72,14 @@ def shaded_fills(colors: FloatArray, ci: I64, tone: FloatArray) -> npt.NDArray[n
 
 
 @lru_cache(maxsize=64)
-def _camera_arrays(cam: Camera) -> tuple[FloatArray, FloatArray, FloatArray, I64]:
+def _camera_arrays(cam: Camera) -> tuple[F64, F64, F64, I64]:
     """Toward the viewer, right, up, and the indices of the normals turned toward the viewer."""
     v = np.array(cam.toward_viewer)
     facing: I64 = np.flatnonzero(NORMALS @ v > 1e-9).astype(np.int64)
     return v, np.array(cam.right), np.array(cam.up), facing
 
 
-def visible_faces(cells: I64, colors: FloatArray, cam: Camera) -> Faces:
+def visible_faces(cells: I64, colors: F64, cam: Camera) -> Faces:
     """:func:`chaingeo.pictures.raster.visible_faces`, the same arrays."""
     if len(cells) == 0:
         return no_faces()

@@ -28,6 +28,7 @@ from typing import Final, TypeVar
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import F64
 from chaingeo.kernels.jit import mode as jit_mode
 from chaingeo.pictures import rasterjit
 from chaingeo.pictures.facesjit import visible_faces
@@ -49,7 +50,6 @@ from chaingeo.pictures.raster import (
     Camera,
     Faces,
     Flat,
-    FloatArray,
     Projector,
     scaled,
 )
@@ -178,12 +178,10 @@ def _back(plan: _Plan, size: int) -> _Back:
     return _Back(plan, big)
 
 
-def _packed_walls(
-    walls: list[tuple[RGB, FloatArray, FloatArray]], edges: list[FloatArray], k: int
-) -> rasterjit.Packed:
+def _packed_walls(walls: list[tuple[RGB, F64, F64]], edges: list[F64], k: int) -> rasterjit.Packed:
     """``_wall_shapes`` and then the back frame edges, packed from their pixel arrays as they
     come (a frame that follows the pieces draws its walls anew on most pictures)."""
-    pts: list[FloatArray] = []
+    pts: list[F64] = []
     meta: list[tuple[int, int, int]] = []
     colors: list[RGB] = []
     for fill, corners, ends in walls:
@@ -241,7 +239,7 @@ def _union(a: Box, b: Box) -> Box:
     return min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3])
 
 
-def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
+def _touched(pix: F64, margin: int, k: int, size: int) -> Box:
     """Final pixels the faces at drawing pixels ``pix`` may change (fill, edges, reduction)."""
     lo = pix.reshape(-1, 2).min(axis=0) - margin
     hi = pix.reshape(-1, 2).max(axis=0) + margin
@@ -250,7 +248,7 @@ def _touched(pix: FloatArray, margin: int, k: int, size: int) -> Box:
     return max(0, x0), max(0, y0), min(size, x1), min(size, y1)
 
 
-def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, FloatArray]:
+def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, F64]:
     """The picture with the faces drawn (before labels), and their drawing pixels."""
     k = back.plan.k
     if k > 1:  # drawn on a kept work picture: only the reduction is handed out

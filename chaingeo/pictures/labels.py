@@ -17,13 +17,13 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image, ImageDraw
 
+from chaingeo.core.arrays import F64
 from chaingeo.pictures import rasterjit
 from chaingeo.pictures.raster import (
     RGB,
     Box,
     Camera,
     Faces,
-    FloatArray,
     Projector,
     arrow_points,
     arrow_shapes,
@@ -71,9 +71,7 @@ def ink(fill: RGB) -> Pixels:
     return out
 
 
-def text_step(
-    xy: Sequence[float] | FloatArray, text: str, px: int, fill: RGB, anchor: str = "mm"
-) -> Step:
+def text_step(xy: Sequence[float] | F64, text: str, px: int, fill: RGB, anchor: str = "mm") -> Step:
     at = (float(xy[0]), float(xy[1]))
     mask, dx, dy = text_glyph(text, px, anchor)
     x, y = round(at[0]) + dx, round(at[1]) + dy
@@ -126,7 +124,7 @@ def one_by_one(marks: Iterable[TextItem | Step]) -> list[Step]:
     return [m if isinstance(m, Step) else item_step(m) for m in marks]
 
 
-def arrow_step(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> Step:
+def arrow_step(a: F64, b: F64, fill: RGB, width: int) -> Step:
     reach = max(4.0, 3.2 * width) + width + 2
     ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
     box = (
@@ -201,7 +199,7 @@ def tick_marks(
 
 
 def _ticks(
-    base: FloatArray,
+    base: F64,
     axis: int,
     cells: range,
     every: int,

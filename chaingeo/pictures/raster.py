@@ -23,10 +23,11 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw, ImageFont
 from zlib_ng import zlib_ng
 
+from chaingeo.core.arrays import F64
+
 RGB = tuple[int, int, int]
 #: A colour as ``"#rrggbb"`` or an ``(r, g, b)`` triple.
 ColorLike = str | tuple[int, int, int]
-FloatArray = npt.NDArray[np.float64]
 #: (x0, y0, x1, y1) in pixels, the end exclusive.
 Box = tuple[int, int, int, int]
 #: Deflate level for PNG (zlib-ng): fast, and fixed so the same picture gives the same bytes.
@@ -68,7 +69,7 @@ class Camera:
     tick_edges: tuple[tuple[int, tuple[str, str, str]], ...]
 
 
-def _oblique(azimuth_deg: float, elevation_deg: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+def _oblique(azimuth_deg: float, elevation_deg: float) -> tuple[F64, F64, F64]:
     a, e = math.radians(azimuth_deg), math.radians(elevation_deg)
     v = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
     r = np.cross(np.array([0.0, 0.0, 1.0]), v)
@@ -105,7 +106,7 @@ def parse_color(color: ColorLike) -> RGB:
 class Faces:
     """Visible cube faces, far to near: screen corners (n, 4, 2), fill colours, their cells."""
 
-    corners: FloatArray
+    corners: F64
     fills: npt.NDArray[np.uint8]
     cells: npt.NDArray[np.int64]
     normals: npt.NDArray[np.int64]  # index into NORMALS
@@ -121,7 +122,7 @@ def no_faces() -> Faces:
     )
 
 
-def visible_faces(cells: npt.NDArray[np.int64], colors: FloatArray, cam: Camera) -> Faces:
+def visible_faces(cells: npt.NDArray[np.int64], colors: F64, cam: Camera) -> Faces:
     """Faces not shared by two filled cells and turned toward the camera, sorted far to near."""
     v = np.array(cam.toward_viewer)
     facing = np.flatnonzero(NORMALS @ v > 1e-9)
@@ -198,22 +199,20 @@ def _text_mask(text: str, px: int, anchor: str) -> tuple[Image.Image, int, int]:
     return mask, left, top
 
 
-def _text_at(
-    xy: Sequence[float] | FloatArray, text: str, px: int, anchor: str
-) -> tuple[Image.Image, Box]:
+def _text_at(xy: Sequence[float] | F64, text: str, px: int, anchor: str) -> tuple[Image.Image, Box]:
     mask, dx, dy = _text_mask(text, px, anchor)
     x, y = round(float(xy[0])) + dx, round(float(xy[1])) + dy
     return mask, (x, y, x + mask.size[0], y + mask.size[1])
 
 
-def text_box(xy: Sequence[float] | FloatArray, text: str, px: int, anchor: str = "mm") -> Box:
+def text_box(xy: Sequence[float] | F64, text: str, px: int, anchor: str = "mm") -> Box:
     """The pixels :func:`put_text` may change (end exclusive)."""
     return _text_at(xy, text, px, anchor)[1]
 
 
 def put_text(
     image: Image.Image,
-    xy: Sequence[float] | FloatArray,
+    xy: Sequence[float] | F64,
     text: str,
     px: int,
     fill: RGB,
@@ -235,12 +234,12 @@ def put_text(
 class Projector:
     """World point -> screen pixel (final resolution) for one camera and one image layout."""
 
-    right: FloatArray
-    up: FloatArray
+    right: F64
+    up: F64
     scale: float
     origin: tuple[float, float]
 
-    def __call__(self, p: npt.ArrayLike) -> FloatArray:
+    def __call__(self, p: npt.ArrayLike) -> F64:
         q = np.asarray(p, dtype=np.float64)
         if q.ndim == 1:  # one point (labels): the same arithmetic on scalars, 5x faster
             x1 = float(q @ self.right) * self.scale + self.origin[0]
@@ -250,7 +249,7 @@ class Projector:
         y = -(q @ self.up) * self.scale + self.origin[1]
         return np.stack([x, y], axis=-1)
 
-    def screen(self, xy2: FloatArray) -> FloatArray:
+    def screen(self, xy2: F64) -> F64:
         """Camera-plane coordinates (right, up) -> pixels."""
         out = np.empty_like(xy2)
         out[..., 0] = xy2[..., 0] * self.scale + self.origin[0]
@@ -258,14 +257,14 @@ class Projector:
         return out
 
 
-def frame_corners(lo: Sequence[int], hi: Sequence[int]) -> FloatArray:
+def frame_corners(lo: Sequence[int], hi: Sequence[int]) -> F64:
     return np.array(
         [(x, y, z) for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])],
         dtype=np.float64,
     )
 
 
-def fit(points: FloatArray, cam: Camera, box: tuple[float, float, float, float]) -> Projector:
+def fit(points: F64, cam: Camera, box: tuple[float, float, float, float]) -> Projector:
     """Scale and centre ``points`` (world) into the pixel rectangle ``box`` (x0, y0, x1, y1)."""
     r, u = np.array(cam.right), np.array(cam.up)
     w = max(float(np.ptp(points @ r)), 1e-9)
@@ -278,16 +277,16 @@ def scaled(p: Projector, k: int) -> Projector:
     return Projector(p.right, p.up, p.scale * k, (p.origin[0] * k, p.origin[1] * k))
 
 
-def polygon(draw: ImageDraw.ImageDraw, pts: FloatArray, **kw: object) -> None:
+def polygon(draw: ImageDraw.ImageDraw, pts: F64, **kw: object) -> None:
     draw.polygon([(float(x), float(y)) for x, y in pts], **kw)  # type: ignore[arg-type]
 
 
-def line(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:
+def line(draw: ImageDraw.ImageDraw, a: F64, b: F64, fill: RGB, width: int) -> None:
     draw.line([(float(a[0]), float(a[1])), (float(b[0]), float(b[1]))], fill=fill, width=width)
 
 
 #: A flat shape: (0 polygon fill or 1 polyline, its points in pixels, colour, line width).
-Flat = tuple[int, FloatArray, RGB, int]
+Flat = tuple[int, F64, RGB, int]
 
 
 def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
@@ -301,7 +300,7 @@ def draw_flat(draw: ImageDraw.ImageDraw, shapes: Sequence[Flat]) -> None:
             draw.draw.draw_lines(ring, ink, width)
 
 
-def arrow_points(a: FloatArray, b: FloatArray, width: int) -> list[list[float]] | None:
+def arrow_points(a: F64, b: F64, width: int) -> list[list[float]] | None:
     """The arrow from ``a`` to ``b``: the shaft's two ends, then the head's three corners
     (None when too short to draw). Plain float arithmetic in the order the array expressions
     of the first version took (the same numbers: ticks make three arrows per picture)."""
@@ -318,7 +317,7 @@ def arrow_points(a: FloatArray, b: FloatArray, width: int) -> list[list[float]] 
     return [[ax, ay], [base_x, base_y], [bx, by], left, right]
 
 
-def arrow_shapes(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> list[Flat]:
+def arrow_shapes(a: F64, b: F64, fill: RGB, width: int) -> list[Flat]:
     """A line from ``a`` to ``b`` with a filled head at ``b`` (the font has no arrow glyphs)."""
     pts = arrow_points(a, b, width)
     if pts is None:
@@ -326,7 +325,7 @@ def arrow_shapes(a: FloatArray, b: FloatArray, fill: RGB, width: int) -> list[Fl
     return [(1, np.array(pts[:2]), fill, width), (0, np.array(pts[2:]), fill, 0)]
 
 
-def arrow(draw: ImageDraw.ImageDraw, a: FloatArray, b: FloatArray, fill: RGB, width: int) -> None:
+def arrow(draw: ImageDraw.ImageDraw, a: F64, b: F64, fill: RGB, width: int) -> None:
     draw_flat(draw, arrow_shapes(a, b, fill, width))
 
 
@@ -340,12 +339,10 @@ def draw_faces(draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: 
         draw.line([*ring, ring[0]], fill=EDGE, width=width, joint="curve")
 
 
-def draw_faces_fast(
-    draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: int
-) -> FloatArray:
+def draw_faces_fast(draw: ImageDraw.ImageDraw, faces: Faces, proj: Projector, width: int) -> F64:
     """:func:`draw_faces` calling the core drawing methods ``ImageDraw.polygon`` and ``line``
     end in, without their per-call checks (same pixels); returns the faces' screen corners."""
-    pix: FloatArray = proj.screen(faces.corners)
+    pix: F64 = proj.screen(faces.corners)
     if width > 4:  # wide lines get round joints, drawn by ImageDraw.line itself
         draw_faces(draw, faces, proj, width)
         return pix
@@ -364,13 +361,13 @@ def draw_faces_fast(
 
 
 def fit_centre(
-    points: FloatArray, cam: Camera, box: tuple[float, float, float, float], scale: float
+    points: F64, cam: Camera, box: tuple[float, float, float, float], scale: float
 ) -> tuple[float, float]:
     """Origin that centres ``points`` in ``box`` at a given scale."""
     return centre_at(extreme_sums(points, cam), box, scale)
 
 
-def extreme_sums(points: FloatArray, cam: Camera) -> tuple[float, float]:
+def extreme_sums(points: F64, cam: Camera) -> tuple[float, float]:
     """Along screen right and up: the largest plus the smallest coordinate of ``points``."""
     sx, sy = points @ np.array(cam.right), points @ np.array(cam.up)
     return float(sx.max() + sx.min()), float(sy.max() + sy.min())
@@ -429,7 +426,7 @@ def png_bytes(image: Image.Image) -> bytes:
     )
 
 
-def sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: FloatArray) -> int:
+def sheet_grid(n: int, size: float, title_h: float, label_h: float, spans: F64) -> int:
     """Columns of the piece grid that draw the pieces largest (fewest columns on a tie)."""
     best, best_scale = 1, -1.0
     for cols in range(1, n + 1):
@@ -448,8 +445,8 @@ class Posed:
 
     cells: npt.NDArray[np.int64]
     color: RGB
-    rotation: FloatArray  # (3, 3)
-    translation: FloatArray  # (3,)
+    rotation: F64  # (3, 3)
+    translation: F64  # (3,)
 
 
 def _on_lattice(part: Posed) -> npt.NDArray[np.int64] | None:
@@ -465,12 +462,12 @@ def _on_lattice(part: Posed) -> npt.NDArray[np.int64] | None:
     return np.asarray(np.rint(centres - 0.5), dtype=np.int64)
 
 
-def _shade_of(normals: FloatArray) -> FloatArray:
+def _shade_of(normals: F64) -> F64:
     """Brightness of turned faces: the axis faces' :data:`SHADE` mixed by the squared normal
     components (a convex mix, exact on the axes, so a turn fades smoothly between tones)."""
     pos, neg = np.clip(normals, 0, None) ** 2, np.clip(-normals, 0, None) ** 2
     mix = np.stack([pos[:, 0], neg[:, 0], pos[:, 1], neg[:, 1], pos[:, 2], neg[:, 2]], axis=1)
-    out: FloatArray = mix @ SHADE
+    out: F64 = mix @ SHADE
     return out
 
 
@@ -491,7 +488,7 @@ def posed_faces(parts: Sequence[Posed], cam: Camera) -> Faces:
             return visible_faces(np.zeros((0, 3), np.int64), np.zeros((0, 3)), cam)
         return visible_faces(np.concatenate(cells), np.concatenate(colors), cam)
     v = np.array(cam.toward_viewer)
-    chunks: list[tuple[FloatArray, FloatArray, FloatArray, npt.NDArray[np.int64]]] = []
+    chunks: list[tuple[F64, F64, F64, npt.NDArray[np.int64]]] = []
     for part in parts:
         if len(part.cells) == 0:
             continue

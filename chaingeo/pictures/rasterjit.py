@@ -26,10 +26,10 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import U8
 from chaingeo.kernels.jit import njit
 from chaingeo.pictures.raster import Flat
 
-U8 = npt.NDArray[np.uint8]
 POLYGON = 0
 POLYLINE = 1
 

@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image, ImageDraw
 
+from chaingeo.core.arrays import F64
 from chaingeo.core.geometry import Shape
 from chaingeo.pictures.labels import (
     AXIS_NAMES,
@@ -43,7 +44,6 @@ from chaingeo.pictures.raster import (
     ColorLike,
     Faces,
     Flat,
-    FloatArray,
     Posed,
     Projector,
     box_spans,
@@ -215,7 +215,7 @@ def _plane_is_back(axis: int, side: str, cam: Camera) -> bool:
     return inward * cam.toward_viewer[axis] > 1e-9
 
 
-def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
+def _wall_corners(scene: _Scene, axis: int, side: str) -> F64:
     lo, hi = scene.lo, scene.hi
     b, c = [i for i in range(3) if i != axis]
     fixed = lo[axis] if side == "lo" else hi[axis]
@@ -227,7 +227,7 @@ def _wall_corners(scene: _Scene, axis: int, side: str) -> FloatArray:
     return np.array(pts)
 
 
-def _grid_ends(scene: _Scene, axis: int, side: str) -> FloatArray:
+def _grid_ends(scene: _Scene, axis: int, side: str) -> F64:
     """The ends of a wall's grid lines, two rows a line: across the wall at every cell
     boundary along one of its axes, then along the other."""
     b, c = [i for i in range(3) if i != axis]
@@ -243,9 +243,7 @@ def _grid_ends(scene: _Scene, axis: int, side: str) -> FloatArray:
     return np.concatenate(blocks)
 
 
-def wall_pixels(
-    scene: _Scene, cam: Camera, proj: Projector
-) -> list[tuple[RGB, FloatArray, FloatArray]]:
+def wall_pixels(scene: _Scene, cam: Camera, proj: Projector) -> list[tuple[RGB, F64, F64]]:
     """Each back wall and the floor: its colour, its corners and its grid lines' ends (two rows
     a line) in pixels, in drawing order."""
     out = []
@@ -273,7 +271,7 @@ def _draw_walls(
     draw_flat(draw, _wall_shapes(scene, cam, proj, width))
 
 
-def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[FloatArray, FloatArray]]:
+def _frame_edges(scene: _Scene, cam: Camera, back: bool) -> list[tuple[F64, F64]]:
     """The 12 frame edges that lie between two back walls (``back``) or the others."""
     out = []
     lo, hi = scene.lo, scene.hi

@@ -16,11 +16,11 @@ from typing import Final, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import I64, U8
 from chaingeo.kernels.jit import njit
 from chaingeo.pictures.raster import RGB, Box, text_glyph
-from chaingeo.pictures.rasterjit import U8, Canvas, canvas, rectangle
+from chaingeo.pictures.rasterjit import Canvas, canvas, rectangle
 
-I64 = npt.NDArray[np.int64]
 #: One label: the anchor point (x, y), the text, its pixel size, colour and Pillow anchor.
 TextItem = tuple[float, float, str, int, RGB, str]
 #: Bytes of glyphs past which the next run starts a fresh atlas.

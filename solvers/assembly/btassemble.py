@@ -31,6 +31,7 @@ from typing import Literal
 
 import numpy as np
 
+from chaingeo.core.arrays import I32
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.geometry import Shape
 from chaingeo.solvers.assembly.groups import PieceGroups, analyze_grouped
@@ -42,7 +43,6 @@ from chaingeo.solvers.cover.constrained import (
     PartSpec,
     canonical_keys,
 )
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverError
 from chaingeo.solvers.cover.rowreduce import live_rows
 from chaingeo.solvers.cover.search import CoverSearch
@@ -90,7 +90,7 @@ def bt_packing_spec(puzzle: BTPuzzle, index: int, *, merge_congruent: bool = Fal
 @dataclass(frozen=True)
 class Anchor:
     label: str
-    rows: Int32Array  # the rows searched (every row but the anchored non-representatives)
+    rows: I32  # the rows searched (every row but the anchored non-representatives)
     factor: float  # anchored rows before / after
 
 
@@ -104,7 +104,7 @@ def choose_anchor(packing: Packing) -> Anchor | None:
     if len(maps) == 1 or packing.n_rows == 0:
         return None
     starts = packing.problem.row_start
-    best: tuple[tuple[int, float, int], str, Int32Array, Int32Array] | None = None
+    best: tuple[tuple[int, float, int], str, I32, I32] | None = None
     for t, info in enumerate(packing.types):
         a, b = int(starts[t]), int(starts[t + 1])
         if info.lo != 1 or info.hi != 1 or a == b:
@@ -129,9 +129,7 @@ def choose_anchor(packing: Packing) -> Anchor | None:
     return Anchor(label, np.flatnonzero(keep).astype(np.int32), len(anchored) / len(reps))
 
 
-def _cell_anchor(
-    packing: Packing, maps: Int32Array
-) -> tuple[float, str, Int32Array, Int32Array] | None:
+def _cell_anchor(packing: Packing, maps: I32) -> tuple[float, str, I32, I32] | None:
     problem = packing.problem
     perms = np.stack([packing.symmetries[g].perm for g in packing.group(False)])
     stab = (perms == np.arange(problem.n_cells)[None, :]).sum(axis=0)
@@ -140,7 +138,7 @@ def _cell_anchor(
         return None
     ptr = problem.row_ptr
     owner = np.repeat(np.arange(problem.n_rows, dtype=np.int32), np.diff(ptr))
-    best: tuple[float, str, Int32Array, Int32Array] | None = None
+    best: tuple[float, str, I32, I32] | None = None
     for c in np.flatnonzero(stab == stab.max()):
         group = np.flatnonzero(perms[:, c] == c)
         rows = np.unique(owner[problem.flat_cells == c]).astype(np.int32)
@@ -160,7 +158,7 @@ def iter_classes(
     node_limit: int | None = None,
     anchor: Anchor | Literal["auto"] | None = "auto",
     deadline: Deadline | None = None,
-) -> Iterator[Int32Array]:
+) -> Iterator[I32]:
     """One assembly per class (its rows, sorted), in the search's fixed order. ``anchor``:
     the symmetry cut (:func:`choose_anchor` by default; None searches every row). Past
     ``deadline`` the search stops with its :class:`SearchLimitError`."""
@@ -203,7 +201,7 @@ def iter_classes(
             yield np.sort(sol[sol >= 0]).astype(np.int32)
 
 
-def named_assembly(packing: Packing, rows: Int32Array) -> dict[str, Shape]:
+def named_assembly(packing: Packing, rows: I32) -> dict[str, Shape]:
     """``{piece name: placed voxels}``: copies of a type are ``name``, ``name_2``, ...; in
     BurrTools' piece order (the problem's parts in order, a part's copies together), the order
     its disassembler lists moves in."""

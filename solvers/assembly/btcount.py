@@ -18,8 +18,8 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I32, I64
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import njit
@@ -32,16 +32,20 @@ from chaingeo.solvers.assembly.btassemble import (
     named_assembly,
     piece_groups,
 )
+from chaingeo.solvers.assembly.btparallel import (
+    NO,
+    STUCK,
+    YES,
+    verdicts,
+)
 from chaingeo.solvers.cover.constrained import Packing
 from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.jobs import check_jobs
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import btsearch as bt
 from chaingeo.solvers.motion import levelsearch as ls
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.disassemble import KERNEL_NODES, Analysis, Separations
-
-I64 = npt.NDArray[np.int64]
-Int32Array = npt.NDArray[np.int32]
 
 #: Placement keys ``(transformation, x, y, z)`` packed into one ordered integer.
 _BIAS = 1 << 15
@@ -185,7 +189,7 @@ class RowVerdicts:
                 image[seg] = image[seg][np.argsort(self._key(image[seg]), kind="stable")]
         return image
 
-    def verdict(self, rows: Int32Array) -> bool | None:
+    def verdict(self, rows: I32) -> bool | None:
         """Whether BurrTools takes the assembly ``rows`` apart (None: not decided here)."""
         self.level = None
         pieces = rows[self.piece[rows]].astype(np.int64)
@@ -225,8 +229,20 @@ class StuckCheck:
         self.cells = problem.flat_cells
         self.piece = problem.row_type != packing.hole_type
 
-    def __call__(self, rows: Int32Array) -> bool:
+    def __call__(self, rows: I32) -> bool:
         return bool(mv.stuck(self.pos, self.box, self.row_ptr, self.cells, rows[self.piece[rows]]))
+
+
+class WorkerChecks:
+    """How a worker builds its checks of one packing (picklable, for spawned workers)."""
+
+    def __init__(self, packing: Packing, limits: SearchLimits | None, want_levels: bool) -> None:
+        self.packing = packing
+        self.limits = limits
+        self.want_levels = want_levels
+
+    def __call__(self) -> tuple[StuckCheck, RowVerdicts]:
+        return StuckCheck(self.packing), RowVerdicts(self.packing, self.limits, self.want_levels)
 
 
 @dataclass(frozen=True)
@@ -257,6 +273,7 @@ def count_bt(
     levels: list[str] | None = None,
     partial: bool = False,
     fast: bool = True,
+    jobs: int | None = 1,
 ) -> BTReport:
     """BurrTools' assemblies and solutions of a packing, and the first solution. The search
     and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
@@ -268,7 +285,9 @@ def count_bt(
     was counted (lower bounds) and the error. The running counts are kept in the deadline's
     :class:`chaingeo.solvers.deadline.Progress` as the search goes. ``fast``: BurrTools' verdicts on
     rows (:class:`RowVerdicts`) where they apply; False sends every assembly through the
-    general path (the two are compared in the tests)."""
+    general path (the two are compared in the tests). ``jobs``: processes that take the
+    assemblies apart (None: the machine's cores; :mod:`chaingeo.solvers.assembly.btparallel`),
+    the same figures whatever it is."""
     start = time.perf_counter()
     if deadline is None and limits is not None:
         deadline = Deadline(limits.seconds)
@@ -286,20 +305,21 @@ def count_bt(
         on_rows = RowVerdicts(packing, limits, levels is not None, frame)
     counts = deadline.progress.counts if deadline is not None else {}
     limit: SearchLimitError | None = None
+    worker = None
+    if on_rows is not None:
+        worker = WorkerChecks(packing, limits, levels is not None)
+    stream = verdicts(
+        classes, stuck, on_rows, jobs=check_jobs(jobs), deadline=deadline, worker=worker
+    )
     try:
-        for rows in classes:
+        for rows, code, level in stream:
             tally.assemblies += 1
             counts["assemblies"] = tally.assemblies
-            if stuck is not None and stuck(rows):
+            if code in (STUCK, NO):
                 continue
-            if on_rows is not None:
-                if deadline is not None:
-                    deadline.check()
-                verdict = on_rows.verdict(rows)
-                if verdict is False or (verdict and tally.first is not None):
-                    if verdict:
-                        tally.solution(on_rows.level, counts)
-                    continue
+            if code == YES and tally.first is not None:
+                tally.solution(level, counts)
+                continue
             asm = named_assembly(packing, rows)
             if frame is not None:
                 if len(asm) < 2:
@@ -317,6 +337,8 @@ def count_bt(
         if not partial:
             raise
         limit = e  # an assembly being taken apart then is counted, its verdict is not
+    finally:
+        stream.close()  # stops the workers, if any
     label = None if anchor is None else anchor.label
     seconds = time.perf_counter() - start
     return BTReport(

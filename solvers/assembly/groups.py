@@ -13,8 +13,13 @@ The whole puzzle is always searched (a first separation is needed). :class:`Grou
 the plain disassembler (:mod:`chaingeo.solvers.motion.disassemble`) with that rule at its one hook
 (``subpart``); rule 2's counts are shared by everything one analysis accepts, and a part
 accepted on a branch that is later abandoned keeps its share (BurrTools never abandons one: it
-stops at the first separation, the default here too). The optimal full disassembly (o_i) is not
-searched with groups: its lower bounds assume every piece comes apart.
+stops at the first separation, the default here too).
+
+*o_i with groups* (:func:`optimal_grouped`): the fewest moves to a state whose every part is one
+piece or pieces all of one group (rule 1). The search's bound on the removals a part still needs
+counts the part's *classes* (the pieces of one group together, every other piece alone): any
+finished state has at least one part per class. Rule 2 accepts a part because it is stuck, which
+a shortest plan does not aim at: where the analysis needs it, o_i is not searched.
 """
 
 from __future__ import annotations
@@ -25,9 +30,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from chaingeo.core.geometry import Shape
+from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion.disassemble import Analysis, Separation, Separations, _Solver
+from chaingeo.solvers.motion.disassemble import (
+    Analysis,
+    OptimalLimitError,
+    Separation,
+    Separations,
+    _Solver,
+)
 
 #: A piece's groups: ``(group id, count)`` pairs of its shape (the count is the shape's).
 GroupSpec = tuple[tuple[int, int], ...]
@@ -104,6 +116,16 @@ class GroupedSolver(_Solver):
         self.groups = groups
         self.grouped: list[list[str]] = []  # the parts accepted by rule 2
 
+    def min_removals(self, members: tuple[int, ...]) -> int:
+        """One part per class at the end (rule 1): the pieces of one group together, every
+        other piece alone; so at least classes - 1 removals."""
+        classes: set[int | str] = set()
+        for m in members:
+            name = self.table.names[m]
+            spec = self.groups.groups_of.get(name, ())
+            classes.add(spec[0][0] if len(spec) == 1 else name)
+        return len(classes) - 1
+
     def subpart(
         self, members: tuple[int, ...], offsets: np.ndarray
     ) -> tuple[bool, Separation | None]:
@@ -152,4 +174,50 @@ def analyze_grouped(
         tree=tree,
         states=solver.states,
         first_level=len(tree.moves),
+    )
+
+
+#: Why o_i is not given when the analysis accepts a stuck part by its group (rule 2).
+RULE_TWO = "o_i is not searched where a stuck part is accepted by its group (BurrTools' rule 2)"
+
+
+def optimal_grouped(
+    shapes: Mapping[str, Shape],
+    groups: PieceGroups,
+    *,
+    max_group: int | None = None,
+    limits: SearchLimits | None = None,
+    deadline: Deadline | None = None,
+) -> Analysis:
+    """o_i and an optimal plan under rule 1 (see the module's docstring), seeded by a
+    disassembly over any separation; ``optimal_steps`` None when that disassembly needs rule 2.
+    A cap reached raises :class:`chaingeo.solvers.motion.disassemble.OptimalLimitError` with the
+    bounds proved."""
+    solver = GroupedSolver(shapes, groups, max_group, limits or SearchLimits(), deadline, "any")
+    n = len(solver.table.names)
+    members = tuple(range(n))
+    tree = solver.part_tree(members, np.zeros((n, 3), dtype=np.int64)) if n > 1 else None
+    if tree is None or solver.grouped:
+        done = n == 1 or solver.min_removals(members) == 0
+        return Analysis(done or tree is not None, None, None, 0 if done else None)
+    bound = tree.total_moves()
+    steps, plan = bound, tree.all_moves()
+    least = solver.min_removals(members)
+    if bound > least:
+        solver.bounds = [least, bound]
+        try:
+            found, better = solver.optimal(members, np.zeros((n, 3), dtype=np.int64), bound)
+        except SearchLimitError as e:
+            lo, hi = solver.bounds or (least, bound)
+            raise OptimalLimitError(e, lo, hi) from None
+        if better is not None:
+            steps, plan = found, better
+    return Analysis(
+        disassemblable=True,
+        level=tree.level_text(),
+        moves=bound,
+        optimal_steps=steps,
+        plan=tuple(plan),
+        tree=tree,
+        states=solver.states,
     )

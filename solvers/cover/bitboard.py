@@ -19,16 +19,11 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I32, I64, U64
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover import kernels as kn
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
-
-I32 = npt.NDArray[np.int32]
-I64 = npt.NDArray[np.int64]
-U64 = npt.NDArray[np.uint64]
 
 MAX_CELLS = 64
 #: Levels (from the root) at which the search branches on whichever of the first empty cell and
@@ -286,7 +281,7 @@ def scan_axes(problem: CoverProblem) -> list[int]:
     return axes
 
 
-def scan_order(problem: CoverProblem) -> Int32Array:
+def scan_order(problem: CoverProblem) -> I32:
     """``bit[cell]``: cells ranked in :func:`scan_axes` order."""
     vox = problem.target.voxels - problem.target.min_corner
     axes = scan_axes(problem)
@@ -299,7 +294,7 @@ def scan_order(problem: CoverProblem) -> Int32Array:
 class BitboardArrays:
     """Row masks and per-cell candidate lists of a problem restricted to a subset of rows."""
 
-    def __init__(self, problem: CoverProblem, rows: Int32Array) -> None:
+    def __init__(self, problem: CoverProblem, rows: I32) -> None:
         if problem.n_cells > MAX_CELLS:
             raise ValueError(f"bit-board needs at most {MAX_CELLS} cells, got {problem.n_cells}")
         bit = scan_order(problem)

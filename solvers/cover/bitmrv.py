@@ -27,17 +27,12 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I32, I64, U64
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover import kernels as kn
 from chaingeo.solvers.cover.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
-
-I32 = npt.NDArray[np.int32]
-I64 = npt.NDArray[np.int64]
-U64 = npt.NDArray[np.uint64]
 
 _ONE = np.uint64(1)
 _NONE = np.uint64(0)
@@ -435,7 +430,7 @@ def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide | None) 
 class MRVArrays:
     """Row masks (``W`` words each) of a problem restricted to a subset of its rows."""
 
-    def __init__(self, problem: CoverProblem, rows: Int32Array) -> None:
+    def __init__(self, problem: CoverProblem, rows: I32) -> None:
         n_cells = problem.n_cells
         self.words = W = max(1, -(-n_cells // 64))
         bit = scan_order(problem)  # the first-cell kernel's order: regions_ok relies on it
@@ -510,7 +505,7 @@ class MRVArrays:
         )
 
 
-def _row_cells(problem: CoverProblem, rows: Int32Array) -> tuple[Int32Array, Int32Array]:
+def _row_cells(problem: CoverProblem, rows: I32) -> tuple[I32, I32]:
     """The cells of ``rows`` one after the other, and the index into ``rows`` of each."""
     ptr, flat = problem.row_ptr, problem.flat_cells
     sizes = ptr[rows + 1] - ptr[rows]
@@ -519,7 +514,7 @@ def _row_cells(problem: CoverProblem, rows: Int32Array) -> tuple[Int32Array, Int
     return owner, flat[first + np.arange(len(owner))]
 
 
-def _starts(owner: Int32Array, n: int) -> Int32Array:
+def _starts(owner: I32, n: int) -> I32:
     """Where each of the ``n`` rows begins in :func:`_row_cells`' arrays (rows are never
     empty: a piece has a voxel)."""
     return np.searchsorted(owner, np.arange(n, dtype=np.int32)).astype(np.int32)

@@ -26,10 +26,10 @@ from functools import cached_property
 
 import numpy as np
 
+from chaingeo.core.arrays import I32
 from chaingeo.core.geometry import ROTATION_STACK, SYMMETRIES, Shape
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover.placements import (
-    Int32Array,
     IntArray,
     Placements,
     fitting_shifts,
@@ -199,7 +199,7 @@ class TypeInfo:
 class Symmetry:
     matrix: IntArray
     shift: IntArray
-    perm: Int32Array  # cell i -> cell perm[i]
+    perm: I32  # cell i -> cell perm[i]
     proper: bool
 
 
@@ -216,7 +216,7 @@ class Packing:
     symmetries: tuple[Symmetry, ...]  # identity first, rotations before reflections
     mirror_type: tuple[int, ...]  # per type: its mirror image's type, or -1
     hole_type: int = -1  # the type of holes (see compile_packing), or -1
-    _maps: dict[bool, Int32Array] = field(default_factory=dict, repr=False)
+    _maps: dict[bool, I32] = field(default_factory=dict, repr=False)
 
     @property
     def n_rows(self) -> int:
@@ -234,7 +234,7 @@ class Packing:
         """Indices into :attr:`symmetries`: rotations only, or every symmetry."""
         return [i for i, s in enumerate(self.symmetries) if reflections or s.proper]
 
-    def row_maps(self, reflections: bool) -> Int32Array:
+    def row_maps(self, reflections: bool) -> I32:
         """``maps[g, r]``: the row that symmetry ``g`` of :meth:`group` makes of row ``r``
         (-1: its image is a piece the problem does not have). A symmetry's row is its own
         business, so with the rotations' maps known only the reflections are looked up."""
@@ -249,7 +249,7 @@ class Packing:
             self._maps[reflections] = hit
         return hit
 
-    def _row_maps(self, syms: list[Symmetry]) -> Int32Array:
+    def _row_maps(self, syms: list[Symmetry]) -> I32:
         """Every symmetry at once, type by type (one lookup per type and handedness, not one
         per symmetry and type: 0.05 s on SolidSixPieceBurrs' 12 rotations and 25 pieces)."""
         out = np.full((len(syms), self.n_rows), -1, dtype=np.int32)
@@ -279,7 +279,7 @@ class Packing:
         return self.problem.placed_shape(row)
 
 
-def _lookup_rows(table: IntArray, queries: IntArray) -> Int32Array:
+def _lookup_rows(table: IntArray, queries: IntArray) -> I32:
     """Index of each query row in ``table`` (rows of equal width; equal rows of ``table``: the
     last one), or -1. Rows compared as raw bytes, sorted and bisected in numpy: ~10 ms for
     48 000 queries, and no kernel to load (the first numba load of a process costs ~0.15 s)."""
@@ -468,7 +468,7 @@ def _hole_rows(target: Shape, cells: list[int]) -> Placements:
     )
 
 
-def canonical_keys(maps: Int32Array, solutions: Int32Array) -> Int32Array:
+def canonical_keys(maps: I32, solutions: I32) -> I32:
     """Per solution (rows, -1 padded), the least sorted row set among its images under the
     group of ``maps`` (images through a -1 are skipped: not assemblies of this problem)."""
     out = np.empty(solutions.shape, dtype=np.int32)
@@ -477,7 +477,7 @@ def canonical_keys(maps: Int32Array, solutions: Int32Array) -> Int32Array:
 
 
 @njit(cache=True)
-def _least_images(maps: Int32Array, solutions: Int32Array, out: Int32Array) -> None:
+def _least_images(maps: I32, solutions: I32, out: I32) -> None:
     """:func:`canonical_keys` in one pass per solution, over its real rows only (numpy's
     version built every image of every solution, padding included: 0.05 s of
     SolidSixPieceBurrs' 4199 raw assemblies)."""

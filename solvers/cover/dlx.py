@@ -20,16 +20,11 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I32
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover import kernels as kn
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverProblem
-
-I32 = npt.NDArray[np.int32]
-I64 = npt.NDArray[np.int64]
-U64 = npt.NDArray[np.uint64]
 
 PRIMARY, SECONDARY, COUNTER = 0, 1, 2
 
@@ -256,7 +251,7 @@ def dlx_run(links: Links, cols: Columns, lv: kn.Levels, ctl: kn.Control) -> int:
 class DLXArrays:
     """The linked-list matrix of a problem restricted to a subset of its rows."""
 
-    def __init__(self, problem: CoverProblem, rows: Int32Array) -> None:
+    def __init__(self, problem: CoverProblem, rows: I32) -> None:
         T = len(problem.types)
         n_cells = problem.n_cells
         n_cols = T + n_cells

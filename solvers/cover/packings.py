@@ -44,13 +44,14 @@ first yield what they found. Every function also takes a ``deadline``
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
+from chaingeo.core.arrays import I32
 from chaingeo.core.geometry import Shape
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import (
     CoverError,
     CoverProblem,
@@ -103,7 +104,7 @@ class Solution:
         return [s for _, s in self.placements]
 
 
-def make_solution(problem: CoverProblem, rows: Int32Array) -> Solution:
+def make_solution(problem: CoverProblem, rows: I32) -> Solution:
     ids = sorted(int(r) for r in rows if r >= 0)
     per_type: dict[int, list[int]] = {}
     for r in ids:
@@ -132,17 +133,15 @@ class AnchorPlan:
     """
 
     label: str  # the anchor piece's name, or "cell [x, y, z]"
-    rows: Int32Array  # every anchored row
-    group: Int32Array  # the subgroup used (indices into the problem's row maps)
+    rows: I32  # every anchored row
+    group: I32  # the subgroup used (indices into the problem's row maps)
     exact: bool  # a unique piece under the whole group: free-rep solutions are all distinct
-    free_reps: Int32Array  # reps whose stabiliser is trivial (orbit size len(group))
-    fixed_reps: Int32Array  # reps with a non-trivial stabiliser
-    fixed_orbit: Int32Array  # orbit size of each fixed rep
+    free_reps: I32  # reps whose stabiliser is trivial (orbit size len(group))
+    fixed_reps: I32  # reps with a non-trivial stabiliser
+    fixed_orbit: I32  # orbit size of each fixed rep
 
 
-def _orbits(
-    maps: Int32Array, group: Int32Array, rows: Int32Array
-) -> tuple[Int32Array, Int32Array, Int32Array]:
+def _orbits(maps: I32, group: I32, rows: I32) -> tuple[I32, I32, I32]:
     """Orbit representatives of ``rows`` under ``group``: free, fixed, and fixed orbit sizes."""
     sub = maps[group]
     reps = np.unique(sub[:, rows].min(axis=0))
@@ -212,7 +211,7 @@ def _cell_anchor(problem: CoverProblem) -> AnchorPlan | None:
     return None if best is None else best[1]
 
 
-def canonical_forms(problem: CoverProblem, solutions: Int32Array, chunk: int = 4096) -> Int32Array:
+def canonical_forms(problem: CoverProblem, solutions: I32, chunk: int = 4096) -> I32:
     """Lexicographically least sorted row set of each solution over the symmetry group.
 
     ``solutions`` is ``(n, k)`` row ids, ``-1`` padded; the result is ``(n, k)`` (padding last).
@@ -233,7 +232,7 @@ def canonical_forms(problem: CoverProblem, solutions: Int32Array, chunk: int = 4
     return np.where(out == big, -1, out)
 
 
-def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> int:
+def _count_distinct_forms(problem: CoverProblem, blocks: list[I32]) -> int:
     if not blocks:
         return 0
     width = max(b.shape[1] for b in blocks)
@@ -243,7 +242,7 @@ def _count_distinct_forms(problem: CoverProblem, blocks: list[Int32Array]) -> in
     return len(np.unique(canonical_forms(problem, sols), axis=0))
 
 
-def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, reps: Int32Array) -> Int32Array:
+def _restricted_rows(problem: CoverProblem, plan: AnchorPlan, reps: I32) -> I32:
     keep = np.ones(problem.n_rows, dtype=bool)
     keep[plan.rows] = False
     keep[reps] = True
@@ -262,12 +261,16 @@ def count_packings(
     symmetry: bool = True,
     anchor: str | None = None,
     deadline: Deadline | None = None,
+    jobs: int = 1,
 ) -> CoverResult:
-    """Count all solutions and (if asked) the distinct ones up to the target's symmetries."""
+    """Count all solutions and (if asked) the distinct ones up to the target's symmetries.
+    ``jobs`` > 1: the searches' subtrees on that many worker processes
+    (:mod:`chaingeo.solvers.cover.parallel`; not with a node limit or a deadline), the same
+    counts."""
     problem = _problem(pieces, target, optional, reflections)
     syms, _ = problem.symmetry
     plan = anchor_plan(problem, anchor) if symmetry else None
-    budget = _Budget(node_limit, deadline)
+    budget = _CoverBudget(node_limit, deadline, jobs, engine)
     if plan is None:
         search = budget.search(problem, None, engine)
         if not distinct:
@@ -275,12 +278,16 @@ def count_packings(
             return CoverResult(total, None, budget.stats, len(syms), None)
         every = budget.collect(search)
         return CoverResult(
-            search.found, _count_distinct_forms(problem, every), budget.stats, len(syms), None
+            sum(len(b) for b in every),
+            _count_distinct_forms(problem, every),
+            budget.stats,
+            len(syms),
+            None,
         )
     h = len(plan.group)
     total = 0
     n_distinct = 0
-    blocks: list[Int32Array] = []
+    blocks: list[I32] = []
     if len(plan.free_reps):
         search = budget.search(problem, _restricted_rows(problem, plan, plan.free_reps), engine)
         if distinct and not plan.exact:
@@ -306,23 +313,60 @@ def count_packings(
     return CoverResult(total, n_distinct if distinct else None, budget.stats, len(syms), plan.label)
 
 
-class _Budget:
+class _CoverBudget:
     """Shares one node limit (and the deadline) across the several searches of a count."""
 
-    def __init__(self, node_limit: int | None, deadline: Deadline | None) -> None:
+    def __init__(
+        self,
+        node_limit: int | None,
+        deadline: Deadline | None,
+        jobs: int = 1,
+        engine: Engine = "auto",
+    ) -> None:
         if node_limit is not None and node_limit < 0:
             raise CoverError(f"node_limit: must be >= 0, got {node_limit}")
+        if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+            raise CoverError(f"jobs: expected a positive number of processes, got {jobs!r}")
         self.limit = node_limit
         self.deadline = deadline
         self.stats = CoverStats()
         self.found = 0
+        bounded = deadline is not None and deadline.bounded
+        self.jobs = jobs if node_limit is None and not bounded else 1
+        self.engine = engine
 
-    def search(self, problem: CoverProblem, rows: Int32Array | None, engine: Engine) -> CoverSearch:
+    def _parallel(self, search: CoverSearch, collect: bool) -> list[I32]:
+        """The search's subtrees on the workers (its own kernel never runs)."""
+        from chaingeo.solvers.cover import parallel
+
+        t0 = time.perf_counter()
+        if collect:
+            blocks, nodes = parallel.collect_parallel(
+                search.problem, search.rows, self.engine, self.jobs
+            )
+            found = sum(len(b) for b in blocks)
+        else:
+            blocks = []
+            found, nodes = parallel.count_parallel(
+                search.problem, search.rows, self.engine, self.jobs
+            )
+        seconds = time.perf_counter() - t0
+        self.stats += CoverStats(nodes, 0, seconds, search.engine, search.kernel)
+        self.found += found
+        self.parallel_found = found
+        return blocks
+
+    def _worth_workers(self, search: CoverSearch) -> bool:
+        from chaingeo.solvers.cover.parallel import MIN_ROWS
+
+        return self.jobs > 1 and len(search.rows) >= MIN_ROWS
+
+    def search(self, problem: CoverProblem, rows: I32 | None, engine: Engine) -> CoverSearch:
         left = None if self.limit is None else max(self.limit - self.stats.nodes, 0)
         return CoverSearch(problem, rows, engine=engine, node_limit=left, deadline=self.deadline)
 
-    def _run(self, search: CoverSearch, collect: bool) -> list[Int32Array]:
-        blocks: list[Int32Array] = []
+    def _run(self, search: CoverSearch, collect: bool) -> list[I32]:
+        blocks: list[I32] = []
         try:
             if collect:
                 blocks.extend(search.batches(4096))
@@ -336,10 +380,15 @@ class _Budget:
         return blocks
 
     def count(self, search: CoverSearch) -> int:
+        if self._worth_workers(search):
+            self._parallel(search, False)
+            return self.parallel_found
         self._run(search, False)
         return search.found
 
-    def collect(self, search: CoverSearch) -> list[Int32Array]:
+    def collect(self, search: CoverSearch) -> list[I32]:
+        if self._worth_workers(search):
+            return self._parallel(search, True)
         return self._run(search, True)
 
 

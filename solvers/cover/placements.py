@@ -17,11 +17,10 @@ from functools import lru_cache
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import I32, Bools
 from chaingeo.core.geometry import SYMMETRIES, Shape
 
 IntArray = npt.NDArray[np.int64]
-Int32Array = npt.NDArray[np.int32]
-BoolArray = npt.NDArray[np.bool_]
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,13 +30,13 @@ class TargetIndex:
     target: Shape
     origin: IntArray  # min corner of the target
     dims: tuple[int, int, int]  # bounding-box extent
-    grid: Int32Array  # cell index at [x, y, z] - origin, or -1 outside the target
+    grid: I32  # cell index at [x, y, z] - origin, or -1 outside the target
 
     @property
     def n_cells(self) -> int:
         return len(self.target)
 
-    def index_of(self, cells: npt.ArrayLike) -> Int32Array:
+    def index_of(self, cells: npt.ArrayLike) -> I32:
         """Cell indices of absolute voxels (``-1`` for voxels outside the target)."""
         v = np.asarray(cells, dtype=np.int64).reshape(-1, 3) - self.origin
         inside = np.all((v >= 0) & (v < np.asarray(self.dims)), axis=1)
@@ -60,7 +59,7 @@ def target_index(target: Shape) -> TargetIndex:
     return TargetIndex(target, origin, dims, grid)
 
 
-def fitting_shifts(fits: BoolArray, vox: IntArray, layer: IntArray) -> tuple[IntArray, IntArray]:
+def fitting_shifts(fits: Bools, vox: IntArray, layer: IntArray) -> tuple[IntArray, IntArray]:
     """Every ``(orientation, shift)`` putting each voxel ``vox[o, j]`` (orientations of ``k``
     voxels, each at the origin) on a cell where ``fits[layer[o, j]]`` holds (``fits``:
     ``(layers, *dims)``, a layer per colour), in orientation order then lexicographic shift
@@ -113,10 +112,10 @@ class Placements:
 
     shape: Shape
     orientations: tuple[Shape, ...]
-    cells: Int32Array  # (n, len(shape))
-    orientation: Int32Array  # (n,)
+    cells: I32  # (n, len(shape))
+    orientation: I32  # (n,)
     offset: IntArray  # (n, 3)
-    lookup: Int32Array  # (n_orientations, *dims)
+    lookup: I32  # (n_orientations, *dims)
     origin: IntArray  # the target's min corner: lookup translations are relative to it
 
     def __len__(self) -> int:
@@ -181,7 +180,7 @@ def target_symmetries(target: Shape, reflections: bool = True) -> list[tuple[Int
     return out
 
 
-def cell_permutation(target: Shape, m: IntArray, t: IntArray) -> Int32Array:
+def cell_permutation(target: Shape, m: IntArray, t: IntArray) -> I32:
     """``perm[i]`` = index of the image of cell ``i`` under the symmetry ``v -> m v + t``."""
     idx = target_index(target)
     perm = idx.index_of(target.voxels @ np.asarray(m).T + np.asarray(t))

@@ -20,10 +20,10 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
+from chaingeo.core.arrays import I32
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import Shape, box_cells
 from chaingeo.solvers.cover.placements import (
-    Int32Array,
     IntArray,
     Placements,
     cell_permutation,
@@ -122,7 +122,7 @@ class CoverProblem:
     optional: frozenset[int]  # indices of cells that may stay empty
     types: tuple[PieceType, ...]
     table: tuple[Placements, ...]  # placements of each type
-    row_type: Int32Array  # (R,) type of each row
+    row_type: I32  # (R,) type of each row
     row_start: IntArray  # (T + 1,) rows of type t are row_start[t] : row_start[t + 1]
     reflections: bool  # reflections were asked for
     _cache: dict[object, object] = field(default_factory=dict, repr=False)
@@ -136,9 +136,9 @@ class CoverProblem:
     def n_rows(self) -> int:
         return len(self.row_type)
 
-    def row_cells(self, row: int) -> Int32Array:
+    def row_cells(self, row: int) -> I32:
         t = int(self.row_type[row])
-        cells: Int32Array = self.table[t].cells[row - int(self.row_start[t])]
+        cells: I32 = self.table[t].cells[row - int(self.row_start[t])]
         return cells
 
     @cached_property
@@ -150,7 +150,7 @@ class CoverProblem:
         return ptr
 
     @cached_property
-    def flat_cells(self) -> Int32Array:
+    def flat_cells(self) -> I32:
         parts = [p.cells.reshape(-1) for p in self.table]
         return np.concatenate(parts).astype(np.int32) if parts else np.zeros(0, np.int32)
 
@@ -169,12 +169,12 @@ class CoverProblem:
         return key == mirrored
 
     @cached_property
-    def symmetry(self) -> tuple[tuple[tuple[IntArray, IntArray], ...], Int32Array]:
+    def symmetry(self) -> tuple[tuple[tuple[IntArray, IntArray], ...], I32]:
         """``(symmetries, row_maps)``: the faithful group and ``row_maps[g, r]`` = image row."""
         use_mirrors = self.reflections and self.mirror_invariant
         syms = target_symmetries(self.target, reflections=use_mirrors)
         kept: list[tuple[IntArray, IntArray]] = []
-        maps: list[Int32Array] = []
+        maps: list[I32] = []
         seen: set[bytes] = set()
         opt = np.asarray(sorted(self.optional), dtype=np.int32)
         for m, t in syms:
@@ -204,7 +204,7 @@ class CoverProblem:
         """Per type: orientation key -> orientation number (see :func:`_orientation_keys`)."""
         return [{k: i for i, k in enumerate(_orientation_keys(_stacked(p)))} for p in self.table]
 
-    def _row_map(self, m: IntArray, t: IntArray) -> Int32Array | None:
+    def _row_map(self, m: IntArray, t: IntArray) -> I32 | None:
         origin = target_index(self.target).origin
         out = np.empty(self.n_rows, dtype=np.int32)
         for ti, table in enumerate(self.table):
@@ -224,7 +224,7 @@ class CoverProblem:
             out[s : s + len(table)] = rows + int(self.row_start[image_type])
         return out
 
-    def cell_permutations(self) -> Int32Array:
+    def cell_permutations(self) -> I32:
         syms, _ = self.symmetry
         return np.stack([cell_permutation(self.target, m, t) for m, t in syms])
 

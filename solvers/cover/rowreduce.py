@@ -15,12 +15,11 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import I32, I64
 from chaingeo.kernels.jit import mode, njit
 from chaingeo.solvers.cover.problem import CoverProblem
 
-I64 = npt.NDArray[np.int64]
 B1 = npt.NDArray[np.bool_]
-Int32Array = npt.NDArray[np.int32]
 
 #: Passes over the rows at most (each after the first only when some row died).
 MAX_PASSES = 16
@@ -97,7 +96,7 @@ def _some_column_gone(
     return False
 
 
-def live_rows(problem: CoverProblem, rows: Int32Array | None = None) -> Int32Array:
+def live_rows(problem: CoverProblem, rows: I32 | None = None) -> I32:
     """``rows`` (default: all) without the rows no cover of ``problem`` can hold, in order.
 
     Columns: every cell (required unless optional) and, for a piece used at most once, the
@@ -112,9 +111,7 @@ def live_rows(problem: CoverProblem, rows: Int32Array | None = None) -> Int32Arr
     return np.flatnonzero(alive).astype(np.int32)
 
 
-def columns(
-    problem: CoverProblem, rows: Int32Array | None = None
-) -> tuple[I64, I64, I64, I64, B1, B1]:
+def columns(problem: CoverProblem, rows: I32 | None = None) -> tuple[I64, I64, I64, I64, B1, B1]:
     """The arrays :func:`_dead_rows` takes: rows' columns, columns' rows, required, alive."""
     n_rows, n_cells = problem.n_rows, problem.n_cells
     alive = np.zeros(n_rows, dtype=np.bool_)

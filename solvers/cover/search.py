@@ -24,12 +24,12 @@ from typing import Literal
 
 import numpy as np
 
+from chaingeo.core.arrays import I32
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.cover import kernels
 from chaingeo.solvers.cover.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
 from chaingeo.solvers.cover.bitmrv import MRVArrays, mrv_run
 from chaingeo.solvers.cover.dlx import DLXArrays, dlx_run
-from chaingeo.solvers.cover.placements import Int32Array
 from chaingeo.solvers.cover.problem import CoverError, CoverProblem
 from chaingeo.solvers.deadline import Deadline
 
@@ -120,7 +120,7 @@ def choose_engine(problem: CoverProblem, engine: Engine) -> Literal["dlx", "bitb
 Arrays = DLXArrays | BitboardArrays | MRVArrays
 
 
-def _arrays(problem: CoverProblem, rows: Int32Array, kernel: Kernel) -> Arrays:
+def _arrays(problem: CoverProblem, rows: I32, kernel: Kernel) -> Arrays:
     key = (kernel, rows.tobytes())
     hit = problem._cache.get(key)
     if hit is None:
@@ -150,7 +150,7 @@ class CoverSearch:
     def __init__(
         self,
         problem: CoverProblem,
-        rows: Int32Array | None = None,
+        rows: I32 | None = None,
         *,
         engine: Engine = "auto",
         rng: np.random.Generator | None = None,
@@ -220,7 +220,7 @@ class CoverSearch:
     def done(self) -> bool:
         return int(self._regs[kernels.REG_STATUS]) == kernels.DONE
 
-    def _kernel(self, out: Int32Array, max_store: int, stop_after: int, node_limit: int) -> int:
+    def _kernel(self, out: I32, max_store: int, stop_after: int, node_limit: int) -> int:
         """One call of the search's kernel up to ``node_limit`` nodes in total; solutions go to
         ``out`` (see :func:`chaingeo.solvers.cover.dlx.dlx_run`)."""
         a = self._arr
@@ -239,7 +239,7 @@ class CoverSearch:
             return bitboard_run(a.rows, self._occ, lv, ctl)
         return mrv_run(a.rows, self._stack, ctl, self._wide)
 
-    def _call(self, max_store: int, stop_after: int) -> Int32Array:
+    def _call(self, max_store: int, stop_after: int) -> I32:
         out = np.zeros((max(max_store, 1), self._depth), dtype=np.int32)
         t0 = time.perf_counter()
         self._expired = False
@@ -250,7 +250,7 @@ class CoverSearch:
         self._seconds += time.perf_counter() - t0
         return out[:n]
 
-    def _sliced(self, deadline: Deadline, out: Int32Array, max_store: int, stop_after: int) -> int:
+    def _sliced(self, deadline: Deadline, out: I32, max_store: int, stop_after: int) -> int:
         """:meth:`_kernel` in slices of :attr:`_slice` nodes, the deadline checked before each:
         returns the solutions stored, with :attr:`_expired` set when the deadline passed."""
         regs = self._regs
@@ -301,7 +301,7 @@ class CoverSearch:
                 self._raise_limit()
         return self.found
 
-    def batches(self, size: int = 1024) -> Iterator[Int32Array]:
+    def batches(self, size: int = 1024) -> Iterator[I32]:
         """Solutions as arrays of row ids (``-1`` padded), at most ``size`` per batch.
 
         At the node limit the solutions found so far are yielded, then

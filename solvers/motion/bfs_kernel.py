@@ -14,8 +14,8 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I64
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion.movement import (
     Pieces,
@@ -24,9 +24,6 @@ from chaingeo.solvers.motion.movement import (
     rebuild_table,
     shift_child,
 )
-
-I64 = npt.NDArray[np.int64]
-I16 = npt.NDArray[np.int16]
 
 #: Status codes returned by :func:`expand` (5 and 6 are
 #: :mod:`chaingeo.solvers.motion.turnmoves`' own).

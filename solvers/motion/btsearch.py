@@ -25,8 +25,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I64
 from chaingeo.core.kinematics import Move, SearchLimitError
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.deadline import Deadline
@@ -46,9 +46,6 @@ from chaingeo.solvers.motion.levelsearch import (
     _record,
 )
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable, part_size
-
-I64 = npt.NDArray[np.int64]
-I16 = npt.NDArray[np.int16]
 
 #: Status of :func:`part_search`: a separation found, the part cannot come apart, a buffer to
 #: grow (the caller grows it and calls again), past the node budget (call again to go on),

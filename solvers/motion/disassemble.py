@@ -48,6 +48,7 @@ if TYPE_CHECKING:  # imported when a puzzle turns: most never do
 
 __all__ = [
     "Analysis",
+    "OptimalLimitError",
     "SearchLimitError",
     "SearchLimits",
     "Separation",
@@ -170,6 +171,9 @@ class _Solver:
         self.first_memo: dict[PartKey, Separation | None] = {}
         self.opt_memo: dict[PartKey, tuple[int, bool, list[Move | TurnMove]]] = {}
         self.states = 0
+        #: ``[lo, hi]`` proven on the whole puzzle's o_i while :meth:`optimal` searches it (set
+        #: by the caller that asks for them; None otherwise).
+        self.bounds: list[int] | None = None
 
     def key(self, members: tuple[int, ...], offsets: np.ndarray) -> PartKey:
         if self.turn_table is not None:
@@ -381,17 +385,22 @@ class _Solver:
         return tree is not None, tree
 
     # -- optimal full disassembly --------------------------------------------------------------
+    def min_removals(self, members: tuple[int, ...]) -> int:
+        """Removals any plan needs to finish the part: every piece comes apart (with piece
+        groups, :class:`chaingeo.solvers.assembly.groups.GroupedSolver` needs fewer)."""
+        return len(members) - 1
+
     def optimal(
         self, members: tuple[int, ...], offsets: np.ndarray, budget: int, floor: int = 0
     ) -> tuple[int, list[Move | TurnMove] | None]:
         """``(f, plan)`` with ``f`` the fewest moves to take the part apart if that is below
         ``budget``; otherwise ``(lower bound >= budget, None)``. ``floor`` is a proven lower
         bound on ``f`` from the caller: the search stops as soon as a plan meets it."""
-        n = len(members)
-        if n == 1:
+        least = self.min_removals(members)
+        if least == 0:
             return 0, []
-        if n - 1 >= budget:
-            return n - 1, None
+        if least >= budget:
+            return least, None
         k = self.key(members, offsets)
         memo = self.opt_memo.get(k)
         if memo is not None:
@@ -400,24 +409,52 @@ class _Solver:
                 return (value, plan) if value < budget else (value, None)
             if value >= budget:
                 return value, None
+        top, self.bounds = self.bounds, None  # only the outermost call proves the whole's bounds
+        try:
+            return self._optimal_part(members, offsets, budget, floor, k, top)
+        finally:
+            self.bounds = top
+
+    def _optimal_part(
+        self,
+        members: tuple[int, ...],
+        offsets: np.ndarray,
+        budget: int,
+        floor: int,
+        k: PartKey,
+        top: list[int] | None,
+    ) -> tuple[int, list[Move | TurnMove] | None]:
+        """:meth:`optimal` past its memo: the search itself (``top``: the whole puzzle's
+        bounds, updated as they are proved, when this is the outermost call)."""
+        after = self.min_removals(members) - 1  # removals still needed after the first
         s = self.search(members, offsets)
         best, best_plan = budget, None
-        while not s.exhausted and s.depth + 1 + (n - 2) < best and best > floor:
-            for sp in s.unique_splits(s.expand_layers(best - n)):
+        while not s.exhausted and s.depth + 1 + after < best and best > floor:
+            if top is not None:
+                # Every removal above the next layer has been tried: a shorter plan first
+                # separates there or deeper, then needs ``after`` more removals.
+                top[0] = max(top[0], min(best, s.depth + 1 + after))
+            removals = s.expand_layers(best - 2 - after)
+            if top is not None and removals:
+                top[0] = max(top[0], min(best, removals[0].depth + 1 + after))
+            for sp in s.unique_splits(removals):
                 if best <= floor:
                     break
                 r = sp.removal
                 rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
                 base = r.depth + 1
-                if base + (len(rm) - 1) + (len(lm) - 1) >= best:
+                left_least = self.min_removals(lm)
+                if base + self.min_removals(rm) + left_least >= best:
                     continue
-                fa, pa = self.optimal(rm, roff, best - base - (len(lm) - 1))
+                fa, pa = self.optimal(rm, roff, best - base - left_least)
                 if pa is None:
                     continue
                 fb, pb = self.optimal(lm, loff, best - base - fa)
                 if pb is None:
                     continue
                 best = base + fa + fb
+                if top is not None:
+                    top[1] = min(top[1], best)
                 best_plan = [
                     *s.path_to(r.node),
                     s.removal_move(r),
@@ -504,6 +541,16 @@ def _decode(
     return build(root)
 
 
+class OptimalLimitError(SearchLimitError):
+    """The optimal search stopped at a cap, with what it proved: ``lo <= o_i <= hi`` (``hi``:
+    the shortest full disassembly found, ``lo``: no shorter one exists)."""
+
+    def __init__(self, cause: SearchLimitError, lo: int, hi: int) -> None:
+        super().__init__(cause.reason, cause.cap)
+        self.lo = lo
+        self.hi = hi
+
+
 def analyze_assembly(
     shapes: Mapping[str, Shape],
     *,
@@ -563,7 +610,13 @@ def analyze_assembly(
         floor = lower_bound or 0
         bound = seed.total_moves()
         if bound > floor:
-            found, better = solver.optimal(members, offsets, bound, floor)
+            # BurrTools' own plan (``tree``) may be the shorter: an upper bound too.
+            solver.bounds = [max(floor, solver.min_removals(members)), min(bound, total)]
+            try:
+                found, better = solver.optimal(members, offsets, bound, floor)
+            except SearchLimitError as e:
+                lo, hi = solver.bounds or (floor, bound)
+                raise OptimalLimitError(e, lo, hi) from None
             steps, plan = (found, better) if better is not None else (bound, plan)
         else:
             steps = bound

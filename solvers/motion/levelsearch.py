@@ -14,14 +14,11 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I64
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
-
-I64 = npt.NDArray[np.int64]
-I16 = npt.NDArray[np.int16]
 
 #: Status codes in ``ctx[STATUS]`` (0: fine): a cap reached, more nodes expanded than
 #: ``params[BUDGET]``, or a buffer to enlarge and rerun.

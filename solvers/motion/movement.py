@@ -17,14 +17,9 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I32, I64, U64
 from chaingeo.kernels.jit import njit
-
-I64 = npt.NDArray[np.int64]
-I16 = npt.NDArray[np.int16]
-I32 = npt.NDArray[np.int32]
-U64 = npt.NDArray[np.uint64]
 
 #: "Never meets": larger than any real gap.
 INF = 1 << 40

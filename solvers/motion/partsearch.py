@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -115,7 +116,47 @@ def part_size(members: Sequence[int]) -> int:
     return n
 
 
-class PartSearch:
+TableT = TypeVar("TableT")
+
+
+class LayeredSearch(Generic[TableT]):
+    """What the layered breadth-first searches of one part share (translations only here,
+    with turns in :class:`chaingeo.solvers.motion.turnsearch.TurnPartSearch`): the part, its
+    caps, its deadline, and the state cap's error."""
+
+    def __init__(
+        self,
+        table: TableT,
+        members: Sequence[int],
+        *,
+        max_group: int | None,
+        limits: SearchLimits,
+        deadline: Deadline,
+        chunk: int,
+    ) -> None:
+        self.n = part_size(members)
+        self.table = table
+        self.members = tuple(members)
+        self.max_group = -1 if max_group is None else int(max_group)
+        self.group_limit = int(limits.group_limit)
+        self.limits = limits
+        self.deadline = deadline
+        self.chunk = chunk
+        self.n_states = 1
+        self.n_seps = 0
+
+    def next_capacity(self, cap: int) -> int:
+        """The state buffers' next size after ``cap``; at the state cap, its
+        :class:`SearchLimitError`."""
+        if cap >= self.limits.max_states:
+            raise SearchLimitError(
+                f"state cap of {self.limits.max_states} reached in a {self.n}-piece part",
+                "max_states",
+            )
+        return min(2 * cap, self.limits.max_states)
+
+
+class PartSearch(LayeredSearch[PieceTable]):
     """Layered breadth-first search of one part from one configuration."""
 
     def __init__(
@@ -129,13 +170,10 @@ class PartSearch:
         deadline: Deadline,
         chunk: int = 20000,
     ) -> None:
-        n = self.n = part_size(members)
-        self.table = table
-        self.members = tuple(members)
-        self.max_group = -1 if max_group is None else int(max_group)
-        self.limits = limits
-        self.deadline = deadline
-        self.chunk = chunk
+        super().__init__(
+            table, members, max_group=max_group, limits=limits, deadline=deadline, chunk=chunk
+        )
+        n = self.n
         vox, starts, lo, hi = table.part_arrays(self.members)
         cap = max(2, min(128, limits.max_states))  # most parts come apart in a few states
         # The kernel's bundles are kept, and replaced only when a buffer grows: every call
@@ -157,8 +195,6 @@ class PartSearch:
         start = start - start[0]
         row = start.reshape(-1).astype(np.int16)
         mv.find_or_insert(self.tree.states, 0, self.tree.table, row)
-        self.n_states = 1
-        self.n_seps = 0
         # Layer d holds nodes layers[d]:layers[d + 1]; ``node``: the next one to expand.
         self.layers = np.zeros(cap + 2, dtype=np.int64)
         self.layers[1] = 1
@@ -191,12 +227,7 @@ class PartSearch:
         states, parent, move, table = self.tree
         cap = states.shape[0]
         if self.n_states + 1 >= cap:
-            if cap >= self.limits.max_states:
-                raise SearchLimitError(
-                    f"state cap of {self.limits.max_states} reached in a {self.n}-piece part",
-                    "max_states",
-                )
-            new_cap = min(2 * cap, self.limits.max_states)
+            new_cap = self.next_capacity(cap)
             states, parent, move = bfs.grow_search(states, parent, move, new_cap)
             self.layers = np.concatenate([self.layers, np.zeros_like(self.layers)])[: new_cap + 2]
         self.tree = bfs.Tree(states, parent, move, bfs.fit_table(table, states, self.n_states))

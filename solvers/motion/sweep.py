@@ -23,11 +23,9 @@ from functools import cache
 from typing import NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I64
 from chaingeo.kernels.jit import njit
-
-I64 = npt.NDArray[np.int64]
 
 #: Stencils cover relative positions up to this (doubled units, both coordinates): every cell of
 #: a 12-cell-wide part, about any centre in its box.

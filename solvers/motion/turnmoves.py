@@ -27,8 +27,8 @@ from collections.abc import Mapping, Sequence
 from typing import NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I64, U64
 from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
 from chaingeo.core.turns import quarter_index
 from chaingeo.kernels.jit import njit
@@ -36,8 +36,6 @@ from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.sweep import FAR_LIMIT, StencilArrays, rmax2, rmin2, turn_hit
 
-I64 = npt.NDArray[np.int64]
-U64 = npt.NDArray[np.uint64]
 N_ROT = 24
 #: Extra status of the search kernel: a cell lies beyond
 #: :data:`chaingeo.solvers.motion.sweep.FAR_LIMIT` of a turn's axis, where the exact int64 test

@@ -32,7 +32,7 @@ from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion import turnmoves as tm
-from chaingeo.solvers.motion.partsearch import Removal, Split, part_size
+from chaingeo.solvers.motion.partsearch import LayeredSearch, Removal, Split
 from chaingeo.solvers.motion.sweep import FAR_LIMIT, Stencils, stencils, swept_through
 
 _DIR_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
@@ -51,7 +51,7 @@ def _direction(vec: np.ndarray) -> int:
 _expand_turns = Pinned(tm.expand_turns)
 
 
-class TurnPartSearch:
+class TurnPartSearch(LayeredSearch[tm.TurnTable]):
     """Layered breadth-first search of one part from one configuration, turns included."""
 
     def __init__(
@@ -65,14 +65,10 @@ class TurnPartSearch:
         deadline: Deadline,
         chunk: int = 2000,
     ) -> None:
-        n = self.n = part_size(members)
-        self.table = table
-        self.members = tuple(members)
-        self.max_group = -1 if max_group is None else int(max_group)
-        self.group_limit = int(limits.group_limit)
-        self.limits = limits
-        self.deadline = deadline
-        self.chunk = chunk
+        super().__init__(
+            table, members, max_group=max_group, limits=limits, deadline=deadline, chunk=chunk
+        )
+        n = self.n
         self.vox, self.starts, self.lo, self.hi, self.rod = table.part_arrays(self.members)
         cap = max(2, min(1024, limits.max_states))
         self.states = np.zeros((cap, 4 * n), dtype=np.int16)
@@ -87,8 +83,6 @@ class TurnPartSearch:
         self.origin = start[0, :3].copy()  # the anchor's real offset: T starts as this shift
         row = np.concatenate([(start[:, :3] - self.origin).reshape(-1), start[:, 3]])
         mv.find_or_insert(self.states, 0, self.hash, row.astype(np.int16))
-        self.n_states = 1
-        self.n_seps = 0
         self.layers: list[int] = [0, 1]
 
     @property
@@ -102,12 +96,7 @@ class TurnPartSearch:
     def _grow_states(self) -> None:
         cap = self.states.shape[0]
         if self.n_states + 1 >= cap:
-            if cap >= self.limits.max_states:
-                raise SearchLimitError(
-                    f"state cap of {self.limits.max_states} reached in a {self.n}-piece part",
-                    "max_states",
-                )
-            new_cap = min(2 * cap, self.limits.max_states)
+            new_cap = self.next_capacity(cap)
             self.states = np.concatenate([self.states, np.zeros_like(self.states)])[:new_cap]
             self.parent = np.concatenate([self.parent, np.full(cap, -1, dtype=np.int64)])[:new_cap]
             self.move = np.concatenate([self.move, np.zeros_like(self.move)])[:new_cap]

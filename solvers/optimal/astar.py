@@ -232,7 +232,7 @@ def astar_optimal(
     sizes = (sum(len(s) == 2 for s in fam), sum(len(s) == 3 for s in fam))
     if n == 1:
         return AStarResult(0, (), 0, 1, 0, 0, 0, 0, 0, 0, sizes)
-    run = ak.Run(table, pdb, -1 if max_group is None else int(max_group), lim, deadline)
+    run = ak.AStarRun(table, pdb, -1 if max_group is None else int(max_group), lim, deadline)
     goal = run.search()
     plan: tuple[Move, ...] = ()
     steps: int | None = None

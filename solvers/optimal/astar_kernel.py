@@ -3,7 +3,7 @@ resumable loop.
 
 A whole state is one ``int16`` row of ``4 n``: ``row[i]`` is the label of piece ``i``'s part
 (its smallest piece index), ``row[n + 3 i + t]`` its offset relative to that piece. The loop
-(:func:`run_astar`) keeps everything in arrays owned by :class:`Run` and returns a status when
+(:func:`run_astar`) keeps everything in arrays owned by :class:`AStarRun` and returns a status when
 a buffer is full, a pattern-database entry is missing, a batch is done (so Python can check
 the deadline) or the search ends; the next call resumes where it stopped (a node whose
 expansion was cut short is expanded again from scratch; its children already stored are found
@@ -16,8 +16,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I32, I64, U8
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import entry, njit
 from chaingeo.solvers.motion import movement as mv
@@ -27,9 +27,6 @@ if TYPE_CHECKING:
     from chaingeo.solvers.deadline import Deadline
     from chaingeo.solvers.motion.partsearch import PieceTable
     from chaingeo.solvers.optimal.pattern_db import PatternDB
-
-I64 = npt.NDArray[np.int64]
-I32 = npt.NDArray[np.int32]
 
 
 @dataclass(frozen=True)
@@ -45,10 +42,6 @@ class AStarLimits:
     seconds: float | None = 300.0
     group_limit: int = 4096
 
-
-I16 = npt.NDArray[np.int16]
-U8 = npt.NDArray[np.uint8]
-U64 = npt.NDArray[np.uint64]
 
 FOUND, EXHAUSTED, NEED_STATES, NEED_HEAP, NEED_PDB, NEED_MOVES, YIELD, LIMIT, GROUPS = range(9)
 # Registers shared with Python.
@@ -77,7 +70,7 @@ def pdb_view(pdb: PatternDB, miss: I16) -> PDBView:
 
 
 class Nodes(NamedTuple):
-    """The stored states (:class:`Run`'s arrays): ``rows`` and their hash ``table``; per node
+    """The stored states (:class:`AStarRun`'s arrays): ``rows`` and their hash ``table``; per node
     ``g``, ``h``, the active part's ``h``, ``f``, the parent and the move from it (group mask,
     direction, ``k``; 0 for a removal), and whether it is closed."""
 
@@ -462,7 +455,7 @@ def run_astar(
     regs: I64, nodes: Nodes, heap: Heap, pieces: Pieces, pdb: PDBView, max_expansions: int,
     batch: int,
 ) -> int:  # fmt: skip
-    """A* from the stored states until a status (module docstring); see :class:`Run`."""
+    """A* from the stored states until a status (module docstring); see :class:`AStarRun`."""
     n = pieces.lo.shape[0]
     work = (
         np.empty(nodes.rows.shape[1], dtype=np.int16),
@@ -486,7 +479,7 @@ def run_astar(
         done += 1
 
 
-class Run:
+class AStarRun:
     """One A* search's arrays, and the Python loop that serves the kernel's requests."""
 
     def __init__(

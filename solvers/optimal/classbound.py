@@ -98,7 +98,7 @@ def join(a: ClassVector, b: ClassVector) -> ClassVector:
 MAX_BUDGET = 127
 
 
-class Packing:
+class ClassPacking:
     """Class vectors packed in one integer, 8 bits per class (the searches compare millions of
     them). A field holds a count up to :data:`MAX_BUDGET`, its top bit is a guard, so
     comparison and maximum work on every field at once without borrows crossing fields:
@@ -201,7 +201,7 @@ class ClassVectors:
         self.max_group = -1 if max_group is None else max_group
         self.max_states = max_states
         self.states = 0
-        self.packing = Packing()
+        self.packing = ClassPacking()
         self.memo: dict[tuple[tuple[int, ...], bytes], tuple[int, list[int]]] = {}
         self.buf = np.zeros((4096, 4), dtype=np.int64)
         self.groups = np.zeros(group_limit + 1, dtype=np.uint64)

@@ -23,18 +23,13 @@ from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
-import numpy.typing as npt
 
+from chaingeo.core.arrays import I16, I32, I64
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import entry, njit
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.partsearch import PieceTable
-
-I64 = npt.NDArray[np.int64]
-I32 = npt.NDArray[np.int32]
-I16 = npt.NDArray[np.int16]
-U64 = npt.NDArray[np.uint64]
 
 #: ``g`` of a state from which the sub-puzzle never comes apart (larger than any real plan).
 DEAD = 1 << 20

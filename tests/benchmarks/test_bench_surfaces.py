@@ -1,5 +1,5 @@
 """``chain bench robustness``, round three (issue #37): every class of
-:mod:`chaingeo.benchmarks.surfaces` runs its cases (seeded, each bounded in time) and finds no
+:mod:`chaingeo.benchmarks._surfaces` runs its cases (seeded, each bounded in time) and finds no
 traceback, hang, wrong acceptance or file outside its folder."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from chaingeo.benchmarks import surfaces as bench
+from chaingeo.benchmarks import _surfaces as bench
 
 
 @pytest.mark.parametrize("cls", bench.CLASSES, ids=lambda c: c.__name__)

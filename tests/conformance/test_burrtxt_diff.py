@@ -14,6 +14,8 @@ The larger sweeps are ``-m slow``. burrTxt is built from ``../shared/burrtools-s
 
 from __future__ import annotations
 
+import json
+import os
 import time
 from pathlib import Path
 
@@ -21,7 +23,7 @@ import numpy as np
 import pytest
 
 from chaingeo.core.formats.bt_write import assembled_puzzle, write_xmpuzzle
-from chaingeo.core.formats.burrtools import read_xmpuzzle
+from chaingeo.core.formats.burrtools import BurrToolsError, read_xmpuzzle
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.rules import PuzzleRules
@@ -36,6 +38,14 @@ from tests.support.shared_files import BT
 LEVELS = sorted((ROOT / "levels" / "puzzle").glob("*.json"))
 FEATURES = sorted((ROOT / "tests" / "data" / "burrtools").glob("*.xmpuzzle"))
 SHARED = sorted(BT.glob("*.xmpuzzle")) if BT is not None else []
+#: More of BurrTools' example files, where ``$CHAIN_BURRTOOLS_EXAMPLES`` names a folder of them
+#: (test data only, never in the project; e.g. BurrTools' ``examples/``).
+_MORE = Path(os.environ.get("CHAIN_BURRTOOLS_EXAMPLES", "/nonexistent"))
+SHARED += sorted(
+    p
+    for p in (_MORE.glob("*.xmpuzzle") if _MORE.is_dir() else [])
+    if p.name not in {q.name for q in SHARED}
+)
 SEED = 20
 
 
@@ -201,7 +211,14 @@ def test_more_generated_puzzles_agree(
 
 
 def _problems(path: Path) -> list[tuple[Path, int]]:
-    return [(path, i) for i in range(len(read_xmpuzzle(path).problems))]
+    """The problems of a file; none for one of BurrTools' other grids (we read cubes only)."""
+    try:
+        puzzle = read_xmpuzzle(path)
+    except BurrToolsError:
+        if path.parent == _MORE:
+            return []
+        raise
+    return [(path, i) for i in range(len(puzzle.problems))]
 
 
 FILES = [pi for p in FEATURES for pi in _problems(p)]
@@ -229,3 +246,24 @@ def test_burrtools_files_agree(binary: Path, path: Path, problem: int) -> None:
 )
 def test_burrtools_files_agree_given_time(binary: Path, path: Path, problem: int) -> None:
     compare(binary, "file", f"{path.name} problem {problem}", path, 300, problem)
+
+
+@pytest.mark.parametrize(
+    ("path", "problem"), SHARED_FILES, ids=[f"{p.stem}-{i}" for p, i in SHARED_FILES]
+)
+def test_chain_analyze_prints_burrtxt_figures_by_default(
+    binary: Path, path: Path, problem: int, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``chain analyze FILE`` with no option: burrTxt's assemblies and solutions, one of its
+    levels, and the convention named (files burrTxt finishes in 5 s)."""
+    from chaingeo.cli.main import main
+
+    ref = bt.run(binary, path, 5, problem)
+    if ref is None:
+        pytest.skip("burrTxt takes more than 5 s")
+    args = ["analyze", str(path), "--problem", str(problem), "--no-optimal", "--jit", "numba"]
+    assert main(args) in (0, 1)
+    row = json.loads(capsys.readouterr().out)
+    assert (row["assemblies"], row["solutions"]) == (ref.assemblies, ref.solutions)
+    assert row["convention"] == "burrtxt"
+    assert row["level"] in ref.levels or (not ref.levels and row["level"] is None)

@@ -146,4 +146,5 @@ def test_every_other_json_file_goes_through_the_bounded_reader(
     with pytest.raises(ValueError, match="cannot read replay file"):
         ReplayAgent({"file": str(path)})
     assert main(["cover", "--pieces", str(path), "--box", "2x2x2"]) == 2
-    assert "--pieces" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "--pieces" in err or "not a regular file" in err

@@ -149,6 +149,9 @@ def test_leaderboard_shows_the_reports_numbers(made: tuple[Path, PriceTable], si
     want = [[f(v) for f, v in zip(expected.formats, row, strict=True)] for row in expected.rows]
     assert shown["table1"][1:] == want
     assert {"difficulty", "interactive_vs_oneshot", "levels"} <= set(shown)
+    # the same error bars as the markdown and the CSV, and the caption naming their methods
+    assert f"Uncertainty: {expected.caption}." in (site / "index.html").read_text("utf-8")
+    assert all("[" in cell for cell in [row[3] for row in shown["table1"][1:]])
     assert shown["difficulty"][0][1:] == [
         f"{f} {d}" for f in ("Puzzle", "Stacking") for d in ("Easy", "Mid", "Hard")
     ]

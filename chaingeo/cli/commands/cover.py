@@ -4,7 +4,9 @@ Prints one JSON object: ``solutions`` (all packings), ``distinct`` (up to the bo
 and reflections, reflections only when the piece set is mirror-closed), ``seconds`` (wall time
 of the count, JIT loading excluded), ``nodes`` and the search details. Pieces are always free
 3D pieces (a flat pentomino may be turned over or stood up), so the solid-pentomino counts need
-no extra flag.
+no extra flag. ``--jobs N`` (default: the machine's cores) searches the subtrees of a large
+search on N worker processes (:mod:`chaingeo.solvers.cover.parallel`): the same counts, a
+different ``nodes`` (each subtree's search places its forced rows again).
 """
 
 from __future__ import annotations
@@ -40,6 +42,13 @@ def register(sub: Any) -> None:
     p.add_argument("--no-distinct", action="store_true", help="count all packings only")
     p.add_argument("--no-symmetry", action="store_true", help="search without symmetry reduction")
     p.add_argument("--node-limit", type=int, default=None, help="stop after this many nodes")
+    p.add_argument(
+        "--jobs",
+        type=int,
+        default=None,
+        help="worker processes searching subtrees of a large search (default: the machine's "
+        "cores; one with --node-limit); the same counts whatever it is",
+    )
     p.set_defaults(func=run)
 
 
@@ -118,6 +127,11 @@ def run(args: argparse.Namespace) -> int:
         box = level_box
     else:
         raise CommandError("--box is required unless --pieces is a stacking level file")
+    from chaingeo.solvers.jobs import default_jobs
+
+    if args.jobs is not None and args.jobs < 1:
+        raise CommandError(f"--jobs: expected a positive number of processes, got {args.jobs}")
+    jobs = default_jobs() if args.jobs is None else args.jobs
     count_packings([Shape([(0, 0, 0)])], (1, 1, 1), engine=args.engine)  # load the JIT
     t0 = time.perf_counter()
     try:
@@ -129,6 +143,7 @@ def run(args: argparse.Namespace) -> int:
             engine=args.engine,
             node_limit=args.node_limit,
             symmetry=not args.no_symmetry,
+            jobs=jobs,
         )
     except CoverLimitError as e:
         raise CommandError(str(e)) from None

@@ -28,10 +28,13 @@ import re
 import sys
 from collections import Counter
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from chaingeo.cli.errors import CommandError
 from chaingeo.cli.out_arg import add_out
+
+if TYPE_CHECKING:
+    from chaingeo.evaluation.episode import Outcome
 
 
 def register(sub: Any) -> None:
@@ -204,16 +207,12 @@ def _say_tool_fallback(run: str, records: list[dict[str, Any]]) -> None:
 MAX_REASON_CHARS = 300
 
 
-def _error_reasons(records: list[dict[str, Any]]) -> list[str]:
+def _error_reasons(failed: list[Outcome]) -> list[str]:
     """One line per distinct reason of the errored episodes, most frequent first, with counts
     (cleaned of code points a terminal cannot take, bounded)."""
     from chaingeo.evaluation.sanitize import clean_text, shorten
 
-    reasons = Counter(
-        shorten(clean_text(str(r.get("error") or r.get("error_type") or "?")), MAX_REASON_CHARS)
-        for r in records
-        if r.get("status") == "error"
-    )
+    reasons = Counter(shorten(clean_text(o.error or "?"), MAX_REASON_CHARS) for o in failed)
     return [f"  {n} x {reason}" for reason, n in sorted(reasons.items(), key=lambda x: -x[1])]
 
 
@@ -296,7 +295,7 @@ def run(args: argparse.Namespace) -> int:
     )
     runs: list[Run] = []
     errored: dict[str, int] = {}
-    failed: list[dict[str, Any]] = []
+    failed: list[Outcome] = []
     for name in names:
         # Built-in baselines take no model options; only pass what was given explicitly.
         opts = (
@@ -321,14 +320,14 @@ def run(args: argparse.Namespace) -> int:
                 raise CommandError(str(e)) from None
             run_dir = args.out / f"{_slug(spec.label)}-{proto_name}"
             try:
-                evaluate(levels, spec, run_dir, proto, cfg, prices, stream=sys.stderr)
+                outcomes = evaluate(levels, spec, run_dir, proto, cfg, prices, stream=sys.stderr)
             except AuthenticationError as e:
                 raise CommandError(f"{spec.label}: authentication failed: {e}") from None
-            runs.append(load_run(run_dir))
-            records = list(RunLog(run_dir).latest().values())
-            errored[run_dir.name] = sum(r.get("status") == "error" for r in records)
-            failed += [r for r in records if r.get("status") == "error"]
-            _say_tool_fallback(run_dir.name, records)
+            runs.append(load_run(run_dir))  # the run's header, for the table's row name
+            errors = [o for o in outcomes if o.error is not None]
+            errored[run_dir.name] = len(errors)
+            failed += errors
+            _say_tool_fallback(run_dir.name, list(RunLog(run_dir).latest().values()))
     total = sum(errored.values())
     if total:
         where = ", ".join(f"{name}: {n}" for name, n in errored.items() if n)

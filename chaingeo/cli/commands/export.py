@@ -25,14 +25,12 @@ def register(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from chaingeo.cli.level_arg import find_level
+    from chaingeo.core.files import atomic_write
     from chaingeo.pictures.mesh import export_level
 
     level = find_level(args.level)
     target: Path = args.out or Path(f"{level.id}.{args.format}")
     data = export_level(level, args.format)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = target.with_name(f".{target.name}.tmp")
-    tmp.write_bytes(data)
-    tmp.replace(target)
+    atomic_write(target, data)  # a unique temporary name, removed if the disk is full
     print(target)
     return 0

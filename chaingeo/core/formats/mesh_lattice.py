@@ -36,10 +36,10 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core import limits
+from chaingeo.core.arrays import F64
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.level import LevelError
 
-FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
 #: A face is axis-aligned when its normal is within this angle (radians) of an axis.
@@ -75,18 +75,18 @@ class PartMesh:
     """One part in the assembled arrangement: world-space triangles and its material colour."""
 
     name: str
-    vertices: FloatArray
+    vertices: F64
     faces: IntArray
     rgba: tuple[float, float, float, float] | None
     material: str | None
     files: tuple[str, ...]  # the visual meshes, relative to the model folder
 
     @cached_property
-    def triangles(self) -> FloatArray:
+    def triangles(self) -> F64:
         return np.ascontiguousarray(self.vertices[self.faces], dtype=np.float64)
 
     @cached_property
-    def bounds(self) -> tuple[FloatArray, FloatArray]:
+    def bounds(self) -> tuple[F64, F64]:
         return self.vertices.min(axis=0), self.vertices.max(axis=0)
 
     @cached_property
@@ -101,7 +101,7 @@ class PartMesh:
 # ---------------------------------------------------------------------------------------------
 
 
-def rpy_matrix(roll: float, pitch: float, yaw: float) -> FloatArray:
+def rpy_matrix(roll: float, pitch: float, yaw: float) -> F64:
     """URDF's fixed-axis roll-pitch-yaw rotation ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``, with a
     rotation within 1e-4 of a signed permutation snapped to it (the files round angles)."""
     cr, sr, cp, sp = math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch)
@@ -125,8 +125,8 @@ def rpy_matrix(roll: float, pitch: float, yaw: float) -> FloatArray:
 class Planes:
     """A part's axis-aligned face planes: per axis, positions and areas (clustered)."""
 
-    positions: tuple[FloatArray, FloatArray, FloatArray]
-    weights: tuple[FloatArray, FloatArray, FloatArray]
+    positions: tuple[F64, F64, F64]
+    weights: tuple[F64, F64, F64]
     aligned_area: float
     total_area: float
 
@@ -134,7 +134,7 @@ class Planes:
     def aligned_share(self) -> float:
         return self.aligned_area / self.total_area if self.total_area > 0 else 0.0
 
-    def significant(self, axis: int) -> tuple[FloatArray, FloatArray]:
+    def significant(self, axis: int) -> tuple[F64, F64]:
         keep = self.weights[axis] >= MIN_PLANE_WEIGHT * self.aligned_area
         return self.positions[axis][keep], self.weights[axis][keep]
 
@@ -150,8 +150,8 @@ def face_planes(part: PartMesh, tolerance: float) -> Planes:
     unit[ok] = cross[ok] / norm[ok, None]
     centre = tri.mean(axis=1)
     cos_min = math.cos(ALIGNED_ANGLE)
-    positions: list[FloatArray] = []
-    weights: list[FloatArray] = []
+    positions: list[F64] = []
+    weights: list[F64] = []
     aligned = 0.0
     for axis in range(3):
         sel = ok & (np.abs(unit[:, axis]) >= cos_min)
@@ -171,11 +171,11 @@ def face_planes(part: PartMesh, tolerance: float) -> Planes:
     )
 
 
-def _wrap(x: FloatArray) -> FloatArray:
+def _wrap(x: F64) -> F64:
     return np.asarray(x - np.round(x), dtype=np.float64)
 
 
-def circular_origin(pos: FloatArray, w: FloatArray, unit: float) -> float:
+def circular_origin(pos: F64, w: F64, unit: float) -> float:
     """The origin (mod ``unit``) that best aligns weighted positions: the phases' circular mean."""
     angle = 2 * np.pi * pos / unit
     return float(
@@ -330,7 +330,7 @@ def fit_lattice(
 
 
 @numba.njit(cache=True, parallel=True)
-def _winding_kernel(points: FloatArray, tri: FloatArray, out: FloatArray) -> None:
+def _winding_kernel(points: F64, tri: F64, out: F64) -> None:
     """Generalised winding number (Jacobson et al. 2013): the solid angles of all triangles
     seen from each point over 4 pi; about 1 inside a closed surface, 0 outside. Points run in
     parallel; each point's sum is in triangle order, so results do not depend on threads."""
@@ -351,7 +351,7 @@ def _winding_kernel(points: FloatArray, tri: FloatArray, out: FloatArray) -> Non
         out[i] = total / (4.0 * math.pi)
 
 
-def winding_numbers(part: PartMesh, points: FloatArray) -> FloatArray:
+def winding_numbers(part: PartMesh, points: F64) -> F64:
     """The winding number of ``part``'s surface at each point (deterministic, no acceleration
     structure: parts here have at most tens of thousands of triangles)."""
     out = np.zeros(len(points), dtype=np.float64)
@@ -365,12 +365,12 @@ class AxisMap:
     """Lattice coordinate -> world coordinate along one axis for one part: piecewise linear
     through the part's planes (index, position), slope ``unit`` outside them."""
 
-    indices: FloatArray
-    positions: FloatArray
+    indices: F64
+    positions: F64
     unit: float
     base: float  # world position of index 0 when there is no plane
 
-    def __call__(self, t: FloatArray) -> FloatArray:
+    def __call__(self, t: F64) -> F64:
         if len(self.indices) == 0:
             return np.asarray(self.base + t * self.unit, dtype=np.float64)
         k0, k1 = self.indices[0], self.indices[-1]
@@ -380,7 +380,7 @@ class AxisMap:
         return np.asarray(np.where(t > k1, p1 + (t - k1) * self.unit, out), dtype=np.float64)
 
 
-def axis_map(pos: FloatArray, w: FloatArray, unit: float, start: float) -> AxisMap:
+def axis_map(pos: F64, w: F64, unit: float, start: float) -> AxisMap:
     """Snap each plane to the nearest index of the grid starting at ``start`` (world position of
     index 0) and anchor that index at the planes' weighted mean position."""
     if len(pos) == 0:

@@ -31,8 +31,8 @@ import numpy as np
 import trimesh
 
 from chaingeo.core import limits
+from chaingeo.core.arrays import F64
 from chaingeo.core.formats.mesh_lattice import (
-    FloatArray,
     IntArray,
     ModelImportError,
     PartMesh,
@@ -207,7 +207,7 @@ def load_urdf_part(urdf: Path, model_dir: Path) -> PartMesh:
     visuals = list(root.iter("visual"))
     if len(visuals) > limits.MAX_PART_MESHES:
         raise at.fail(f"{len(visuals)} visuals; at most {limits.MAX_PART_MESHES}")
-    verts: list[FloatArray] = []
+    verts: list[F64] = []
     faces: list[IntArray] = []
     files: list[str] = []
     rgba: tuple[float, float, float, float] | None = None

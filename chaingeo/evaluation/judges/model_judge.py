@@ -17,7 +17,13 @@ from typing import Any, Final
 from chaingeo.evaluation.agents.base import ObservationLike, StateLike
 from chaingeo.evaluation.agents.http import ChatClient, ServerSettings
 from chaingeo.evaluation.agents.prompt import user_content
-from chaingeo.evaluation.judges.selection import CheckedReply, Judge, Preference
+from chaingeo.evaluation.judges.selection import (
+    Candidates,
+    CheckedReply,
+    Judge,
+    Preference,
+    Seen,
+)
 from chaingeo.evaluation.usage import Usage
 
 JUDGE_PROMPT: Final = (
@@ -45,12 +51,7 @@ class ModelJudge(Judge):
     def start(self, seed: int) -> None:
         self._client = self.server.client(seed + 1)
 
-    def preference(
-        self,
-        state: StateLike,
-        candidates: Sequence[CheckedReply],
-        observation: ObservationLike | None = None,
-    ) -> Preference:
+    def preference(self, state: StateLike, candidates: Candidates, obs: Seen = None) -> Preference:
         """The candidate the model picks first (when it picks one of two or more distinct
         legal actions); the rest in sampling order."""
         offered: list[CheckedReply] = []
@@ -59,9 +60,9 @@ class ModelJudge(Judge):
             if c.legal and c.reply.action is not None and c.reply.action not in seen:
                 seen.add(c.reply.action)
                 offered.append(c)
-        if len(offered) < 2 or observation is None:
+        if len(offered) < 2 or obs is None:
             return lambda c: ()
-        best = self._ask(offered, observation)
+        best = self._ask(offered, obs)
         return lambda c: (int(c.index != best),)
 
     def _ask(self, offered: Sequence[CheckedReply], observation: ObservationLike) -> int | None:

@@ -40,6 +40,9 @@ class CheckedReply:
 
 #: Orders legal candidates: the key of each (smaller first).
 Preference = Callable[[CheckedReply], tuple[int, ...]]
+#: What a judge ranks: the turn's candidates, and what the agent saw (when known).
+Candidates = Sequence[CheckedReply]
+Seen = ObservationLike | None
 
 
 class Judge:
@@ -63,12 +66,7 @@ class Judge:
             c.index for c in sorted(candidates, key=lambda c: (not c.legal, prefer(c), c.index))
         ]
 
-    def preference(
-        self,
-        state: StateLike,
-        candidates: Sequence[CheckedReply],
-        observation: ObservationLike | None = None,
-    ) -> Preference:
+    def preference(self, state: StateLike, candidates: Candidates, obs: Seen = None) -> Preference:
         """How this judge orders legal candidates (smaller first); none by default."""
         return lambda c: ()
 
@@ -80,12 +78,7 @@ class FirstLegal(Judge):
 class Vote(Judge):
     name = "vote"
 
-    def preference(
-        self,
-        state: StateLike,
-        candidates: Sequence[CheckedReply],
-        observation: ObservationLike | None = None,
-    ) -> Preference:
+    def preference(self, state: StateLike, candidates: Candidates, obs: Seen = None) -> Preference:
         votes = Counter(c.result.action.to_text() for c in candidates if c.legal and c.result)
         return lambda c: (-votes[c.result.action.to_text()] if c.legal and c.result else 0,)
 
@@ -93,12 +86,7 @@ class Vote(Judge):
 class ProgressJudge(Judge):
     name = "progress"
 
-    def preference(
-        self,
-        state: StateLike,
-        candidates: Sequence[CheckedReply],
-        observation: ObservationLike | None = None,
-    ) -> Preference:
+    def preference(self, state: StateLike, candidates: Candidates, obs: Seen = None) -> Preference:
         def key(c: CheckedReply) -> tuple[int, ...]:
             if c.after is None:
                 return ()

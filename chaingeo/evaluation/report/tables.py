@@ -325,11 +325,12 @@ def is_human(run: Run) -> bool:
 def _human_row(name: str, tier: str, records: Sequence[dict[str, Any]]) -> list[Any]:
     won = [r for r in records if r.get("success")]
     times = [float(r["solve_seconds"]) for r in won if r.get("solve_seconds") is not None]
-    shares = [sum(1 for t in times if a <= t < b) / len(times) for a, b in TIME_TIERS]
+    # each time tier's share of the solves: a rate, with its Wilson interval
+    shares = [stats.rate(sum(1 for t in times if a <= t < b), len(times)) for a, b in TIME_TIERS]
     outcomes = [Outcome.from_record(r) for r in records]
     figures = [METRICS[m].compute(outcomes, 1) for m in _HUMAN_METRICS]
     median = f"{statistics.median(times):.0f}" if times else "—"
-    return [name, tier, *figures, median, *(f"{100 * x:.0f}" if times else "—" for x in shares)]
+    return [name, tier, *figures, median, *shares]
 
 
 #: The registered metrics of the human table, after the study and the tier.
@@ -339,7 +340,8 @@ _HUMAN_METRICS: Final = ("episodes", "pass@1", "avg_steps", "normdist")
 def human_table(runs: Sequence[Run]) -> Table:
     """Each human study's episodes by tier (family and difficulty, then all): Pass@1 with its
     95% interval, AvgSteps and NormDist of the solved (mean ± standard error), the median
-    solve time, and the share (%) of solves under 5, 5-15 and over 15 minutes."""
+    solve time, and the share (%) of solves under 5, 5-15 and over 15 minutes (each with its
+    95% Wilson interval)."""
     rows: list[list[Any]] = []
     for run in (r for r in runs if is_human(r)):
         records = list(RunLog(run.path).latest().values())
@@ -353,7 +355,7 @@ def human_table(runs: Sequence[Run]) -> Table:
         "Human baseline: success and solve times by tier (Pass@1, %)",
         ["Study", "Tier", *titles, "Median solve s", "< 5 min %", "5-15 min %", "> 15 min %"],
         rows,
-        [None, None, *(METRICS[m] for m in _HUMAN_METRICS), None, None, None, None],
+        [None, None, *(METRICS[m] for m in _HUMAN_METRICS), None, *[METRICS["pass@1"]] * 3],
     )
 
 

@@ -106,7 +106,7 @@ def _text_only(message: ChatMessageUser) -> ChatMessageUser:
 @solver
 def play_level(
     levels: Mapping[str, Level],
-    protocol: ProtocolConfig,
+    protocols: Mapping[str, ProtocolConfig],
     dialect: str = "text",
     images: bool = True,
     views: Sequence[str] | None = None,
@@ -114,11 +114,13 @@ def play_level(
     seed: int = 0,
     sampling: Mapping[str, Any] | None = None,
 ) -> Solver:
-    """Play the sample's level to the end of its episode; the outcome goes to the store."""
+    """Play the sample's level under its protocol (``metadata["protocol"]``, one of
+    ``protocols``) to the end of its episode; the outcome goes to the store."""
     config = GenerateConfig(**dict(sampling or {}))
 
     async def solve(state: TaskState, generate: Generate) -> TaskState:
         level = levels[str(state.metadata.get("level_id", state.sample_id))]
+        protocol = protocols[str(state.metadata.get("protocol", "interactive"))]
         episode = Episode(
             level,
             protocol,
@@ -152,7 +154,8 @@ def play_level(
             )
             reply = read_reply(dialect, message.text, calls, oneshot=episode.oneshot)
             results = episode.play(reply)
-            answers = _tool_answers(message, calls, results) if calls and offered else []
+            interactive = calls and offered and not episode.oneshot  # one-shot: no feedback
+            answers = _tool_answers(message, calls, results) if interactive else []
             state.messages.extend(answers)
             _note(turn, reply, results)
             before = [_text_only(shown), message, *answers] if answers else []

@@ -143,33 +143,15 @@ def chain(
         proto = cfg.protocol(name, history_window=window)  # type: ignore[arg-type]
         protos[name] = proto
         samples += [_sample(lv, proto, dialect, on, views) for lv in chosen]
-    solvers = {
-        name: play_level(by_id, proto, dialect, on, views, agent, int(seed), cfg.sampling())  # type: ignore[arg-type]
-        for name, proto in protos.items()
-    }
+    solver = play_level(by_id, protos, dialect, on, views, agent, int(seed), cfg.sampling())  # type: ignore[arg-type]
     return Task(
         dataset=MemoryDataset(samples, name="chaingeo"),
-        solver=_by_protocol(solvers),
+        solver=solver,
         scorer=success(),
         metrics=METRICS,
         epochs=Epochs(1, REDUCERS),
         name="chain",
     )
-
-
-def _by_protocol(solvers: dict[str, Any]) -> Any:
-    """One solver that plays each sample under its own protocol."""
-    from inspect_ai.solver import Generate, TaskState, solver
-
-    @solver
-    def protocols() -> Any:
-        async def solve(state: TaskState, generate: Generate) -> TaskState:
-            result: TaskState = await solvers[state.metadata["protocol"]](state, generate)
-            return result
-
-        return solve
-
-    return protocols()
 
 
 __all__: Sequence[str] = ["chain", "select_levels"]

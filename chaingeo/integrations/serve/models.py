@@ -57,7 +57,7 @@ class ChainObservation(Observation):  # type: ignore[misc]
     family: str = ""
     instruction: str = ""
     #: The whole observation as the harness's prompt text (instruction, pieces, recent turns,
-    #: steps left, the views' names).
+    #: steps left, the views' names, and why the last reply could not be read, if it could not).
     text: str = ""
     #: What the last action did (the machine's feedback), None after a reset.
     feedback: str | None = None

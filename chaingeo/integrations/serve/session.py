@@ -17,6 +17,7 @@ from chaingeo.core import limits
 from chaingeo.core.level import Level
 from chaingeo.evaluation.agents.base import Reply, StepResultLike
 from chaingeo.evaluation.agents.dialects import DIALECTS, read_reply, tool_call
+from chaingeo.evaluation.agents.prompt import observation_text
 from chaingeo.evaluation.agents.tools import tool_specs
 from chaingeo.evaluation.episode import Episode, Outcome, ProtocolConfig
 from chaingeo.integrations.game import total_reward
@@ -44,7 +45,9 @@ class Options:
     images: bool = False
     history: int = 5
     max_steps: int | None = None
-    legal: bool = False
+    #: True, False, or "auto": only where the legal list is short enough to send every step
+    #: and a player needs it (stacking placements, puzzle turns; a big puzzle's moves are many).
+    legal: bool | str = False
     scene: bool = False
     text_state: bool = False
 
@@ -83,7 +86,7 @@ def read_options(data: Mapping[str, Any]) -> Options:
         images=_bool(data, "images", False),
         history=history,
         max_steps=_int(data, "max_steps", None, 1, limits.MAX_STEPS),
-        legal=_bool(data, "legal", False),
+        legal="auto" if data.get("legal") == "auto" else _bool(data, "legal", False),
         scene=_bool(data, "scene", False),
         text_state=_bool(data, "text_state", False),
     )
@@ -143,6 +146,12 @@ class Play:
     def outcome(self) -> Outcome:
         return self.episode.outcome()
 
+    @property
+    def sends_legal(self) -> bool:
+        if self.options.legal == "auto":
+            return self.level.family == "stacking" or bool(getattr(self.level.rules, "turns", 0))
+        return bool(self.options.legal)
+
     def observation(self) -> ChainObservation:
         opts, s, level, ep = self.options, self.state, self.level, self.episode
         obs = ep.observation()
@@ -157,7 +166,7 @@ class Play:
             level_id=level.id,
             family=level.family,
             instruction=obs.instruction,
-            text=obs.to_text(),
+            text=observation_text(obs, ep.note),
             feedback=None if self.last is None else self.last.feedback,
             last=last,
             success=bool(s.is_success()),
@@ -165,7 +174,7 @@ class Play:
             steps_left=int(s.steps_left),
             max_steps=int(s.max_steps),
             optimal_steps=None if self.hide_optimal else level.optimal_steps,
-            legal=[a.to_text() for a in s.legal_actions()] if opts.legal else None,
+            legal=[a.to_text() for a in s.legal_actions()] if self.sends_legal else None,
             images={k: base64.b64encode(v).decode("ascii") for k, v in obs.images.items()},
             scene=scene_json(s) if opts.scene else None,
         )

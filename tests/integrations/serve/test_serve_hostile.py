@@ -67,7 +67,7 @@ def _ws(url: str, **kwargs: Any) -> Any:
 
 def _ask(ws: Any, message: dict[str, Any]) -> dict[str, Any]:
     ws.send(json.dumps(message))
-    reply: dict[str, Any] = json.loads(ws.recv(timeout=30))
+    reply: dict[str, Any] = json.loads(ws.recv(timeout=120))
     return reply
 
 
@@ -88,7 +88,7 @@ def test_random_frames_get_answers_never_a_broken_session(
     with _ws(url) as ws:
         for frame in batch:
             ws.send(frame)
-            reply = json.loads(ws.recv(timeout=30))
+            reply = json.loads(ws.recv(timeout=120))
             assert reply["type"] in ("observation", "state", "error"), reply
             if reply["type"] == "error":
                 assert reply["data"]["code"] in ("VALIDATION_ERROR", "EXECUTION_ERROR"), reply
@@ -179,7 +179,7 @@ def test_sessions_are_bounded_in_count_idle_time_and_messages(
             b = later.enter_context(_ws(url))
             assert _ask(b, {"type": "state"})["type"] == "state"
             with _ws(url) as c:  # a third is refused: OpenEnv's capacity error, then closed
-                reply = json.loads(c.recv(timeout=30))
+                reply = json.loads(c.recv(timeout=120))
                 assert reply["data"]["code"] == "CAPACITY_REACHED"
             for _ in range(3):
                 assert _ask(a, {"type": "state"})["type"] == "state"

@@ -45,7 +45,7 @@ def url() -> Iterator[str]:
 
 
 def _client(url: str) -> GenericEnvClient:
-    return GenericEnvClient(base_url=url, message_timeout_s=60)
+    return GenericEnvClient(base_url=url, message_timeout_s=180)
 
 
 async def _play_plan(url: str, level_id: str, **options: Any) -> list[dict[str, Any]]:
@@ -156,6 +156,17 @@ def test_an_illegal_action_costs_a_step_like_an_agents(url: str) -> None:
     obs = asyncio.run(go())
     assert obs["steps"] == 1 and not obs["last"]["legal"] and obs["feedback"]
 
+    async def untagged() -> dict[str, Any]:
+        async with _client(url) as env:
+            await env.reset(level=PUZZLE, dialect="text")
+            r = await env.step({"text": "move red -y inf"})  # no <action> tags
+            obs: dict[str, Any] = r.observation
+            return obs
+
+    obs = asyncio.run(untagged())
+    assert obs["steps"] == 1 and obs["last"]["error"] == "unparseable"
+    assert "no <action>...</action> found" in obs["text"]
+
 
 def test_32_sessions_at_once_all_finish(url: str) -> None:
     """32 WebSocket sessions over five levels, interleaved; each reaches success on its own."""
@@ -194,3 +205,23 @@ def test_http_routes_answer_4xx_to_bad_input(url: str) -> None:
     assert post(f"{url}/step", json={"action": {"bad": 1}}).status_code == 422
     levels = get(f"{url}/levels").json()
     assert [lv["id"] for lv in levels] == sorted(IDS)
+
+
+@pytest.mark.slow
+def test_every_shipped_levels_oracle_plan_succeeds_over_the_wire() -> None:
+    """All shipped levels, 8 sessions at a time, each plan played step by step to success."""
+    from chaingeo.core.suite import shipped_levels
+
+    ids = shipped_levels()
+    with running(Catalog({i: shipped_level(i) for i in ids}), max_sessions=8) as base:
+
+        async def share(part: list[str]) -> list[tuple[str, dict[str, Any]]]:
+            return [(i, (await _play_plan(base, i))[-2]) for i in part]
+
+        async def all_of() -> list[list[tuple[str, dict[str, Any]]]]:
+            return await asyncio.gather(*(share(ids[k::8]) for k in range(8)))
+
+        results = [r for part in asyncio.run(all_of()) for r in part]
+    assert len(results) == len(ids) > 100
+    for level_id, last in results:
+        assert last["success"] and last["steps"] == shipped_level(level_id).optimal_steps, level_id

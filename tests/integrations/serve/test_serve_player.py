@@ -80,6 +80,9 @@ def _play(page: Page, text: str, keys_only: bool = False) -> None:
     if words[0] == "rotate":
         page.key(words[2])
         page.key("r" if words[3] == "+90" else "f")
+        choices = page.js("window.chainPlayer.status().choices")
+        if choices:  # several centres work: the page offers them, numbered
+            page.key(str(choices.index(text) + 1))
         return
     assert words[0] == "move" and len(words) == 4, text
     page.key("0" if words[3] == "inf" else words[3])
@@ -191,3 +194,25 @@ def test_canvas_colours_undo_and_markup_stays_text(devtools: str) -> None:
             assert page.js("document.title") == "CHAIN-geo player"
         finally:
             page.close()
+
+
+@pytest.mark.slow
+def test_every_shipped_puzzle_and_some_stacking_levels_in_the_browser(devtools: str) -> None:
+    """Free play: every shipped puzzle (clicks and keys) and the first ten stacking levels (keys
+    alone) to the solved screen in exactly o_i steps."""
+    from chaingeo.core.suite import shipped_levels
+
+    ids = shipped_levels("puzzle") + shipped_levels("stacking")[:10]
+    with running(Catalog({i: shipped_level(i) for i in ids})) as url:
+        for level_id in ids:
+            level = shipped_level(level_id)
+            page = open_page(devtools, f"{url}/play/{level_id}")
+            try:
+                _solve(page, level, keys_only=level.family == "stacking")
+                assert page.js("window.chainPlayer.status().steps") == level.optimal_steps
+            except Exception as e:
+                status = page.js("JSON.stringify(window.chainPlayer.status())")
+                feedback = page.js("document.getElementById('feedback').textContent")
+                raise AssertionError(f"{level_id}: {status} {feedback}") from e
+            finally:
+                page.close()

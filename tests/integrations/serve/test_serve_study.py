@@ -88,3 +88,5 @@ def test_two_participants_make_a_human_row(
     human = next(line for line in out.splitlines() if line.startswith("| human | all |"))
     assert "| 6 | 66.7 [50.0, 100.0] |" in human
     assert "Human baseline" in out and (tmp_path / "report" / "human.md").exists()
+    head = (tmp_path / "report" / "human.csv").read_text().splitlines()[0].split(",")
+    assert {"< 5 min % low", "< 5 min % high"} <= set(head)  # a share is a rate: its interval

@@ -34,7 +34,18 @@ def test_solid_six_piece_burrs_1063_assemblies_314_solutions(
 ) -> None:
     """Cutler's 314 solid six-piece burrs: BurrTools reports 1063 assemblies, 314 solutions."""
     assert BT is not None
-    assert main(["analyze", str(BT / "SolidSixPieceBurrs.xmpuzzle"), "--no-optimal"]) == 0
+    assert (
+        main(
+            [
+                "analyze",
+                str(BT / "SolidSixPieceBurrs.xmpuzzle"),
+                "--no-optimal",
+                "--mirrors",
+                "keep",
+            ]
+        )
+        == 0
+    )
     out = json.loads(capsys.readouterr().out)
     assert out["assemblies"] == 1063 and out["solutions"] == 314
     assert out["level"] == "1"

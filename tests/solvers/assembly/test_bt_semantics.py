@@ -273,13 +273,20 @@ def test_chain_analyze_lists_every_problem(
     soma = EXAMPLES["soma_problems"]()
     small = BTPuzzle(soma.shapes, soma.problems[1:], colors=soma.colors)
     path = write_xmpuzzle(small, Path(str(tmp_path)) / "two.xmpuzzle")
-    assert main(["analyze", str(path), "--no-optimal"]) == 0
+    assert main(["analyze", str(path), "--no-optimal", "--mirrors", "keep"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert [(p["problem"], p["assemblies"], p["solutions"]) for p in out["problems"]] == [
         (0, 122, 122),
         (1, 20, 20),
     ]
-    assert main(["analyze", str(path), "--problem", "1", "--mirrors", "drop"]) == 0
+    assert {p["convention"] for p in out["problems"]} == {"mirrors-kept"}
+    assert main(["analyze", str(path), "--no-optimal"]) == 0  # burrTxt's figures by default
+    out = json.loads(capsys.readouterr().out)
+    assert [(p["assemblies"], p["convention"]) for p in out["problems"]] == [
+        (61, "burrtxt"),
+        (18, "burrtxt"),
+    ]
+    assert main(["analyze", str(path), "--problem", "1"]) == 0
     one = json.loads(capsys.readouterr().out)
     assert (one["problem"], one["name"], one["assemblies"], one["solutions"]) == (
         1,
@@ -292,15 +299,15 @@ def test_chain_analyze_lists_every_problem(
     assert "problem 5 does not exist" in capsys.readouterr().err
 
 
-def test_chain_analyze_with_groups_says_why_there_is_no_o_i(
-    capsys: pytest.CaptureFixture[str],
-) -> None:
-
+def test_chain_analyze_gives_o_i_with_groups(capsys: pytest.CaptureFixture[str]) -> None:
+    """The pin and ring are one group: the ring's way off the maze is the whole plan (17
+    moves, BurrTools' level), and no shorter one exists
+    (tests/solvers/assembly/test_group_optimal.py checks plans and bounds)."""
     path = DATA / "burrtools" / "ring_maze.xmpuzzle"
     assert main(["analyze", str(path)]) == 0
     out = json.loads(capsys.readouterr().out)
     assert (out["assemblies"], out["solutions"], out["level"], out["moves"]) == (2, 2, "17", 17)
-    assert out["optimal_steps"] is None and "piece groups" in out["optimal_error"]
+    assert out["optimal_steps"] == 17 and "optimal_error" not in out
 
 
 def test_bench_burrtools_quick(capsys: pytest.CaptureFixture[str]) -> None:

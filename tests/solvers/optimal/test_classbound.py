@@ -19,8 +19,8 @@ from chaingeo.solvers.motion.disassemble import analyze_assembly, translations
 from chaingeo.solvers.optimal.blockbound import end_first_plan
 from chaingeo.solvers.optimal.classbound import (
     MAX_BUDGET,
+    ClassPacking,
     ClassVector,
-    Packing,
     band_blocks,
     below,
     class_lower_bound,
@@ -38,7 +38,7 @@ def test_vector_algebra() -> None:
     b = (((0, 1), 1), ((2, 3), 1))
     assert join(a, b) == (((0, 1), 2), ((2, 3), 1))
     assert below(a, join(a, b)) and below(b, join(a, b)) and not below(a, b)
-    pk = Packing()
+    pk = ClassPacking()
     pa, pb = pk.encode(a), pk.encode(b)
     assert pk.decode(pk.join(pa, pb)) == join(a, b) and pk.total(pa) == 2
     assert pk.minimal([pk.join(pa, pb), pa, pb, 0]) == [0]
@@ -61,7 +61,7 @@ _vectors = st.lists(
 def test_packed_vectors_agree_with_the_counts(a: ClassVector, b: ClassVector) -> None:
     """The packed fields compare, join and add up as the counts per class do (no borrow or
     carry crosses a field, whatever order the classes were met in)."""
-    pk = Packing()
+    pk = ClassPacking()
     pb, pa = pk.encode(b), pk.encode(a)
     assert pk.decode(pa) == a and pk.decode(pb) == b
     assert pk.below(pa, pb) == below(a, b) and pk.below(pb, pa) == below(b, a)

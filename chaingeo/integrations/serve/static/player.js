@@ -31,7 +31,7 @@ function connect() {
 }
 
 function resetData(images) {
-  const data = { legal: true, scene: true, history: 5, images };
+  const data = { legal: "auto", scene: true, history: 5, images };
   if (STUDY) data.participant = game.participant;
   else data.level = game.level;
   return data;
@@ -529,9 +529,12 @@ window.chainPlayer = {
     for (const c of m.piece.cells) {
       for (const [n] of FACES) {
         const p = new THREE.Vector3(c[0] + 0.5 + 0.45 * n[0], c[1] + 0.5 + 0.45 * n[1], c[2] + 0.5 + 0.45 * n[2]).project(camera);
-        const x = r.left + ((p.x + 1) / 2) * r.width;
-        const y = r.top + ((1 - p.y) / 2) * r.height;
-        if (x > r.left && x < r.right && y > r.top && y < r.bottom && hitAt(x, y) === name) return [x, y];
+        const x = Math.round(r.left + ((p.x + 1) / 2) * r.width);
+        const y = Math.round(r.top + ((1 - p.y) / 2) * r.height);
+        if (x - 2 <= r.left || x + 2 >= r.right || y - 2 <= r.top || y + 2 >= r.bottom) continue;
+        // a point whose neighbours hit the same piece: a click there cannot land on another
+        const around = [[0, 0], [-2, 0], [2, 0], [0, -2], [0, 2]];
+        if (around.every(([dx, dy]) => hitAt(x + dx, y + dy) === name)) return [x, y];
       }
     }
     return null;
@@ -542,7 +545,7 @@ window.chainPlayer = {
       success: game.obs ? game.obs.success : false, waiting: game.waiting, level: game.level,
       selected: [...game.selected].sort(), cursor: names()[game.cursor] || null,
       ghost: game.ghost ? cellsText(game.ghost) : null, distance: game.distance, axis: game.axis,
-      names: names(), sent: game.sent.slice(),
+      names: names(), sent: game.sent.slice(), choices: game.turnChoices.slice(),
     };
   },
 };

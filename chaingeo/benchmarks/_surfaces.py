@@ -21,121 +21,25 @@ import json
 import os
 import random
 import tempfile
-import threading
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 from typing import Any
 
-from chaingeo.core.errors import ChainGeoError
-
-SEED = 20261128
-#: Seconds one case may take before it counts as a hang.
-CASE_SECONDS = 20.0
-
-
-@dataclass
-class Surface:
-    """The counts of one surface (one row of the table)."""
-
-    name: str
-    cases: int = 0
-    tracebacks: int = 0
-    hangs: int = 0
-    wrong: int = 0
-    outside: int = 0
-    kinds: dict[str, int] = field(default_factory=dict)
-
-    def bad(self) -> int:
-        return self.tracebacks + self.hangs + self.wrong + self.outside
-
-    def run(self, call: Callable[[], Any], wrong: Callable[[Any], bool] = lambda _: False) -> Any:
-        """One case: ``call()`` in a thread bounded by :data:`CASE_SECONDS`; a typed error
-        is a refusal, anything else escaping a traceback; ``wrong(result)`` a wrong
-        acceptance."""
-        self.cases += 1
-        out: list[Any] = []
-        err: list[BaseException] = []
-
-        def body() -> None:
-            try:
-                out.append(call())
-            except ChainGeoError as e:
-                err.append(e)
-            except BaseException as e:  # the figure this class exists for
-                err.append(e)
-
-        worker = threading.Thread(target=body, daemon=True)
-        worker.start()
-        worker.join(CASE_SECONDS)
-        if worker.is_alive():
-            self.hangs += 1
-            return None
-        if err:
-            if not isinstance(err[0], ChainGeoError):
-                self.tracebacks += 1
-                name = type(err[0]).__name__
-                self.kinds[name] = self.kinds.get(name, 0) + 1
-            return err[0]
-        if wrong(out[0]):
-            self.wrong += 1
-        return out[0]
-
-
-def _always(_: Any) -> bool:
-    return True
-
-
-def _never(_: Any) -> bool:
-    return False
-
-
-def _valid(verdict: Any) -> bool:
-    return bool(verdict.valid)
-
-
-def _usable(found: Any) -> bool:
-    return bool(found.usable)
-
-
-def _grew(seen: list[str], before: int, _: Any) -> bool:
-    return len(seen) > before
-
-
-def _whole_clip(clip: Any) -> bool:
-    return len(clip.frames) == 120
-
-
-def _refused_but_used(env: Any, used: int, out: Any) -> bool:
-    return bool(out[4]["error"] == "refused" and env.state.steps_used != used)
-
-
-def _special(path: Path, kind: str) -> Path:
-    """``path`` made a link to ``/dev/zero``, a FIFO (opened for writing by a helper thread
-    after a while, so a reader that blocks on it ends), or a sparse file of 3 GB."""
-    path.unlink(missing_ok=True)
-    if kind == "zero":
-        path.symlink_to("/dev/zero")
-    elif kind == "fifo":
-        os.mkfifo(path)
-
-        def release() -> None:
-            with contextlib.suppress(OSError):
-                fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK)
-                os.close(fd)
-
-        timer = threading.Timer(CASE_SECONDS + 1, release)
-        timer.daemon = True
-        timer.start()
-    else:
-        with open(path, "wb") as fh:
-            fh.truncate(3 * 1024**3)
-    return path
-
-
-SPECIALS = ("zero", "fifo", "huge")
-
+from chaingeo.benchmarks._surface_kit import (
+    SEED,
+    SPECIALS,
+    Surface,
+    always,
+    grew,
+    never,
+    refused_but_used,
+    special,
+    surface_table,
+    usable,
+    valid,
+    whole_clip,
+)
 
 # ---------------------------------------------------------------------------------------------
 # check-trajectory
@@ -174,9 +78,9 @@ def trajectories(tmp: Path) -> Surface:
             bad["frames"][rng.randrange(len(bad["frames"]))]["poses"][key] = value
             s.run(partial(verdict, json.dumps(bad)), invented)
     for text in ("[" * 100_000, '{"format": 1e999}', "[" + "9" * 5000 + "]", "", "\ud800"):
-        s.run(partial(verdict, text), _valid)
+        s.run(partial(verdict, text), valid)
     for kind in SPECIALS:
-        path = _special(tmp / f"t-{kind}.json", kind)
+        path = special(tmp / f"t-{kind}.json", kind)
         with contextlib.suppress(UnreadableFile):
             s.run(partial(verdict, path))
     return s
@@ -238,10 +142,10 @@ def kernel_store(tmp: Path) -> Surface:
         lambda f: edit(f, lambda b: b["exports"].update({"chaingeo.x.y:k": {"a": "k1"}})),
         lambda f: (f / aot.MANIFEST).write_text("[" * 200_000),
         lambda f: (f / aot.MANIFEST).write_text('{"format": 2, "sources": ' + "9" * 5000),
-        lambda f: _special(f / aot.MANIFEST, "zero"),
-        lambda f: _special(f / aot.MANIFEST, "fifo"),
-        lambda f: _special(f / aot.MANIFEST, "huge"),
-        lambda f: _special(path_of(f), "fifo"),
+        lambda f: special(f / aot.MANIFEST, "zero"),
+        lambda f: special(f / aot.MANIFEST, "fifo"),
+        lambda f: special(f / aot.MANIFEST, "huge"),
+        lambda f: special(path_of(f), "fifo"),
     ]
     imported: list[str] = []
     real = importlib.util.module_from_spec
@@ -257,8 +161,8 @@ def kernel_store(tmp: Path) -> Surface:
             damage(folder)
             before = len(imported)
             aot._loaded = None
-            s.run(partial(aot.load, folder), partial(_grew, imported, before))
-            s.run(partial(aot.status, folder), _usable)
+            s.run(partial(aot.load, folder), partial(grew, imported, before))
+            s.run(partial(aot.status, folder), usable)
     finally:
         setattr(importlib.util, "module_from_spec", real)  # noqa: B010
         aot._loaded = None
@@ -270,7 +174,7 @@ def kernel_store(tmp: Path) -> Surface:
 # ---------------------------------------------------------------------------------------------
 
 
-def _a_run(root: Path) -> Path:
+def _a_run(root: Path, resume: bool = False) -> Path:
     from chaingeo.core.geometry import Shape
     from chaingeo.core.level import stacking_level
     from chaingeo.evaluation.agents.base import AgentSpec
@@ -278,7 +182,8 @@ def _a_run(root: Path) -> Path:
 
     cells = [Shape([(i, 0, 0)]) for i in range(2)]
     levels = [stacking_level(f"L{i}", "easy", (2, 1, 1), cells) for i in range(2)]
-    evaluate(levels, AgentSpec("random"), root / "run", None, RunConfig(progress=False))
+    cfg = RunConfig(progress=False, resume=resume)
+    evaluate(levels, AgentSpec("random"), root / "run", None, cfg)
     return root / "run"
 
 
@@ -319,11 +224,11 @@ def run_folders(tmp: Path) -> Surface:
         record(lambda r: r.update(steps=5)),
         record(lambda r: r.update(cost_usd="free")),
         record(lambda r: r["steps"].append({"turn": "x"})),
-        lambda r: _special(r / "episodes.jsonl", "zero"),
-        lambda r: _special(r / "episodes.jsonl", "fifo"),
-        lambda r: _special(r / "header.json", "zero"),
-        lambda r: _special(r / "header.json", "fifo"),
-        lambda r: _special(r / "header.json", "huge"),
+        lambda r: special(r / "episodes.jsonl", "zero"),
+        lambda r: special(r / "episodes.jsonl", "fifo"),
+        lambda r: special(r / "header.json", "zero"),
+        lambda r: special(r / "header.json", "fifo"),
+        lambda r: special(r / "header.json", "huge"),
         lambda r: (r / "header.json").write_text("[" * 100_000),
         outside,
     ]
@@ -342,7 +247,7 @@ def run_folders(tmp: Path) -> Surface:
         # Each damage but the last must be refused; the last (a picture linked from outside
         # the run) is read, but the picture must not be copied.
         last = i == len(damages) - 1
-        result = s.run(partial(report, run, i), _always if not last else _never)
+        result = s.run(partial(report, run, i), always if not last else never)
         if isinstance(result, tuple) and result[1]:
             s.outside += 1
     return s
@@ -403,7 +308,7 @@ def identifiers(tmp: Path) -> Surface:
                 bad["id"] += suffix
             else:
                 bad["pieces"][0][fieldname] += suffix
-            s.run(partial(parse_level, bad, "bench"), _always)
+            s.run(partial(parse_level, bad, "bench"), always)
     path = tmp / "ok.json"
     path.write_text(json.dumps(data))
     s.run(lambda: load_level(path))
@@ -450,14 +355,14 @@ def game_doors(tmp: Path, calls: int = 600) -> Surface:
                 env.reset(seed=1)
             action, used = next(actions), env.state.steps_used
 
-            unused = partial(_refused_but_used, env, used)
+            unused = partial(refused_but_used, env, used)
             if isinstance(s.run(partial(env.step, action), unused), BaseException) and (
                 env.state.steps_used != used
             ):
                 s.wrong += 1  # it raised after using the step
         hostile_options: list[Any] = ["x", 5, ["level"], {"level": ["x"]}, {"level": "nope"}]
         for options in hostile_options:
-            s.run(partial(env.reset, options=options), _always)
+            s.run(partial(env.reset, options=options), always)
     vector = gymnasium.vector.SyncVectorEnv([lambda: StackingEnv([levels[1]], images=False)] * 2)
     vector.reset(seed=2)
     actions = _hostile_actions(rng, [p.name for p in levels[1].pieces])
@@ -490,7 +395,7 @@ def writers(tmp: Path) -> Surface:
             continue
         fd = files.lock_folder(target)
         try:
-            s.run(partial(files.lock_folder, target), _always)
+            s.run(partial(files.lock_folder, target), always)
         finally:
             files.unlock_folder(fd)
     real_write, real_atomic = os.write, files.atomic_write
@@ -527,21 +432,8 @@ def writers(tmp: Path) -> Surface:
 def _resumed_keys(root: Path) -> list[str]:
     from chaingeo.evaluation.logs import RunLog
 
-    run = _a_run_resumed(root)
+    run = _a_run(root, resume=True)
     return [str(r["key"]) for r in RunLog(run).records()]
-
-
-def _a_run_resumed(root: Path) -> Path:
-    from chaingeo.core.geometry import Shape
-    from chaingeo.core.level import stacking_level
-    from chaingeo.evaluation.agents.base import AgentSpec
-    from chaingeo.evaluation.runner import RunConfig, evaluate
-
-    cells = [Shape([(i, 0, 0)]) for i in range(2)]
-    levels = [stacking_level(f"L{i}", "easy", (2, 1, 1), cells) for i in range(2)]
-    cfg = RunConfig(progress=False, resume=True)
-    evaluate(levels, AgentSpec("random"), root / "run", None, cfg)
-    return root / "run"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -573,7 +465,7 @@ def video_limits(tmp: Path) -> Surface:
             for pixels, frames in ((160 * 120 * 20, 10_000), (10**12, 15)):
                 setattr(limits, "MAX_VIDEO_TOTAL_PIXELS", pixels)  # noqa: B010
                 setattr(limits, "MAX_VIDEO_FRAMES", frames)  # noqa: B010
-                s.run(partial(read_clip, out), _whole_clip)
+                s.run(partial(read_clip, out), whole_clip)
     finally:
         setattr(limits, "MAX_VIDEO_TOTAL_PIXELS", saved[0])  # noqa: B010
         setattr(limits, "MAX_VIDEO_FRAMES", saved[1])  # noqa: B010
@@ -601,25 +493,4 @@ def surfaces() -> list[Surface]:
     return rows
 
 
-def surface_table(rows: list[Surface]) -> str:
-    """Markdown: one row a surface, as the issue's table, then the totals."""
-    head = "| surface | cases | tracebacks | hangs | wrong acceptances | files outside/partial |"
-    lines = [head, "|---|---:|---:|---:|---:|---:|"]
-    for r in [*rows, _total(rows)]:
-        kinds = f" ({', '.join(f'{k} {v}' for k, v in sorted(r.kinds.items()))})" if r.kinds else ""
-        lines.append(
-            f"| {r.name} | {r.cases} | {r.tracebacks}{kinds} | {r.hangs} | {r.wrong} | "
-            f"{r.outside} |"
-        )
-    return "\n".join(lines)
-
-
-def _total(rows: list[Surface]) -> Surface:
-    total = Surface("**all**")
-    for r in rows:
-        total.cases += r.cases
-        total.tracebacks += r.tracebacks
-        total.hangs += r.hangs
-        total.wrong += r.wrong
-        total.outside += r.outside
-    return total
+__all__ = ["CLASSES", "Surface", "surface_table", "surfaces"]
