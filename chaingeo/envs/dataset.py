@@ -37,6 +37,9 @@ from chaingeo.pictures.pictures import level_pictures
 LEVELS: Final = "levels"
 DEMONSTRATIONS: Final = "demonstrations"
 CONFIGS: Final = (LEVELS, DEMONSTRATIONS)
+#: Multiple-choice questions with proven answers (`chain questions --hf DIR`), a configuration
+#: of its own beside the two above; the card lists it when its shards are there.
+QUESTIONS: Final = "questions"
 #: Rows per Parquet row group: small groups keep a reader's memory low on picture columns.
 ROW_GROUP_ROWS: Final = 64
 SPLIT_NAMES: Final = frozenset({"train", "validation", "test"})
@@ -76,6 +79,20 @@ FEATURES: Final[dict[str, dict[str, Any]]] = {
         "reward": {"dtype": "float64", "_type": "Value"},
         "terminated": {"dtype": "bool", "_type": "Value"},
         "feedback": _STRING,
+    },
+    QUESTIONS: {
+        "id": _STRING,
+        "category": _STRING,
+        "level": _STRING,
+        "question": _STRING,
+        "A": _STRING,
+        "B": _STRING,
+        "C": _STRING,
+        "D": _STRING,
+        "answer": _STRING,
+        "state": [_STRING],
+        "proof": _STRING,
+        "images": _IMAGES,
     },
 }
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Final
 
 from chaingeo.core.level import Level
-from chaingeo.envs.dataset import CONFIGS, LEVELS, splits_on_disk
+from chaingeo.envs.dataset import CONFIGS, LEVELS, QUESTIONS, splits_on_disk
 
 PRETTY_NAME: Final = "CHAIN-geo: interlocking puzzles and 3D stacking, exact levels and plans"
 _SIZES: Final = ((1_000, "n<1K"), (10_000, "1K<n<10K"), (100_000, "10K<n<100K"))
@@ -84,7 +84,9 @@ def _header(folder: Path, rows: int, licenses: Sequence[str]) -> str:
     lines += ["- reinforcement-learning", "- image-text-to-text"]
     lines += ["tags:", "- 3d", "- puzzles", "- planning"]
     lines += ["size_categories:", f"- {_size_category(rows)}", "configs:"]
-    for config in CONFIGS:
+    for config in (*CONFIGS, QUESTIONS):
+        if not splits_on_disk(folder, config):
+            continue
         lines.append(f"- config_name: {config}")
         if config == LEVELS:
             lines.append("  default: true")

@@ -140,6 +140,18 @@ def register(sub: Any) -> None:
     )
     # The module providing new_state and observe; tests point it at a double.
     p.add_argument("--env", default="chaingeo", help=argparse.SUPPRESS)
+    p.add_argument(
+        "--questions",
+        type=Path,
+        metavar="FILE",
+        help="instead of levels: ask the questions.jsonl of `chain questions` single-turn",
+    )
+    p.add_argument(
+        "--split",
+        choices=("test", "train", "all"),
+        default="test",
+        help="with --questions: the questions asked",
+    )
     p.set_defaults(func=run)
 
 
@@ -205,6 +217,10 @@ def _error_reasons(failed: list[Outcome]) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.questions is not None:
+        from chaingeo.cli.eval_questions import run_questions
+
+        return run_questions(args, dict(_option(o) for o in args.agent_option))
     from chaingeo.cli.level_arg import find_level
     from chaingeo.core.level import load_levels
     from chaingeo.core.suite import suite_folder
