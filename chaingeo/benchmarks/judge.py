@@ -78,7 +78,7 @@ def cached_case(seed: int, kind: str, style: str) -> Case:
             case: Case = pickle.load(f)
         return case
     case = make_case(seed, kind, style)
-    tmp = path.with_suffix(".part")
+    tmp = path.with_suffix(f".{os.getpid()}.part")
     with open(tmp, "wb") as f:
         pickle.dump(case, f)
     tmp.replace(path)

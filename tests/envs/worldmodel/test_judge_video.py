@@ -304,7 +304,7 @@ def test_an_mp4_is_read_and_judged(tmp_path: Path) -> None:
     level = _level("puzzle-easy-09-cube3")
     mp4 = write_mp4(puzzle_video(level, size=256), tmp_path / "v.mp4")
     report = judge_video(mp4)
-    assert report["valid"] is True and report["colors"]["from"] == "first frame"
+    assert report["valid"] is True and report["colors"]["from"] == "video"
 
 
 def test_unreadable_input_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
