@@ -278,6 +278,19 @@ def _peaks(hist: FloatArray, total: float) -> list[tuple[float, float]]:
     return out
 
 
+def _border_chromaticity(frames: list[U8]) -> FloatArray:
+    """The median chromaticity of the pictures' outer rows and columns: the background (a
+    tinted ground is saturated enough to pass for a piece colour, and its shadows share its
+    chromaticity)."""
+    ring = np.concatenate(
+        [np.concatenate([f[:3].reshape(-1, 3), f[-3:].reshape(-1, 3), f[:, :3].reshape(-1, 3),
+                         f[:, -3:].reshape(-1, 3)]) for f in frames]
+    ).astype(np.float64)  # fmt: skip
+    chroma, _ = _chromaticity(ring)
+    out: FloatArray = np.median(chroma, axis=0)
+    return out
+
+
 def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
     """Classes from the chromatic colours of frames sampled over the whole video (a piece
     brought in later has its colour too), clustered by chromaticity, the number of colours
@@ -293,7 +306,12 @@ def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
     cell = np.clip((chroma * n).astype(np.int64), 0, n - 1)
     hist = np.zeros((n, n))
     np.add.at(hist, (cell[:, 0], cell[:, 1]), weight)
-    peaks = _peaks(hist, float(weight.sum()))
+    ground = _border_chromaticity([frames[i] for i in picks.astype(int).tolist()])
+    peaks = [
+        c
+        for c in _peaks(hist, float(weight.sum()))
+        if np.hypot(*(np.array(c) - ground)) > JOIN_RADIUS
+    ]
     if not peaks:
         raise ValueError("the video shows no coloured piece (nothing is saturated)")
     centres = np.array(peaks)

@@ -33,6 +33,8 @@ PERSIST: Final = 3
 OCCLUDED_GAP: Final = 0.6
 #: Furthest move (share of the frame's longer side) of a piece between two frames.
 FAST_SHARE: Final = 0.25
+#: Least jump of a teleport (share of the frame's longer side).
+JUMP_SHARE: Final = 0.1
 #: Pixels from the picture's edge within which a part touches the border.
 BORDER: Final = 3
 #: Growth (share of the frame's longer side) of a mask when matching across one frame.
@@ -73,7 +75,7 @@ class Event:
     before: int = 1
 
 
-VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "pass_through")
+VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "teleport", "pass_through")
 
 
 def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
@@ -161,17 +163,22 @@ def solid_of(masks: list[BoolArray]) -> BoolArray:
 
 
 def frame_objects(
-    masks: list[BoolArray], min_area: int, occluders: BoolArray | None = None
+    masks: list[BoolArray],
+    min_area: int,
+    occluders: BoolArray | None = None,
+    unknown: BoolArray | None = None,
 ) -> tuple[list[Obj], BoolArray]:
     """Objects of one frame (each class's components grouped across occluders), and the
     frame's piece pixels (:func:`solid_of`) with ``occluders`` (a box's wire frame drawn over
-    the pieces), which hide pieces as pieces do."""
+    the pieces), which hide pieces as pieces do; ``unknown`` pixels (neither a piece's colour
+    nor the background's) join two parts of a colour as an occluder would, and count for
+    nothing else."""
     solid = solid_of(masks if occluders is None else [*masks, occluders])
     out: list[Obj] = []
     for k, mask in enumerate(masks):
         comps = components(mask, min_area)
         group = list(range(len(comps)))
-        others = solid & ~mask
+        others = (solid if unknown is None else solid | unknown) & ~mask
         for i in range(len(comps)):
             for j in range(i + 1, len(comps)):
                 ri, rj = _root(group, i), _root(group, j)
@@ -237,7 +244,38 @@ class Tracker:
                 else:
                     out.extend(self._fewer(b, k))
         out.extend(self._swaps())
+        out.extend(self._jumps())
         return sorted(out, key=lambda e: (e.frame, e.kind, e.piece))
+
+    def _jumps(self) -> list[Event]:
+        """Teleports: a piece at rest in one place, then at rest in another JUMP_SHARE of the
+        frame or more away, with no frame between (motion, however fast, passes through
+        places; our own videos ease every move in and out)."""
+        out: list[Event] = []
+        for b in range(1, len(self.frames)):
+            for k in range(len(self.names)):
+                before, now = self._of(b - 1, k), self._of(b, k)
+                gone = [p for p in before if not self._touching(p, now) and not p.touches_border()]
+                new = [c for c in now if not self._touching(c, before) and not c.touches_border()]
+                for p in gone:
+                    far = [c for c in new if _alike(p, c) and self._jump(p, c)]
+                    if far and self._resting(p, b - 2) and self._resting(far[0], b + 1):
+                        new.remove(far[0])
+                        name = self.names[k]
+                        detail = f"the {name} piece jumped to another place between two frames"
+                        out.append(Event("teleport", b, name, None, detail, (p.mask, far[0].mask)))
+        return out
+
+    def _jump(self, p: Obj, c: Obj) -> bool:
+        d = float(np.hypot(*(_centroid(c.mask) - _centroid(p.mask))))
+        return d >= JUMP_SHARE * max(p.mask.shape)
+
+    def _resting(self, o: Obj, t: int) -> bool:
+        """Whether frame ``t`` shows ``o``'s colour where ``o`` is (half of it, or more), or
+        ``t`` is outside the video."""
+        if not 0 <= t < len(self.frames):
+            return True
+        return any(_overlaps(x, o) for x in self._of(t, o.cls))
 
     def _touching(self, a: Obj, objs: list[Obj]) -> list[Obj]:
         grown = dilate(a.mask, self.reach)

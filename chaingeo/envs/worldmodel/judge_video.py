@@ -218,7 +218,7 @@ def judge_frames(
     masks = [class_masks(f, model) for f in frames]
     wire = level is not None and getattr(level, "box", None) is not None
     objects = [
-        frame_objects(m, area, _wire(f, m) if wire else None if colors else unknown(f, m))
+        frame_objects(m, area, _wire(f, m) if wire else None, None if colors else unknown(f, m))
         for f, m in zip(frames, masks, strict=True)
     ]
     events = Tracker(objects, model.names).events()
