@@ -25,11 +25,12 @@ from chaingeo.core.suite import suite_folder
 from chaingeo.envs.render.raster import Posed, parse_color
 from chaingeo.envs.render.scene import render_frame
 from chaingeo.envs.worldmodel.judge_segment import U8, BoolArray, components, dilate, shrink
+from chaingeo.envs.worldmodel.judge_track import gap_covered
 from chaingeo.envs.worldmodel.shaded import Part, Shader, random_look
 from chaingeo.envs.worldmodel.video import _puzzle_shots
 
-#: Bumped whenever the cases a seed gives change (cached cases are keyed by it).
-VERSION: Final = 1
+#: Bumped whenever the cases a seed gives change (cached cases are keyed by it), per class.
+VERSIONS: Final = {"split": 2}
 #: Corruption classes, and the verdict kinds that count as catching each.
 CLASSES: Final = (
     "vanish_background",
@@ -373,8 +374,14 @@ def split(d: _Draft, rng: np.random.Generator) -> _Found:
         )
         d.set_part(u, k, a)
         d.scene[u].append(b)
-    if _parts(d.mask(min(LENGTH - 1, t + 3), k), d.least() // 3) < 2:
+    after = min(LENGTH - 1, t + 3)
+    comps = components(d.mask(after, k), d.least() // 3)
+    if len(comps) < 2:
         return None
+    lab = d.labels(after)
+    others = (lab > 0) & ~d.mask(after, k)
+    if gap_covered(comps[0], comps[1], others):
+        return None  # the gap lies behind another piece: no background between the halves
     return t, t + 2, (k,)
 
 

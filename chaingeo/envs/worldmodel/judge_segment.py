@@ -201,6 +201,9 @@ RAY_DEGREES: Final = 4.5
 JOIN_RADIUS: Final = 0.075
 #: Chroma distance (CIELAB a*, b*) from the background's within which a colour is background.
 BACKGROUND_CHROMA: Final = 12.0
+#: Unknown pixels are dark (a piece's face in its own shade; a pale or half-transparent blend
+#: of a piece with the ground, as video models draw a ghost, is no occluder).
+UNKNOWN_LIGHTNESS: Final = 40.0
 #: Frames sampled for the palette (evenly over the video).
 PALETTE_FRAMES: Final = 12
 
@@ -506,8 +509,8 @@ def class_masks(frame: U8, model: ColorModel) -> list[BoolArray]:
 
 
 def unknown(frame: U8, masks: list[BoolArray]) -> BoolArray:
-    """Pixels of no piece class that do not look like the background either: a piece's face
-    too dark or too pale to classify, a highlight, an edge. The background is what the picture's
+    """Pixels of no piece class that do not look like the background either and are dark: a
+    piece's face too dark to classify. The background is what the picture's
     border shows (a grey ground, its shadows, white): colours within BACKGROUND_CHROMA of its
     median chroma (CIELAB a*, b*), at any lightness. A gap through such pixels is no break."""
     lab = _table_lab()[_table_index(frame)]
@@ -517,5 +520,5 @@ def unknown(frame: U8, masks: list[BoolArray]) -> BoolArray:
     edge = ring & ~piece
     a0, b0 = (float(np.median(lab[..., c][edge])) if edge.any() else 0.0 for c in (1, 2))
     near = np.hypot(lab[..., 1] - a0, lab[..., 2] - b0) <= BACKGROUND_CHROMA
-    out: BoolArray = ~near & ~piece
+    out: BoolArray = ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
     return out

@@ -33,6 +33,8 @@ PERSIST: Final = 3
 OCCLUDED_GAP: Final = 0.6
 #: Furthest move (share of the frame's longer side) of a piece between two frames.
 FAST_SHARE: Final = 0.25
+#: Frames after which a piece's place is looked at again for another colour.
+LAGS: Final = (2, 6, 11)
 #: Least jump of a teleport (share of the frame's longer side).
 JUMP_SHARE: Final = 0.1
 #: Pixels from the picture's edge within which a part touches the border.
@@ -87,7 +89,7 @@ def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
     return pts[::step]
 
 
-def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
+def gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
     """Whether the gap between ``a`` and ``b`` (the pixels within half their distance plus a
     little of both) lies mostly on other pieces (an occluder) rather than on background."""
     pa, pb = _boundary_points(a), _boundary_points(b)
@@ -182,7 +184,7 @@ def frame_objects(
         for i in range(len(comps)):
             for j in range(i + 1, len(comps)):
                 ri, rj = _root(group, i), _root(group, j)
-                if ri != rj and _gap_covered(comps[i], comps[j], others):
+                if ri != rj and gap_covered(comps[i], comps[j], others):
                     group[rj] = ri
         for r in sorted({_root(group, i) for i in range(len(comps))}):
             members = [c for i, c in enumerate(comps) if _root(group, i) == r]
@@ -245,7 +247,69 @@ class Tracker:
                     out.extend(self._fewer(b, k))
         out.extend(self._swaps())
         out.extend(self._jumps())
+        for e in self._identity():
+            if not any(
+                o.piece == e.piece
+                and o.kind in ("recolor", "merge")
+                and abs(o.frame - e.frame) <= 3
+                for o in out
+            ):
+                out.append(e)
         return sorted(out, key=lambda e: (e.frame, e.kind, e.piece))
+
+    def _class_pixels(self, t: int, k: int) -> BoolArray:
+        out = np.zeros_like(self.solid[t])
+        for o in self._of(t, k):
+            out |= o.mask
+        return out
+
+    def _identity(self) -> list[Event]:
+        """Recolours and merges, abrupt or gradual: a piece at rest whose place shows another
+        colour LAGS frames later (and still two frames after), its own colour nowhere near, while
+        that other colour changed nowhere else (the other piece did not move over it)."""
+        out: list[Event] = []
+        seen: set[str] = set()
+        n = len(self.frames)
+        for b in range(2, n):
+            for p in self.frames[b - 1]:
+                name = self.names[p.cls]
+                if name in seen or p.touches_border() or not self._resting(p, b - 2):
+                    continue
+                if _share(self._class_pixels(b, p.cls), p.mask) >= 0.8:
+                    continue  # still its colour in the next frame: nothing starts here
+                ev = self._changed(p, b)
+                if ev is not None:
+                    seen.add(name)
+                    out.append(ev)
+        return out
+
+    def _changed(self, p: Obj, b: int) -> Event | None:
+        n = len(self.frames)
+        for lag in LAGS:
+            t = b + lag
+            if t + 2 >= n:
+                return None
+            if any(_share(self._class_pixels(u, p.cls), dilate(p.mask, self.reach)) > 0.2
+                   for u in (t, t + 2)):  # fmt: skip
+                continue
+            for j in range(len(self.names)):
+                if j == p.cls:
+                    continue
+                now = [self._class_pixels(u, j) for u in (t, t + 2)]
+                was = self._class_pixels(b - 1, j)
+                if min(_share(m, p.mask) for m in now) < 0.6 or _share(was, p.mask) > 0.2:
+                    continue
+                ring = ~dilate(p.mask, 3)
+                moved = float((now[0] & ring ^ was & ring).sum())
+                if moved > 0.3 * p.area:
+                    continue  # the other colour moved elsewhere too: it came over this piece
+                name, other = self.names[p.cls], self.names[j]
+                joined = bool((dilate(p.mask, 2) & was).any())
+                kind = "merge" if joined else "recolor"
+                how = "fused into" if joined else "turned"
+                detail = f"the {name} piece {how} {other} over {lag} frames"
+                return Event(kind, b, name, other, detail, (p.mask, now[0]))
+        return None
 
     def _jumps(self) -> list[Event]:
         """Teleports: a piece at rest in one place, then at rest in another JUMP_SHARE of the
@@ -268,7 +332,7 @@ class Tracker:
 
     def _jump(self, p: Obj, c: Obj) -> bool:
         d = float(np.hypot(*(_centroid(c.mask) - _centroid(p.mask))))
-        return d >= JUMP_SHARE * max(p.mask.shape)
+        return bool(d >= JUMP_SHARE * max(p.mask.shape))
 
     def _resting(self, o: Obj, t: int) -> bool:
         """Whether frame ``t`` shows ``o``'s colour where ``o`` is (half of it, or more), or
@@ -468,6 +532,11 @@ class Tracker:
 def _alike(a: Obj, b: Obj) -> bool:
     """Areas within a factor of two (one silhouette seen twice, not a piece and a sliver)."""
     return min(a.area, b.area) >= 0.5 * max(a.area, b.area)
+
+
+def _share(pixels: BoolArray, region: BoolArray) -> float:
+    """The share of ``region`` that ``pixels`` cover."""
+    return float((pixels & region).sum()) / max(1.0, float(region.sum()))
 
 
 def _overlaps(a: Obj, b: Obj) -> bool:
