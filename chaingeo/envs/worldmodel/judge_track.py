@@ -283,6 +283,13 @@ class Tracker:
                     out.append(ev)
         return out
 
+    def _went_elsewhere(self, p: Obj, b: int, t: int) -> bool:
+        """Whether ``p``'s colour kept its area by frame ``t`` (the piece moved away and what
+        it hid shows now) or reached the border on the way (carried out)."""
+        area = [int(self._class_pixels(u, p.cls).sum()) for u in (b - 1, t)]
+        border = any(o.touches_border() for u in range(b - 1, t + 1) for o in self._of(u, p.cls))
+        return border or area[1] > area[0] - 0.6 * p.area
+
     def _changed(self, p: Obj, b: int) -> Event | None:
         n = len(self.frames)
         for lag in LAGS:
@@ -292,6 +299,8 @@ class Tracker:
             if any(_share(self._class_pixels(u, p.cls), dilate(p.mask, self.reach)) > 0.2
                    for u in (t, t + 2)):  # fmt: skip
                 continue
+            if self._went_elsewhere(p, b, t):
+                return None
             for j in range(len(self.names)):
                 if j == p.cls:
                     continue
