@@ -71,6 +71,36 @@ def test_the_judge_leaves_a_clean_clip_alone(seed: int, style: str) -> None:
     assert verdict.valid, [(e.kind, e.frame, e.piece) for e in verdict.violations]
 
 
+def test_the_issue_example_a_piece_blanked_for_the_middle_third_is_lost() -> None:
+    """Issue #35: one piece's colour replaced by the background for the middle third of our
+    luban-6 plan video (its cube outlines stay) was judged valid with the level."""
+    from chaingeo.core.level import load_level
+    from chaingeo.core.suite import suite_folder
+    from chaingeo.envs.worldmodel.judge_segment import class_masks, palette_model, shrink
+    from chaingeo.envs.worldmodel.video import puzzle_video
+
+    level = load_level(suite_folder("puzzle") / "puzzle-easy-02-luban-6-piece.json")
+    frames = [
+        shrink(np.asarray(f.convert("RGB"), dtype=np.uint8))
+        for f in puzzle_video(level, size=256).frames
+    ]
+    colors = [
+        (p.name, (int(p.rgb[1:3], 16), int(p.rgb[3:5], 16), int(p.rgb[5:7], 16)))
+        for p in level.pieces
+    ]
+    k = [n for n, _ in colors].index("blue")
+    n = len(frames)
+    for i in range(n // 3, 2 * n // 3):
+        f = frames[i] = frames[i].copy()
+        m = class_masks(f, palette_model(colors))[k]
+        f[m & (f.max(axis=2) > 60)] = 255  # the background's white; black outlines kept
+    verdict = judge_frames(frames, colors, level)
+    found = [(e.kind, e.frame, e.piece) for e in verdict.violations]
+    assert any(kind == "lost" and p == "blue" and abs(f - n // 3) <= 2 for kind, f, p in found), (
+        found
+    )
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("kind", CLASSES)
 @pytest.mark.parametrize("style", ["flat", "shaded"])
@@ -78,3 +108,52 @@ def test_every_class_builds_in_both_styles(kind: str, style: str) -> None:
     case = make_case(7, kind, style)
     assert case.kind == kind and case.style == style and case.pieces
     assert 0 < case.frame <= case.end < len(case.frames)
+
+
+def _held_out() -> dict[str, tuple[int, int]]:
+    """(caught, cases) per class on the whole held-out range (`chain bench judge`'s set)."""
+    from chaingeo.benchmarks.judge import CLEAN, HELD_OUT, PER_CLASS, plan, run_range
+
+    rows = run_range(plan(HELD_OUT, PER_CLASS, CLEAN), 2)
+    out: dict[str, tuple[int, int]] = {}
+    for _, kind, _, caught, _, _ in rows:
+        if caught is not None:
+            k, n = out.get(kind, (0, 0))
+            out[kind] = (k + int(caught), n + 1)
+    return out
+
+
+#: Least share caught per class on the held-out range (what the judge reached, less a margin:
+#: a regression guard), and the most false alarms on its 100 clean videos.
+FLOORS = {
+    "vanish_background": 0.8,
+    "vanish_white": 0.8,
+    "vanish_neighbour": 0.8,
+    "recolour_abrupt": 0.7,
+    "recolour_gradual": 0.5,
+    "split": 0.8,
+    "merge": 0.7,
+    "duplicate": 0.65,
+    "teleport": 0.4,
+}
+MOST_FALSE_ALARMS = 0.06
+
+
+@pytest.mark.slow
+def test_the_held_out_set_keeps_its_figures() -> None:
+    got = _held_out()
+    for kind, floor in FLOORS.items():
+        k, n = got[kind]
+        assert k >= floor * n, (kind, k, n)
+    k, n = got["clean"]
+    assert n >= 100 and k <= MOST_FALSE_ALARMS * n, (k, n)
+    assert sum(n for kind, (_, n) in got.items() if kind != "clean") >= 300
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="issue #35's target is not reached yet (see the benchmarks)")
+def test_the_held_out_set_meets_the_issue_target() -> None:
+    got = _held_out()
+    assert all(k >= 0.95 * n for kind, (k, n) in got.items() if kind != "clean")
+    k, n = got["clean"]
+    assert k <= 0.02 * n
