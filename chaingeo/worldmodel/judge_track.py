@@ -33,6 +33,10 @@ PERSIST: Final = 3
 OCCLUDED_GAP: Final = 0.6
 #: Furthest move (share of the frame's longer side) of a piece between two frames.
 FAST_SHARE: Final = 0.25
+#: Frames after which a piece's place is looked at again for another colour.
+LAGS: Final = (2, 6, 11)
+#: Least jump of a teleport (share of the frame's longer side).
+JUMP_SHARE: Final = 0.1
 #: Pixels from the picture's edge within which a part touches the border.
 BORDER: Final = 3
 #: Growth (share of the frame's longer side) of a mask when matching across one frame.
@@ -73,7 +77,7 @@ class Event:
     before: int = 1
 
 
-VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "pass_through")
+VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "teleport", "pass_through")
 
 
 def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
@@ -85,7 +89,7 @@ def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
     return pts[::step]
 
 
-def _gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
+def gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
     """Whether the gap between ``a`` and ``b`` (the pixels within half their distance plus a
     little of both) lies mostly on other pieces (an occluder) rather than on background."""
     pa, pb = _boundary_points(a), _boundary_points(b)
@@ -161,21 +165,26 @@ def solid_of(masks: list[BoolArray]) -> BoolArray:
 
 
 def frame_objects(
-    masks: list[BoolArray], min_area: int, occluders: BoolArray | None = None
+    masks: list[BoolArray],
+    min_area: int,
+    occluders: BoolArray | None = None,
+    unknown: BoolArray | None = None,
 ) -> tuple[list[Obj], BoolArray]:
     """Objects of one frame (each class's components grouped across occluders), and the
     frame's piece pixels (:func:`solid_of`) with ``occluders`` (a box's wire frame drawn over
-    the pieces), which hide pieces as pieces do."""
+    the pieces), which hide pieces as pieces do; ``unknown`` pixels (neither a piece's colour
+    nor the background's) join two parts of a colour as an occluder would, and count for
+    nothing else."""
     solid = solid_of(masks if occluders is None else [*masks, occluders])
     out: list[Obj] = []
     for k, mask in enumerate(masks):
         comps = components(mask, min_area)
         group = list(range(len(comps)))
-        others = solid & ~mask
+        others = (solid if unknown is None else solid | unknown) & ~mask
         for i in range(len(comps)):
             for j in range(i + 1, len(comps)):
                 ri, rj = _root(group, i), _root(group, j)
-                if ri != rj and _gap_covered(comps[i], comps[j], others):
+                if ri != rj and gap_covered(comps[i], comps[j], others):
                     group[rj] = ri
         for r in sorted({_root(group, i) for i in range(len(comps))}):
             members = [c for i, c in enumerate(comps) if _root(group, i) == r]
@@ -237,7 +246,109 @@ class Tracker:
                 else:
                     out.extend(self._fewer(b, k))
         out.extend(self._swaps())
+        out.extend(self._jumps())
+        for e in self._identity():
+            if not any(
+                o.piece == e.piece
+                and o.kind in ("recolor", "merge")
+                and abs(o.frame - e.frame) <= 3
+                for o in out
+            ):
+                out.append(e)
         return sorted(out, key=lambda e: (e.frame, e.kind, e.piece))
+
+    def _class_pixels(self, t: int, k: int) -> BoolArray:
+        out = np.zeros_like(self.solid[t])
+        for o in self._of(t, k):
+            out |= o.mask
+        return out
+
+    def _identity(self) -> list[Event]:
+        """Recolours and merges, abrupt or gradual: a piece at rest whose place shows another
+        colour LAGS frames later (and still two frames after), its own colour nowhere near, while
+        that other colour changed nowhere else (the other piece did not move over it)."""
+        out: list[Event] = []
+        seen: set[str] = set()
+        n = len(self.frames)
+        for b in range(2, n):
+            for p in self.frames[b - 1]:
+                name = self.names[p.cls]
+                if name in seen or p.touches_border() or not self._resting(p, b - 2):
+                    continue
+                if _share(self._class_pixels(b, p.cls), p.mask) >= 0.8:
+                    continue  # still its colour in the next frame: nothing starts here
+                ev = self._changed(p, b)
+                if ev is not None:
+                    seen.add(name)
+                    out.append(ev)
+        return out
+
+    def _went_elsewhere(self, p: Obj, b: int, t: int) -> bool:
+        """Whether ``p``'s colour kept its area by frame ``t`` (the piece moved away and what
+        it hid shows now) or reached the border on the way (carried out)."""
+        area = [int(self._class_pixels(u, p.cls).sum()) for u in (b - 1, t)]
+        border = any(o.touches_border() for u in range(b - 1, t + 1) for o in self._of(u, p.cls))
+        return border or area[1] > area[0] - 0.6 * p.area
+
+    def _changed(self, p: Obj, b: int) -> Event | None:
+        n = len(self.frames)
+        for lag in LAGS:
+            t = b + lag
+            if t + 2 >= n:
+                return None
+            if any(_share(self._class_pixels(u, p.cls), dilate(p.mask, self.reach)) > 0.2
+                   for u in (t, t + 2)):  # fmt: skip
+                continue
+            if self._went_elsewhere(p, b, t):
+                return None
+            for j in range(len(self.names)):
+                if j == p.cls:
+                    continue
+                now = [self._class_pixels(u, j) for u in (t, t + 2)]
+                was = self._class_pixels(b - 1, j)
+                if min(_share(m, p.mask) for m in now) < 0.6 or _share(was, p.mask) > 0.2:
+                    continue
+                ring = ~dilate(p.mask, 3)
+                moved = float((now[0] & ring ^ was & ring).sum())
+                if moved > 0.3 * p.area:
+                    continue  # the other colour moved elsewhere too: it came over this piece
+                name, other = self.names[p.cls], self.names[j]
+                joined = bool((dilate(p.mask, 2) & was).any())
+                kind = "merge" if joined else "recolor"
+                how = "fused into" if joined else "turned"
+                detail = f"the {name} piece {how} {other} over {lag} frames"
+                return Event(kind, b, name, other, detail, (p.mask, now[0]))
+        return None
+
+    def _jumps(self) -> list[Event]:
+        """Teleports: a piece at rest in one place, then at rest in another JUMP_SHARE of the
+        frame or more away, with no frame between (motion, however fast, passes through
+        places; our own videos ease every move in and out)."""
+        out: list[Event] = []
+        for b in range(1, len(self.frames)):
+            for k in range(len(self.names)):
+                before, now = self._of(b - 1, k), self._of(b, k)
+                gone = [p for p in before if not self._touching(p, now) and not p.touches_border()]
+                new = [c for c in now if not self._touching(c, before) and not c.touches_border()]
+                for p in gone:
+                    far = [c for c in new if _alike(p, c) and self._jump(p, c)]
+                    if far and self._resting(p, b - 2) and self._resting(far[0], b + 1):
+                        new.remove(far[0])
+                        name = self.names[k]
+                        detail = f"the {name} piece jumped to another place between two frames"
+                        out.append(Event("teleport", b, name, None, detail, (p.mask, far[0].mask)))
+        return out
+
+    def _jump(self, p: Obj, c: Obj) -> bool:
+        d = float(np.hypot(*(_centroid(c.mask) - _centroid(p.mask))))
+        return bool(d >= JUMP_SHARE * max(p.mask.shape))
+
+    def _resting(self, o: Obj, t: int) -> bool:
+        """Whether frame ``t`` shows ``o``'s colour where ``o`` is (half of it, or more), or
+        ``t`` is outside the video."""
+        if not 0 <= t < len(self.frames):
+            return True
+        return any(_overlaps(x, o) for x in self._of(t, o.cls))
 
     def _touching(self, a: Obj, objs: list[Obj]) -> list[Obj]:
         grown = dilate(a.mask, self.reach)
@@ -430,6 +541,11 @@ class Tracker:
 def _alike(a: Obj, b: Obj) -> bool:
     """Areas within a factor of two (one silhouette seen twice, not a piece and a sliver)."""
     return min(a.area, b.area) >= 0.5 * max(a.area, b.area)
+
+
+def _share(pixels: BoolArray, region: BoolArray) -> float:
+    """The share of ``region`` that ``pixels`` cover."""
+    return float((pixels & region).sum()) / max(1.0, float(region.sum()))
 
 
 def _overlaps(a: Obj, b: Obj) -> bool:

@@ -32,12 +32,13 @@ from chaingeo.worldmodel.judge_segment import (
     ColorModel,
     Colors,
     class_masks,
-    clustered_model,
     confusable,
     dilate,
     min_area,
     palette_model,
     shrink,
+    unknown,
+    video_model,
 )
 from chaingeo.worldmodel.judge_track import (
     VIOLATIONS,
@@ -240,7 +241,7 @@ def judge_frames(
     the reading of occlusion and shading by our renderer's model."""
     try:
         if not colors:
-            model = clustered_model(frames[0])
+            model = video_model(frames)
         else:
             model = palette_model(colors, RENDER_SHADES if level is not None else SHADES)
     except ValueError as e:
@@ -249,7 +250,7 @@ def judge_frames(
     masks = [class_masks(f, model) for f in frames]
     wire = level is not None and getattr(level, "box", None) is not None
     objects = [
-        frame_objects(m, area, _wire(f, m) if wire else None)
+        frame_objects(m, area, _wire(f, m) if wire else None, None if colors else unknown(f, m))
         for f, m in zip(frames, masks, strict=True)
     ]
     events = Tracker(objects, model.names).events()

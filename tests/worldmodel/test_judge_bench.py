@@ -1,0 +1,159 @@
+"""The judge's corruption set (chain bench judge): cases are seeded and show what they claim;
+the judge catches a small seeded subset and leaves clean clips alone (the full set is slow)."""
+
+from __future__ import annotations
+
+import hashlib
+
+import numpy as np
+import pytest
+
+from chaingeo.benchmarks.judge import score, wilson
+from chaingeo.worldmodel.corrupt import CLASSES, make_case
+from chaingeo.worldmodel.judge_video import judge_frames
+
+
+def _digest(frames: tuple[np.ndarray, ...]) -> str:
+    h = hashlib.sha256()
+    for f in frames:
+        h.update(f.tobytes())
+    return h.hexdigest()
+
+
+def test_a_case_is_the_same_bytes_from_the_same_seed() -> None:
+    a, b = make_case(3, "recolour_abrupt", "flat"), make_case(3, "recolour_abrupt", "flat")
+    assert _digest(a.frames) == _digest(b.frames) and (a.frame, a.pieces) == (b.frame, b.pieces)
+    c = make_case(4, "recolour_abrupt", "flat")
+    assert _digest(c.frames) != _digest(a.frames)
+
+
+def test_a_vanished_piece_is_gone_from_its_pixels() -> None:
+    """Ground truth by construction: where the piece showed, the corrupted frame differs."""
+    case = make_case(0, "vanish_white", "shaded")
+    t = case.frame
+    assert 0 < t < len(case.frames) and case.truth
+    where = case.truth[1]
+    assert where.sum() > 100
+    px = case.frames[t][where].astype(np.int64)
+    assert float(px.mean()) > 200  # white, through blur, noise and JPEG
+
+
+def test_wilson_interval() -> None:
+    lo, hi = wilson(95, 100)
+    assert lo == pytest.approx(0.888, abs=1e-3) and hi == pytest.approx(0.978, abs=1e-3)
+    assert wilson(0, 0) == (0.0, 1.0)
+
+
+#: A seeded subset the judge catches (class, seed, style) and clean clips it passes.
+CAUGHT = (
+    ("vanish_background", 0, "flat"),
+    ("teleport", 8, "flat"),
+    ("vanish_neighbour", 12, "shaded"),
+)
+CLEAN = ((80, "flat"), (82, "shaded"))
+
+
+@pytest.mark.parametrize(("kind", "seed", "style"), CAUGHT)
+def test_the_judge_catches_a_seeded_corruption(kind: str, seed: int, style: str) -> None:
+    case = make_case(seed, kind, style)
+    verdict = judge_frames(list(case.frames))
+    assert score(case, list(verdict.violations)), [
+        (e.kind, e.frame, e.piece) for e in verdict.violations
+    ]
+    for e in verdict.violations:
+        assert e.kind and e.piece and e.frame >= 0 and e.detail
+
+
+@pytest.mark.parametrize(("seed", "style"), CLEAN)
+def test_the_judge_leaves_a_clean_clip_alone(seed: int, style: str) -> None:
+    case = make_case(seed, "clean", style)
+    verdict = judge_frames(list(case.frames))
+    assert verdict.valid, [(e.kind, e.frame, e.piece) for e in verdict.violations]
+
+
+def test_the_issue_example_a_piece_blanked_for_the_middle_third_is_lost() -> None:
+    """Issue #35: one piece's colour replaced by the background for the middle third of our
+    luban-6 plan video (its cube outlines stay) was judged valid with the level."""
+    from chaingeo.core.level import load_level
+    from chaingeo.core.suite import suite_folder
+    from chaingeo.worldmodel.judge_segment import class_masks, palette_model, shrink
+    from chaingeo.worldmodel.video import puzzle_video
+
+    level = load_level(suite_folder("puzzle") / "puzzle-easy-02-luban-6-piece.json")
+    frames = [
+        shrink(np.asarray(f.convert("RGB"), dtype=np.uint8))
+        for f in puzzle_video(level, size=256).frames
+    ]
+    colors = [
+        (p.name, (int(p.rgb[1:3], 16), int(p.rgb[3:5], 16), int(p.rgb[5:7], 16)))
+        for p in level.pieces
+    ]
+    k = [n for n, _ in colors].index("blue")
+    n = len(frames)
+    for i in range(n // 3, 2 * n // 3):
+        f = frames[i] = frames[i].copy()
+        m = class_masks(f, palette_model(colors))[k]
+        f[m & (f.max(axis=2) > 60)] = 255  # the background's white; black outlines kept
+    verdict = judge_frames(frames, colors, level)
+    found = [(e.kind, e.frame, e.piece) for e in verdict.violations]
+    assert any(kind == "lost" and p == "blue" and abs(f - n // 3) <= 2 for kind, f, p in found), (
+        found
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", CLASSES)
+@pytest.mark.parametrize("style", ["flat", "shaded"])
+def test_every_class_builds_in_both_styles(kind: str, style: str) -> None:
+    case = make_case(7, kind, style)
+    assert case.kind == kind and case.style == style and case.pieces
+    assert 0 < case.frame <= case.end < len(case.frames)
+
+
+def _held_out() -> dict[str, tuple[int, int]]:
+    """(caught, cases) per class on the whole held-out range (`chain bench judge`'s set)."""
+    from chaingeo.benchmarks.judge import CLEAN, HELD_OUT, PER_CLASS, plan, run_range
+
+    rows = run_range(plan(HELD_OUT, PER_CLASS, CLEAN), 2)
+    out: dict[str, tuple[int, int]] = {}
+    for _, kind, _, caught, _, _ in rows:
+        if caught is not None:
+            k, n = out.get(kind, (0, 0))
+            out[kind] = (k + int(caught), n + 1)
+    return out
+
+
+#: Least share caught per class on the held-out range (what the judge reached, less a margin:
+#: a regression guard), and the most false alarms on its 100 clean videos.
+FLOORS = {
+    "vanish_background": 0.8,
+    "vanish_white": 0.8,
+    "vanish_neighbour": 0.8,
+    "recolour_abrupt": 0.7,
+    "recolour_gradual": 0.5,
+    "split": 0.8,
+    "merge": 0.7,
+    "duplicate": 0.65,
+    "teleport": 0.4,
+}
+MOST_FALSE_ALARMS = 0.06
+
+
+@pytest.mark.slow
+def test_the_held_out_set_keeps_its_figures() -> None:
+    got = _held_out()
+    for kind, floor in FLOORS.items():
+        k, n = got[kind]
+        assert k >= floor * n, (kind, k, n)
+    k, n = got["clean"]
+    assert n >= 100 and k <= MOST_FALSE_ALARMS * n, (k, n)
+    assert sum(n for kind, (_, n) in got.items() if kind != "clean") >= 300
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="issue #35's target is not reached yet (see the benchmarks)")
+def test_the_held_out_set_meets_the_issue_target() -> None:
+    got = _held_out()
+    assert all(k >= 0.95 * n for kind, (k, n) in got.items() if kind != "clean")
+    k, n = got["clean"]
+    assert k <= 0.02 * n
