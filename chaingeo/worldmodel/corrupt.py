@@ -20,11 +20,12 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import suite_folder
 from chaingeo.pictures.raster import Posed, parse_color
 from chaingeo.pictures.scene import render_frame
-from chaingeo.worldmodel.judge_segment import U8, BoolArray, components, dilate, shrink
+from chaingeo.worldmodel.judge_segment import components, dilate, shrink
 from chaingeo.worldmodel.judge_track import gap_covered
 from chaingeo.worldmodel.shaded import Part, Shader, random_look
 from chaingeo.worldmodel.video import _puzzle_shots
@@ -101,7 +102,7 @@ class Case:
     frames: tuple[U8, ...]
     colors: tuple[tuple[str, tuple[int, int, int]], ...]
     #: Where the pieces involved show just before and at the first corrupted frame.
-    truth: tuple[BoolArray, ...] = ()
+    truth: tuple[Bools, ...] = ()
 
 
 @lru_cache(maxsize=16)
@@ -208,9 +209,9 @@ class _Draft:
             self._labels[key] = self.render.labels(self.scene[i], i)
         return self._labels[key]
 
-    def mask(self, i: int, label: int) -> BoolArray:
+    def mask(self, i: int, label: int) -> Bools:
         lab = self.labels(i)
-        out: BoolArray = (lab == label) | (lab == label + COPY)
+        out: Bools = (lab == label) | (lab == label + COPY)
         return out
 
     def least(self) -> int:
@@ -340,7 +341,7 @@ def recolour_gradual(d: _Draft, rng: np.random.Generator) -> _Found:
     return _recolour(d, rng, int(rng.integers(GRADUAL[0], GRADUAL[1] + 1)))
 
 
-def _parts(m: BoolArray, least: int) -> int:
+def _parts(m: Bools, least: int) -> int:
     return len(components(m, least))
 
 

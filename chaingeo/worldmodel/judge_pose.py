@@ -24,9 +24,10 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image, ImageDraw
 
+from chaingeo.core.arrays import F64, U8, Bools
 from chaingeo.pictures.raster import Camera, visible_faces
 from chaingeo.pictures.scene import CAMERAS
-from chaingeo.worldmodel.judge_segment import U8, BoolArray, FloatArray, dilate
+from chaingeo.worldmodel.judge_segment import dilate
 from chaingeo.worldmodel.judge_track import Event
 
 if TYPE_CHECKING:
@@ -51,16 +52,13 @@ STILL_FRAMES: Final = 4
 NEAR: Final = tuple(float(d) for d in np.arange(-2.0, 2.01, 0.25) if abs(d) > 1e-9)
 
 
-Bools = npt.NDArray[np.bool_]
-
-
 @dataclass(frozen=True)
 class _Piece:
     """One piece's visible faces alone (camera plane corners, depth of each face's centre)."""
 
     label: int
-    corners: FloatArray  # (n, 4, 2)
-    depth: FloatArray  # (n,)
+    corners: F64  # (n, 4, 2)
+    depth: F64  # (n,)
     cells: npt.NDArray[np.int64]
 
 
@@ -75,7 +73,7 @@ def _pieces(level: Level, cam: Camera) -> list[_Piece]:
     return out
 
 
-class _Scene:
+class _PoseScene:
     """Draws label images of the pieces at translations, with the fitted camera."""
 
     def __init__(self, pieces: list[_Piece], cam: Camera, shape: tuple[int, int]) -> None:
@@ -90,7 +88,7 @@ class _Scene:
         self._owner = np.repeat(np.arange(len(pieces)), [len(p.depth) for p in pieces])
         self._shifts: dict[tuple[float, ...], tuple[float, float, float]] = {}
 
-    def fit(self, solid: BoolArray) -> float:
+    def fit(self, solid: Bools) -> float:
         """Scale and offset from the bounding box of ``solid``; the relative mismatch of the
         two scale estimates."""
         every = np.concatenate([p.corners.reshape(-1, 2) for p in self.pieces])
@@ -147,7 +145,7 @@ class _Scene:
             )
         return out
 
-    def _faces(self, t: FloatArray) -> tuple[npt.NDArray[np.intp], list[list[float]]]:
+    def _faces(self, t: F64) -> tuple[npt.NDArray[np.intp], list[list[float]]]:
         """Faces in drawing order (a stable sort by depth: ties keep piece, then face order)
         and each face's pixel corners (x0, y0, ... x3, y3), in that order."""
         s = np.array([self._shift(tuple(off)) for off in t.tolist()]).reshape(-1, 3)[self._owner]
@@ -158,7 +156,7 @@ class _Scene:
         xy: list[list[float]] = np.stack([x, y], axis=2)[order].reshape(-1, 8).tolist()
         return order, xy
 
-    def _paint(self, t: FloatArray, start: int | None = None) -> npt.NDArray[np.uint8]:
+    def _paint(self, t: F64, start: int | None = None) -> npt.NDArray[np.uint8]:
         """The label image of the faces in drawing order, from the first face of piece
         ``start`` on when given (earlier faces cannot show over it)."""
         order, xy = self._faces(t)
@@ -171,24 +169,24 @@ class _Scene:
             core.draw_polygon(xy[k], labels[k], 1)
         return np.asarray(img, dtype=np.uint8)
 
-    def draw(self, t: FloatArray) -> npt.NDArray[np.uint8]:
+    def draw(self, t: F64) -> npt.NDArray[np.uint8]:
         """The label image (0: nothing) with piece i translated by ``t[i]`` (cells)."""
         return self._paint(t)
 
-    def mask(self, t: FloatArray, i: int) -> BoolArray:
+    def mask(self, t: F64, i: int) -> Bools:
         """Where piece ``i`` shows in :meth:`draw` of ``t`` (the faces drawn before its first
         one are skipped: they are overdrawn or elsewhere)."""
-        out: BoolArray = self._paint(t, i) == i + 1
+        out: Bools = self._paint(t, i) == i + 1
         return out
 
 
 class _Target:
     """A seen silhouette and its one-pixel growth, scored against many drawn ones."""
 
-    def __init__(self, seen: BoolArray) -> None:
+    def __init__(self, seen: Bools) -> None:
         self.seen, self.grown, self.area = seen, dilate(seen, 1), np.count_nonzero(seen)
 
-    def iou(self, drawn: BoolArray) -> float:
+    def iou(self, drawn: Bools) -> float:
         """:func:`_iou` of ``drawn`` with the seen silhouette (the same sums)."""
         total = np.count_nonzero(drawn) + self.area
         if total == 0:
@@ -197,7 +195,7 @@ class _Target:
         return float(same) / total
 
 
-def _iou(a: BoolArray, b: BoolArray) -> float:
+def _iou(a: Bools, b: Bools) -> float:
     """Agreement of two silhouettes, forgiving one pixel at the boundary (drawn edges and
     anti-aliasing move it): the Dice coefficient of each against the other grown by one."""
     total = np.count_nonzero(a) + np.count_nonzero(b)
@@ -206,7 +204,7 @@ def _iou(a: BoolArray, b: BoolArray) -> float:
     return float(np.count_nonzero(a & dilate(b, 1)) + np.count_nonzero(b & dilate(a, 1))) / total
 
 
-def _labels(masks: list[BoolArray]) -> U8:
+def _labels(masks: list[Bools]) -> U8:
     out = np.zeros(masks[0].shape, dtype=np.uint8)
     for i, m in enumerate(masks):
         out[m] = i + 1
@@ -218,17 +216,17 @@ class _Tracker:
     the agreement of its last fit as its own baseline (drawn edges and anti-aliasing cost some
     pieces more than others), and is searched for only when it falls clearly below it."""
 
-    def __init__(self, scene: _Scene, names: tuple[str, ...], base: list[float]) -> None:
+    def __init__(self, scene: _PoseScene, names: tuple[str, ...], base: list[float]) -> None:
         self.scene, self.names = scene, names
         self.t = np.zeros((len(names), 3))
         self.base = list(base)
         self.gone = np.zeros(len(names), dtype=bool)
         self.span = int(np.ceil(max(scene.shape) / max(scene.scale, 1e-9))) + 2
 
-    def _score(self, i: int, t: FloatArray, seen: _Target) -> float:
+    def _score(self, i: int, t: F64, seen: _Target) -> float:
         return seen.iou(self.scene.mask(t, i))
 
-    def _candidates(self, i: int, far: bool) -> list[FloatArray]:
+    def _candidates(self, i: int, far: bool) -> list[F64]:
         """Poses one axis away from the piece's nearest lattice pose (no drift across axes)."""
         steps = [float(d) for d in range(-self.span, self.span + 1) if d] if far else list(NEAR)
         steps.sort(key=abs)
@@ -268,7 +266,7 @@ class _Tracker:
             self.base[i] = best
         return moved, lost
 
-    def _search(self, i: int, seen: U8, now: float) -> tuple[float, FloatArray]:
+    def _search(self, i: int, seen: U8, now: float) -> tuple[float, F64]:
         """The best pose of piece ``i``: near its last one (nearest first, stopping at a match
         as good as its baseline), else anywhere along the three axes."""
         best, pose = now, self.t
@@ -285,7 +283,7 @@ class _Tracker:
                     return best, pose
         return best, pose
 
-    def swept(self, i: int, before: FloatArray, after: FloatArray) -> list[set[tuple[int, ...]]]:
+    def swept(self, i: int, before: F64, after: F64) -> list[set[tuple[int, ...]]]:
         """Cells piece ``i`` fills at each whole position from one pose to the next along the
         axis of the move, ends rounded (first and last: the two poses)."""
         d = after - before
@@ -300,7 +298,7 @@ class _Tracker:
             out.append({tuple(c) for c in (self.scene.pieces[i].cells + off).tolist()})
         return out
 
-    def cells(self, j: int, pose: FloatArray) -> set[tuple[int, ...]]:
+    def cells(self, j: int, pose: F64) -> set[tuple[int, ...]]:
         off = np.rint(pose).astype(np.int64)
         return {tuple(c) for c in (self.scene.pieces[j].cells + off).tolist()}
 
@@ -309,13 +307,13 @@ class Fit:
     """Where the tracker put every piece in every frame, with the fitted camera: the level
     drawn at those poses tells occlusion (a piece seen in parts round another) from a break."""
 
-    def __init__(self, scene: _Scene, poses: dict[int, FloatArray], gone: dict[int, Bools]):
+    def __init__(self, scene: _PoseScene, poses: dict[int, F64], gone: dict[int, Bools]):
         self.scene, self.poses, self.gone = scene, poses, gone
 
-    def _best(self, g: int, i: int, seen: BoolArray) -> tuple[float, FloatArray, BoolArray]:
+    def _best(self, g: int, i: int, seen: Bools) -> tuple[float, F64, Bools]:
         """Piece ``i``'s best agreement with ``seen`` at frame ``g``: at its tracked pose or
         up to a cell from it along one axis (the tracker refits only on a clear loss)."""
-        best: tuple[float, FloatArray, BoolArray] = (-1.0, self.poses[g][i], seen)
+        best: tuple[float, F64, Bools] = (-1.0, self.poses[g][i], seen)
         steps = [(0, 0.0)] + [(a, d) for a in range(3) for d in NEAR if abs(d) <= 1.0]
         target = _Target(seen)
         for a, d in steps:
@@ -328,7 +326,7 @@ class Fit:
                 best = (score, t[i], drawn)
         return best
 
-    def explains(self, masks: list[list[BoolArray]], f: int, i: int, area: int) -> bool:
+    def explains(self, masks: list[list[Bools]], f: int, i: int, area: int) -> bool:
         """Whether piece ``i`` is seen in frames ``f - 1`` and ``f`` as the level drawn near
         its tracked poses shows it (no jump; no part missing in open view; no extra part):
         what changed there is occlusion, not a break, a copy or a loss."""
@@ -348,7 +346,7 @@ class Fit:
 
 
 def pass_through(
-    level: Level, masks: list[list[BoolArray]], names: tuple[str, ...]
+    level: Level, masks: list[list[Bools]], names: tuple[str, ...]
 ) -> tuple[list[Event], list[str], Fit | None]:
     """Pass-through violations of a video drawn by our camera, and why not when undecidable.
     The camera is fitted on the first frame, or on the last one played backwards (a video
@@ -359,7 +357,7 @@ def pass_through(
     pieces = _pieces(level, cam)
     agree = 0.0
     for order in (list(range(len(masks))), list(range(len(masks) - 1, -1, -1))):
-        scene = _Scene(pieces, cam, masks[0][0].shape)
+        scene = _PoseScene(pieces, cam, masks[0][0].shape)
         first = _labels(masks[order[0]])
         mismatch = scene.fit(first > 0) if (first > 0).any() else 1.0
         base = scene.refine(first) if mismatch <= MAX_SCALE_MISMATCH else [0.0]
@@ -372,9 +370,9 @@ def pass_through(
 
 
 def _follow(
-    scene: _Scene,
+    scene: _PoseScene,
     names: tuple[str, ...],
-    masks: list[list[BoolArray]],
+    masks: list[list[Bools]],
     order: list[int],
     base: list[float],
 ) -> tuple[list[Event], list[str], Fit]:
@@ -415,7 +413,7 @@ def _follow(
     return events, why, fit
 
 
-def _still(poses: list[FloatArray], gone: list[npt.NDArray[np.bool_]], n: int, i: int) -> list[int]:
+def _still(poses: list[F64], gone: list[npt.NDArray[np.bool_]], n: int, i: int) -> list[int]:
     """The pieces other than ``i`` that stay put for STILL_FRAMES around step ``n`` (a piece
     moving at the same time may be moving with it: not checked against it)."""
     lo, hi = max(0, n - STILL_FRAMES), min(len(poses), n + STILL_FRAMES + 1)

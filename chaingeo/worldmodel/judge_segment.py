@@ -23,14 +23,10 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image
 
+from chaingeo.core.arrays import F64, U8, Bools
 from chaingeo.core.colors import PALETTE, ciede2000, srgb_to_lab
 from chaingeo.kernels.jit import njit
 from chaingeo.pictures.raster import SHADE
-
-U8 = npt.NDArray[np.uint8]
-I32 = npt.NDArray[np.int32]
-FloatArray = npt.NDArray[np.float64]
-BoolArray = npt.NDArray[np.bool_]
 
 #: Longer side of a frame once shrunk: enough for pieces, cheap for every later step.
 WORK_SIZE: Final = 320
@@ -65,18 +61,18 @@ class ColorModel:
     colours, and the class of every 5-bit RGB colour (0: background)."""
 
     names: tuple[str, ...]
-    lab: FloatArray
+    lab: F64
     table: U8
     source: str  # "level" or "first frame"
 
 
-def _table_rgb() -> FloatArray:
+def _table_rgb() -> F64:
     q = np.arange(32768)
     return np.stack([(q >> 10) & 31, (q >> 5) & 31, q & 31], axis=1) * 8.0 + 4.0
 
 
 @lru_cache(maxsize=1)
-def _table_lab() -> FloatArray:
+def _table_lab() -> F64:
     """CIELAB of every table colour (the same for every model: computed once)."""
     return srgb_to_lab(_table_rgb())
 
@@ -98,7 +94,7 @@ def palette_model(colors: Colors, shades: tuple[float, ...] = SHADES) -> ColorMo
     return _palette_model(tuple(colors), shades)
 
 
-def _shaded_lab(rgb: tuple[int, int, int], shades: tuple[float, ...]) -> FloatArray:
+def _shaded_lab(rgb: tuple[int, int, int], shades: tuple[float, ...]) -> F64:
     lit = np.array(rgb, dtype=np.float64)[None, :] * np.array(shades)[:, None]
     return srgb_to_lab(np.clip(lit, 0, 255))
 
@@ -134,13 +130,13 @@ def _palette_model(
     return ColorModel(names, srgb_to_lab(np.array([c for _, c in colors])), label, "level")
 
 
-def _hue_chroma(lab: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _hue_chroma(lab: F64) -> tuple[F64, F64]:
     return np.degrees(np.arctan2(lab[..., 2], lab[..., 1])) % 360, np.hypot(
         lab[..., 1], lab[..., 2]
     )
 
 
-def _hue_peaks(hues: FloatArray) -> list[float]:
+def _hue_peaks(hues: F64) -> list[float]:
     """Peaks of a circular hue histogram (5 degree bins, smoothed), strongest first, each
     holding MIN_PEAK_SHARE of the pixels within MERGE_DEGREES / 2, none closer than that."""
     hist = np.bincount((hues // 5).astype(np.int64) % 72, minlength=72).astype(np.float64)
@@ -163,7 +159,7 @@ def _hue_peaks(hues: FloatArray) -> list[float]:
     return peaks
 
 
-def _angle(a: float | FloatArray, b: float) -> FloatArray:
+def _angle(a: float | F64, b: float) -> F64:
     d = np.abs((np.asarray(a, dtype=np.float64) - b + 180.0) % 360.0 - 180.0)
     return d
 
@@ -208,7 +204,7 @@ UNKNOWN_LIGHTNESS: Final = 40.0
 PALETTE_FRAMES: Final = 12
 
 
-def _chromaticity(rgb: FloatArray) -> tuple[FloatArray, BoolArray]:
+def _chromaticity(rgb: F64) -> tuple[F64, Bools]:
     """(r, g) = (R, G) / (R + G + B) of sRGB colours, which a change of light intensity leaves
     alone (sRGB is close to a power of linear light: scaling scales all three channels alike),
     and whether each colour is saturated and bright enough to have a reliable one."""
@@ -219,7 +215,7 @@ def _chromaticity(rgb: FloatArray) -> tuple[FloatArray, BoolArray]:
     return chroma, ok
 
 
-def _smoothed(hist: FloatArray) -> FloatArray:
+def _smoothed(hist: F64) -> F64:
     out = hist.copy()
     for axis in (0, 1):
         acc = np.zeros_like(out)
@@ -229,7 +225,7 @@ def _smoothed(hist: FloatArray) -> FloatArray:
     return out
 
 
-def _ridge(smooth: FloatArray, a: tuple[float, float], b: tuple[float, float]) -> float:
+def _ridge(smooth: F64, a: tuple[float, float], b: tuple[float, float]) -> float:
     """The least smoothed density on the straight way from peak ``a`` to peak ``b``."""
     n = CHROMA_BINS
     ts = np.linspace(0.0, 1.0, 17)
@@ -246,7 +242,7 @@ def _on_ray(a: tuple[float, float], b: tuple[float, float]) -> bool:
     return bool(abs((ta - tb + 180.0) % 360.0 - 180.0) <= RAY_DEGREES)
 
 
-def _peaks(hist: FloatArray, total: float) -> list[tuple[float, float]]:
+def _peaks(hist: F64, total: float) -> list[tuple[float, float]]:
     """Local maxima of the smoothed chromaticity histogram holding PEAK_SHARE of ``total``
     within PEAK_RADIUS, strongest first; a weaker peak joined to a kept one by a ridge without
     a valley (density never below VALLEY of its own) is the same colour (a highlight or a shadow
@@ -281,7 +277,7 @@ def _peaks(hist: FloatArray, total: float) -> list[tuple[float, float]]:
     return out
 
 
-def _border_chromaticity(frames: list[U8]) -> FloatArray:
+def _border_chromaticity(frames: list[U8]) -> F64:
     """The median chromaticity of the pictures' outer rows and columns: the background (a
     tinted ground is saturated enough to pass for a piece colour, and its shadows share its
     chromaticity)."""
@@ -290,7 +286,7 @@ def _border_chromaticity(frames: list[U8]) -> FloatArray:
                          f[:, -3:].reshape(-1, 3)]) for f in frames]
     ).astype(np.float64)  # fmt: skip
     chroma, _ = _chromaticity(ring)
-    out: FloatArray = np.median(chroma, axis=0)
+    out: F64 = np.median(chroma, axis=0)
     return out
 
 
@@ -331,7 +327,7 @@ def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
     return ColorModel(_names(np.array(labs)), np.array(labs), table, "video")
 
 
-def _names(centres: FloatArray) -> tuple[str, ...]:
+def _names(centres: F64) -> tuple[str, ...]:
     pal = srgb_to_lab(np.array([c.rgb for c in PALETTE]))
     names: list[str] = []
     for lab in centres:
@@ -356,14 +352,14 @@ def shrink(frame: U8) -> U8:
 # ---------------------------------------------------------------------------------------------
 
 
-def _spread(mask: BoolArray, r: int, grow: bool) -> BoolArray:
+def _spread(mask: Bools, r: int, grow: bool) -> Bools:
     """Dilation (grow) or erosion by a (2r+1)-square, separably; outside counts as empty.
     (A kernel: the judge spreads masks some hundred thousand times a video.)"""
     if r <= 0:
         return mask.copy()
     h, w = mask.shape
     flat = np.ascontiguousarray(mask, dtype=np.bool_).ravel().view(np.uint8)
-    out: BoolArray = _spread_kernel(flat, h, w, r, grow).view(np.bool_).reshape(h, w)
+    out: Bools = _spread_kernel(flat, h, w, r, grow).view(np.bool_).reshape(h, w)
     return out
 
 
@@ -411,16 +407,16 @@ def _spread_kernel(flat: U8, h: int, w: int, r: int, grow: bool) -> U8:
     return out
 
 
-def dilate(mask: BoolArray, r: int) -> BoolArray:
+def dilate(mask: Bools, r: int) -> Bools:
     return _spread(mask, r, True)
 
 
-def close(mask: BoolArray, r: int = 2) -> BoolArray:
+def close(mask: Bools, r: int = 2) -> Bools:
     """Closing: gaps narrower than about 2r pixels filled."""
     return _spread(dilate(mask, r), r, False) | mask
 
 
-def clean(mask: BoolArray) -> BoolArray:
+def clean(mask: Bools) -> Bools:
     """Opening (radius 1: slivers and specks go) then closing (radius 2)."""
     return close(dilate(_spread(mask, 1, False), 1))
 
@@ -470,7 +466,7 @@ def _label_kernel(flat: npt.NDArray[np.uint8], h: int, w: int) -> npt.NDArray[np
     return out
 
 
-def components(mask: BoolArray, min_area: int) -> list[BoolArray]:
+def components(mask: Bools, min_area: int) -> list[Bools]:
     """The 8-connected components of ``mask`` of at least ``min_area`` pixels, in scan order."""
     h, w = mask.shape
     lab = _label_kernel(mask.astype(np.uint8).ravel(), h, w).reshape(h, w)
@@ -502,13 +498,13 @@ def _classify_kernel(flat: U8, table: U8) -> U8:
     return out
 
 
-def class_masks(frame: U8, model: ColorModel) -> list[BoolArray]:
+def class_masks(frame: U8, model: ColorModel) -> list[Bools]:
     """One cleaned mask per class (index i: class i + 1) of a working-size frame."""
     raw = classify(frame, model)
     return [clean(raw == i + 1) for i in range(len(model.names))]
 
 
-def unknown(frame: U8, masks: list[BoolArray]) -> BoolArray:
+def unknown(frame: U8, masks: list[Bools]) -> Bools:
     """Pixels of no piece class that do not look like the background either and are dark: a
     piece's face too dark to classify. The background is what the picture's
     border shows (a grey ground, its shadows, white): colours within BACKGROUND_CHROMA of its
@@ -520,5 +516,5 @@ def unknown(frame: U8, masks: list[BoolArray]) -> BoolArray:
     edge = ring & ~piece
     a0, b0 = (float(np.median(lab[..., c][edge])) if edge.any() else 0.0 for c in (1, 2))
     near = np.hypot(lab[..., 1] - a0, lab[..., 2] - b0) <= BACKGROUND_CHROMA
-    out: BoolArray = ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
+    out: Bools = ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
     return out

@@ -21,8 +21,9 @@ from typing import Final
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import F64, Bools
 from chaingeo.kernels.jit import njit
-from chaingeo.worldmodel.judge_segment import BoolArray, FloatArray, close, components, dilate
+from chaingeo.worldmodel.judge_segment import close, components, dilate
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
 #: hold.
@@ -48,7 +49,7 @@ class Obj:
     """One piece as seen in one frame: its colour class (0-based), pixels and parts."""
 
     cls: int
-    mask: BoolArray
+    mask: Bools
     parts: int
 
     @property
@@ -71,7 +72,7 @@ class Event:
     piece: str
     other: str | None = None
     detail: str = ""
-    masks: tuple[BoolArray, ...] = field(default=(), compare=False, repr=False)
+    masks: tuple[Bools, ...] = field(default=(), compare=False, repr=False)
     #: How many of ``masks`` (the first ones) are seen in frame ``frame - 1``; the rest in
     #: ``frame``.
     before: int = 1
@@ -80,7 +81,7 @@ class Event:
 VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "teleport", "pass_through")
 
 
-def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
+def _boundary_points(mask: Bools, limit: int = 300) -> np.ndarray:
     edge = mask & ~(
         np.roll(mask, 1, 0) & np.roll(mask, -1, 0) & np.roll(mask, 1, 1) & np.roll(mask, -1, 1)
     )
@@ -89,7 +90,7 @@ def _boundary_points(mask: BoolArray, limit: int = 300) -> np.ndarray:
     return pts[::step]
 
 
-def gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
+def gap_covered(a: Bools, b: Bools, others: Bools) -> bool:
     """Whether the gap between ``a`` and ``b`` (the pixels within half their distance plus a
     little of both) lies mostly on other pieces (an occluder) rather than on background."""
     pa, pb = _boundary_points(a), _boundary_points(b)
@@ -107,7 +108,7 @@ def gap_covered(a: BoolArray, b: BoolArray, others: BoolArray) -> bool:
     return float((lens & others[y0:y1, x0:x1]).sum()) >= OCCLUDED_GAP * float(lens.sum())
 
 
-def _distances(mask: BoolArray, r: int) -> np.ndarray:
+def _distances(mask: Bools, r: int) -> np.ndarray:
     """Chessboard distance to ``mask`` (0 on it), capped at r + 1: what growing the mask a
     pixel at a time within the picture gives (a shortest chessboard path stays within the
     box of its ends), in two passes instead of r growths."""
@@ -117,7 +118,7 @@ def _distances(mask: BoolArray, r: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def _chessboard_kernel(flat: BoolArray, h: int, w: int, cap: int) -> npt.NDArray[np.int64]:
+def _chessboard_kernel(flat: Bools, h: int, w: int, cap: int) -> npt.NDArray[np.int64]:
     """Two-pass chamfer over the 8 neighbours, all steps 1: exact for the chessboard metric."""
     out = np.full(h * w, cap, dtype=np.int64)
     for i in range(h * w):
@@ -144,8 +145,8 @@ def _chessboard_kernel(flat: BoolArray, h: int, w: int, cap: int) -> npt.NDArray
     return out
 
 
-def _centroid(mask: BoolArray) -> FloatArray:
-    out: FloatArray = np.argwhere(mask).mean(axis=0)
+def _centroid(mask: Bools) -> F64:
+    out: F64 = np.argwhere(mask).mean(axis=0)
     return out
 
 
@@ -155,7 +156,7 @@ def _root(group: list[int], i: int) -> int:
     return i
 
 
-def solid_of(masks: list[BoolArray]) -> BoolArray:
+def solid_of(masks: list[Bools]) -> Bools:
     """Every piece pixel of a frame, closed so that the drawn edges between two pieces of
     different colours count as piece, not background."""
     solid = np.zeros_like(masks[0]) if masks else np.zeros((1, 1), bool)
@@ -165,11 +166,11 @@ def solid_of(masks: list[BoolArray]) -> BoolArray:
 
 
 def frame_objects(
-    masks: list[BoolArray],
+    masks: list[Bools],
     min_area: int,
-    occluders: BoolArray | None = None,
-    unknown: BoolArray | None = None,
-) -> tuple[list[Obj], BoolArray]:
+    occluders: Bools | None = None,
+    unknown: Bools | None = None,
+) -> tuple[list[Obj], Bools]:
     """Objects of one frame (each class's components grouped across occluders), and the
     frame's piece pixels (:func:`solid_of`) with ``occluders`` (a box's wire frame drawn over
     the pieces), which hide pieces as pieces do; ``unknown`` pixels (neither a piece's colour
@@ -213,7 +214,7 @@ def smoothed_counts(raw: np.ndarray) -> np.ndarray:
 class Tracker:
     """Finds the events of a sequence of per-frame objects (see the module docstring)."""
 
-    def __init__(self, frames: list[tuple[list[Obj], BoolArray]], names: tuple[str, ...]) -> None:
+    def __init__(self, frames: list[tuple[list[Obj], Bools]], names: tuple[str, ...]) -> None:
         self.frames = [objs for objs, _ in frames]
         self.solid = [solid for _, solid in frames]
         self.names = names
@@ -257,7 +258,7 @@ class Tracker:
                 out.append(e)
         return sorted(out, key=lambda e: (e.frame, e.kind, e.piece))
 
-    def _class_pixels(self, t: int, k: int) -> BoolArray:
+    def _class_pixels(self, t: int, k: int) -> Bools:
         out = np.zeros_like(self.solid[t])
         for o in self._of(t, k):
             out |= o.mask
@@ -416,7 +417,7 @@ class Tracker:
         carried in at speed (our videos bring pieces in fast) is past the reach of one frame."""
         return any(o.touches_border() for t in (b - 1, b - 2) if t >= 0 for o in self._of(t, k))
 
-    def _under_others(self, whole: BoolArray, parts: list[Obj], t: int) -> bool:
+    def _under_others(self, whole: Bools, parts: list[Obj], t: int) -> bool:
         """Whether what ``whole`` has beyond ``parts`` lies, at frame ``t``, mostly on other
         pieces: the parts are one piece seen round an occluder, not a break or a fusion."""
         rest = whole & ~dilate(np.logical_or.reduce([o.mask for o in parts]), 1)
@@ -543,7 +544,7 @@ def _alike(a: Obj, b: Obj) -> bool:
     return min(a.area, b.area) >= 0.5 * max(a.area, b.area)
 
 
-def _share(pixels: BoolArray, region: BoolArray) -> float:
+def _share(pixels: Bools, region: Bools) -> float:
     """The share of ``region`` that ``pixels`` cover."""
     return float((pixels & region).sum()) / max(1.0, float(region.sum()))
 

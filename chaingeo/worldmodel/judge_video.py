@@ -23,12 +23,11 @@ import numpy.typing as npt
 from PIL import Image
 
 from chaingeo.core import limits
+from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.worldmodel.judge_segment import (
     RENDER_SHADES,
     SHADES,
-    U8,
-    BoolArray,
     ColorModel,
     Colors,
     class_masks,
@@ -97,7 +96,7 @@ def _check_header(frames: float, w: int, h: int) -> None:
         )
 
 
-class _Budget:
+class _PixelBudget:
     """The limits checked on each decoded frame as it arrives (a header can lie or say
     nothing: a raw H.264 stream or a streamed MKV has no frame count): its pixels, the frames
     so far and the pixels of all of them together."""
@@ -130,7 +129,7 @@ def _read_gif(path: Path) -> Clip:
     with Image.open(path) as im:
         w, h = im.size
         _check_header(0, w, h)
-        budget = _Budget()
+        budget = _PixelBudget()
         out = []
         for i in itertools.count():
             try:
@@ -154,7 +153,7 @@ def _read_ffmpeg(path: Path) -> Clip:
         duration = float(meta.get("duration") or 0.0)
         _check_header(duration * max(fps, 1.0), w, h)
         out: list[U8] = []
-        budget = _Budget()
+        budget = _PixelBudget()
         for frame in reader:  # type: ignore[attr-defined]
             arr = budget.take(np.asarray(frame, dtype=np.uint8))
             out.append(shrink(np.ascontiguousarray(arr[..., :3])))
@@ -276,13 +275,13 @@ def judge_frames(
     return Verdict(violations, notes, tuple(undecided), model, len(frames))
 
 
-def _wire(frame: U8, masks: list[BoolArray]) -> BoolArray:
+def _wire(frame: U8, masks: list[Bools]) -> Bools:
     """Pixels of the box's wire frame our renderer draws over a stacking scene: a dark
     neutral grey (render._FRAME, anti-aliased) that is no piece's colour."""
     r, g, b = (frame[..., c].astype(np.int16) for c in range(3))  # per channel: cheaper
     spread = np.maximum(np.maximum(r, g), b) - np.minimum(np.minimum(r, g), b)
     grey = (spread <= WIRE_CHROMA) & (np.abs((r + g + b) / 3.0 - WIRE_GREY) <= WIRE_SPREAD)
-    out: BoolArray = grey & ~np.logical_or.reduce(masks)
+    out: Bools = grey & ~np.logical_or.reduce(masks)
     return out
 
 
@@ -291,7 +290,7 @@ def _with_level(
     colors: Colors,
     names: tuple[str, ...],
     events: list[Event],
-    kept: list[list[BoolArray]],
+    kept: list[list[Bools]],
     area: int,
 ) -> tuple[list[Event], list[str]]:
     """Events read with the level: pass-throughs added; a change the level drawn at the
@@ -321,8 +320,8 @@ def _with_level(
 
 def _misread(
     frames: tuple[U8, ...] | list[U8],
-    masks: list[list[BoolArray]],
-    kept: list[list[BoolArray]],
+    masks: list[list[Bools]],
+    kept: list[list[Bools]],
     e: Event,
     names: tuple[str, ...],
 ) -> bool:
@@ -342,9 +341,7 @@ def _misread(
     return float((fragments & near).sum()) >= 0.5 * float(m.sum())
 
 
-def _sunk(
-    e: Event, masks: list[list[BoolArray]], solids: list[BoolArray], names: tuple[str, ...]
-) -> Event:
+def _sunk(e: Event, masks: list[list[Bools]], solids: list[Bools], names: tuple[str, ...]) -> Event:
     """A piece said lost whose last silhouette was mostly surrounded by other pieces (or the
     box's wire frame) and whose colour still shows in fragments where it was: it went out of
     sight among them (a piece lowered into a box behind pieces placed before), not lost."""
@@ -360,7 +357,7 @@ def _sunk(
     return replace(e, kind="hidden", detail=detail)
 
 
-def _union(objs: list[Obj], k: int, shape: tuple[int, ...]) -> BoolArray:
+def _union(objs: list[Obj], k: int, shape: tuple[int, ...]) -> Bools:
     """Class ``k``'s pixels that belong to objects (components past the least area)."""
     out = np.zeros(shape, dtype=bool)
     for o in objs:
@@ -369,7 +366,7 @@ def _union(objs: list[Obj], k: int, shape: tuple[int, ...]) -> BoolArray:
     return out
 
 
-def _tinted(frame: U8, masks: tuple[BoolArray, ...], which: range) -> Image.Image:
+def _tinted(frame: U8, masks: tuple[Bools, ...], which: range) -> Image.Image:
     out = frame.astype(np.float64)
     for i in which:
         if i < len(masks):

@@ -20,13 +20,10 @@ import numpy as np
 import numpy.typing as npt
 from PIL import Image, ImageFilter
 
+from chaingeo.core.arrays import F64, I32, U8
 from chaingeo.kernels.jit import njit
 from chaingeo.pictures.raster import FACE_CORNERS, NORMALS
 from chaingeo.pictures.scene import CAMERAS
-
-FloatArray = npt.NDArray[np.float64]
-I32 = npt.NDArray[np.int32]
-U8 = npt.NDArray[np.uint8]
 
 #: Supersampling per side (soft, anti-aliased edges once averaged down).
 SUPER: Final = 2
@@ -42,8 +39,8 @@ class Part:
     label: int
     cells: npt.NDArray[np.int64]
     rgb: tuple[float, float, float]
-    rotation: FloatArray
-    translation: FloatArray
+    rotation: F64
+    translation: F64
 
 
 @dataclass(frozen=True)
@@ -53,17 +50,17 @@ class Look:
 
     width: int
     height: int
-    light: FloatArray  # unit vector toward the light
+    light: F64  # unit vector toward the light
     ambient: float
     diffuse: float
     specular: float
     shininess: float
-    ground: tuple[FloatArray, FloatArray]  # RGB 0-1 at the top and bottom of the picture
+    ground: tuple[F64, F64]  # RGB 0-1 at the top and bottom of the picture
     shadow: float  # share of the light a shadow takes away
     blur: float  # Gaussian radius (output pixels)
     noise: float  # standard deviation (levels)
     quality: int  # JPEG quality
-    drift: FloatArray  # (frames, 3): x, y shift (share of width) and log-scale, per frame
+    drift: F64  # (frames, 3): x, y shift (share of width) and log-scale, per frame
     margin: float
 
 
@@ -101,7 +98,7 @@ def random_look(rng: np.random.Generator, frames: int) -> Look:
 
 def _outer_faces(
     part: Part,
-) -> tuple[FloatArray, FloatArray]:
+) -> tuple[F64, F64]:
     """World corners (n, 4, 3) and unit normals (n, 3) of a part's faces not shared by two of
     its cells."""
     cells = np.asarray(part.cells, dtype=np.int64)
@@ -124,9 +121,7 @@ def _outer_faces(
 
 
 @njit(cache=True)
-def _raster_kernel(
-    xy: FloatArray, depth: FloatArray, h: int, w: int, zbuf: FloatArray, idbuf: I32
-) -> None:
+def _raster_kernel(xy: F64, depth: F64, h: int, w: int, zbuf: F64, idbuf: I32) -> None:
     """Depth-buffered fill of quads (two triangles each): the nearest (largest depth) face's
     index at each pixel centre."""
     for f in range(xy.shape[0]):
@@ -158,7 +153,7 @@ def _raster_kernel(
                         idbuf[k] = f
 
 
-def _raster(xy: FloatArray, depth: FloatArray, h: int, w: int) -> tuple[FloatArray, I32]:
+def _raster(xy: F64, depth: F64, h: int, w: int) -> tuple[F64, I32]:
     zbuf = np.full(h * w, -np.inf)
     idbuf = np.full(h * w, -1, dtype=np.int32)
     if len(xy):
@@ -168,22 +163,22 @@ def _raster(xy: FloatArray, depth: FloatArray, h: int, w: int) -> tuple[FloatArr
 
 @njit(cache=True)
 def _shade_kernel(
-    zbuf: FloatArray,
+    zbuf: F64,
     idbuf: I32,
     front: npt.NDArray[np.int64],
-    normals: FloatArray,
-    colors: FloatArray,
+    normals: F64,
+    colors: F64,
     labels: I32,
-    cam: FloatArray,
-    setup: FloatArray,
-    smap: FloatArray,
-    basis: FloatArray,
-    frame: FloatArray,
-    light_pos: FloatArray,
-    mat: FloatArray,
-    top: FloatArray,
-    bottom: FloatArray,
-    out: FloatArray,
+    cam: F64,
+    setup: F64,
+    smap: F64,
+    basis: F64,
+    frame: F64,
+    light_pos: F64,
+    mat: F64,
+    top: F64,
+    bottom: F64,
+    out: F64,
     lab: I32,
 ) -> None:
     """Per pixel: the world point seen (a face, or the ground plane), its shadow (3x3 samples
@@ -257,7 +252,7 @@ class Shader:
         self.ground_z = float(lo[2])
         self.light_pos = (lo + hi) / 2 + look.light * 2.5 * float(np.ptp(box, axis=0).max())
 
-    def _screen(self, pts: FloatArray, i: int) -> tuple[FloatArray, FloatArray]:
+    def _screen(self, pts: F64, i: int) -> tuple[F64, F64]:
         """Supersampled pixel coordinates and depth of world points at frame ``i``."""
         dx, dy, ds = self.look.drift[min(i, len(self.look.drift) - 1)]
         s = self.scale * np.exp(ds) * SUPER
@@ -266,9 +261,7 @@ class Shader:
         y = -(pts @ self.up - self.centre[1]) * s + h / 2 + dy * w
         return np.stack([x, y], axis=-1), pts @ self.v
 
-    def _shadow_map(
-        self, corners: FloatArray, normals: FloatArray
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+    def _shadow_map(self, corners: F64, normals: F64) -> tuple[F64, F64, F64]:
         """Depth map along the light of the faces turned to it, and its frame: (lr, lu, light)
         rows and (lo_u, lo_v, pixels per cell)."""
         light = self.look.light
@@ -289,7 +282,7 @@ class Shader:
         zbuf, _ = _raster(xy, pts @ light, SHADOW_SIZE, SHADOW_SIZE)
         return zbuf, basis, np.array([lo_u, lo_v, k])
 
-    def draw(self, parts: list[Part], i: int) -> tuple[FloatArray, I32]:
+    def draw(self, parts: list[Part], i: int) -> tuple[F64, I32]:
         """Frame ``i`` as RGB in 0-1 at supersampled size, before degradations, and its label
         buffer (0: ground) at output size."""
         look = self.look
@@ -325,7 +318,7 @@ class Shader:
         )  # fmt: skip
         return out, lab[SUPER // 2 :: SUPER, SUPER // 2 :: SUPER].copy()
 
-    def finish(self, picture: FloatArray, rng: np.random.Generator) -> U8:
+    def finish(self, picture: F64, rng: np.random.Generator) -> U8:
         """Averaged down to output size, blurred, noised and JPEG-compressed."""
         look = self.look
         h, w = look.height, look.width

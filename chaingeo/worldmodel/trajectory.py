@@ -31,6 +31,7 @@ from typing import Any, Final
 import numpy as np
 import numpy.typing as npt
 
+from chaingeo.core.arrays import F64
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.files import UnreadableFile, atomic_write, parse_json
 from chaingeo.core.geometry import ROTATIONS, Cell, Shape
@@ -50,7 +51,6 @@ from chaingeo.worldmodel.video import (
 )
 
 FORMAT: Final = "chain-trajectory/1"
-FloatArray = npt.NDArray[np.float64]
 
 
 class TrajectoryError(ChainGeoError, ValueError):
@@ -61,8 +61,8 @@ class TrajectoryError(ChainGeoError, ValueError):
 class Pose:
     """A rigid pose ``p -> rotation @ p + translation`` (floats), or the cells a piece fills."""
 
-    rotation: FloatArray | None = None
-    translation: FloatArray | None = None
+    rotation: F64 | None = None
+    translation: F64 | None = None
     cells: tuple[Cell, ...] | None = None
 
 
@@ -213,13 +213,11 @@ class _Parking:
         every = np.concatenate([s.voxels for s in level.shapes.values()])
         self.away = max(3 * int(np.ptp(every, axis=0).max() + 1) + 4, self.span + 1)
         self.spacing = 4 * (self.span + self.away)
-        self.disp: dict[str, FloatArray] = {n: np.zeros(3) for n in level.shapes}
+        self.disp: dict[str, F64] = {n: np.zeros(3) for n in level.shapes}
         self.places = 0
         self.frames: list[Frame] = [self.poses()]
 
-    def poses(
-        self, moving: Sequence[str] = (), extra: tuple[FloatArray, FloatArray] | None = None
-    ) -> Frame:
+    def poses(self, moving: Sequence[str] = (), extra: tuple[F64, F64] | None = None) -> Frame:
         out: Frame = {}
         for n in self.engine.shapes:
             p = lattice_pose(ROTATIONS[self.engine.rotation_of(n)], self.engine.offsets[n])
@@ -263,7 +261,7 @@ class _Parking:
         self.engine = self.engine.apply(move)
         self._park(group, d, far)
 
-    def _park(self, group: Sequence[str], d: FloatArray, far: int) -> None:
+    def _park(self, group: Sequence[str], d: F64, far: int) -> None:
         """Out by ``far`` (as the video shows it), then up, across to a new place, and down."""
         self.slide(group, d * far, OUT_FRAMES)
         if d[2] < 0:  # below its part: first step aside, out of the part's column
@@ -291,7 +289,7 @@ def puzzle_trajectory(level: Level, moves: Sequence[Move | TurnMove] | None = No
     return park.frames if level.goal == "disassemble" else park.frames[::-1]
 
 
-def _placing(shape: Shape, cells: Shape) -> tuple[FloatArray, FloatArray]:
+def _placing(shape: Shape, cells: Shape) -> tuple[F64, F64]:
     """The rotation and offset that take the tray ``shape`` onto ``cells``."""
     target = cells.cell_set
     for r in ROTATIONS:

@@ -25,6 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core import limits
+from chaingeo.core.arrays import F64
 from chaingeo.core.geometry import ROTATIONS, Cell, Shape, rotation_index
 from chaingeo.core.level import Level
 from chaingeo.core.turns import AXES, lateral, quarter_matrix, spinning_rods, swept_by
@@ -36,7 +37,6 @@ TOL: Final = 1e-6
 MAX_VIOLATIONS: Final = 1000
 #: Widest turn swept exactly (cells from the axis); a wider one is undecided.
 MAX_TURN_RADIUS: Final = 16
-FloatArray = npt.NDArray[np.float64]
 
 
 @dataclass
@@ -72,8 +72,8 @@ class Poses:
     names: list[str]
     ok: npt.NDArray[np.bool_]
     lat: npt.NDArray[np.bool_]
-    rot: FloatArray
-    tr: FloatArray
+    rot: F64
+    tr: F64
     ridx: npt.NDArray[np.int64]
     off: npt.NDArray[np.int64]
 
@@ -94,7 +94,7 @@ def _rigid_cells(
     return None
 
 
-def _read_pose(p: Pose, shape: Any) -> tuple[str | None, FloatArray, FloatArray, int, Cell | None]:
+def _read_pose(p: Pose, shape: Any) -> tuple[str | None, F64, F64, int, Cell | None]:
     """(why it is not rigid or None, rotation, translation, rotation index or -1, lattice
     offset or None)."""
     if p.cells is not None:
@@ -191,7 +191,7 @@ class Motion:
     pivot: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
 
-def _relative(ps: Poses, a: int, b: int, j: int) -> tuple[FloatArray, FloatArray]:
+def _relative(ps: Poses, a: int, b: int, j: int) -> tuple[F64, F64]:
     """Motions of piece ``j`` from frame ``a``: rotations ``R_i R_a^T`` and translations."""
     ra, ta = ps.rot[a, j], ps.tr[a, j]
     rr = ps.rot[a : b + 1, j] @ ra.T
@@ -205,7 +205,7 @@ def _first(bad: npt.NDArray[np.bool_]) -> int | None:
     return int(hits[0]) if hits.size else None
 
 
-def _classify_slide(rr: FloatArray, tt: FloatArray, axis: int, k: int) -> tuple[str, int] | None:
+def _classify_slide(rr: F64, tt: F64, axis: int, k: int) -> tuple[str, int] | None:
     """Why these relative poses are no slide by ``k`` along ``axis`` (and the first frame
     that shows it), or None."""
     others = [i for i in range(3) if i != axis]
@@ -222,7 +222,7 @@ def _classify_slide(rr: FloatArray, tt: FloatArray, axis: int, k: int) -> tuple[
     return None if not found else (min(found)[1], min(found)[0])
 
 
-def _pivot(q: FloatArray, u: FloatArray, axis: int) -> FloatArray | None:
+def _pivot(q: F64, u: F64, axis: int) -> F64 | None:
     """The point ``c`` (axis coordinate 0) with ``u = c - q c``, if the turn keeps cells on
     cells (its line through cell centres or cell corners)."""
     uu, vv = lateral(axis)
@@ -236,9 +236,7 @@ def _pivot(q: FloatArray, u: FloatArray, axis: int) -> FloatArray | None:
     return c
 
 
-def _classify_turn(
-    rr: FloatArray, tt: FloatArray, axis: int, quarter: int
-) -> tuple[tuple[str, int] | None, FloatArray]:
+def _classify_turn(rr: F64, tt: F64, axis: int, quarter: int) -> tuple[tuple[str, int] | None, F64]:
     q = rr[-1]
     last = len(rr) - 1
     if abs(tt[-1][axis]) > TOL:

@@ -23,9 +23,9 @@ from pathlib import Path
 from typing import Final
 
 import numpy as np
-import numpy.typing as npt
 from PIL import Image
 
+from chaingeo.core.arrays import F64
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import Cell, Shape
 from chaingeo.core.kinematics import (
@@ -41,7 +41,6 @@ from chaingeo.envs.actions.types import action_of_move
 from chaingeo.pictures.raster import RGB, Posed, parse_color
 from chaingeo.pictures.scene import render_frame
 
-FloatArray = npt.NDArray[np.float64]
 PuzzleStep = Move | TurnMove
 #: Frames per kind of step (a slide, a turn, a group carried out, a piece lowered), and the
 #: frames a position is held at the start, after each step and at the end.
@@ -73,8 +72,8 @@ class PlanVideo:
 
 
 #: One picture's content: every visible piece's name and pose (rotation, translation).
-_Pose = tuple[FloatArray, FloatArray]
-_Shot = tuple[tuple[str, FloatArray, FloatArray], ...]
+_Pose = tuple[F64, F64]
+_Shot = tuple[tuple[str, F64, F64], ...]
 
 
 def _ease(i: int, n: int) -> float:
@@ -82,7 +81,7 @@ def _ease(i: int, n: int) -> float:
     return (1.0 - math.cos(math.pi * i / n)) / 2.0
 
 
-def _turn_matrix(axis: int, angle: float) -> FloatArray:
+def _turn_matrix(axis: int, angle: float) -> F64:
     """Right-handed rotation by ``angle`` radians about coordinate axis ``axis``."""
     c, s = math.cos(angle), math.sin(angle)
     u, v = (axis + 1) % 3, (axis + 2) % 3
@@ -314,7 +313,7 @@ def _stacking_shots(
     placed = {n for n, _ in order}
     rest = [(p.name, p.shape) for p in level.pieces if p.name not in placed]  # stay waiting
     per_row = max(1, math.ceil(math.sqrt(len(order) + len(rest))))
-    waiting: dict[str, FloatArray] = {}
+    waiting: dict[str, F64] = {}
     x, y, row_depth, width = bx + 1, 0, 0, bx
     for i, (name, cells) in enumerate([*order, *rest]):
         if i and i % per_row == 0:
@@ -326,7 +325,7 @@ def _stacking_shots(
         width = max(width, x - 1)
     tallest = max((s.extent[2] for _, s in [*order, *rest]), default=0)
     clear = max(bz, tallest) + 1  # the height a carried piece's bottom rises to
-    at: dict[str, FloatArray] = dict(waiting)
+    at: dict[str, F64] = dict(waiting)
     segments: list[list[_Shot]] = []
 
     def shot() -> _Shot:

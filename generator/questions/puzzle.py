@@ -14,7 +14,7 @@ from chaingeo.core.kinematics import DIRECTIONS, Assembly
 from chaingeo.core.level import Level
 from chaingeo.generator.questions.common import CATEGORIES, names_text, pick
 from chaingeo.generator.questions.model import Option, Question, draft
-from chaingeo.generator.questions.states import PuzzleView, puzzle_views
+from chaingeo.generator.questions.states import ShownPuzzle, puzzle_views
 from chaingeo.solvers.graphs import blocking_graphs, closure, contact_graph, minimal_groups
 
 #: Questions of one kind asked about one state, at most.
@@ -25,11 +25,11 @@ _BIG = 16
 SLIDE = "slide one unit along {d} on its own (every other piece stays where it is)"
 
 
-def _graphs(view: PuzzleView) -> tuple[Assembly, dict[str, nx.DiGraph]]:
+def _graphs(view: ShownPuzzle) -> tuple[Assembly, dict[str, nx.DiGraph]]:
     return view.state, blocking_graphs(view.state)
 
 
-def _views(level: Level) -> list[PuzzleView]:
+def _views(level: Level) -> list[ShownPuzzle]:
     views = list(puzzle_views(level))
     return views[-4:] if len(level.pieces) > _BIG else views
 

@@ -22,7 +22,7 @@ from chaingeo.core.level import Level
 from chaingeo.core.rules import StackingRules, placement_rejection
 from chaingeo.generator.questions.common import CATEGORIES, pick
 from chaingeo.generator.questions.model import CELLS_FIELD, Option, Question, draft
-from chaingeo.generator.questions.states import StackingView, stacking_views
+from chaingeo.generator.questions.states import ShownStacking, stacking_views
 from chaingeo.solvers.cover.packings import first_packing
 from chaingeo.solvers.graphs import contact_graph
 
@@ -33,7 +33,7 @@ TRIED = 8
 
 
 @dataclass(frozen=True)
-class Candidate:
+class PlacementOption:
     cells: tuple[Cell, ...]
     outside: tuple[Cell, ...]
     overlaps: dict[str, list[Cell]]
@@ -52,11 +52,11 @@ class Candidate:
         }
 
 
-_CACHE: dict[tuple[str, str, int, str], list[Candidate]] = {}
+_CACHE: dict[tuple[str, str, int, str], list[PlacementOption]] = {}
 _COMPLETIONS: dict[tuple[str, str, int, str, tuple[Cell, ...]], dict[str, Any]] = {}
 
 
-def candidates(level: Level, view: StackingView, name: str) -> list[Candidate]:
+def candidates(level: Level, view: ShownStacking, name: str) -> list[PlacementOption]:
     """Every orientation of ``name`` at every offset within one cell of the box, in a fixed
     order, classified against the pieces placed (remembered for the level last asked about:
     four categories ask about the same placements)."""
@@ -69,7 +69,7 @@ def candidates(level: Level, view: StackingView, name: str) -> list[Candidate]:
     return _CACHE[key]
 
 
-def _candidates(level: Level, view: StackingView, name: str) -> Iterator[Candidate]:
+def _candidates(level: Level, view: ShownStacking, name: str) -> Iterator[PlacementOption]:
     assert level.box is not None and isinstance(level.rules, StackingRules)
     box = level.box
     occupied = view.occupied
@@ -88,25 +88,27 @@ def _classify(
     occupied: dict[Cell, str],
     box: tuple[int, int, int],
     rules: StackingRules,
-) -> Candidate:
+) -> PlacementOption:
     outside = tuple(c for c in cells if not all(0 <= c[i] < box[i] for i in range(3)))
     overlaps: dict[str, list[Cell]] = {}
     for c in cells:
         if c in occupied:
             overlaps.setdefault(occupied[c], []).append(c)
     if outside or overlaps:  # the rules refuse it for the same reason; no need to ask them
-        return Candidate(cells, outside, overlaps, "outside the box" if outside else "overlap")
+        return PlacementOption(
+            cells, outside, overlaps, "outside the box" if outside else "overlap"
+        )
     why = placement_rejection(Shape(cells), occupied, box, rules)
-    return Candidate(cells, outside, overlaps, None if why is None else why.reason)
+    return PlacementOption(cells, outside, overlaps, None if why is None else why.reason)
 
 
-def _option(name: str, c: Candidate) -> Option:
+def _option(name: str, c: PlacementOption) -> Option:
     return Option(f"{name} at {CELLS_FIELD}", c.cells)
 
 
 def _near(
-    rng: np.random.Generator, right: Candidate, pool: list[Candidate], k: int
-) -> list[Candidate]:
+    rng: np.random.Generator, right: PlacementOption, pool: list[PlacementOption], k: int
+) -> list[PlacementOption]:
     """``k`` of ``pool`` nearest ``right`` (cells' centre), ties broken at random."""
     centre = np.mean(right.cells, axis=0)
     noise = rng.random(len(pool))
@@ -120,7 +122,7 @@ def _near(
     return [pool[i] for i in order[:k]]
 
 
-def _views(level: Level) -> list[StackingView]:
+def _views(level: Level) -> list[ShownStacking]:
     return list(stacking_views(level)) if level.family == "stacking" else []
 
 
@@ -157,7 +159,7 @@ def fits_questions(level: Level, rng: np.random.Generator) -> list[Question]:
     return out
 
 
-def _touches(view: StackingView, c: Candidate) -> list[str]:
+def _touches(view: ShownStacking, c: PlacementOption) -> list[str]:
     g = contact_graph({**view.placed, "?": c.cells})
     return sorted(g.neighbors("?"))
 
@@ -203,7 +205,7 @@ def supported_questions(level: Level, rng: np.random.Generator) -> list[Question
     return out
 
 
-def _completion(level: Level, view: StackingView, name: str, c: Candidate) -> dict[str, Any]:
+def _completion(level: Level, view: ShownStacking, name: str, c: PlacementOption) -> dict[str, Any]:
     """Can the tray's other pieces fill the box's empty cells once ``c`` is placed? With a
     packing as the witness, or none (the exact-cover search found none: a proof)."""
     key = (level.id, level.provenance.signature, view.step, name, c.cells)
@@ -212,7 +214,7 @@ def _completion(level: Level, view: StackingView, name: str, c: Candidate) -> di
     return _COMPLETIONS[key]
 
 
-def _complete(level: Level, view: StackingView, name: str, c: Candidate) -> dict[str, Any]:
+def _complete(level: Level, view: ShownStacking, name: str, c: PlacementOption) -> dict[str, Any]:
     assert level.box is not None
     filled = set(view.occupied) | set(c.cells)
     empty = [cell for cell in box_cells(level.box).cells if cell not in filled]
@@ -243,8 +245,8 @@ def _cover_questions(level: Level, rng: np.random.Generator, category: str) -> l
             continue
         for name in pick(rng, list(view.tray), 1):
             legal = [c for c in candidates(level, view, name) if c.rejection is None]
-            yes: list[tuple[Candidate, dict[str, Any]]] = []
-            no: list[tuple[Candidate, dict[str, Any]]] = []
+            yes: list[tuple[PlacementOption, dict[str, Any]]] = []
+            no: list[tuple[PlacementOption, dict[str, Any]]] = []
             for c in pick(rng, legal, TRIED):
                 proof = _completion(level, view, name, c)
                 (yes if proof["completable"] else no).append((c, proof))

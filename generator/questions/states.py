@@ -18,13 +18,13 @@ from chaingeo.core.level import Level, PuzzleSolution, StackingSolution
 
 
 @dataclass(frozen=True)
-class PuzzleView:
+class ShownPuzzle:
     step: int
     state: Assembly
 
 
 @dataclass(frozen=True)
-class StackingView:
+class ShownStacking:
     step: int
     placed: dict[str, Shape]
     tray: tuple[str, ...]
@@ -34,7 +34,7 @@ class StackingView:
         return {c: n for n, s in sorted(self.placed.items()) for c in s.cells}
 
 
-def puzzle_views(level: Level) -> Iterator[PuzzleView]:
+def puzzle_views(level: Level) -> Iterator[ShownPuzzle]:
     """Every state of the solution with a part of two pieces or more, start first."""
     assert isinstance(level.solution, PuzzleSolution)
     moves = list(level.solution.moves)
@@ -48,14 +48,14 @@ def puzzle_views(level: Level) -> Iterator[PuzzleView]:
         if not state.is_separated():
             by_step[len(plan) - j if assemble else j] = state
     for step in sorted(by_step):
-        yield PuzzleView(step, by_step[step])
+        yield ShownPuzzle(step, by_step[step])
 
 
-def stacking_views(level: Level) -> Iterator[StackingView]:
+def stacking_views(level: Level) -> Iterator[ShownStacking]:
     """The box after each prefix of the solution's placing order (empty first, full never)."""
     assert isinstance(level.solution, StackingSolution)
     sol = level.solution
     for j in range(len(sol.order)):
         placed = {n: sol.placements[n] for n in sol.order[:j]}
         tray = tuple(p.name for p in level.pieces if p.name not in placed)
-        yield StackingView(j, placed, tray)
+        yield ShownStacking(j, placed, tray)

@@ -11,14 +11,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from PIL import Image, ImageDraw
 
+from chaingeo.core.arrays import F64, U8, Bools
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import suite_folder
 from chaingeo.pictures.scene import CAMERAS
-from chaingeo.worldmodel.judge_pose import _iou, _pieces, _Scene, _Target
+from chaingeo.worldmodel.judge_pose import _iou, _pieces, _PoseScene, _Target
 from chaingeo.worldmodel.judge_segment import (
-    U8,
-    BoolArray,
-    FloatArray,
     _spread,
     _table_index,
     classify,
@@ -32,7 +30,7 @@ from chaingeo.worldmodel.judge_video import _wire
 LEVELS = ("puzzle-easy-09-cube3", "puzzle-mid-08-burr3", "puzzle-hard-10-cube4")
 
 
-def _spread_ref(mask: BoolArray, r: int, grow: bool) -> BoolArray:
+def _spread_ref(mask: Bools, r: int, grow: bool) -> Bools:
     out = mask.copy()
     for axis in (0, 1):
         src = out.copy()
@@ -52,7 +50,7 @@ def _spread_ref(mask: BoolArray, r: int, grow: bool) -> BoolArray:
     return out
 
 
-def _distances_ref(mask: BoolArray, r: int) -> npt.NDArray[np.int64]:
+def _distances_ref(mask: Bools, r: int) -> npt.NDArray[np.int64]:
     out = np.full(mask.shape, r + 1, dtype=np.int64)
     out[mask] = 0
     grown = mask
@@ -64,16 +62,16 @@ def _distances_ref(mask: BoolArray, r: int) -> npt.NDArray[np.int64]:
 
 
 @st.composite
-def masks(draw: st.DrawFn) -> BoolArray:
+def masks(draw: st.DrawFn) -> Bools:
     h, w = draw(st.integers(1, 40)), draw(st.integers(1, 40))
     rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
-    out: BoolArray = rng.random((h, w)) < draw(st.sampled_from([0.002, 0.05, 0.3, 0.7, 0.97]))
+    out: Bools = rng.random((h, w)) < draw(st.sampled_from([0.002, 0.05, 0.3, 0.7, 0.97]))
     return out
 
 
 @settings(max_examples=300, deadline=None)
 @given(masks(), st.integers(-1, 25), st.booleans())
-def test_spread_is_the_shifted_copies(mask: BoolArray, r: int, grow: bool) -> None:
+def test_spread_is_the_shifted_copies(mask: Bools, r: int, grow: bool) -> None:
     want, got = _spread_ref(mask, r, grow), _spread(mask, r, grow)
     assert got.dtype == want.dtype and np.array_equal(got, want)
     view = _spread(mask[:, ::2], r, grow)  # a strided view
@@ -82,7 +80,7 @@ def test_spread_is_the_shifted_copies(mask: BoolArray, r: int, grow: bool) -> No
 
 @settings(max_examples=200, deadline=None)
 @given(masks(), st.integers(0, 30))
-def test_distances_are_the_repeated_growths(mask: BoolArray, r: int) -> None:
+def test_distances_are_the_repeated_growths(mask: Bools, r: int) -> None:
     want, got = _distances_ref(mask, r), _distances(mask, r)
     assert got.dtype == want.dtype and np.array_equal(got, want)
 
@@ -92,9 +90,9 @@ def _level(name: str) -> Level:
     return load_level(suite_folder("puzzle") / f"{name}.json")
 
 
-def _draw_ref(scene: _Scene, t: FloatArray) -> U8:
+def _draw_ref(scene: _PoseScene, t: F64) -> U8:
     """The drawing as it was: a list sorted by depth, one ImageDraw.polygon a face."""
-    polys: list[tuple[float, FloatArray, int]] = []
+    polys: list[tuple[float, F64, int]] = []
     for p, off in zip(scene.pieces, t, strict=True):
         shift = np.array([off @ scene.right, off @ scene.up])
         depth = p.depth + float(off @ scene.v)
@@ -123,7 +121,7 @@ def test_scene_draws_as_imagedraw_polygon(
     """Pixel for pixel, over scales, offsets and translations (quarter cells, ties of depth
     between pieces included); and a piece's mask alone is its label in the whole drawing."""
     cam = CAMERAS["iso"]
-    scene = _Scene(_pieces(_level(name), cam), cam, (120, 160))
+    scene = _PoseScene(_pieces(_level(name), cam), cam, (120, 160))
     scene.scale, scene.origin = scale, np.array(origin)
     rng = np.random.default_rng(seed)
     n = len(scene.pieces)

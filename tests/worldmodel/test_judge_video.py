@@ -13,11 +13,10 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from chaingeo.cli.main import main
+from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.level import Level
 from chaingeo.core.suite import suite_folder
 from chaingeo.worldmodel.judge_segment import (
-    U8,
-    BoolArray,
     class_masks,
     components,
     min_area,
@@ -58,7 +57,7 @@ def _frames(name: str) -> tuple[U8, ...]:
     return tuple(shrink(np.asarray(im.convert("RGB"), dtype=np.uint8)) for im in video.frames)
 
 
-def _mask(frame: U8, colors: Colors, piece: int) -> BoolArray:
+def _mask(frame: U8, colors: Colors, piece: int) -> Bools:
     return class_masks(frame, palette_model(colors))[piece]
 
 
@@ -221,7 +220,7 @@ def _corrupt(kind: str, frame: U8, colors: Colors, k: int) -> U8:
     return out
 
 
-def _paint(out: U8, frame: U8, m: BoolArray, color: tuple[int, int, int]) -> None:
+def _paint(out: U8, frame: U8, m: Bools, color: tuple[int, int, int]) -> None:
     rgb = np.array(color, dtype=np.float64)
     shade = frame[m].astype(np.float64).max(axis=1, keepdims=True) / 255.0
     out[m] = np.clip(rgb[None, :] * shade, 0, 255).astype(np.uint8)
@@ -247,7 +246,7 @@ def test_corruptions_are_caught_with_kind_and_frame(
     )
 
 
-def _paste(frame: U8, src: U8, m: BoolArray, dy: int, dx: int) -> U8:
+def _paste(frame: U8, src: U8, m: Bools, dy: int, dx: int) -> U8:
     out = frame.copy()
     ys, xs = np.nonzero(m)
     out[ys + dy, xs + dx] = src[ys, xs]
