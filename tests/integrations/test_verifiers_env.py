@@ -260,3 +260,26 @@ def test_the_vf_eval_command(tmp_path: Path) -> None:
     assert trace["rewards"]["format"]["score"] == 1.0  # 'finish' is a readable action
     assert trace["info"]["chaingeo"]["finished"] is True
     assert sum(r["score"] * r["weight"] for r in trace["rewards"].values()) == pytest.approx(0.1)
+
+
+def test_without_the_plugin_the_id_resolves_in_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    """No plugin distribution: the alias module stands in (a proper module, spec and all), and
+    verifiers' own loaders find our classes through it."""
+    from verifiers.v1.utils import loaders
+
+    import chaingeo.integrations.verifiers as ours
+    from chaingeo.integrations.verifiers import plugin_module
+
+    real = importlib.util.find_spec
+
+    def no_plugin(name: str, *args: Any) -> Any:
+        return None if name == plugin_module.PLUGIN_MODULE else real(name, *args)
+
+    monkeypatch.delitem(sys.modules, plugin_module.PLUGIN_MODULE, raising=False)
+    monkeypatch.setattr(importlib.util, "find_spec", no_plugin)
+    plugin_module.install_alias()
+    monkeypatch.setattr(importlib.util, "find_spec", real)
+    alias = sys.modules[plugin_module.PLUGIN_MODULE]
+    assert alias.__spec__ is not None and real(plugin_module.PLUGIN_MODULE) is not None
+    assert loaders.taskset_class(TASKSET_ID) is ours.ChainGeoTaskset
+    assert loaders.harness_class(TASKSET_ID) is ours.ChainGeoHarness

@@ -11,6 +11,7 @@ the wheel as from a clone.
 
 from __future__ import annotations
 
+import importlib.machinery
 import importlib.util
 import shutil
 import subprocess
@@ -33,6 +34,7 @@ def install_alias() -> None:
     from chaingeo.integrations.verifiers.taskset import ChainGeoTaskset
 
     alias = types.ModuleType(PLUGIN_MODULE, "CHAIN-geo's verifiers classes (in-process alias)")
+    alias.__spec__ = importlib.machinery.ModuleSpec(PLUGIN_MODULE, None)
     alias.ChainGeoEnv = ChainGeoEnv  # type: ignore[attr-defined]
     alias.ChainGeoHarness = ChainGeoHarness  # type: ignore[attr-defined]
     alias.ChainGeoTaskset = ChainGeoTaskset  # type: ignore[attr-defined]
