@@ -304,7 +304,8 @@ def _recolour_from(d: _Draft, t: int, k: int, rgb: tuple[float, ...], frames: in
             d.set_part(u, k, replace(p, rgb=mix))  # type: ignore[arg-type]
 
 
-def vanish_neighbour(d: _Draft, rng: np.random.Generator) -> _Found:
+def _touching_onset(d: _Draft, rng: np.random.Generator) -> tuple[int, int, int] | None:
+    """A corruption's onset frame and piece, and a piece shown touching it then (None: none)."""
     got = _onset(d, rng)
     if got is None:
         return None
@@ -312,7 +313,14 @@ def vanish_neighbour(d: _Draft, rng: np.random.Generator) -> _Found:
     near = [j for j in d.touching(t, k) if d.shown(t, j)]
     if not near:
         return None
-    j = int(rng.choice(near))
+    return t, k, int(rng.choice(near))
+
+
+def vanish_neighbour(d: _Draft, rng: np.random.Generator) -> _Found:
+    got = _touching_onset(d, rng)
+    if got is None:
+        return None
+    t, k, j = got
     _recolour_from(d, t, k, d.rgb[j], 1)
     return t, t, (k, j)
 
@@ -389,14 +397,10 @@ def split(d: _Draft, rng: np.random.Generator) -> _Found:
 def merge(d: _Draft, rng: np.random.Generator) -> _Found:
     """The piece takes a touching piece's colour over three frames and moves with it from then
     on: two pieces become one."""
-    got = _onset(d, rng)
+    got = _touching_onset(d, rng)
     if got is None:
         return None
-    t, k = got
-    near = [j for j in d.touching(t, k) if d.shown(t, j)]
-    if not near:
-        return None
-    j = int(rng.choice(near))
+    t, k, j = got
     pj, pk = d.part(t, j), d.part(t, k)
     assert pj is not None and pk is not None
     for u in range(t, LENGTH):
