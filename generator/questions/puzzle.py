@@ -61,17 +61,8 @@ def can_slide_questions(level: Level, rng: np.random.Generator) -> list[Question
                 "blockers": {n: sorted(g.successors(n)) for n in sorted([right, *wrong])},
             }
             prompt = f"In the state shown, which of these pieces can {SLIDE.format(d=d)}?"
-            out.append(
-                draft(
-                    "can-slide",
-                    level,
-                    view.step,
-                    prompt,
-                    Option(right),
-                    [Option(w) for w in wrong],
-                    proof,
-                )
-            )
+            answer, decoys = Option(right), [Option(w) for w in wrong]
+            out.append(draft("can-slide", level, view.step, prompt, answer, decoys, proof))
         for x in pick(rng, names, PER_STATE):
             free_d = [d for d in sorted(DIRECTIONS) if graphs[d].out_degree(x) == 0]
             stuck_d = [d for d in sorted(DIRECTIONS) if graphs[d].out_degree(x) > 0]
@@ -88,17 +79,8 @@ def can_slide_questions(level: Level, rng: np.random.Generator) -> list[Question
                 f"In the state shown, along which of these directions can {x} slide one "
                 "unit on its own (every other piece stays where it is)?"
             )
-            out.append(
-                draft(
-                    "can-slide",
-                    level,
-                    view.step,
-                    prompt,
-                    Option(right),
-                    [Option(w) for w in wrong],
-                    proof,
-                )
-            )
+            answer, decoys = Option(right), [Option(w) for w in wrong]
+            out.append(draft("can-slide", level, view.step, prompt, answer, decoys, proof))
     return out
 
 
@@ -145,17 +127,8 @@ def first_move_questions(level: Level, rng: np.random.Generator) -> list[Questio
                 "one unit together along the direction given, every other piece staying "
                 "where it is?"
             )
-            out.append(
-                draft(
-                    "first-move",
-                    level,
-                    view.step,
-                    prompt,
-                    _group_option(*right),
-                    [_group_option(*w) for w in wrong],
-                    proof,
-                )
-            )
+            answer, decoys = _group_option(*right), [_group_option(*w) for w in wrong]
+            out.append(draft("first-move", level, view.step, prompt, answer, decoys, proof))
     return out
 
 

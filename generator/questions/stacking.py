@@ -145,17 +145,8 @@ def fits_questions(level: Level, rng: np.random.Generator) -> list[Question]:
                 "counted from 1.)"
             )
             proof = {"piece": name, "options": [c.to_json() for c in [right, *wrong]]}
-            out.append(
-                draft(
-                    "fits",
-                    level,
-                    view.step,
-                    prompt,
-                    _option(name, right),
-                    [_option(name, w) for w in wrong],
-                    proof,
-                )
-            )
+            answer, decoys = _option(name, right), [_option(name, w) for w in wrong]
+            out.append(draft("fits", level, view.step, prompt, answer, decoys, proof))
     return out
 
 
@@ -191,17 +182,8 @@ def supported_questions(level: Level, rng: np.random.Generator) -> list[Question
                 "rule": "drop" if drop else "contact",
                 "options": [{**c.to_json(), "touches": _touches(view, c)} for c in [right, *wrong]],
             }
-            out.append(
-                draft(
-                    "supported",
-                    level,
-                    view.step,
-                    prompt,
-                    _option(name, right),
-                    [_option(name, w) for w in wrong],
-                    proof,
-                )
-            )
+            answer, decoys = _option(name, right), [_option(name, w) for w in wrong]
+            out.append(draft("supported", level, view.step, prompt, answer, decoys, proof))
     return out
 
 
@@ -269,17 +251,8 @@ def _cover_questions(level: Level, rng: np.random.Generator, category: str) -> l
                     "(x,y,z), counted from 1.)"
                 )
             proof = {"piece": name, "options": [{**c.to_json(), **p} for c, p in [right, *wrong]]}
-            out.append(
-                draft(
-                    category,
-                    level,
-                    view.step,
-                    prompt,
-                    _option(name, right[0]),
-                    [_option(name, w) for w, _ in wrong],
-                    proof,
-                )
-            )
+            answer, decoys = _option(name, right[0]), [_option(name, w) for w, _ in wrong]
+            out.append(draft(category, level, view.step, prompt, answer, decoys, proof))
     return out
 
 
