@@ -38,6 +38,7 @@ from chaingeo.solvers.assembly.groups import (
 from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.figures import PuzzleFigures
+from chaingeo.solvers.jobs import Farm
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion.disassemble import (
     Analysis,
@@ -252,7 +253,7 @@ def level_analysis_row(
     assemble: bool,
     mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
-    jobs: int | None = 1,
+    jobs: int | Farm | None = 1,
 ) -> dict[str, Any]:
     """The figures of one of our puzzle levels (a dict, with ``plan``): BurrTools' assemblies and
     solutions of the level written as a BurrTools file (:func:`level_puzzle`: each piece its
@@ -267,9 +268,7 @@ def level_analysis_row(
     max_group = level_max_group(level)
     out: dict[str, Any] = {"assemblies": None, "solutions": None}
     if assemble:
-        from chaingeo.core.formats.bt_level import level_puzzle
-
-        packing = compile_packing(bt_packing_spec(level_puzzle(level), 0))
+        packing = level_packing(level)
         rep = count_figures(packing, out, mirrors, max_group, limits, deadline, "", jobs)
         deadline = deadline if rep.complete else grace_deadline(limits)
     out.update(
@@ -285,6 +284,14 @@ def level_analysis_row(
         )
     )
     return out
+
+
+def level_packing(level: Level) -> Packing:
+    """A level as BurrTools' assembler sees it: the level written as a BurrTools file
+    (:func:`chaingeo.core.formats.bt_level.level_puzzle`, each piece its own shape)."""
+    from chaingeo.core.formats.bt_level import level_puzzle
+
+    return compile_packing(bt_packing_spec(level_puzzle(level), 0))
 
 
 def optimal_error_of(e: SearchLimitError) -> dict[str, Any]:
@@ -323,7 +330,7 @@ def count_figures(
     limits: SearchLimits,
     deadline: Deadline,
     label: str,
-    jobs: int | None = 1,
+    jobs: int | Farm | None = 1,
 ) -> BTReport:
     """Count BurrTools' assemblies and solutions into ``out``; a cap reached ends the count,
     and ``out`` then says so: ``counts_complete`` false, the counts lower bounds, ``limit``
@@ -366,7 +373,7 @@ def problem_analysis_row(
     assemble: bool,
     mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
-    jobs: int | None = 1,
+    jobs: int | Farm | None = 1,
 ) -> dict[str, Any]:
     """The figures of one problem of a BurrTools puzzle (a dict, with ``plan``): BurrTools'
     assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.assembly.btassemble`), then
@@ -444,6 +451,7 @@ def analyze(
     mirrors: Mirrors = "drop",
     deadline: Deadline | None = None,
     jobs: int | None = None,
+    scheduler: str | None = None,
 ) -> PuzzleFigures:
     """Assemblies, solutions, level, moves and o_i of a puzzle, as ``chain analyze`` prints
     them (:meth:`PuzzleFigures.to_json`).
@@ -454,11 +462,12 @@ def analyze(
     ``optimal`` / ``assemble``: search o_i / count assemblies. ``mirrors``: see
     :mod:`chaingeo.solvers.assembly.btassemble`. Everything runs within ``deadline`` (default:
     one of ``limits.seconds``; ``limits`` default :data:`DEFAULT_LIMITS`). ``jobs``: worker
-    processes for the counts (None: the machine's cores); the figures do not depend on it."""
+    processes for the counts (None: the machine's cores), or ``scheduler``: the address of a
+    Dask cluster that does them; the figures do not depend on either."""
     from chaingeo.kernels.jit import mode
-    from chaingeo.solvers.jobs import check_jobs
+    from chaingeo.solvers.jobs import as_farm
 
-    jobs = check_jobs(jobs)
+    farm = as_farm(jobs, scheduler)
     limits = DEFAULT_LIMITS if limits is None else limits
     deadline = Deadline(limits.seconds) if deadline is None else deadline
     start = time.perf_counter()
@@ -468,12 +477,12 @@ def analyze(
     several = False
     if isinstance(source, BTPuzzle):
         several = problem is None and len(source.problems) != 1
-        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline, jobs)
+        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline, farm)
     else:
         from chaingeo.core.suite import load_level
 
         level = load_level(source) if isinstance(source, str | os.PathLike) else source
-        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline, jobs)]
+        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline, farm)]
     meta: dict[str, Any] = {"file": file, "kernels": mode()}
     meta["seconds"] = round(time.perf_counter() - start, 3)
     if several:
@@ -489,7 +498,7 @@ def _puzzle_rows(
     assemble: bool,
     mirrors: Mirrors,
     deadline: Deadline,
-    jobs: int | None,
+    jobs: int | Farm | None,
 ) -> list[dict[str, Any]]:
     """The rows of problem ``problem``, or with None of the puzzle's only problem, or of every
     one."""

@@ -24,6 +24,7 @@ class Progress:
     def __init__(self) -> None:
         self.stage = ""
         self.counts: dict[str, int] = {}
+        self.workers: dict[int, float] = {}  # CPU seconds of counting, per process id
 
     def text(self) -> str:
         counts = ", ".join(f"{k} {v}" for k, v in self.counts.items())

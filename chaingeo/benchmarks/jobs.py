@@ -3,7 +3,8 @@
 Each row runs three whole processes on one file, in the same run, each ``--repeat`` times
 (interleaved, best wall time kept): BurrTools' burrTxt, ``chain analyze --no-optimal --jobs 1``
 and ``--jobs N`` (N: the machine's cores, at least 2). It reports their wall times and CPU
-seconds (the process and its workers), ``scaling`` (jobs 1 wall / jobs N wall), ``vs_burrtxt``
+seconds (the process and its workers), ``scaling`` (jobs 1 wall / jobs N wall), ``cpu_ratio``
+(jobs N CPU / jobs 1 CPU), ``balance`` (least / most counting CPU of a worker), ``vs_burrtxt``
 (burrTxt wall / jobs N wall; above 1: faster than burrTxt), whether the two lines of ours are the
 same bytes (wall time aside) and whether they agree with burrTxt's counts. The machine's load
 average is printed with each row: on a busy machine the workers get no more cores than it has
@@ -40,9 +41,10 @@ def _children_cpu() -> float:
     return ru.ru_utime + ru.ru_stime
 
 
-def run_ours(path: Path, jobs: int, seconds: float) -> tuple[float, float, str]:
+def run_ours(path: Path, jobs: int, seconds: float) -> tuple[float, float, str, list[float]]:
     """``chain analyze PATH --no-optimal --jobs JOBS`` as a whole process: wall seconds, CPU
-    seconds (it and its workers) and its JSON line without the wall time."""
+    seconds (it and its workers), its JSON line without the wall time and the counting CPU
+    seconds of each worker (from its standard error; empty with one)."""
     cmd = [sys.executable, "-m", "chaingeo.cli.main", "analyze", str(path), "--no-optimal"]
     cmd += ["--jobs", str(jobs), "--seconds", str(seconds)]
     cpu = _children_cpu()
@@ -53,7 +55,15 @@ def run_ours(path: Path, jobs: int, seconds: float) -> tuple[float, float, str]:
     row = json.loads(line)
     row.pop("seconds", None)
     row.pop("file", None)
-    return wall, _children_cpu() - cpu, json.dumps(row, sort_keys=True)
+    return wall, _children_cpu() - cpu, json.dumps(row, sort_keys=True), _workers(done.stderr)
+
+
+def _workers(stderr: str) -> list[float]:
+    marker = "counting CPU seconds per worker: "
+    for line in stderr.splitlines():
+        if marker in line:
+            return [float(x) for x in line.split(marker, 1)[1].split(",")]
+    return []
 
 
 def compare(name: str, path: Path, binary: Path, jobs: int, repeat: int) -> dict[str, Any]:
@@ -62,6 +72,7 @@ def compare(name: str, path: Path, binary: Path, jobs: int, repeat: int) -> dict
     best = {"burrtxt": float("inf"), "jobs1": float("inf"), "jobsN": float("inf")}
     cpu = {"jobs1": 0.0, "jobsN": 0.0}
     lines: dict[str, str] = {}
+    workers: list[float] = []
     bt = None
     for _ in range(max(repeat, 1)):
         try:
@@ -70,9 +81,10 @@ def compare(name: str, path: Path, binary: Path, jobs: int, repeat: int) -> dict
         except (subprocess.TimeoutExpired, BurrTxtError):
             bt = None
         for key, n in (("jobs1", 1), ("jobsN", jobs)):
-            wall, used, lines[key] = run_ours(path, n, seconds)
+            wall, used, lines[key], per_worker = run_ours(path, n, seconds)
             if wall < best[key]:
                 best[key], cpu[key] = wall, used
+                workers = per_worker if key == "jobsN" else workers
     ours = json.loads(lines["jobsN"])
     row: dict[str, Any] = {"instance": name, "jobs": jobs, "load": os.getloadavg()[0]}
     row.update({f"{k}_seconds": round(v, 3) for k, v in best.items()})
@@ -80,6 +92,12 @@ def compare(name: str, path: Path, binary: Path, jobs: int, repeat: int) -> dict
     row["ours"] = {k: ours.get(k) for k in ("assemblies", "solutions", "convention")}
     row["same_bytes"] = lines["jobs1"] == lines["jobsN"]
     row["scaling"] = round(best["jobs1"] / best["jobsN"], 2)
+    # CPU that N workers spend against one (the cost of cutting and merging), and how evenly
+    # they shared it (least / most busy worker): figures a busy machine does not distort.
+    row["cpu_ratio"] = round(cpu["jobsN"] / cpu["jobs1"], 2) if cpu["jobs1"] else None
+    row["worker_cpu_seconds"] = workers
+    busiest = max(workers, default=0.0)
+    row["balance"] = round(min(workers) / busiest, 2) if busiest > 0 else None
     if bt is not None:
         row["burrtxt"] = {"assemblies": bt.assemblies, "solutions": bt.solutions}
         row["vs_burrtxt"] = round(best["burrtxt"] / best["jobsN"], 2)

@@ -15,6 +15,7 @@ to the general path, which answers exactly as before.
 from __future__ import annotations
 
 import time
+from collections.abc import Generator
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,7 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.assembly.btassemble import (
+    Anchor,
     BTFrame,
     Mirrors,
     choose_anchor,
@@ -36,11 +38,16 @@ from chaingeo.solvers.assembly.btparallel import (
     NO,
     STUCK,
     YES,
+    Verdict,
+    class_plan,
+    large,
+    split_classes,
     verdicts,
 )
 from chaingeo.solvers.cover.constrained import Packing
+from chaingeo.solvers.cover.rowreduce import live_rows
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.jobs import check_jobs
+from chaingeo.solvers.jobs import Farm, as_farm
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import btsearch as bt
 from chaingeo.solvers.motion import levelsearch as ls
@@ -234,15 +241,30 @@ class StuckCheck:
 
 
 class WorkerChecks:
-    """How a worker builds its checks of one packing (picklable, for spawned workers)."""
+    """How a worker builds its checks of one packing (picklable, for spawned workers and
+    Dask): the stuck test unless piece groups forbid it, BurrTools' verdicts on rows when
+    ``fast``."""
 
-    def __init__(self, packing: Packing, limits: SearchLimits | None, want_levels: bool) -> None:
+    def __init__(
+        self,
+        packing: Packing,
+        limits: SearchLimits | None,
+        want_levels: bool,
+        *,
+        stuck: bool = True,
+        fast: bool = True,
+    ) -> None:
         self.packing = packing
         self.limits = limits
         self.want_levels = want_levels
+        self.stuck = stuck
+        self.fast = fast
 
-    def __call__(self) -> tuple[StuckCheck, RowVerdicts]:
-        return StuckCheck(self.packing), RowVerdicts(self.packing, self.limits, self.want_levels)
+    def __call__(self) -> tuple[StuckCheck | None, RowVerdicts | None]:
+        stuck = StuckCheck(self.packing) if self.stuck else None
+        if not self.fast:
+            return stuck, None
+        return stuck, RowVerdicts(self.packing, self.limits, self.want_levels)
 
 
 @dataclass(frozen=True)
@@ -273,7 +295,8 @@ def count_bt(
     levels: list[str] | None = None,
     partial: bool = False,
     fast: bool = True,
-    jobs: int | None = 1,
+    jobs: int | Farm | None = 1,
+    scheduler: str | None = None,
 ) -> BTReport:
     """BurrTools' assemblies and solutions of a packing, and the first solution. The search
     and every disassembly share ``deadline`` (default: one of ``limits.seconds``; without
@@ -285,9 +308,10 @@ def count_bt(
     was counted (lower bounds) and the error. The running counts are kept in the deadline's
     :class:`chaingeo.solvers.deadline.Progress` as the search goes. ``fast``: BurrTools' verdicts on
     rows (:class:`RowVerdicts`) where they apply; False sends every assembly through the
-    general path (the two are compared in the tests). ``jobs``: processes that take the
-    assemblies apart (None: the machine's cores; :mod:`chaingeo.solvers.assembly.btparallel`),
-    the same figures whatever it is."""
+    general path (the two are compared in the tests). ``jobs``: processes that search and
+    judge the subtrees of a large count (None: the machine's cores), or ``scheduler``: the
+    Dask cluster that does (:mod:`chaingeo.solvers.assembly.btparallel`); the same figures
+    whatever they are."""
     start = time.perf_counter()
     if deadline is None and limits is not None:
         deadline = Deadline(limits.seconds)
@@ -296,21 +320,17 @@ def count_bt(
     groups = piece_groups(packing)
     # With piece groups a part may be done without moving (pieces of one group stay together).
     stuck = None if groups.any() else StuckCheck(packing)
-    classes = iter_classes(
-        packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor, deadline=deadline
-    )
     frame = BTFrame(packing) if separations == "first" else None
     on_rows = None
     if fast and frame is not None and stuck is not None:
         on_rows = RowVerdicts(packing, limits, levels is not None, frame)
     counts = deadline.progress.counts if deadline is not None else {}
     limit: SearchLimitError | None = None
-    worker = None
-    if on_rows is not None:
-        worker = WorkerChecks(packing, limits, levels is not None)
-    stream = verdicts(
-        classes, stuck, on_rows, jobs=check_jobs(jobs), deadline=deadline, worker=worker
+    checks = WorkerChecks(
+        packing, limits, levels is not None, stuck=stuck is not None, fast=on_rows is not None
     )
+    farm = as_farm(jobs, scheduler)
+    stream = _stream(packing, mirrors, node_limit, anchor, deadline, (stuck, on_rows), checks, farm)
     try:
         for rows, code, level in stream:
             tally.assemblies += 1
@@ -344,6 +364,30 @@ def count_bt(
     return BTReport(
         tally.assemblies, tally.solutions, tally.first, tally.first_analysis, seconds, label, limit
     )
+
+
+def _stream(
+    packing: Packing,
+    mirrors: Mirrors,
+    node_limit: int | None,
+    anchor: Anchor | None,
+    deadline: Deadline | None,
+    here: tuple[StuckCheck | None, RowVerdicts | None],
+    checks: WorkerChecks,
+    farm: Farm,
+) -> Generator[Verdict, None, None]:
+    """Every class with its verdict: a large search cut into subtrees on ``farm``
+    (:func:`chaingeo.solvers.assembly.btparallel.split_classes`), a small one (or one under a
+    node limit) in this process, in its own order."""
+    if node_limit is None and packing.n_rows:
+        rows = live_rows(packing.problem, None if anchor is None else anchor.rows)
+        if large(packing.problem, rows):
+            plan = class_plan(packing, packing.row_maps(mirrors == "drop"), checks)
+            return split_classes(plan, rows, farm, deadline)
+    classes = iter_classes(
+        packing, mirrors=mirrors, node_limit=node_limit, anchor=anchor, deadline=deadline
+    )
+    return verdicts(classes, *here, deadline)
 
 
 @dataclass

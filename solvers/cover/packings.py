@@ -62,6 +62,7 @@ from chaingeo.solvers.cover.problem import (
 )
 from chaingeo.solvers.cover.search import CoverLimitError, CoverSearch, CoverStats, Engine
 from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.jobs import Farm
 
 __all__ = [
     "AnchorPlan",
@@ -261,12 +262,12 @@ def count_packings(
     symmetry: bool = True,
     anchor: str | None = None,
     deadline: Deadline | None = None,
-    jobs: int = 1,
+    jobs: int | Farm = 1,
 ) -> CoverResult:
     """Count all solutions and (if asked) the distinct ones up to the target's symmetries.
-    ``jobs`` > 1: the searches' subtrees on that many worker processes
-    (:mod:`chaingeo.solvers.cover.parallel`; not with a node limit or a deadline), the same
-    counts."""
+    ``jobs`` > 1: the searches' subtrees on that many worker processes, or on the Dask cluster
+    of a :class:`chaingeo.solvers.jobs.Farm` (:mod:`chaingeo.solvers.cover.parallel`; not with
+    a node limit or a deadline), the same counts."""
     problem = _problem(pieces, target, optional, reflections)
     syms, _ = problem.symmetry
     plan = anchor_plan(problem, anchor) if symmetry else None
@@ -320,19 +321,22 @@ class _CoverBudget:
         self,
         node_limit: int | None,
         deadline: Deadline | None,
-        jobs: int = 1,
+        jobs: int | Farm = 1,
         engine: Engine = "auto",
     ) -> None:
         if node_limit is not None and node_limit < 0:
             raise CoverError(f"node_limit: must be >= 0, got {node_limit}")
-        if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        if not isinstance(jobs, Farm) and (
+            isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1
+        ):
             raise CoverError(f"jobs: expected a positive number of processes, got {jobs!r}")
         self.limit = node_limit
         self.deadline = deadline
         self.stats = CoverStats()
         self.found = 0
         bounded = deadline is not None and deadline.bounded
-        self.jobs = jobs if node_limit is None and not bounded else 1
+        farm = jobs if isinstance(jobs, Farm) else Farm(jobs)
+        self.farm = farm if node_limit is None and not bounded else Farm(1)
         self.engine = engine
 
     def _parallel(self, search: CoverSearch, collect: bool) -> list[I32]:
@@ -342,13 +346,13 @@ class _CoverBudget:
         t0 = time.perf_counter()
         if collect:
             blocks, nodes = parallel.collect_parallel(
-                search.problem, search.rows, self.engine, self.jobs
+                search.problem, search.rows, self.engine, self.farm
             )
             found = sum(len(b) for b in blocks)
         else:
             blocks = []
             found, nodes = parallel.count_parallel(
-                search.problem, search.rows, self.engine, self.jobs
+                search.problem, search.rows, self.engine, self.farm
             )
         seconds = time.perf_counter() - t0
         self.stats += CoverStats(nodes, 0, seconds, search.engine, search.kernel)
@@ -359,7 +363,7 @@ class _CoverBudget:
     def _worth_workers(self, search: CoverSearch) -> bool:
         from chaingeo.solvers.cover.parallel import MIN_ROWS
 
-        return self.jobs > 1 and len(search.rows) >= MIN_ROWS
+        return self.farm.parallel and len(search.rows) >= MIN_ROWS
 
     def search(self, problem: CoverProblem, rows: I32 | None, engine: Engine) -> CoverSearch:
         left = None if self.limit is None else max(self.limit - self.stats.nodes, 0)

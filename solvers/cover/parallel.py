@@ -7,7 +7,8 @@ Every cover holds exactly one row through that cell, so the subtrees' covers are
 search's, each met once. Subtrees are cut again, level by level, until there are
 :data:`PARTS` of them or :data:`MAX_DEPTH` levels; the cut depends on the problem only, never
 on the number of workers, so the counts and the collected covers (in subtree order) are the same
-whatever it is. Workers are forked (they inherit the compiled kernels and the problem).
+whatever it is. Workers are forked (they inherit the compiled kernels and the problem), or the
+subtrees go to a Dask cluster (:class:`chaingeo.solvers.jobs.Farm`).
 """
 
 from __future__ import annotations
@@ -20,8 +21,8 @@ import numpy as np
 from chaingeo.core.arrays import I32
 from chaingeo.solvers.cover.bitboard import scan_order
 from chaingeo.solvers.cover.problem import CoverProblem
-from chaingeo.solvers.cover.search import CoverSearch, Engine, choose_kernel
-from chaingeo.solvers.jobs import fork_pool
+from chaingeo.solvers.cover.search import CoverLimitError, CoverSearch, Engine, choose_kernel
+from chaingeo.solvers.jobs import Farm, as_farm, farm_map
 
 #: Subtrees the tree is cut into (when it is that wide: the last level cut stops there; each
 #: subtree's search costs its own set-up), and levels cut at most.
@@ -32,24 +33,72 @@ MAX_DEPTH: Final = 3
 MIN_ROWS: Final = 1500
 
 
-def split_rows(problem: CoverProblem, rows: I32, engine: Engine) -> list[I32]:
-    """The subtrees of the search over ``rows`` (see the module's docstring), in order."""
+def split_rows(
+    problem: CoverProblem,
+    rows: I32,
+    engine: Engine,
+    *,
+    parts: int | None = None,
+    max_depth: int | None = None,
+) -> list[I32]:
+    """The subtrees of the search over ``rows`` (see the module's docstring), in order: about
+    ``parts`` of them (default :data:`PARTS`), cut ``max_depth`` levels at most (default
+    :data:`MAX_DEPTH`)."""
     first_cell = choose_kernel(problem, engine) == "bitboard-first"
     scan = scan_order(problem) if first_cell else np.arange(problem.n_cells, dtype=np.int32)
-    parts = [np.ascontiguousarray(rows, dtype=np.int32)]
-    for _ in range(MAX_DEPTH):
-        if len(parts) >= PARTS:
+    want = PARTS if parts is None else parts
+    out = [np.ascontiguousarray(rows, dtype=np.int32)]
+    for _ in range(MAX_DEPTH if max_depth is None else max_depth):
+        if len(out) >= want:
             break
         cut: list[I32] = []
-        for i, part in enumerate(parts):
-            if len(cut) + len(parts) - i >= PARTS:
+        changed = False  # a level that cuts nothing ends the cutting (dead subtrees dropped)
+        for i, part in enumerate(out):
+            if len(cut) + len(out) - i >= want:
                 cut.append(part)  # enough subtrees: the rest stay whole
             else:
-                cut.extend(_cut(problem, part, scan, first_cell))
-        if len(cut) == len(parts):
+                pieces = _cut(problem, part, scan, first_cell)
+                changed |= len(pieces) != 1 or pieces[0] is not part
+                cut.extend(pieces)
+        if not changed:
             break
-        parts = cut
-    return parts
+        out = cut
+    return out
+
+
+def split_widest(problem: CoverProblem, rows: I32, engine: Engine, parts: int) -> list[I32]:
+    """The search over ``rows`` cut into about ``parts`` subtrees, in order: a subtree whose
+    search ends within :data:`PROBE_NODES` nodes is left whole (dropped when it holds no
+    cover), and of the others the one of most rows is cut next. A search whose first cuts leave
+    most branches dead so still ends in many live subtrees."""
+    first_cell = choose_kernel(problem, engine) == "bitboard-first"
+    scan = scan_order(problem) if first_cell else np.arange(problem.n_cells, dtype=np.int32)
+    out = [np.ascontiguousarray(rows, dtype=np.int32)]
+    big = [True]  # per part: its search outlasts the probe
+    while len(out) < parts and any(big):
+        i = max((k for k in range(len(out)) if big[k]), key=lambda k: (len(out[k]), -k))
+        pieces = _cut(problem, out[i], scan, first_cell)
+        if len(pieces) == 1 and pieces[0] is out[i]:
+            big[i] = False
+            continue
+        sizes = [_probe(problem, p, engine) for p in pieces]
+        out[i : i + 1] = [p for p, n in zip(pieces, sizes, strict=True) if n != 0]
+        big[i : i + 1] = [n < 0 for n in sizes if n != 0]
+    return out
+
+
+#: Nodes a subtree's search may take and still be left whole by :func:`split_widest`.
+PROBE_NODES: Final = 2000
+
+
+def _probe(problem: CoverProblem, rows: I32, engine: Engine) -> int:
+    """The covers of the search over ``rows`` if it ends within :data:`PROBE_NODES` nodes,
+    else -1."""
+    search = CoverSearch(problem, rows, engine=engine, node_limit=PROBE_NODES)
+    try:
+        return search.count()
+    except CoverLimitError:
+        return -1
 
 
 def _cut(problem: CoverProblem, rows: I32, scan: I32, first_cell: bool) -> list[I32]:
@@ -98,33 +147,31 @@ def _cut(problem: CoverProblem, rows: I32, scan: I32, first_cell: bool) -> list[
     return out
 
 
-def count_parallel(problem: CoverProblem, rows: I32, engine: Engine, jobs: int) -> tuple[int, int]:
-    """``(covers, nodes)`` of the search over ``rows``, its subtrees on ``jobs`` workers."""
+def count_parallel(
+    problem: CoverProblem, rows: I32, engine: Engine, jobs: int | Farm
+) -> tuple[int, int]:
+    """``(covers, nodes)`` of the search over ``rows``, its subtrees on ``jobs`` workers (or a
+    :class:`chaingeo.solvers.jobs.Farm`: a Dask cluster)."""
     parts = split_rows(problem, rows, engine)
-    results = _map(problem, engine, jobs, parts, collect=False)
+    results = _map(problem, engine, as_farm(jobs), parts, collect=False)
     return sum(r[0] for r in results), sum(r[1] for r in results)
 
 
 def collect_parallel(
-    problem: CoverProblem, rows: I32, engine: Engine, jobs: int
+    problem: CoverProblem, rows: I32, engine: Engine, jobs: int | Farm
 ) -> tuple[list[I32], int]:
     """Every cover of the search over ``rows`` (blocks in subtree order) and the nodes."""
     parts = split_rows(problem, rows, engine)
-    results = _map(problem, engine, jobs, parts, collect=True)
+    results = _map(problem, engine, as_farm(jobs), parts, collect=True)
     blocks = [b for r in results for b in r[2]]
     return blocks, sum(r[1] for r in results)
 
 
-_WORK: list[tuple[CoverProblem, Engine]] = []
-
-
-def _start(problem: CoverProblem, engine: Engine) -> None:
-    _WORK[:] = [(problem, engine)]
-
-
-def _search(args: tuple[I32, bool]) -> tuple[int, int, list[I32]]:
+def _search(
+    work: tuple[CoverProblem, Engine], args: tuple[I32, bool]
+) -> tuple[int, int, list[I32]]:
+    problem, engine = work
     rows, collect = args
-    problem, engine = _WORK[0]
     search = CoverSearch(problem, rows, engine=engine)
     blocks = list(search.batches(4096)) if collect else []
     if not collect:
@@ -133,16 +180,8 @@ def _search(args: tuple[I32, bool]) -> tuple[int, int, list[I32]]:
 
 
 def _map(
-    problem: CoverProblem, engine: Engine, jobs: int, parts: Sequence[I32], collect: bool
+    problem: CoverProblem, engine: Engine, farm: Farm, parts: Sequence[I32], collect: bool
 ) -> list[tuple[int, int, list[I32]]]:
-    """Each part searched (on ``jobs`` workers when more than one), results in part order."""
+    """Each part searched (on the farm's workers), results in part order."""
     work = [(p, collect) for p in parts]
-    if jobs <= 1:
-        _start(problem, engine)
-        return [_search(w) for w in work]
-    pool = fork_pool(jobs, _start, (problem, engine))
-    try:
-        return pool.map(_search, work, chunksize=1)
-    finally:
-        pool.terminate()
-        pool.join()
+    return list(farm_map(_search, (problem, engine), work, farm))

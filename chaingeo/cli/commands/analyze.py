@@ -28,9 +28,10 @@ lower bounds) and ``limit`` naming the cap and its flag, and still gives level, 
 the known assembly (the first solution found, a ``.xmpuzzle``'s stored assembly, or a level's
 own), which get a further :data:`chaingeo.solvers.analysis.GRACE_SECONDS` at most.
 
-``--jobs N`` (default: the machine's cores) counts with N worker processes taking the
-assemblies apart while one search enumerates them (:mod:`chaingeo.solvers.assembly.btparallel`):
-the same bytes whatever N, in less wall time on a large count.
+``--jobs N`` (default: the machine's cores) cuts a large count's search into subtrees that N
+worker processes enumerate and take apart (:mod:`chaingeo.solvers.assembly.btparallel`), merged
+in a fixed order: the same bytes whatever N, in less wall time. ``--scheduler ADDRESS`` sends the
+same subtrees to a Dask cluster.
 
 Exit status: 0 when every figure is complete; 1 when counting was cut short by a cap; 2 when
 some file failed (its line carries ``error``; the message is also on standard error).
@@ -127,8 +128,15 @@ def register(sub: Any) -> None:
         "--jobs",
         type=int,
         default=None,
-        help="worker processes that take the assemblies apart while counting (default: the "
-        "machine's cores); the figures are the same whatever it is",
+        help="worker processes that search and take apart the assemblies of a large count "
+        "(default: the machine's cores); the figures are the same whatever it is",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        default=None,
+        help="count on the Dask cluster at ADDRESS instead of local workers (the cluster "
+        "extra); the same figures",
     )
     p.add_argument("--no-optimal", action="store_true", help="skip the optimal-plan search")
     p.add_argument(
@@ -263,7 +271,7 @@ def _within(
     )
     deadline = Deadline(limits.seconds, stated=args.seconds)
     with ProgressLines(f"chain analyze: {spec}", deadline.progress):
-        return analyze(
+        figures = analyze(
             source,
             limits=limits,
             problem=problem,
@@ -272,7 +280,13 @@ def _within(
             mirrors=args.mirrors,
             deadline=deadline,
             jobs=args.jobs,
+            scheduler=getattr(args, "scheduler", None),
         )
+    workers = deadline.progress.workers
+    if len(workers) > 1:  # how evenly the workers shared the count (stderr: not the figures)
+        cpu = ", ".join(f"{s:.2f}" for s in sorted(workers.values(), reverse=True))
+        print(f"chain analyze: {spec}: counting CPU seconds per worker: {cpu}", file=sys.stderr)
+    return figures
 
 
 @lru_cache(maxsize=1)

@@ -5,8 +5,9 @@ and reflections, reflections only when the piece set is mirror-closed), ``second
 of the count, JIT loading excluded), ``nodes`` and the search details. Pieces are always free
 3D pieces (a flat pentomino may be turned over or stood up), so the solid-pentomino counts need
 no extra flag. ``--jobs N`` (default: the machine's cores) searches the subtrees of a large
-search on N worker processes (:mod:`chaingeo.solvers.cover.parallel`): the same counts, a
-different ``nodes`` (each subtree's search places its forced rows again).
+search on N worker processes (:mod:`chaingeo.solvers.cover.parallel`), ``--scheduler ADDRESS`` on
+a Dask cluster: the same counts, a different ``nodes`` (each subtree's search places its forced
+rows again).
 """
 
 from __future__ import annotations
@@ -48,6 +49,13 @@ def register(sub: Any) -> None:
         default=None,
         help="worker processes searching subtrees of a large search (default: the machine's "
         "cores; one with --node-limit); the same counts whatever it is",
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        default=None,
+        help="search the subtrees on the Dask cluster at ADDRESS instead of local workers (the "
+        "cluster extra); the same counts",
     )
     p.set_defaults(func=run)
 
@@ -127,11 +135,11 @@ def run(args: argparse.Namespace) -> int:
         box = level_box
     else:
         raise CommandError("--box is required unless --pieces is a stacking level file")
-    from chaingeo.solvers.jobs import default_jobs
+    from chaingeo.solvers.jobs import as_farm
 
     if args.jobs is not None and args.jobs < 1:
         raise CommandError(f"--jobs: expected a positive number of processes, got {args.jobs}")
-    jobs = default_jobs() if args.jobs is None else args.jobs
+    jobs = as_farm(args.jobs, args.scheduler)
     count_packings([Shape([(0, 0, 0)])], (1, 1, 1), engine=args.engine)  # load the JIT
     t0 = time.perf_counter()
     try:

@@ -27,6 +27,7 @@ def register(sub: Any) -> None:
     _register_suite(fam)
     _register_puzzle(fam)
     _register_puzzle_suite(fam)
+    _register_puzzle_counts(fam)
 
 
 def add_run_options(p: argparse.ArgumentParser, *, count: bool = True) -> None:
@@ -252,6 +253,45 @@ def _register_puzzle_suite(fam: Any) -> None:
                    help="CHAIN's puzzle models (e.g. ../shared/chain-models)")  # fmt: skip
     p.add_argument("--jobs", type=int, default=1, help="suite entries built in parallel")
     p.set_defaults(func=_run_puzzle_suite)
+
+
+def _register_puzzle_counts(fam: Any) -> None:
+    p = fam.add_parser(
+        "puzzle-counts",
+        help="complete assembly and solution counts into the puzzle levels' stats",
+    )
+    p.add_argument("--levels", type=Path, default=Path("levels") / "puzzle",
+                   help="the folder of puzzle levels to count (written back)")  # fmt: skip
+    p.add_argument("--only", nargs="+", default=(), metavar="ID", help="count these levels only")
+    p.add_argument("--recount", action="store_true", help="count levels that have counts too")
+    p.add_argument("--jobs", type=int, default=None,
+                   help="worker processes of a count (default: the machine's cores)")  # fmt: skip
+    p.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                   help="count on the Dask cluster at ADDRESS")  # fmt: skip
+    p.set_defaults(func=_run_puzzle_counts)
+
+
+def _run_puzzle_counts(args: argparse.Namespace) -> int:
+    import sys
+
+    from chaingeo.core.errors import ChainGeoError
+    from chaingeo.generator.counts import count_folder
+    from chaingeo.solvers.jobs import as_farm
+
+    if args.jobs is not None and args.jobs < 1:
+        raise CommandError(f"--jobs: expected a positive number of processes, got {args.jobs}")
+    try:
+        done = count_folder(
+            args.levels,
+            as_farm(args.jobs, args.scheduler),
+            recount=args.recount,
+            only=args.only,
+            log=lambda s: print(s, file=sys.stderr, flush=True),
+        )
+    except (ChainGeoError, RuntimeError) as e:
+        raise CommandError(str(e)) from None
+    print(json.dumps({"levels": str(args.levels), "counted": [lv.id for lv in done]}))
+    return 0
 
 
 def _run_puzzle_suite(args: argparse.Namespace) -> int:
