@@ -13,7 +13,8 @@ entry, listed in :data:`SUITE`:
   signature is new within the entry are kept. A puzzle made by two entries stops the build (change a
   seed).
 
-Entries are independent, so they run in parallel; ids are then given in :data:`SUITE` order.
+Entries are independent, so they run in parallel; ids are then given in :data:`SUITE` order, and
+each level gets its complete counts (:mod:`chaingeo.generator.counts`).
 Every search is bounded by state caps only, never by time, so every machine makes the same
 files.
 """
@@ -27,11 +28,13 @@ from pathlib import Path
 from typing import Literal
 
 from chaingeo.core.formats.models import import_model
-from chaingeo.core.level import Difficulty, Level, revalidate, save_level
+from chaingeo.core.level import Difficulty, Level, load_level, revalidate, save_level
 from chaingeo.generator.config import PuzzleConfig
+from chaingeo.generator.counts import count_level, reuse_counts
 from chaingeo.generator.imported import imported_puzzle_level
 from chaingeo.generator.puzzle import make
 from chaingeo.generator.result import GenerationRejection
+from chaingeo.solvers.jobs import Farm
 from chaingeo.solvers.limits import SearchLimits
 
 Goal = Literal["disassemble", "assemble"]
@@ -174,10 +177,13 @@ def build_puzzle_suite(
     max_items: int = 400,
     jobs: int = 1,
     log: Callable[[str], None] | None = None,
+    counts_from: Path | None = None,
 ) -> list[Level]:
     """Build every entry of :data:`SUITE` into ``out`` (old ``puzzle-*.json`` removed), CHAIN's
     models read from ``models``; ``jobs`` entries at a time (joblib processes), the same bytes
-    for any ``jobs``."""
+    for any ``jobs``. Each level then gets its complete counts (:mod:`chaingeo.generator.counts`):
+    those stored in ``counts_from`` (default: ``out`` as it was) for the same puzzle, else
+    counted on ``jobs`` worker processes."""
     if not models.is_dir():
         raise RuntimeError(
             f"{models}: no such folder (CHAIN's models, e.g. ../shared/chain-models)"
@@ -199,6 +205,7 @@ def build_puzzle_suite(
             first = owner.setdefault(item.provenance.signature, where)
             if first != where:
                 raise RuntimeError(f"the same puzzle comes from {first} and {where}: change a seed")
+    stored = [load_level(p) for p in sorted((counts_from or out).glob("puzzle-*.json"))]
     out.mkdir(parents=True, exist_ok=True)
     for old in sorted(out.glob("puzzle-*.json")):
         old.unlink()
@@ -211,6 +218,7 @@ def build_puzzle_suite(
                 f"puzzle-{entry.difficulty}-{number[entry.difficulty]:02d}-{_shape_of(entry)}"
             )
             level = revalidate(dataclasses.replace(item, id=level_id))
+            level = reuse_counts(level, stored) or count_level(level, Farm(jobs))
             save_level(level, out / f"{level_id}.json")
             made.append(level)
             if log is not None:

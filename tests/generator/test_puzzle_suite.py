@@ -120,7 +120,7 @@ def test_suite_rebuilds_byte_for_byte(tmp_path: Path) -> None:
     from chaingeo.generator.puzzle_suite import build_puzzle_suite
 
     assert MODELS is not None
-    build_puzzle_suite(tmp_path, MODELS, jobs=2)
+    build_puzzle_suite(tmp_path, MODELS, jobs=2, counts_from=SUITE)
     for lv in LEVELS:
         assert (tmp_path / f"{lv.id}.json").read_bytes() == level_bytes(lv)
 

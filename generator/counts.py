@@ -1,0 +1,113 @@
+"""Complete counts in a puzzle level's stats: BurrTools' assemblies and solutions of the level
+written as a BurrTools file, as ``chain analyze`` counts them (burrTxt's convention: an assembly
+and its mirror image are one), with how they were obtained.
+
+``chain generate puzzle-counts [--levels levels/puzzle] [--jobs N | --scheduler ADDRESS]`` counts
+the levels of a folder that do not yet hold complete counts (``--recount``: all of them) and
+writes them back; :func:`chaingeo.generator.puzzle_suite.build_puzzle_suite` runs the same step
+on the levels it makes, reusing a stored count only for the same puzzle (the same bytes apart
+from the counts). Counting has no clock: the disassembler's state caps are ``chain analyze``'s
+caps, raised to :data:`COUNT_STATES` states a part (one assembly of a 36-piece tower needs more than
+``chain analyze``'s default), so every machine writes the same files; a count that meets a cap is
+an error (it would not be complete).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable, Iterable, Mapping
+from pathlib import Path
+from typing import Any, Final
+
+import chaingeo
+from chaingeo.core.level import Level, level_bytes, load_level, revalidate, save_level
+from chaingeo.generator.batch import GenerationError
+from chaingeo.solvers.analysis import count_figures, level_max_group, level_packing
+from chaingeo.solvers.deadline import Deadline
+from chaingeo.solvers.jobs import Farm
+from chaingeo.solvers.limits import SearchLimits
+
+#: The stats keys the count step writes.
+COUNT_KEYS: Final = ("assemblies", "solutions", "counts")
+#: States a part's disassembly may take while counting (``chain analyze --max-states``).
+COUNT_STATES: Final = 20_000_000
+#: The caps of counting: no clock.
+COUNT_LIMITS: Final = SearchLimits(max_states=COUNT_STATES, seconds=None)
+#: How the counts were obtained (stored with them).
+PROGRAM: Final = f"chain analyze --no-optimal --max-states {COUNT_STATES}"
+
+
+def has_counts(level: Level) -> bool:
+    """Whether the level's stats hold complete counts."""
+    info = level.stats.get("counts")
+    return (
+        isinstance(info, Mapping)
+        and info.get("complete") is True
+        and all(isinstance(level.stats.get(k), int) for k in ("assemblies", "solutions"))
+    )
+
+
+def without_counts(level: Level) -> Level:
+    """The level with no counts in its stats (what the puzzle is, apart from them)."""
+    stats = {k: v for k, v in level.stats.items() if k not in COUNT_KEYS}
+    return dataclasses.replace(level, stats=stats)
+
+
+def count_level(level: Level, farm: Farm) -> Level:
+    """The level with complete counts in its stats (see the module's docstring)."""
+    out: dict[str, Any] = {}
+    rep = count_figures(
+        level_packing(level), out, "drop", level_max_group(level), COUNT_LIMITS, Deadline(None),
+        "", farm,
+    )  # fmt: skip
+    if not rep.complete:
+        raise GenerationError(f"{level.id}: counting stopped ({out.get('limit')})")
+    counts = {
+        "assemblies": rep.assemblies,
+        "solutions": rep.solutions,
+        "counts": {
+            "complete": True,
+            "convention": out["convention"],
+            "program": PROGRAM,
+            "version": chaingeo.__version__,
+        },
+    }
+    return revalidate(dataclasses.replace(level, stats={**without_counts(level).stats, **counts}))
+
+
+def reuse_counts(level: Level, stored: Iterable[Level]) -> Level | None:
+    """``level`` with the complete counts of a stored level of the same puzzle, if any."""
+    mine = level_bytes(without_counts(level))
+    for old in stored:
+        if has_counts(old) and level_bytes(without_counts(old)) == mine:
+            counts = {k: old.stats[k] for k in COUNT_KEYS}
+            return revalidate(dataclasses.replace(level, stats={**level.stats, **counts}))
+    return None
+
+
+def count_folder(
+    folder: Path,
+    farm: Farm,
+    *,
+    recount: bool = False,
+    only: Iterable[str] = (),
+    log: Callable[[str], None] | None = None,
+) -> list[Level]:
+    """Count the ``puzzle-*.json`` levels of ``folder`` lacking complete counts (all with
+    ``recount``; only the ids in ``only`` when given) and write them back."""
+    wanted = set(only)
+    done: list[Level] = []
+    for path in sorted(folder.glob("puzzle-*.json")):
+        level = load_level(path)
+        if (wanted and level.id not in wanted) or (has_counts(level) and not recount):
+            continue
+        start = time.perf_counter()
+        level = count_level(level, farm)
+        save_level(level, path)
+        done.append(level)
+        if log is not None:
+            s = level.stats
+            log(f"{level.id}: {s['assemblies']} assemblies, {s['solutions']} solutions "
+                f"({time.perf_counter() - start:.1f} s)")  # fmt: skip
+    return done
