@@ -13,6 +13,7 @@ import pytest
 from chaingeo.core.arrays import I32
 from chaingeo.core.formats.bt_level import level_puzzle
 from chaingeo.core.formats.burrtools import BTPuzzle, read_xmpuzzle
+from chaingeo.core.piecesets import SOMA
 from chaingeo.core.suite import load_level
 from chaingeo.solvers import jobs as jobs_mod
 from chaingeo.solvers.analysis import analyze
@@ -21,6 +22,7 @@ from chaingeo.solvers.assembly.btassemble import Mirrors, bt_packing_spec
 from chaingeo.solvers.assembly.btcount import count_bt
 from chaingeo.solvers.cover import parallel as cover_parallel
 from chaingeo.solvers.cover.constrained import Packing, compile_packing
+from chaingeo.solvers.cover.packings import count_packings
 from chaingeo.solvers.cover.problem import CoverProblem
 from chaingeo.solvers.cover.search import Engine
 from chaingeo.solvers.deadline import Deadline
@@ -121,9 +123,12 @@ def test_a_deadline_stops_the_workers() -> None:
         assert 0 <= rep.solutions <= rep.assemblies < 518_400
 
 
-def test_a_dask_cluster_gives_the_same_bytes(split_small: list[int]) -> None:
+@pytest.mark.slow
+def test_a_dask_cluster_gives_the_same_bytes(
+    split_small: list[int], monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The subtrees on a Dask cluster (threads of this process): the same figures, levels and
-    first solution as in this process."""
+    first solution as in this process, and the same exact-cover counts."""
     distributed = pytest.importorskip("distributed")
     puzzle = level_puzzle(load_level("puzzle-mid-02-interlocking-cube"))
     packing = compile_packing(bt_packing_spec(puzzle, 0))
@@ -135,6 +140,10 @@ def test_a_dask_cluster_gives_the_same_bytes(split_small: list[int]) -> None:
         figures = analyze(
             "puzzle-mid-02-interlocking-cube", optimal=False, scheduler=cluster.scheduler_address
         )
+        monkeypatch.setattr(cover_parallel, "MIN_ROWS", 1)
+        farm = jobs_mod.Farm(1, cluster.scheduler_address)
+        on_cluster = count_packings(SOMA.pieces, (3, 3, 3), jobs=farm)
+    assert (on_cluster.solutions, on_cluster.distinct) == (11520, 240)
     assert there == here and max(split_small) > 1
     local = analyze("puzzle-mid-02-interlocking-cube", optimal=False, jobs=1)
     assert figures.to_json().split('"seconds"')[0] == local.to_json().split('"seconds"')[0]
