@@ -17,10 +17,10 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections.abc import Callable, Iterable, Mapping
+from importlib.metadata import version
 from pathlib import Path
 from typing import Any, Final
 
-import chaingeo
 from chaingeo.core.level import Level, level_bytes, load_level, revalidate, save_level
 from chaingeo.generator.batch import GenerationError
 from chaingeo.solvers.analysis import count_figures, level_max_group, level_packing
@@ -70,7 +70,7 @@ def count_level(level: Level, farm: Farm) -> Level:
             "complete": True,
             "convention": out["convention"],
             "program": PROGRAM,
-            "version": chaingeo.__version__,
+            "version": version("chaingeo"),
         },
     }
     return revalidate(dataclasses.replace(level, stats={**without_counts(level).stats, **counts}))
