@@ -26,10 +26,11 @@ from tests.support.shipped import shipped
 LEVELS = shipped("puzzle")
 #: Counted again in the default run (a few seconds in all); the others in the slow run.
 CHEAP_ASSEMBLIES = 5000
-#: Shipped levels still without complete counts, and why: 39,916,800 assemblies (its 11
-#: congruent sticks are separate BurrTools shapes, 11! orders), each a disassembly of
-#: about 0.5 ms: hours of CPU. Counted, it leaves this set (the test below says so).
-UNCOUNTED = {"puzzle-hard-03-luban-separate-pieces"}
+#: Shipped levels still without complete counts, and why. hard-03: 39,916,800 assemblies
+#: (its 11 congruent sticks are separate BurrTools shapes, 11! orders), each a disassembly of
+#: about 0.5 ms: hours of CPU. hard-09: one assembly's disassembly outgrows 2,000,000 states
+#: a part and needs gigabytes past it. Counted, a level leaves this set (the test says so).
+UNCOUNTED = {"puzzle-hard-03-luban-separate-pieces", "puzzle-hard-09-burr36"}
 
 
 def test_every_shipped_puzzle_level_has_complete_counts() -> None:
