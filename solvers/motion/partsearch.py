@@ -2,7 +2,8 @@
 
 A *part* is a set of pieces still to be taken apart; its states are the pieces' offsets relative
 to its first piece. :class:`PartSearch` grows the search one depth layer at a time (numba does
-the expansion, :mod:`chaingeo.solvers.motion.movement`), remembers each state's parent and the move
+the expansion, :mod:`chaingeo.solvers.motion.kinematics_kernel`), remembers each state's parent and
+the move
 that made it, and collects every removal (a move that splits the part) seen on the way.
 """
 
@@ -20,7 +21,7 @@ from chaingeo.kernels.jit import Pinned
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 

@@ -1,4 +1,5 @@
 """Pillow's polygon fill, lines and 2x2 reduction as numba kernels on ``(h, w, 3)`` uint8 arrays.
+The reference it must equal is :mod:`chaingeo.pictures.raster` (Pillow's drawing).
 
 The renderer draws thousands of small polygons and lines per observation through Pillow, one
 Python call each. These kernels follow Pillow's own C code (``libImaging/Draw.c``: vertices

@@ -1,5 +1,5 @@
 """Exact quarter-turn sweeps in int64 (numba): the one stencil table, and the test for cells
-beyond it.
+beyond it. The reference it must equal is :mod:`chaingeo.core.turns`.
 
 The question is :func:`chaingeo.core.turns.square_hit`'s: does unit square ``s``, turning
 counter-clockwise through 90 degrees about O, overlap fixed unit square ``f`` (doubled
