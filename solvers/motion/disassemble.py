@@ -123,6 +123,21 @@ class Analysis:
     #: True when ``level`` is BurrTools' own figure (its first separation took it apart).
     burrtools: bool = False
 
+    @classmethod
+    def taken_apart(
+        cls,
+        tree: Separation,
+        moves: int,
+        steps: int | None,
+        plan: Sequence[Move | TurnMove],
+        states: int,
+        first_level: int | None = None,
+        burrtools: bool = False,
+    ) -> Analysis:
+        """A puzzle that comes apart: its level read off the separation ``tree``."""
+        level = tree.level_text()
+        return cls(True, level, moves, steps, tuple(plan), tree, states, first_level, burrtools)
+
 
 PartKey = tuple[tuple[int, ...], bytes]
 #: ``"first"``: BurrTools' disassembler (its first separation or nothing); ``"any"``: any
@@ -622,17 +637,7 @@ def analyze_assembly(
             steps = bound
         if steps < floor:
             raise ValueError(f"a plan of {steps} moves is below the lower bound {floor}")
-    return Analysis(
-        disassemblable=True,
-        level=tree.level_text(),
-        moves=total,
-        optimal_steps=steps,
-        plan=tuple(plan),
-        tree=tree,
-        states=solver.states,
-        first_level=len(tree.moves),
-        burrtools=bt_level,
-    )
+    return Analysis.taken_apart(tree, total, steps, plan, solver.states, len(tree.moves), bt_level)
 
 
 def translations(plan: Sequence[Move | TurnMove]) -> list[Move]:

@@ -28,8 +28,6 @@ from chaingeo.core.geometry import ROTATIONS, rotation_index
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
 from chaingeo.kernels.jit import Pinned
-from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs
 from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion import turns_kernel as tm
@@ -55,22 +53,11 @@ _expand_turns = Pinned(tm.expand_turns)
 class TurnPartSearch(LayeredSearch[tm.TurnTable]):
     """Layered breadth-first search of one part from one configuration, turns included."""
 
-    def __init__(
-        self,
-        table: tm.TurnTable,
-        members: Sequence[int],
-        poses: np.ndarray,
-        *,
-        max_group: int | None,
-        limits: SearchLimits,
-        deadline: Deadline,
-        chunk: int = 2000,
-    ) -> None:
-        super().__init__(
-            table, members, max_group=max_group, limits=limits, deadline=deadline, chunk=chunk
-        )
-        n = self.n
-        self.vox, self.starts, self.lo, self.hi, self.rod = table.part_arrays(self.members)
+    CHUNK = 2000
+
+    def _begin(self, poses: np.ndarray) -> None:
+        n, limits = self.n, self.limits
+        self.vox, self.starts, self.lo, self.hi, self.rod = self.table.part_arrays(self.members)
         cap = max(2, min(1024, limits.max_states))
         self.states = np.zeros((cap, 4 * n), dtype=np.int16)
         self.parent = np.full(cap, -1, dtype=np.int64)
