@@ -169,10 +169,13 @@ class PartSearch(LayeredSearch[PieceTable]):
         limits: SearchLimits,
         deadline: Deadline,
         chunk: int = 20000,
+        peel: bool = False,
     ) -> None:
         super().__init__(
             table, members, max_group=max_group, limits=limits, deadline=deadline, chunk=chunk
         )
+        #: Stop at states where one piece comes free alone (the optimal search's pruning).
+        self.peel = peel
         n = self.n
         vox, starts, lo, hi = table.part_arrays(self.members)
         cap = max(2, min(128, limits.max_states))  # most parts come apart in a few states
@@ -246,7 +249,7 @@ class PartSearch(LayeredSearch[PieceTable]):
             self.deadline.check()
             status, self.node, self.n_states, self.n_seps, self.n_layers = _expand(
                 self.tree, self.n_states, self.node, self.layers, self.n_layers, deepest,
-                self.chunk, self.pieces, self.seps, self.n_seps,
+                self.chunk, self.pieces, self.seps, self.n_seps, self.peel,
             )  # fmt: skip
             if status == bfs.DONE:
                 break
