@@ -37,9 +37,9 @@ import numpy as np
 
 from chaingeo.core.kinematics import Move
 from chaingeo.core.turns import TurnMove
+from chaingeo.solvers.motion.partsearch import PartSearch
 
 if TYPE_CHECKING:
-    from chaingeo.solvers.motion.partsearch import PartSearch
     from chaingeo.solvers.motion.turnsearch import TurnPartSearch
 
 #: A part state: its members (global indices) and their offsets (relative, as bytes).
@@ -168,6 +168,8 @@ class OptimalParts:
         """A single piece free at the start comes out first (exact: see the module
         docstring); None when no single piece is free. ``top``: as in :meth:`_optimal_part`,
         proved through the rest's own bounds (one more than theirs)."""
+        if not isinstance(s, PartSearch):  # turns: not peeled
+            return None
         n = s.n
         for r in s.expand_layers(0):
             if r.depth != 0 or r.mask.bit_count() not in (1, n - 1):
