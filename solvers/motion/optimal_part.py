@@ -37,7 +37,7 @@ import numpy as np
 
 from chaingeo.core.kinematics import Move
 from chaingeo.core.turns import TurnMove
-from chaingeo.solvers.motion.partsearch import PartSearch
+from chaingeo.solvers.motion.partsearch import PartSearch, Removal
 
 if TYPE_CHECKING:
     from chaingeo.solvers.motion.turnsearch import TurnPartSearch
@@ -111,10 +111,12 @@ class OptimalParts:
         after = self.min_removals(members) - 1  # removals still needed after the first
         s = self.search(members, offsets, self.peel)
         best, best_plan = budget, None
-        if self.peel:
-            peeled = self._peel(s, budget, floor, k, top)
+        if self.peel:  # the start's removals: a free piece settles the part
+            first = s.expand_layers(0)
+            peeled = self._peel(s, first, budget, floor, k, top)
             if peeled is not None:
                 return peeled
+            best, best_plan = self._splits(s, first, best, best_plan, floor, top)
         while not s.exhausted and s.depth + 1 + after < best and best > floor:
             if top is not None:
                 # Every removal above the next layer has been tried: a shorter plan first
@@ -123,30 +125,7 @@ class OptimalParts:
             removals = s.expand_layers(best - 2 - after)
             if top is not None and removals:
                 top[0] = max(top[0], min(best, removals[0].depth + 1 + after))
-            for sp in s.unique_splits(removals):
-                if best <= floor:
-                    break
-                r = sp.removal
-                rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
-                base = r.depth + 1
-                left_least = self.min_removals(lm)
-                if base + self.min_removals(rm) + left_least >= best:
-                    continue
-                fa, pa = self.optimal(rm, roff, best - base - left_least)
-                if pa is None:
-                    continue
-                fb, pb = self.optimal(lm, loff, best - base - fa)
-                if pb is None:
-                    continue
-                best = base + fa + fb
-                if top is not None:
-                    top[1] = min(top[1], best)
-                best_plan = [
-                    *s.path_to(r.node),
-                    s.removal_move(r),
-                    *pb,
-                    *pa,
-                ]
+            best, best_plan = self._splits(s, removals, best, best_plan, floor, top)
         self.states += s.n_states
         if best_plan is not None:
             self.opt_memo[k] = (best, True, best_plan)
@@ -157,9 +136,42 @@ class OptimalParts:
         self.opt_memo[k] = (budget, False, [])
         return budget, None
 
+    def _splits(
+        self,
+        s: PartSearch | TurnPartSearch,
+        removals: list[Removal],
+        best: int,
+        best_plan: list[Move | TurnMove] | None,
+        floor: int,
+        top: list[int] | None,
+    ) -> tuple[int, list[Move | TurnMove] | None]:
+        """The best plan so far after trying ``removals`` (found by ``s``), each followed by
+        optimal plans of its two parts within what is left of ``best``."""
+        for sp in s.unique_splits(removals):
+            if best <= floor:
+                break
+            r = sp.removal
+            rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
+            base = r.depth + 1
+            left_least = self.min_removals(lm)
+            if base + self.min_removals(rm) + left_least >= best:
+                continue
+            fa, pa = self.optimal(rm, roff, best - base - left_least)
+            if pa is None:
+                continue
+            fb, pb = self.optimal(lm, loff, best - base - fa)
+            if pb is None:
+                continue
+            best = base + fa + fb
+            if top is not None:
+                top[1] = min(top[1], best)
+            best_plan = [*s.path_to(r.node), s.removal_move(r), *pb, *pa]
+        return best, best_plan
+
     def _peel(
         self,
         s: PartSearch | TurnPartSearch,
+        first: list[Removal],
         budget: int,
         floor: int,
         k: PartKey,
@@ -171,7 +183,7 @@ class OptimalParts:
         if not isinstance(s, PartSearch):  # turns: not peeled
             return None
         n = s.n
-        for r in s.expand_layers(0):
+        for r in first:
             if r.depth != 0 or r.mask.bit_count() not in (1, n - 1):
                 continue
             rm, roff, lm, loff = s.split(r)

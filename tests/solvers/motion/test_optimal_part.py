@@ -149,3 +149,28 @@ def shipped_puzzles() -> list[Level]:
 def test_peeled_matches_plain_on_shipped_levels(level: Level) -> None:
     max_group = level.rules.max_group if isinstance(level.rules, PuzzleRules) else None
     assert check_same(level.shapes, max_group) is not None
+
+
+def scattered(seed: int) -> dict[str, Shape]:
+    """Four pieces (not connected) sharing out a 3x3x2 box at random."""
+    rng = np.random.default_rng(seed)
+    cells = [(x, y, z) for x in range(3) for y in range(3) for z in range(2)]
+    owner = rng.integers(0, 4, len(cells)).tolist()
+    return {
+        f"p{k}": Shape([c for c, o in zip(cells, owner, strict=True) if o == k]) for k in range(4)
+    }
+
+
+@pytest.mark.parametrize("seed", [20, 100, 102, 107, 198, 247])
+def test_group_removals_at_the_start_are_tried(seed: int) -> None:
+    """Starts where only groups of two come free: without a seed plan to lean on (a large
+    budget), the peeled search still tries them and agrees with the plain one."""
+    shapes = scattered(seed)
+    n = len(shapes)
+    found = []
+    for peel in (True, False):
+        solver = _Solver(shapes, None, SearchLimits(seconds=60))
+        solver.peel = peel
+        found.append(solver.optimal(tuple(range(n)), np.zeros((n, 3), dtype=np.int64), 50))
+    assert found[0][0] == found[1][0] == n - 1
+    assert found[0][1] is not None and replay_disassembly(shapes, found[0][1]).is_separated()
