@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Final
 
 from chaingeo.core.errors import ChainGeoError
@@ -45,7 +46,7 @@ from chaingeo.solvers.motion.disassemble import (
     Rods,
     analyze_assembly,
 )
-from chaingeo.solvers.motion.movement import MAX_PIECES
+from chaingeo.solvers.motion.kinematics_kernel import MAX_PIECES
 
 if TYPE_CHECKING:  # a BurrTools file needs neither the level reader nor its imports
     from chaingeo.core.level import Level
@@ -54,6 +55,7 @@ __all__ = [
     "DEFAULT_LIMITS",
     "NotAPuzzleError",
     "PuzzleFigures",
+    "RowOptions",
     "analyze",
     "analyze_level",
     "analyze_puzzle",
@@ -245,15 +247,25 @@ def optimal_figures(
     return {"optimal_steps": best.optimal_steps, "plan": best.plan}
 
 
-def level_analysis_row(
-    level: Level,
-    limits: SearchLimits,
-    optimal: bool,
-    assemble: bool,
-    mirrors: Mirrors = "drop",
-    deadline: Deadline | None = None,
-    jobs: int | None = 1,
-) -> dict[str, Any]:
+@dataclass(frozen=True)
+class RowOptions:
+    """What one row of figures runs under (a level's or a BurrTools problem's): the caps,
+    whether to search o_i and count assemblies, the mirror convention, the time (default: one
+    of ``limits.seconds``) and the counting processes."""
+
+    limits: SearchLimits
+    optimal: bool = True
+    assemble: bool = True
+    mirrors: Mirrors = "drop"
+    deadline: Deadline | None = None
+    jobs: int | None = 1
+
+    def clock(self) -> Deadline:
+        """The row's deadline: the one given, or a new one of ``limits.seconds``."""
+        return Deadline(self.limits.seconds) if self.deadline is None else self.deadline
+
+
+def level_analysis_row(level: Level, how: RowOptions) -> dict[str, Any]:
     """The figures of one of our puzzle levels (a dict, with ``plan``): BurrTools' assemblies and
     solutions of the level written as a BurrTools file (:func:`level_puzzle`: each piece its
     own shape, so the counts are burrTxt's on that file; with the level's ``max_group``), then
@@ -262,11 +274,11 @@ def level_analysis_row(
     lower bounds (see :func:`count_figures`)."""
     if level.family != "puzzle":
         raise NotAPuzzleError(f"{level.id}: a {level.family} level; analyze takes puzzle levels")
-    if deadline is None:
-        deadline = Deadline(limits.seconds)
+    limits, optimal, mirrors, jobs = how.limits, how.optimal, how.mirrors, how.jobs
+    deadline = how.clock()
     max_group = level_max_group(level)
     out: dict[str, Any] = {"assemblies": None, "solutions": None}
-    if assemble:
+    if how.assemble:
         from chaingeo.core.formats.bt_level import level_puzzle
 
         packing = compile_packing(bt_packing_spec(level_puzzle(level), 0))
@@ -358,29 +370,20 @@ def _stored_assembly(puzzle: BTPuzzle, index: int) -> tuple[dict[str, Shape], Pi
     return shapes, PieceGroups(shape_of, groups_of)
 
 
-def problem_analysis_row(
-    puzzle: BTPuzzle,
-    index: int,
-    limits: SearchLimits,
-    optimal: bool,
-    assemble: bool,
-    mirrors: Mirrors = "drop",
-    deadline: Deadline | None = None,
-    jobs: int | None = 1,
-) -> dict[str, Any]:
+def problem_analysis_row(puzzle: BTPuzzle, index: int, how: RowOptions) -> dict[str, Any]:
     """The figures of one problem of a BurrTools puzzle (a dict, with ``plan``): BurrTools'
     assemblies and solutions (``mirrors``: see :mod:`chaingeo.solvers.assembly.btassemble`), then
     level, moves and o_i of the first solution (with ``assemble`` off: of the first stored
     assembly); with piece groups o_i under BurrTools' group rule. Everything runs
     within ``deadline`` (default: one of ``limits.seconds``)."""
-    if deadline is None:
-        deadline = Deadline(limits.seconds)
+    limits, optimal, mirrors, jobs = how.limits, how.optimal, how.mirrors, how.jobs
+    deadline = how.clock()
     prob = puzzle.problem(index)
     out: dict[str, Any] = {"problem": index, "name": prob.name}
     out.update(assemblies=None, solutions=None)
     found: tuple[dict[str, Shape], PieceGroups] | None = None
     first: Analysis | None = None
-    if assemble:
+    if how.assemble:
         packing = compile_packing(bt_packing_spec(puzzle, index))
         rep = count_figures(
             packing, out, mirrors, None, limits, deadline, f"problem {index}: ", jobs
@@ -466,14 +469,15 @@ def analyze(
     if file is not None and file.endswith(".xmpuzzle"):
         source = read_xmpuzzle(file)
     several = False
+    how = RowOptions(limits, optimal, assemble, mirrors, deadline, jobs)
     if isinstance(source, BTPuzzle):
         several = problem is None and len(source.problems) != 1
-        rows = _puzzle_rows(source, problem, limits, optimal, assemble, mirrors, deadline, jobs)
+        rows = _puzzle_rows(source, problem, how)
     else:
         from chaingeo.core.suite import load_level
 
         level = load_level(source) if isinstance(source, str | os.PathLike) else source
-        rows = [level_analysis_row(level, limits, optimal, assemble, mirrors, deadline, jobs)]
+        rows = [level_analysis_row(level, how)]
     meta: dict[str, Any] = {"file": file, "kernels": mode()}
     meta["seconds"] = round(time.perf_counter() - start, 3)
     if several:
@@ -481,25 +485,9 @@ def analyze(
     return PuzzleFigures.from_dict({**rows[0], **meta})
 
 
-def _puzzle_rows(
-    puzzle: BTPuzzle,
-    problem: int | None,
-    limits: SearchLimits,
-    optimal: bool,
-    assemble: bool,
-    mirrors: Mirrors,
-    deadline: Deadline,
-    jobs: int | None,
-) -> list[dict[str, Any]]:
+def _puzzle_rows(puzzle: BTPuzzle, problem: int | None, how: RowOptions) -> list[dict[str, Any]]:
     """The rows of problem ``problem``, or with None of the puzzle's only problem, or of every
     one."""
     if problem is not None or len(puzzle.problems) == 1:
-        return [
-            problem_analysis_row(
-                puzzle, problem or 0, limits, optimal, assemble, mirrors, deadline, jobs
-            )
-        ]
-    return [
-        problem_analysis_row(puzzle, i, limits, optimal, assemble, mirrors, deadline, jobs)
-        for i in range(len(puzzle.problems))
-    ]
+        return [problem_analysis_row(puzzle, problem or 0, how)]
+    return [problem_analysis_row(puzzle, i, how) for i in range(len(puzzle.problems))]

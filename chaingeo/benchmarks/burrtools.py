@@ -243,20 +243,20 @@ def _timed(fn: Callable[[], dict[str, Any]], repeat: int) -> tuple[float, dict[s
 def _warm_up() -> None:
     """Compile every kernel both engines use (bit-board, dancing links, movement)."""
     from chaingeo.generator.bt_examples import linked_rings
-    from chaingeo.solvers.analysis import problem_analysis_row
+    from chaingeo.solvers.analysis import RowOptions, problem_analysis_row
     from chaingeo.solvers.assembly.btassemble import bt_packing_spec
     from chaingeo.solvers.cover.constrained import compile_packing
     from chaingeo.solvers.cover.search import CoverSearch
     from chaingeo.solvers.limits import SearchLimits
 
     puzzle = linked_rings()
-    problem_analysis_row(puzzle, 0, SearchLimits(), True, True)
+    problem_analysis_row(puzzle, 0, RowOptions(SearchLimits()))
     previous_plain(puzzle, 0, SearchLimits(max_states=1000), "keep")
     CoverSearch(compile_packing(bt_packing_spec(puzzle, 0)).problem, engine="dlx").count()
 
 
 def run(args: argparse.Namespace) -> int:
-    from chaingeo.solvers.analysis import problem_analysis_row
+    from chaingeo.solvers.analysis import RowOptions, problem_analysis_row
     from chaingeo.solvers.assembly.btassemble import Mirrors
     from chaingeo.solvers.limits import SearchLimits
 
@@ -268,7 +268,8 @@ def run(args: argparse.Namespace) -> int:
     for name, puzzle, index, mirrors in _instances(args.quick):
         mode: Mirrors = "drop" if mirrors == "drop" else "keep"
         ours_s, ours = _timed(
-            partial(problem_analysis_row, puzzle, index, limits, False, True, mode), args.repeat
+            partial(problem_analysis_row, puzzle, index, RowOptions(limits, False, True, mode)),
+            args.repeat,
         )
         colours = bool(puzzle.colors and puzzle.problems[index].color_pairs)
         previous = previous_colours if colours else previous_plain

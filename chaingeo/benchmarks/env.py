@@ -10,7 +10,8 @@ each), at the environments' default 256 px, under two seeded policies:
   picture new: this times drawing).
 
 Rows with images are timed twice on the very same trajectory: ours (pictures drawn to arrays by
-:mod:`chaingeo.pictures.fastview`'s kernels, cached by what they show) and the reference, the old
+:mod:`chaingeo.pictures.scene_kernel`'s kernels, cached by what they show) and the reference, the
+old
 path (:mod:`chaingeo.pictures.scene` through Pillow, every picture encoded to PNG and decoded
 back, nothing cached) in the same run; ``ratio`` = ours / reference steps per second. ``vs today``
 divides by the single-environment reference of the same family and policy.

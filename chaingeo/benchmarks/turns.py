@@ -27,7 +27,7 @@ from chaingeo.envs.machines.puzzle import PuzzleState
 from chaingeo.envs.machines.puzzle_actions import turn_actions
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.play import EpisodeTask, run_episode
-from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion.turns_kernel import TurnTable
 
 
 def _episode(level: Level, repeat: int) -> tuple[float, float, dict[str, Any]]:

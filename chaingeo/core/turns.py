@@ -290,6 +290,19 @@ def _critical(s: Sequence[int]) -> list[int]:
     return out
 
 
+def edge_roots(m: int, k: int, lo: int, hi: int) -> int:
+    """Where the circle of squared radius ``m`` about O crosses the line ``k`` (the other
+    coordinate ``+-sqrt(h)``, ``h = m - k^2``) within ``[lo, hi]``: bit 0 set when ``+sqrt(h)``
+    lies there, bit 1 when ``-sqrt(h)`` does. Integers only, so the sweep kernel
+    (:mod:`chaingeo.solvers.motion.turns_sweep_kernel`) compiles this very function."""
+    h = m - k * k
+    if h < 0:
+        return 0
+    plus = (lo <= 0 or h >= lo * lo) and (hi >= 0 and h <= hi * hi)
+    minus = (lo <= 0 and h <= lo * lo) and (hi >= 0 or h >= hi * hi)
+    return (1 if plus else 0) | (2 if minus else 0)
+
+
 def _on_circle(s: Sequence[int], m: int) -> list[Point]:
     """Points where the circle of squared radius ``m`` about O crosses the edges of square
     ``s`` (quadrupled units: the square is [2s - 2, 2s + 2]^2)."""
@@ -297,17 +310,9 @@ def _on_circle(s: Sequence[int], m: int) -> list[Point]:
     for i in (0, 1):  # edges x = k (i = 0) and y = k (i = 1)
         lo, hi = 2 * s[1 - i] - 2, 2 * s[1 - i] + 2
         for k in (2 * s[i] - 2, 2 * s[i] + 2):
-            h = m - k * k
-            if h < 0:
-                continue
-            for sign in (1, -1):
-                # the other coordinate is sign * sqrt(h); keep it if lo <= it <= hi
-                if sign > 0:
-                    ok = (lo <= 0 or h >= lo * lo) and (hi >= 0 and h <= hi * hi)
-                else:
-                    ok = (lo <= 0 and h <= lo * lo) and (hi >= 0 or h >= hi * hi)
-                if ok:
-                    pts.append(((k, 1), (sign, h)) if i == 0 else ((sign, h), (k, 1)))
+            roots, h = edge_roots(m, k, lo, hi), m - k * k
+            for sign in [sg for sg, bit in ((1, 1), (-1, 2)) if roots & bit]:
+                pts.append(((k, 1), (sign, h)) if i == 0 else ((sign, h), (k, 1)))
     return pts
 
 

@@ -3,7 +3,7 @@
 The Gymnasium environments hand out pixels, not files: encoding every picture to PNG and
 decoding it back cost about a third of the time spent on an observation's pictures.
 :func:`render_frames` takes the images :func:`chaingeo.envs.observation.render_state` encodes
-(drawn by :mod:`chaingeo.pictures.fastview`, byte-equal to :mod:`chaingeo.pictures.scene`) as
+(drawn by :mod:`chaingeo.pictures.scene_kernel`, byte-equal to :mod:`chaingeo.pictures.scene`) as
 arrays; PNG is lossless, so they are pixel-equal to decoding the PNG (tested).
 PNG stays where bytes are wanted (the harness' logs and agents call ``render_state``);
 :func:`png_frames` keeps the round trip callable as the reference of ``chain bench env``.
@@ -59,9 +59,9 @@ def _views(state: BaseState, size: int) -> dict[str, Frame]:
 
 
 def _draw_views(pieces: PieceMap, box: tuple[int, int, int] | None, size: int) -> dict[str, Frame]:
-    import chaingeo.pictures.fastview as fastview
+    import chaingeo.pictures.scene_kernel as scene_kernel
 
-    return fastview.render_arrays(pieces, box, VIEWS, size)
+    return scene_kernel.render_arrays(pieces, box, VIEWS, size)
 
 
 def _extra(state: BaseState, size: int, tray: PieceMap | None = None) -> Frame:
@@ -90,7 +90,7 @@ def decode_png(data: bytes) -> Frame:
 
 def reference_frames(state: BaseState, size: int) -> dict[str, Frame]:
     """:func:`render_frames` drawn by :mod:`chaingeo.pictures.scene` itself (the reference of
-    :mod:`chaingeo.pictures.fastview`: the same pixels, slower), no PNG."""
+    :mod:`chaingeo.pictures.scene_kernel`: the same pixels, slower), no PNG."""
     return {v: _array(img) for v, img in state_images(state, size, reference=True).items()}
 
 
@@ -151,9 +151,9 @@ class FrameCache:
 
     def clear(self) -> None:
         """Forget every picture (levels were replaced under the same ids), and the layouts
-        :mod:`chaingeo.pictures.fastview` keeps in this process."""
-        import chaingeo.pictures.fastview as fastview
+        :mod:`chaingeo.pictures.scene_kernel` keeps in this process."""
+        import chaingeo.pictures.scene_kernel as scene_kernel
 
         self._store.clear()
         self._pictures = 0
-        fastview.clear()
+        scene_kernel.clear()

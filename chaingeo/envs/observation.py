@@ -267,7 +267,7 @@ def state_images(
     """The pictures of an observation as images (:func:`render_state` encodes them; the
     Gymnasium environments take their pixels): the four views, then the extra picture.
     ``reference`` draws them with :mod:`chaingeo.pictures.scene` itself, the slower reference
-    of :mod:`chaingeo.pictures.fastview` (the same pixels)."""
+    of :mod:`chaingeo.pictures.scene_kernel` (the same pixels)."""
     pieces, box, _ = scene(state)
     images = _views(pieces, box, VIEWS, size, None, reference)
     images[extra_picture(state)] = extra_image(state, size, reference)
@@ -289,7 +289,7 @@ def _views(
         return render_images(pieces, box, views, size, title)
     from PIL import Image as PILImage
 
-    from chaingeo.pictures.fastview import render_arrays
+    from chaingeo.pictures.scene_kernel import render_arrays
 
     arrays = render_arrays(pieces, box, views, size, title)
     return {v: PILImage.fromarray(a) for v, a in arrays.items()}

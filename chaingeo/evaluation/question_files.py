@@ -148,8 +148,8 @@ def assembly_picture(q: Question, level: Level, size: int = VIEW_SIZE) -> bytes:
     drawn from its recipe, labelled A-D) below, every one from the iso corner."""
     from PIL import Image
 
-    from chaingeo.pictures.fastview import render_arrays
     from chaingeo.pictures.raster import png_bytes
+    from chaingeo.pictures.scene_kernel import render_arrays
 
     rgb = {p.name: p.rgb for p in level.pieces}
 

@@ -227,6 +227,28 @@ def _secrets(agent: AgentSpec, protocol: ProtocolConfig) -> list[str]:
     return out
 
 
+class RunOutcomes(list[Outcome]):
+    """What :func:`evaluate` returns: every recorded episode's outcome (a list, in the log's
+    order), with the run's header and the tool refusals its records note, so a caller reports
+    the run without reading it back."""
+
+    def __init__(
+        self, outcomes: Sequence[Outcome], header: dict[str, Any], tools_refused: list[str]
+    ) -> None:
+        super().__init__(outcomes)
+        self.header = header
+        #: Each episode's note that its server refused native tools (played in text instead).
+        self.tools_refused = tools_refused
+
+
+def _refusals(records: Sequence[dict[str, Any]]) -> list[str]:
+    return [
+        str(r["agent_notes"]["tools_refused"])
+        for r in records
+        if isinstance(r.get("agent_notes"), dict) and r["agent_notes"].get("tools_refused")
+    ]
+
+
 def evaluate(
     levels: Sequence[Level],
     agent: AgentSpec,
@@ -235,7 +257,7 @@ def evaluate(
     config: RunConfig | None = None,
     prices: PriceTable | None = None,
     stream: TextIO | None = None,
-) -> list[Outcome]:
+) -> RunOutcomes:
     """Run (or continue) one agent over ``levels``; returns every recorded episode's outcome."""
     protocol = protocol or ProtocolConfig()
     cfg = config or RunConfig()
@@ -278,4 +300,5 @@ def evaluate(
     finally:
         bar.close()
         log.close()
-    return [Outcome.from_record(r) for r in log.latest().values()]
+    latest = list(log.latest().values())
+    return RunOutcomes([Outcome.from_record(r) for r in latest], header, _refusals(latest))

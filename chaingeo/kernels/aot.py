@@ -156,7 +156,8 @@ def _name(v: Any) -> str:
 
 
 def _module_of(path: str) -> str:
-    """The last two parts of a source's module name (``motion.sweep`` from ``.../motion/sweep.py``):
+    """The last two parts of a source's module name (``motion.turns_sweep_kernel`` from
+    ``.../motion/turns_sweep_kernel.py``):
     the installed layout maps folders, so a full name cannot be told from the path alone."""
     parts = Path(path).with_suffix("").parts
     if parts and parts[-1] == "__init__":

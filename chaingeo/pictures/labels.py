@@ -1,7 +1,7 @@
 """The text and arrows of a view (titles, axis ticks, depth labels) as drawing steps that know
 the pixels they may touch.
 
-A step's ``box`` bounds every pixel it can change, so :mod:`chaingeo.pictures.fastview` can keep
+A step's ``box`` bounds every pixel it can change, so :mod:`chaingeo.pictures.scene_kernel` can keep
 a view's labels drawn once and redraw only the steps that overlap the part of the picture the
 pieces changed; drawing every step in order is exactly what the renderer always did.
 """
@@ -18,7 +18,7 @@ import numpy.typing as npt
 from PIL import Image, ImageDraw
 
 from chaingeo.core.arrays import F64
-from chaingeo.pictures import rasterjit
+from chaingeo.pictures import raster_kernel
 from chaingeo.pictures.raster import (
     RGB,
     Box,
@@ -80,7 +80,7 @@ def text_step(xy: Sequence[float] | F64, text: str, px: int, fill: RGB, anchor: 
     return Step(
         box,
         lambda im: put_text(im, at, text, px, fill, anchor),
-        lambda arr: rasterjit.paste_mask(arr, mask, box[0], box[1], color),
+        lambda arr: raster_kernel.paste_mask(arr, mask, box[0], box[1], color),
     )
 
 
@@ -136,7 +136,7 @@ def arrow_step(a: F64, b: F64, fill: RGB, width: int) -> Step:
     pts = arrow_points(a, b, width)
     packed = None  # arrow_shapes, packed for the kernels without the list (views paint often)
     if pts is not None:
-        packed = rasterjit.Packed(
+        packed = raster_kernel.Packed(
             np.array([(1, 2, width), (0, 3, 0)], dtype=np.int64),
             np.array(pts),
             np.array([fill, fill], dtype=np.uint8),
@@ -144,7 +144,7 @@ def arrow_step(a: F64, b: F64, fill: RGB, width: int) -> Step:
     return Step(
         box,
         lambda im: draw_flat(ImageDraw.Draw(im), arrow_shapes(a, b, fill, width)),
-        lambda arr: rasterjit.paint_packed(arr, packed),
+        lambda arr: raster_kernel.paint_packed(arr, packed),
     )
 
 

@@ -563,7 +563,7 @@ def render_tray_image(
 
 def render_tray_image_with(pieces: PieceMap, size: int, title: str, fast: bool) -> Image.Image:
     """:func:`render_tray_image`; ``fast`` keeps each piece's faces and skips Pillow's per-call
-    checks (the same pixels; :mod:`chaingeo.pictures.fastview`)."""
+    checks (the same pixels; :mod:`chaingeo.pictures.scene_kernel`)."""
     _check_tray(pieces, size)
     return _render_tray(pieces, size, title, fast)
 

@@ -5,7 +5,7 @@ The tray changes with every piece placed or taken back, so it is drawn anew on m
 Through Pillow its pieces were drawn by the kernels but then turned into an image for the
 titles, swatches, names and grid lines, and back into an array for the environments; here
 every call is a kernel on the same array, in the renderer's order (swatches by
-:func:`chaingeo.pictures.rasterjit.rectangle`, tested against Pillow, each with its name in
+:func:`chaingeo.pictures.raster_kernel.rectangle`, tested against Pillow, each with its name in
 one kernel call).
 """
 
@@ -15,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.kernels.jit import mode as jit_mode
-from chaingeo.pictures import rasterjit
+from chaingeo.pictures import raster_kernel
 from chaingeo.pictures.labels import ink, paint_steps, title_steps
 from chaingeo.pictures.raster import EDGE, Flat, text_length
 from chaingeo.pictures.scene import (
@@ -47,14 +47,14 @@ def tray_pixels(pieces: PieceMap, size: int, title: str = TRAY_TITLE) -> Pixels:
     if sheet is None or width > 4 or jit_mode() != "numba":  # no pieces, or round joints
         image = render_tray_image_with(pieces, size, title, fast=True)
         return np.array(image, dtype=np.uint8)
-    big = rasterjit.blank(size * _SUPERSAMPLE, _BACKGROUND).copy()
+    big = raster_kernel.blank(size * _SUPERSAMPLE, _BACKGROUND).copy()
     corners = np.concatenate([p.screen(f.corners) for f, p in sheet.drawn])
     fills = np.concatenate([f.fills for f, _ in sheet.drawn])
-    rasterjit.draw_faces(big, corners, fills, _EDGE, width)
-    pixels = rasterjit.reduce2(big)
+    raster_kernel.draw_faces(big, corners, fills, _EDGE, width)
+    pixels = raster_kernel.reduce2(big)
     paint_steps(pixels, title_steps([title, _SHEET_NOTE], size, lay.title_px))
     _labels(pixels, sheet)
-    rasterjit.draw_flat(pixels, _grid(sheet, size))
+    raster_kernel.draw_flat(pixels, _grid(sheet, size))
     return pixels
 
 

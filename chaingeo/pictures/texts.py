@@ -4,7 +4,7 @@ A view prints dozens of labels (titles, tick numbers, axis names, depth labels).
 step and one kernel call each, building and dispatching them cost several times the pasting
 itself. Here a run of labels is one :class:`Texts`: a row per label (where its glyphs lie in
 the atlas, their size, the top-left pixel) and its colour, pasted in order by
-:func:`paste_texts` with the very blend of :func:`chaingeo.pictures.rasterjit.paste_mask`
+:func:`paste_texts` with the very blend of :func:`chaingeo.pictures.raster_kernel.paste_mask`
 (Pillow's ``fill_mask_L``), so the pixels are the same as pasting them one by one.
 """
 
@@ -19,7 +19,7 @@ import numpy.typing as npt
 from chaingeo.core.arrays import I64, U8
 from chaingeo.kernels.jit import njit
 from chaingeo.pictures.raster import RGB, Box, text_glyph
-from chaingeo.pictures.rasterjit import Canvas, canvas, rectangle
+from chaingeo.pictures.raster_kernel import Canvas, canvas, rectangle
 
 #: One label: the anchor point (x, y), the text, its pixel size, colour and Pillow anchor.
 TextItem = tuple[float, float, str, int, RGB, str]
@@ -175,7 +175,7 @@ def _paint_swatches(
 
 
 def paint_swatches(img: U8, swatches: Swatches, outline: U8) -> None:
-    """Each swatch (:func:`chaingeo.pictures.rasterjit.rectangle`, width 1), then its label,
+    """Each swatch (:func:`chaingeo.pictures.raster_kernel.rectangle`, width 1), then its label,
     in order: one kernel call."""
     t = swatches.texts
     _paint_swatches(

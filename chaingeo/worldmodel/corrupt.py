@@ -265,6 +265,17 @@ def _onset(d: _Draft, rng: np.random.Generator, need: int = 6) -> tuple[int, int
     return t, k
 
 
+def _onset_part(d: _Draft, rng: np.random.Generator, need: int) -> tuple[int, int, Part] | None:
+    """:func:`_onset`, with the piece's part in that frame (a piece in view has one)."""
+    got = _onset(d, rng, need)
+    if got is None:
+        return None
+    t, k = got
+    p = d.part(t, k)
+    assert p is not None
+    return t, k, p
+
+
 def _span(rng: np.random.Generator, t: int) -> int:
     """The end of a vanishing: the clip's end, or at least ten frames on (it comes back)."""
     if rng.random() < 0.65:
@@ -356,12 +367,10 @@ def _parts(m: Bools, least: int) -> int:
 def split(d: _Draft, rng: np.random.Generator) -> _Found:
     """The piece's cells cut across its longest extent; one half drifts a cell or more away
     along that axis over three frames, and keeps that gap."""
-    got = _onset(d, rng, 8)
+    got = _onset_part(d, rng, 8)
     if got is None:
         return None
-    t, k = got
-    p = d.part(t, k)
-    assert p is not None
+    t, k, p = got
     cells = np.asarray(p.cells)
     axis = int(np.argmax(np.ptp(cells, axis=0)))
     cut = float(np.median(cells[:, axis])) + float(rng.choice([-0.5, 0.5]))
@@ -478,12 +487,10 @@ def _cells(p: Part) -> set[tuple[int, int, int]]:
 def pass_through(d: _Draft, rng: np.random.Generator) -> _Found:
     """A piece at rest slides along an axis into a piece it touches, through it, and out on
     the far side (or as far as the clip goes), the other piece staying put."""
-    got = _onset(d, rng, 10)
+    got = _onset_part(d, rng, 10)
     if got is None:
         return None
-    t, k = got
-    pk = d.part(t, k)
-    assert pk is not None
+    t, k, pk = got
     others = [p for p in d.scene[t] if p.label != k]
     ways = []
     for j in d.touching(t, k):

@@ -7,6 +7,8 @@ are blocked, or groups that leave a blocker behind: legal-looking, one relation 
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import networkx as nx
 import numpy as np
 
@@ -25,36 +27,44 @@ _BIG = 16
 SLIDE = "slide one unit along {d} on its own (every other piece stays where it is)"
 
 
-def _graphs(view: ShownPuzzle) -> tuple[Assembly, dict[str, nx.DiGraph]]:
-    return view.state, blocking_graphs(view.state)
-
-
-def _views(level: Level) -> list[ShownPuzzle]:
+def _states(level: Level) -> Iterator[tuple[ShownPuzzle, dict[str, nx.DiGraph]]]:
+    """The states every category asks about, with their blocking graphs: a puzzle's (a big
+    one's last four only); none of a stacking level."""
+    if level.family != "puzzle":
+        return
     views = list(puzzle_views(level))
-    return views[-4:] if len(level.pieces) > _BIG else views
+    for view in views[-4:] if len(level.pieces) > _BIG else views:
+        yield view, blocking_graphs(view.state)
 
 
 def _in_parts(state: Assembly) -> list[str]:
     return sorted(n for p in state.parts if len(p) > 1 for n in p)
 
 
+def _free_and_stuck(
+    rng: np.random.Generator, items: list[str], free: set[str]
+) -> tuple[str, list[str]] | None:
+    """One of ``items`` in ``free`` and three not, drawn in that order (None: too few)."""
+    right = [i for i in items if i in free]
+    wrong = [i for i in items if i not in free]
+    if not right or len(wrong) < 3:
+        return None
+    return pick(rng, right, 1)[0], pick(rng, wrong, 3)
+
+
 @CATEGORIES.register("can-slide")
 def can_slide_questions(level: Level, rng: np.random.Generator) -> list[Question]:
     """Which piece can slide along D; along which direction can piece X slide."""
-    if level.family != "puzzle":
-        return []
     out: list[Question] = []
-    for view in _views(level):
-        state, graphs = _graphs(view)
+    for view, graphs in _states(level):
+        state = view.state
         names = _in_parts(state)
         for d in pick(rng, sorted(DIRECTIONS), PER_STATE):
             g = graphs[d]
-            free = [n for n in names if g.out_degree(n) == 0]
-            stuck = [n for n in names if g.out_degree(n) > 0]
-            if not free or len(stuck) < 3:
+            drawn = _free_and_stuck(rng, names, {n for n in names if g.out_degree(n) == 0})
+            if drawn is None:
                 continue
-            right = pick(rng, free, 1)[0]
-            wrong = pick(rng, stuck, 3)
+            right, wrong = drawn
             proof = {
                 "kind": "piece",
                 "direction": d,
@@ -64,12 +74,11 @@ def can_slide_questions(level: Level, rng: np.random.Generator) -> list[Question
             answer, decoys = Option(right), [Option(w) for w in wrong]
             out.append(draft("can-slide", level, view.step, prompt, answer, decoys, proof))
         for x in pick(rng, names, PER_STATE):
-            free_d = [d for d in sorted(DIRECTIONS) if graphs[d].out_degree(x) == 0]
-            stuck_d = [d for d in sorted(DIRECTIONS) if graphs[d].out_degree(x) > 0]
-            if not free_d or len(stuck_d) < 3:
+            free = {d for d in DIRECTIONS if graphs[d].out_degree(x) == 0}
+            drawn = _free_and_stuck(rng, sorted(DIRECTIONS), free)
+            if drawn is None:
                 continue
-            right = pick(rng, free_d, 1)[0]
-            wrong = pick(rng, stuck_d, 3)
+            right, wrong = drawn
             proof = {
                 "kind": "direction",
                 "piece": x,
@@ -92,11 +101,9 @@ def _group_option(pieces: tuple[str, ...] | list[str], d: str) -> Option:
 def first_move_questions(level: Level, rng: np.random.Generator) -> list[Question]:
     """Which piece or group can move now: a least movable group against groups that leave a
     blocker behind."""
-    if level.family != "puzzle":
-        return []
     out: list[Question] = []
-    for view in _views(level):
-        state, graphs = _graphs(view)
+    for view, graphs in _states(level):
+        state = view.state
         movable = [(grp, d) for d in sorted(DIRECTIONS) for grp in minimal_groups(graphs[d])]
         stuck: list[tuple[tuple[str, ...], str]] = []
         for d in sorted(DIRECTIONS):
@@ -135,11 +142,9 @@ def first_move_questions(level: Level, rng: np.random.Generator) -> list[Questio
 @CATEGORIES.register("blocks")
 def blocks_questions(level: Level, rng: np.random.Generator) -> list[Question]:
     """Which piece stops X from sliding along D (X has exactly one blocker there)."""
-    if level.family != "puzzle":
-        return []
     out: list[Question] = []
-    for view in _views(level):
-        state, graphs = _graphs(view)
+    for view, graphs in _states(level):
+        state = view.state
         touching = contact_graph({n: state.cells_of(n) for n in _in_parts(state)}, floor=False)
         cases = [
             (x, d)

@@ -43,8 +43,8 @@ from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.jobs import check_jobs
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import btsearch as bt
+from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion import levelsearch as ls
-from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.disassemble import KERNEL_NODES, Analysis, Separations
 
 #: Placement keys ``(transformation, x, y, z)`` packed into one ordered integer.
@@ -216,7 +216,8 @@ class RowVerdicts:
 
 
 class StuckCheck:
-    """:func:`chaingeo.solvers.motion.movement.stuck` on a packing's rows: an assembly in which
+    """:func:`chaingeo.solvers.motion.kinematics_kernel.stuck` on a packing's rows: an assembly in
+    which
     nothing can move is no solution, so its disassembly search (~0.1 ms of setup) is never built."""
 
     def __init__(self, packing: Packing) -> None:

@@ -166,15 +166,8 @@ def analyze_grouped(
     tree = solver.part_tree(tuple(range(n)), np.zeros((n, 3), dtype=np.int64))
     if tree is None:
         return Analysis(False, None, None, None, states=solver.states)
-    return Analysis(
-        disassemblable=True,
-        level=tree.level_text(),
-        moves=tree.total_moves(),
-        optimal_steps=None,
-        plan=tuple(tree.all_moves()),
-        tree=tree,
-        states=solver.states,
-        first_level=len(tree.moves),
+    return Analysis.taken_apart(
+        tree, tree.total_moves(), None, tree.all_moves(), solver.states, len(tree.moves)
     )
 
 
@@ -213,12 +206,4 @@ def optimal_grouped(
             raise OptimalLimitError(e, lo, hi) from None
         if better is not None:
             steps, plan = found, better
-    return Analysis(
-        disassemblable=True,
-        level=tree.level_text(),
-        moves=bound,
-        optimal_steps=steps,
-        plan=tuple(plan),
-        tree=tree,
-        states=solver.states,
-    )
+    return Analysis.taken_apart(tree, bound, steps, plan, solver.states)

@@ -244,12 +244,7 @@ def bitboard_run(rows: BitboardRows, occ: U64, lv: kn.Levels, ctl: kn.Control) -
         t = rtype[row]
         chosen[k] = row
         if free == 0:  # every mandatory cell covered
-            ok = True
-            for q in counters:
-                if cnt[q] + (1 if q == t else 0) < lo[q]:
-                    ok = False
-                    break
-            if ok:
+            if kn.counts_met(counters, cnt, lo, t):
                 found += 1
                 if max_store > 0:
                     n_out = kn.store_solution(out, n_out, chosen, rid, k)

@@ -377,11 +377,7 @@ def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide | None) 
             t = rtype[r]
             cnt[t] += 1
             if full:  # every mandatory cell covered
-                ok = True
-                for q in counters:
-                    if cnt[q] < lo[q]:
-                        ok = False
-                        break
+                ok = kn.counts_met(counters, cnt, lo, -1)
                 cnt[t] -= 1
                 if ok:
                     found += 1

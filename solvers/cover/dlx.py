@@ -208,11 +208,7 @@ def dlx_run(links: Links, cols: Columns, lv: kn.Levels, ctl: kn.Control) -> int:
             chosen[k] = r
             c = _choose(HR, S)
             if c == 0:
-                ok = True
-                for q in counters:
-                    if cnt[q] < lo[q]:
-                        ok = False
-                        break
+                ok = kn.counts_met(counters, cnt, lo, -1)
                 if ok:
                     found += 1
                     if max_store > 0:

@@ -89,6 +89,16 @@ def shuffle_prefix(buf: np.ndarray, n: int, state: np.ndarray) -> None:
         buf[j] = tmp
 
 
+@njit(cache=True, inline="always")
+def counts_met(counters: Any, cnt: Any, lo: Any, t: int) -> bool:
+    """Whether every counted type has its least count, type ``t`` counted once more than
+    ``cnt`` says (``t = -1``: none): the last test before a full cover is a solution."""
+    for q in counters:  # noqa: SIM110 (numba compiles no generator passed to all())
+        if cnt[q] + (1 if q == t else 0) < lo[q]:
+            return False
+    return True
+
+
 @njit(cache=True)
 def store_solution(
     out: np.ndarray, n_out: int, chosen: np.ndarray, row_ids: np.ndarray, k: int

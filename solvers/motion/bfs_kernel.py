@@ -5,8 +5,9 @@ One kernel call expands layer after layer, without Python between layers, until 
 removal, a buffer is full or a budget of nodes is spent; the caller
 (:class:`chaingeo.solvers.motion.partsearch.PartSearch`, or
 :func:`chaingeo.solvers.motion.levelsearch.greedy` from inside numba) grows the full buffer and
-calls again. The moves of a state come from :func:`chaingeo.solvers.motion.movement.node_moves`,
-states are stored in :func:`chaingeo.solvers.motion.movement.find_or_insert`'s hash table.
+calls again. The moves of a state come from
+:func:`chaingeo.solvers.motion.kinematics_kernel.node_moves`,
+states are stored in :func:`chaingeo.solvers.motion.kinematics_kernel.find_or_insert`'s hash table.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 
 from chaingeo.core.arrays import I16, I64
 from chaingeo.kernels.jit import njit
-from chaingeo.solvers.motion.movement import (
+from chaingeo.solvers.motion.kinematics_kernel import (
     Pieces,
     find_or_insert,
     node_moves,
@@ -26,14 +27,14 @@ from chaingeo.solvers.motion.movement import (
 )
 
 #: Status codes returned by :func:`expand` (5 and 6 are
-#: :mod:`chaingeo.solvers.motion.turnmoves`' own).
+#: :mod:`chaingeo.solvers.motion.turns_kernel`' own).
 DONE, NEED_STATES, NEED_SEPS, TOO_MANY_GROUPS, NEED_MOVES, PAUSED = 0, 1, 2, 3, 4, 7
 
 
 class Tree(NamedTuple):
     """A breadth-first search's growing arrays: the state rows, each state's parent and the move
     that made it (rows), and the open-addressing ``table`` over the rows
-    (:func:`chaingeo.solvers.motion.movement.find_or_insert`);
+    (:func:`chaingeo.solvers.motion.kinematics_kernel.find_or_insert`);
     a search replaces them as they fill (:func:`grow_search`, :func:`fit_table`)."""
 
     states: I16
@@ -77,7 +78,7 @@ def slide_children(
     n_seps: int, n_states: int,
 ) -> tuple[int, int, int]:  # fmt: skip
     """The children of ``node`` (``n`` pieces) by the first ``rows`` slides of ``moves_buf``
-    (:func:`chaingeo.solvers.motion.movement.node_moves`' rows: mask, direction, farthest
+    (:func:`chaingeo.solvers.motion.kinematics_kernel.node_moves`' rows: mask, direction, farthest
     distance, removes): each removal appended to ``seps`` as ``(node, mask, direction)``, each
     new state to the tree with its parent and move (mask, direction, distance; any further
     move columns 0). Returns ``(status, n_states, n_seps)``: DONE, or the buffer to grow (the

@@ -32,7 +32,7 @@ from chaingeo.kernels.jit import njit
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion.levelsearch import (
     EXPANDED,
     GROUP_CAP,
@@ -84,7 +84,8 @@ def _reach(gaps: I64, d: int, i: int, s: int, k: int, limit: int, todo: I64) -> 
 class PartGaps(NamedTuple):
     """A part as :func:`part_search` reads it: the whole puzzle's :class:`PieceTable` arrays,
     the part's pieces (``members``: rows of them) and the memo of their pair gaps
-    (:func:`chaingeo.solvers.motion.movement.memo_pair_gaps`, shared by a puzzle's parts)."""
+    (:func:`chaingeo.solvers.motion.kinematics_kernel.memo_pair_gaps`, shared by a puzzle's
+    parts)."""
 
     vox: I64
     starts: I64

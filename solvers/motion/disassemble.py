@@ -1,7 +1,7 @@
 """Disassembly search: the BurrTools level, and the optimal full disassembly o_i.
 
 Semantics are those of :mod:`chaingeo.core.kinematics` (the reference); the search itself runs on
-:mod:`chaingeo.solvers.motion.movement` (numba). Two questions are answered:
+:mod:`chaingeo.solvers.motion.kinematics_kernel` (numba). Two questions are answered:
 
 * **Level** (BurrTools' notation, e.g. ``"4.9.3"``): by default BurrTools' own answer
   (``separations="first"``, :mod:`chaingeo.solvers.motion.btsearch`): breadth first in its search
@@ -35,8 +35,8 @@ from chaingeo.core.turns import TurnMove
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import btsearch as bt
+from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion import levelsearch as ls
-from chaingeo.solvers.motion import movement as mv
 from chaingeo.solvers.motion.btorient import BTImage, symmetries_of
 from chaingeo.solvers.motion.optimal_part import OptimalParts, PartKey
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PartSearch, PieceTable
@@ -46,7 +46,7 @@ from chaingeo.solvers.motion.partsearch import fast_legal_moves as fast_legal_mo
 from chaingeo.solvers.motion.partsearch import move_rows as move_rows
 
 if TYPE_CHECKING:  # imported when a puzzle turns: most never do
-    from chaingeo.solvers.motion.turnmoves import TurnTable
+    from chaingeo.solvers.motion.turns_kernel import TurnTable
     from chaingeo.solvers.motion.turnsearch import TurnPartSearch
 
 __all__ = [
@@ -125,6 +125,21 @@ class Analysis:
     #: True when ``level`` is BurrTools' own figure (its first separation took it apart).
     burrtools: bool = False
 
+    @classmethod
+    def taken_apart(
+        cls,
+        tree: Separation,
+        moves: int,
+        steps: int | None,
+        plan: Sequence[Move | TurnMove],
+        states: int,
+        first_level: int | None = None,
+        burrtools: bool = False,
+    ) -> Analysis:
+        """A puzzle that comes apart: its level read off the separation ``tree``."""
+        level = tree.level_text()
+        return cls(True, level, moves, steps, tuple(plan), tree, states, first_level, burrtools)
+
 
 #: ``"first"``: BurrTools' disassembler (its first separation or nothing); ``"any"``: any
 #: separation whose parts come apart.
@@ -162,7 +177,7 @@ class _Solver(OptimalParts):
         self.separations: Separations = "any" if turns or max_group is not None else separations
         self.turn_table: TurnTable | None = None
         if turns:
-            from chaingeo.solvers.motion.turnmoves import TurnTable
+            from chaingeo.solvers.motion.turns_kernel import TurnTable
 
             self.turn_table = TurnTable(shapes, rods or {})
         self.max_group = max_group
@@ -545,17 +560,7 @@ def analyze_assembly(
             steps = bound
         if steps < floor:
             raise ValueError(f"a plan of {steps} moves is below the lower bound {floor}")
-    return Analysis(
-        disassemblable=True,
-        level=tree.level_text(),
-        moves=total,
-        optimal_steps=steps,
-        plan=tuple(plan),
-        tree=tree,
-        states=solver.states,
-        first_level=len(tree.moves),
-        burrtools=bt_level,
-    )
+    return Analysis.taken_apart(tree, total, steps, plan, solver.states, len(tree.moves), bt_level)
 
 
 def translations(plan: Sequence[Move | TurnMove]) -> list[Move]:

@@ -18,7 +18,7 @@ import numpy as np
 from chaingeo.core.arrays import I16, I64
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion import bfs_kernel as bfs
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 
 #: Status codes in ``ctx[STATUS]`` (0: fine): a cap reached, more nodes expanded than
 #: ``params[BUDGET]``, or a buffer to enlarge and rerun.
@@ -57,7 +57,7 @@ class LevelTree(NamedTuple):
 class Memo(NamedTuple):
     """Parts already searched: ``keys`` rows (the part's pieces as a mask in four int16, then
     offsets relative to its first piece), their open-addressing ``table``
-    (:func:`chaingeo.solvers.motion.movement.find_or_insert`) and ``val`` (the part's tree
+    (:func:`chaingeo.solvers.motion.kinematics_kernel.find_or_insert`) and ``val`` (the part's tree
     index; -1: cannot come apart)."""
 
     keys: I16

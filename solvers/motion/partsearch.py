@@ -2,7 +2,8 @@
 
 A *part* is a set of pieces still to be taken apart; its states are the pieces' offsets relative
 to its first piece. :class:`PartSearch` grows the search one depth layer at a time (numba does
-the expansion, :mod:`chaingeo.solvers.motion.movement`), remembers each state's parent and the move
+the expansion, :mod:`chaingeo.solvers.motion.kinematics_kernel`), remembers each state's parent and
+the move
 that made it, and collects every removal (a move that splits the part) seen on the way.
 """
 
@@ -10,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Generic, TypeVar
+from typing import ClassVar, Generic, TypeVar
 
 import numpy as np
 
@@ -20,7 +21,7 @@ from chaingeo.kernels.jit import Pinned
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 
 DIRECTION_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 
@@ -122,17 +123,22 @@ TableT = TypeVar("TableT")
 class LayeredSearch(Generic[TableT]):
     """What the layered breadth-first searches of one part share (translations only here,
     with turns in :class:`chaingeo.solvers.motion.turnsearch.TurnPartSearch`): the part, its
-    caps, its deadline, and the state cap's error."""
+    caps, its deadline, and the state cap's error. A subclass names its :attr:`CHUNK` and
+    builds its own buffers from the start configuration in :meth:`_begin`."""
+
+    #: Nodes one kernel call expands at most (when the caller names no ``chunk``).
+    CHUNK: ClassVar[int] = 2000
 
     def __init__(
         self,
         table: TableT,
         members: Sequence[int],
+        start: np.ndarray,
         *,
         max_group: int | None,
         limits: SearchLimits,
         deadline: Deadline,
-        chunk: int,
+        chunk: int | None = None,
     ) -> None:
         self.n = part_size(members)
         self.table = table
@@ -141,9 +147,14 @@ class LayeredSearch(Generic[TableT]):
         self.group_limit = int(limits.group_limit)
         self.limits = limits
         self.deadline = deadline
-        self.chunk = chunk
+        self.chunk = self.CHUNK if chunk is None else chunk
         self.n_states = 1
         self.n_seps = 0
+        self._begin(start)
+
+    def _begin(self, start: np.ndarray) -> None:
+        """Build the search's buffers and put the start configuration in them."""
+        raise NotImplementedError
 
     def next_capacity(self, cap: int) -> int:
         """The state buffers' next size after ``cap``; at the state cap, its
@@ -159,6 +170,8 @@ class LayeredSearch(Generic[TableT]):
 class PartSearch(LayeredSearch[PieceTable]):
     """Layered breadth-first search of one part from one configuration."""
 
+    CHUNK = 20000
+
     def __init__(
         self,
         table: PieceTable,
@@ -168,16 +181,19 @@ class PartSearch(LayeredSearch[PieceTable]):
         max_group: int | None,
         limits: SearchLimits,
         deadline: Deadline,
-        chunk: int = 20000,
+        chunk: int | None = None,
         peel: bool = False,
     ) -> None:
-        super().__init__(
-            table, members, max_group=max_group, limits=limits, deadline=deadline, chunk=chunk
-        )
         #: Stop at states where one piece comes free alone (the optimal search's pruning).
         self.peel = peel
-        n = self.n
-        vox, starts, lo, hi = table.part_arrays(self.members)
+        super().__init__(
+            table, members, offsets, max_group=max_group, limits=limits, deadline=deadline,
+            chunk=chunk,
+        )  # fmt: skip
+
+    def _begin(self, offsets: np.ndarray) -> None:
+        n, limits = self.n, self.limits
+        vox, starts, lo, hi = self.table.part_arrays(self.members)
         cap = max(2, min(128, limits.max_states))  # most parts come apart in a few states
         # The kernel's bundles are kept, and replaced only when a buffer grows: every call
         # expands one or two nodes on a typical part, so building them per call would cost

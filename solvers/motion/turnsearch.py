@@ -3,7 +3,8 @@ turns; the translation-only search stays :class:`chaingeo.solvers.motion.partsea
 
 A turned piece changes orientation, so a state is every piece's *pose*: a rotation index (into
 :data:`chaingeo.core.geometry.ROTATIONS`) and an offset, pieces pre-rotated in
-:class:`chaingeo.solvers.motion.turnmoves.TurnTable`. The first piece (the anchor) never moves: when
+:class:`chaingeo.solvers.motion.turns_kernel.TurnTable`. The first piece (the anchor) never moves:
+when
 it belongs to the group that moves, the rest moves the opposite way (for a turn: turns back about
 the same line), which is the same relative motion. States are therefore seen in a *search frame*
 that differs from the real positions by a rigid motion ``T`` (a rotation and a translation, in
@@ -14,7 +15,7 @@ so they replay as they are with :mod:`chaingeo.core.kinematics`.
 
 Same interface as :class:`~chaingeo.solvers.motion.partsearch.PartSearch` (poses are ``(n, 4)``
 rows: offset, then rotation index); the expansion is the numba kernel
-:func:`chaingeo.solvers.motion.turnmoves.expand_turns`.
+:func:`chaingeo.solvers.motion.turns_kernel.expand_turns`.
 """
 
 from __future__ import annotations
@@ -27,13 +28,11 @@ from chaingeo.core.geometry import ROTATIONS, rotation_index
 from chaingeo.core.kinematics import DIRECTIONS, Assembly, Move, SearchLimitError
 from chaingeo.core.turns import AXES, TurnMove, centre_inside, lateral
 from chaingeo.kernels.jit import Pinned
-from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import bfs_kernel as bfs
-from chaingeo.solvers.motion import movement as mv
-from chaingeo.solvers.motion import turnmoves as tm
+from chaingeo.solvers.motion import kinematics_kernel as mv
+from chaingeo.solvers.motion import turns_kernel as tm
 from chaingeo.solvers.motion.partsearch import LayeredSearch, Removal, Split
-from chaingeo.solvers.motion.sweep import FAR_LIMIT, Stencils, stencils, swept_through
+from chaingeo.solvers.motion.turns_sweep_kernel import FAR_LIMIT, Stencils, stencils, swept_through
 
 _DIR_NAMES: tuple[str, ...] = tuple(DIRECTIONS)
 _DIR_VECS = np.array([DIRECTIONS[d] for d in _DIR_NAMES], dtype=np.int64)
@@ -46,7 +45,7 @@ def _direction(vec: np.ndarray) -> int:
     return int(np.flatnonzero(np.all(vec == _DIR_VECS, axis=1))[0])
 
 
-#: :func:`chaingeo.solvers.motion.turnmoves.expand_turns` as :class:`TurnPartSearch` calls it:
+#: :func:`chaingeo.solvers.motion.turns_kernel.expand_turns` as :class:`TurnPartSearch` calls it:
 #: the types of its arguments are fixed by TurnPartSearch's constructor (see :class:`Pinned`).
 _expand_turns = Pinned(tm.expand_turns)
 
@@ -54,22 +53,11 @@ _expand_turns = Pinned(tm.expand_turns)
 class TurnPartSearch(LayeredSearch[tm.TurnTable]):
     """Layered breadth-first search of one part from one configuration, turns included."""
 
-    def __init__(
-        self,
-        table: tm.TurnTable,
-        members: Sequence[int],
-        poses: np.ndarray,
-        *,
-        max_group: int | None,
-        limits: SearchLimits,
-        deadline: Deadline,
-        chunk: int = 2000,
-    ) -> None:
-        super().__init__(
-            table, members, max_group=max_group, limits=limits, deadline=deadline, chunk=chunk
-        )
-        n = self.n
-        self.vox, self.starts, self.lo, self.hi, self.rod = table.part_arrays(self.members)
+    CHUNK = 2000
+
+    def _begin(self, poses: np.ndarray) -> None:
+        n, limits = self.n, self.limits
+        self.vox, self.starts, self.lo, self.hi, self.rod = self.table.part_arrays(self.members)
         cap = max(2, min(1024, limits.max_states))
         self.states = np.zeros((cap, 4 * n), dtype=np.int16)
         self.parent = np.full(cap, -1, dtype=np.int64)
@@ -266,8 +254,9 @@ def turn_rows(
 ) -> list[tuple[tuple[str, ...], np.ndarray]]:
     """The legal turns of ``state`` in the kernel's raw form: per part of two or more pieces,
     its piece names (sorted) and int64 rows ``(mask, axis, sense, c0, c1, c2)`` (see
-    :func:`chaingeo.solvers.motion.turnmoves.node_turns`). ``table`` holds the state's pieces and
-    rods; ``st`` is the stencil table (the one of :func:`chaingeo.solvers.motion.sweep.stencils`
+    :func:`chaingeo.solvers.motion.turns_kernel.node_turns`). ``table`` holds the state's pieces and
+    rods; ``st`` is the stencil table (the one of
+    :func:`chaingeo.solvers.motion.turns_sweep_kernel.stencils`
     unless a test asks for another reach)."""
     out: list[tuple[tuple[str, ...], np.ndarray]] = []
     st = stencils() if st is None else st
@@ -320,7 +309,8 @@ def fast_legal_turns(
 
 def turn_problem(state: Assembly, move: TurnMove) -> str | None:
     """:meth:`chaingeo.core.kinematics.Assembly.turn_problem` (the same answer, the same words)
-    from the exact pair test of :mod:`chaingeo.solvers.motion.sweep`, whose cost does not grow with
+    from the exact pair test of :mod:`chaingeo.solvers.motion.turns_sweep_kernel`, whose cost does
+    not grow with
     how far the group stands from the axis (the reference lists every cell each cell sweeps)."""
     a = move.axis_index
     group = [c for n in move.pieces for c in state.cells_of(n)]

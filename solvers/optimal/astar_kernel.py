@@ -20,7 +20,7 @@ import numpy as np
 from chaingeo.core.arrays import I16, I32, I64, U8
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import entry, njit
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.optimal.pattern_db import DEAD, KEY_WIDTH, lookup
 
 if TYPE_CHECKING:
@@ -95,7 +95,8 @@ class Heap(NamedTuple):
 
 
 #: The pieces' voxels and boxes, the group caps and the buffers of
-#: :func:`chaingeo.solvers.motion.movement.node_moves` (the bundle every search kernel takes).
+#: :func:`chaingeo.solvers.motion.kinematics_kernel.node_moves` (the bundle every search kernel
+#: takes).
 Pieces = mv.Pieces
 
 
@@ -238,7 +239,8 @@ def _active_part(row: I16, n: int, cnt: I64, members: I64) -> tuple[int, int]:
 
 @njit(cache=True)
 def _part_moves(row: I16, n: int, members: I64, m: int, pieces: Pieces) -> int:
-    """:func:`chaingeo.solvers.motion.movement.node_moves` of the part ``members[:m]`` at its
+    """:func:`chaingeo.solvers.motion.kinematics_kernel.node_moves` of the part ``members[:m]`` at
+    its
     offsets in ``row``: the number of moves written to ``pieces.moves`` (or its -1, -2)."""
     nvox = 0
     for p in range(m):

@@ -64,7 +64,7 @@ import numpy.typing as npt
 
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion.partsearch import PieceTable
 
 #: Counts per class ``((axis, distance), count)``, sorted by class; zero counts left out.

@@ -25,7 +25,8 @@ every child, whatever ``h`` says of them.)
 
 **Search.** ``within(P, r)`` finds a plan of at most ``r`` moves for part ``P`` or proves there
 is none. It prunes when ``h(P) > r`` or a memoised lower bound on ``d(P)`` exceeds ``r``; else
-it tries every legal move of ``P`` (:func:`chaingeo.solvers.motion.movement.node_moves`: one of each
+it tries every legal move of ``P`` (:func:`chaingeo.solvers.motion.kinematics_kernel.node_moves`:
+one of each
 group / rest pair, every finite distance, and the removal), smallest ``f = 1 + bound(child)`` first,
 removals first among equals. A finite move needs ``within(P', r - 1)``. A removal into ``P1``
 and ``P2`` needs ``d(P1) + d(P2) <= r - 1``: ``d(P1)`` is found exactly (deepening from its
@@ -47,7 +48,7 @@ from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import Move, SearchLimitError
 from chaingeo.solvers.deadline import Deadline, deadline_of
 from chaingeo.solvers.limits import SearchLimits
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion.disassemble import Analysis, analyze_assembly
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PieceTable
 from chaingeo.solvers.optimal.classbound import MAX_BUDGET, ClassVectors, moved

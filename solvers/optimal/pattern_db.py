@@ -28,7 +28,7 @@ from chaingeo.core.arrays import I16, I32, I64
 from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.kernels.jit import entry, njit
 from chaingeo.solvers.deadline import Deadline
-from chaingeo.solvers.motion import movement as mv
+from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion.partsearch import PieceTable
 
 #: ``g`` of a state from which the sub-puzzle never comes apart (larger than any real plan).

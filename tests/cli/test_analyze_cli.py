@@ -145,22 +145,24 @@ def test_chain_version(capsys: pytest.CaptureFixture[str]) -> None:
 def test_counting_cut_short_keeps_the_known_assembly_s_figures() -> None:
     from chaingeo.core.formats.bt_level import level_puzzle
     from chaingeo.core.level import load_level
-    from chaingeo.solvers.analysis import level_analysis_row, problem_analysis_row
+    from chaingeo.solvers.analysis import RowOptions, level_analysis_row, problem_analysis_row
     from chaingeo.solvers.deadline import Deadline
     from chaingeo.solvers.limits import SearchLimits
 
     level = load_level(suite_folder("puzzle") / "puzzle-mid-04-burr12.json")
     limits = SearchLimits(seconds=30.0)
     spent = Deadline(0.0)  # counting stops at once; the known assembly gets its own time
-    out = level_analysis_row(level, limits, True, True, deadline=spent)
+    out = level_analysis_row(level, RowOptions(limits, deadline=spent))
     assert out["counts_complete"] is False and out["limit_cap"] == "seconds"
     assert (out["assemblies"], out["solutions"]) == (0, 0)
     assert (out["level"], out["moves"]) == (level.stats["level"], level.stats["moves"])
     assert out["optimal_steps"] == level.optimal_steps
-    stored = problem_analysis_row(level_puzzle(level), 0, limits, True, True, "drop", Deadline(0.0))
+    stored = problem_analysis_row(
+        level_puzzle(level), 0, RowOptions(limits, deadline=Deadline(0.0))
+    )
     assert stored["counts_complete"] is False
     assert (stored["level"], stored["optimal_steps"]) == ("1.2.2", level.optimal_steps)
-    whole = problem_analysis_row(level_puzzle(level), 0, limits, False, True, "drop")
+    whole = problem_analysis_row(level_puzzle(level), 0, RowOptions(limits, optimal=False))
     assert "counts_complete" not in whole
     assert (whole["assemblies"], whole["solutions"], whole["level"]) == (2, 1, "1.2.2")
 

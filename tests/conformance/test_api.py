@@ -160,10 +160,10 @@ def _without_timing(row: dict[str, Any]) -> dict[str, Any]:
 
 def test_analyze_takes_a_level_its_id_or_its_file_and_gives_the_old_figures() -> None:
     from chaingeo.core.suite import suite_folder
-    from chaingeo.solvers.analysis import DEFAULT_LIMITS, level_analysis_row
+    from chaingeo.solvers.analysis import DEFAULT_LIMITS, RowOptions, level_analysis_row
 
     level = chaingeo.load_level("puzzle-easy-07-burr3")
-    old = level_analysis_row(level, DEFAULT_LIMITS, True, True)
+    old = level_analysis_row(level, RowOptions(DEFAULT_LIMITS))
     by_level = chaingeo.analyze(level)
     by_id = chaingeo.analyze(level.id)
     by_path = chaingeo.analyze(suite_folder("puzzle") / f"{level.id}.json")
@@ -184,14 +184,14 @@ def test_analyze_refuses_a_stacking_level_with_a_typed_error() -> None:
 def test_analyze_of_a_burrtools_file_gives_the_old_figures_and_the_command_s_line(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    from chaingeo.solvers.analysis import DEFAULT_LIMITS, problem_analysis_row
+    from chaingeo.solvers.analysis import DEFAULT_LIMITS, RowOptions, problem_analysis_row
 
     puzzle = chaingeo.read_burrtools(SOMA)
     whole = chaingeo.analyze(SOMA)
     assert whole.several and len(whole.problems) == len(puzzle.problems) == 3
     assert whole.level is None and whole.cut_short() == []
     for i, figures in enumerate(whole.problems):
-        old = problem_analysis_row(puzzle, i, DEFAULT_LIMITS, True, True)
+        old = problem_analysis_row(puzzle, i, RowOptions(DEFAULT_LIMITS))
         assert _without_timing(figures.to_dict()) == _without_timing(old)
         one = chaingeo.analyze(puzzle, problem=i)
         assert not one.several

@@ -26,7 +26,7 @@ from chaingeo.core.formats.burrtools import BurrToolsError, parse_xmpuzzle, read
 from chaingeo.core.geometry import Shape, puzzle_signature
 from chaingeo.core.level import LevelError, level_bytes, load_level, save_level
 from chaingeo.core.suite import suite_folder
-from chaingeo.solvers.motion.movement import MAX_PIECES
+from chaingeo.solvers.motion.kinematics_kernel import MAX_PIECES
 from tests.support.env_levels import tiny_level
 
 BURR = suite_folder("puzzle") / "puzzle-easy-04-burr6.json"

@@ -301,14 +301,14 @@ def test_any_readable_problem_is_analysed_or_refused_with_a_value_error(puzzle: 
     """Whatever a readable file's problems say (empty pieces, variable voxels in a piece, no
     parts, colours), the analysis answers or raises a ValueError saying why."""
     from chaingeo.core.kinematics import SearchLimitError
-    from chaingeo.solvers.analysis import problem_analysis_row
+    from chaingeo.solvers.analysis import RowOptions, problem_analysis_row
     from chaingeo.solvers.limits import SearchLimits
 
     back = parse_xmpuzzle(xmpuzzle_bytes(puzzle))
     for i in range(len(back.problems)):
         try:
             out = problem_analysis_row(
-                back, i, SearchLimits(max_states=2000, seconds=5), True, True
+                back, i, RowOptions(SearchLimits(max_states=2000, seconds=5))
             )
         except (ValueError, SearchLimitError):
             continue

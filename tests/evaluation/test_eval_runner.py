@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import io
 import json
 import os
@@ -33,6 +34,21 @@ def _records(run: Path) -> dict[str, dict[str, Any]]:
         assert rec["key"] not in out, f"{rec['key']} recorded twice"
         out[rec["key"]] = rec
     return out
+
+
+def test_what_evaluate_returns_is_the_run_read_back(tmp_path: Path) -> None:
+    """``chain eval`` reports from the returned outcomes and header, never rereading the run:
+    they must say what the run directory says (row name, outcomes, errors, tool notes)."""
+    from chaingeo.evaluation.report.tables import load_run, run_of
+
+    spec = AgentSpec("random", {"label": "rand"})
+    proto = dataclasses.replace(FAKE, candidates=2, judge="vote")
+    got = evaluate(fake_levels(2), spec, tmp_path / "r", proto, RunConfig(progress=False))
+    back = load_run(tmp_path / "r")
+    ours = run_of(tmp_path / "r", got.header, got)
+    assert (ours.name, ours.outcomes, ours.errors) == (back.name, back.outcomes, back.errors)
+    assert ours.name == "rand (best of 2, vote)"
+    assert got.tools_refused == []
 
 
 def test_seeded_runs_repeat_and_parallel_jobs_agree(tmp_path: Path) -> None:

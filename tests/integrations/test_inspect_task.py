@@ -184,3 +184,31 @@ def test_inspect_eval_finds_the_task_by_its_entry_point(tmp_path: Path) -> None:
     assert log.samples is not None and len(log.samples) == 6  # 3 levels x 2 epochs
     assert {s.reducer for s in log.results.scores} == {"mean", "pass_at_k", "pass_hat_k"}  # type: ignore[union-attr]
     assert all({"accuracy", "stderr"} <= set(s.metrics) for s in log.results.scores)  # type: ignore[union-attr]
+
+
+def _offline(cache: Path) -> dict[str, str]:
+    """An environment where tiktoken's cache is empty and its download fails at once."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DATA_GYM_CACHE_DIR",)}
+    closed = "http://127.0.0.1:9"  # the discard port: nothing listens there
+    return {**env, "TIKTOKEN_CACHE_DIR": str(cache), "HTTPS_PROXY": closed, "https_proxy": closed}
+
+
+def test_the_readme_command_runs_offline_with_an_empty_tiktoken_cache(tmp_path: Path) -> None:
+    """The issue's command, model replies without usage (so inspect_ai counts tokens with
+    tiktoken's o200k_base), on a machine that cannot download it: every sample is scored."""
+    cache = tmp_path / "tiktoken"
+    cmd = [
+        *(sys.executable, "-m", "inspect_ai", "eval", "chaingeo/chain"),
+        *("-T", "family=stacking", "-T", "levels=3", "-T", "max_steps=3"),
+        *("--model", "mockllm/model", "--log-dir", str(tmp_path / "logs"), "--display", "none"),
+    ]
+    env = {**_offline(cache), "INSPECT_LOG_FORMAT": "eval"}
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=env, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-2000:]
+    [path] = list((tmp_path / "logs").glob("*.eval"))
+    log = read_eval_log(str(path))
+    assert log.status == "success", log.error
+    assert log.samples is not None and len(log.samples) == 3
+    assert all(s.scores and s.scores["success"].value == 0 for s in log.samples)
+    assert all(s.model_usage for s in log.samples), "inspect_ai counted the tokens"
+    assert all({"accuracy", "stderr"} <= set(s.metrics) for s in log.results.scores)  # type: ignore[union-attr]

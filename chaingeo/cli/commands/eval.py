@@ -189,13 +189,8 @@ def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "-", text).strip("-") or "agent"
 
 
-def _say_tool_fallback(run: str, records: list[dict[str, Any]]) -> None:
+def _say_tool_fallback(run: str, refused: list[str]) -> None:
     """One line per run whose server refused native tools (its episodes were played in text)."""
-    refused = [
-        str(r["agent_notes"]["tools_refused"])
-        for r in records
-        if isinstance(r.get("agent_notes"), dict) and r["agent_notes"].get("tools_refused")
-    ]
     if refused:
         print(
             f"NOTE: {run}: the server refused tools ({refused[0]}); {len(refused)} episode(s)"
@@ -228,8 +223,7 @@ def run(args: argparse.Namespace) -> int:
     from chaingeo.evaluation.agents.openai_chat import provider_fields
     from chaingeo.evaluation.agents.registry import BASELINES
     from chaingeo.evaluation.eval_config import ConfigError, EvalConfig, load_config
-    from chaingeo.evaluation.logs import RunLog
-    from chaingeo.evaluation.report.tables import Run, load_run, table1
+    from chaingeo.evaluation.report.tables import Run, run_of, table1
     from chaingeo.evaluation.runner import RunConfig, evaluate
     from chaingeo.evaluation.usage import PriceTable
 
@@ -323,11 +317,11 @@ def run(args: argparse.Namespace) -> int:
                 outcomes = evaluate(levels, spec, run_dir, proto, cfg, prices, stream=sys.stderr)
             except AuthenticationError as e:
                 raise CommandError(f"{spec.label}: authentication failed: {e}") from None
-            runs.append(load_run(run_dir))  # the run's header, for the table's row name
+            runs.append(run_of(run_dir, outcomes.header, outcomes))
             errors = [o for o in outcomes if o.error is not None]
             errored[run_dir.name] = len(errors)
             failed += errors
-            _say_tool_fallback(run_dir.name, list(RunLog(run_dir).latest().values()))
+            _say_tool_fallback(run_dir.name, outcomes.tools_refused)
     total = sum(errored.values())
     if total:
         where = ", ".join(f"{name}: {n}" for name, n in errored.items() if n)

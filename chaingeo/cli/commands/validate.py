@@ -59,7 +59,7 @@ def recheck_optimal(level: Level) -> int:
     from chaingeo.core.limits import RECHECK_MAX_STATES
     from chaingeo.solvers.analysis import analyze_level, level_blocks
     from chaingeo.solvers.limits import SearchLimits
-    from chaingeo.solvers.motion.movement import MAX_PIECES
+    from chaingeo.solvers.motion.kinematics_kernel import MAX_PIECES
 
     if level.family != "puzzle":
         return len(level.pieces)

@@ -29,7 +29,12 @@ from chaingeo.core.rules import Rejection, StackingRules
 from chaingeo.core.turns import TurnMove
 from chaingeo.envs.actions import chain_dialect
 from chaingeo.envs.actions.chain_dialect import PlacementCellsError
-from chaingeo.envs.actions.turn_text import TurnTextError, is_turn_text, parse_turn
+from chaingeo.envs.actions.turn_text import (
+    TurnTextError,
+    is_turn_text,
+    parse_turn,
+    tokenise,
+)
 from chaingeo.envs.actions.types import (
     Action,
     AmbiguousActionError,
@@ -107,19 +112,7 @@ def _normalise(text: str) -> str:
 
 
 def _tokenise(s: str) -> list[Token]:
-    tokens: list[Token] = []
-    pos = 0
-    s = s.rstrip()
-    while pos < len(s):
-        m = _TOKEN_RE.match(s, pos)
-        if m is None or m.end() == pos:
-            bad = s[pos:].strip()[:1]
-            raise _Unparseable(f"unexpected character {bad!r}")
-        kind = m.lastgroup
-        assert kind is not None
-        tokens.append((kind, m.group(kind)))
-        pos = m.end()
-    return tokens
+    return tokenise(_TOKEN_RE, s, _Unparseable)
 
 
 def _turn_text(text: str, normalised: str) -> TurnRequest:

@@ -11,6 +11,7 @@ brackets, commas, ``about z``, ``by 90 degrees``; an unsigned 90 is +90; words s
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from typing import Final
 
 from chaingeo.core import limits
@@ -47,14 +48,19 @@ def is_turn_text(normalised: str) -> bool:
     return m is not None and m.group(0) in VERBS
 
 
-def _tokens(s: str) -> list[tuple[str, str]]:
+def tokenise(
+    pattern: re.Pattern[str], s: str, error: Callable[[str], Exception]
+) -> list[tuple[str, str]]:
+    """``s`` (trailing space dropped) as ``(kind, text)`` tokens, ``kind`` the name of the group
+    of ``pattern`` that matched; ``error(hint)`` is raised at the first character none matches.
+    Both action grammars (ours and the turn words) read text through it."""
     out: list[tuple[str, str]] = []
     pos = 0
     s = s.rstrip()
     while pos < len(s):
-        m = _TOKEN_RE.match(s, pos)
+        m = pattern.match(s, pos)
         if m is None or m.end() == pos:
-            raise TurnTextError(f"unexpected character {s[pos:].strip()[:1]!r}")
+            raise error(f"unexpected character {s[pos:].strip()[:1]!r}")
         kind = m.lastgroup
         assert kind is not None
         out.append((kind, m.group(kind)))
@@ -79,7 +85,8 @@ def _half(digits: str) -> int:
 
 def parse_turn(normalised: str) -> TurnRequest:
     """Read a turn; :class:`TurnTextError` if it is not one."""
-    tokens = [t for t in _tokens(normalised) if not (t[0] == "word" and t[1] in _FILLER)]
+    words = tokenise(_TOKEN_RE, normalised, TurnTextError)
+    tokens = [t for t in words if not (t[0] == "word" and t[1] in _FILLER)]
     tokens = [t for t in tokens if t != ("sym", "\u00b0")]
     i = 1  # after the verb
     names: list[str] = []

@@ -46,7 +46,7 @@ from chaingeo.envs.machines.move_table import LazyBlock, MoveRange, MoveTable
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion.disassemble import move_rows
 from chaingeo.solvers.motion.partsearch import PieceTable
-from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion.turns_kernel import TurnTable
 from chaingeo.solvers.motion.turnsearch import turn_rows
 
 #: Movable groups along one direction before a state's action list gives up with a

@@ -11,7 +11,7 @@ from chaingeo.core.level import Level, PuzzleSolution
 from chaingeo.core.rules import PuzzleRules
 from chaingeo.envs.machines.puzzle_turns import PartKey, turned_part_key
 from chaingeo.solvers.motion.partsearch import PieceTable
-from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion.turns_kernel import TurnTable
 
 PositionKey = tuple[PartKey, ...]
 

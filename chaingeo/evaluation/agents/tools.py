@@ -111,22 +111,19 @@ _MOVE_PROPS: Final[dict[str, Any]] = {
         "description": 'how many units, or "inf" to slide out (or in) from afar',
     },
 }
-MOVE: Final = _function(
-    "move",
-    "Slide a group of pieces along an axis by a number of units, or to infinity.",
-    _MOVE_PROPS,
-    ("pieces", "direction", "distance"),
-)
-MOVE_ASSEMBLE: Final = _function(
-    "move",
+
+
+def _move(description: str, **extra: dict[str, Any]) -> dict[str, Any]:
+    """The ``move`` tool: the slide's own arguments, required, and any optional ``extra``."""
+    return _function("move", description, {**_MOVE_PROPS, **extra}, tuple(_MOVE_PROPS))
+
+
+MOVE: Final = _move("Slide a group of pieces along an axis by a number of units, or to infinity.")
+MOVE_ASSEMBLE: Final = _move(
     "Slide a group of pieces along an axis by a number of units, or bring a whole part in "
     'from afar (distance "inf"), optionally saying which part it joins and where it lands.',
-    {
-        **_MOVE_PROPS,
-        "into": _group_schema("assembly: the part it joins (colour names)"),
-        "offset": _triple("assembly: [dx, dy, dz] from its place in the target; [0,0,0] exact"),
-    },
-    ("pieces", "direction", "distance"),
+    into=_group_schema("assembly: the part it joins (colour names)"),
+    offset=_triple("assembly: [dx, dy, dz] from its place in the target; [0,0,0] exact"),
 )
 ROTATE: Final = _function(
     "rotate",

@@ -83,15 +83,19 @@ def find_runs(paths: Sequence[str | Path]) -> list[Path]:
 
 def load_run(path: str | Path) -> Run:
     log = RunLog(path)
-    header = log.header()
-    latest = list(log.latest().values())
+    return run_of(path, log.header(), [Outcome.from_record(r) for r in log.latest().values()])
+
+
+def run_of(path: str | Path, header: dict[str, Any], outcomes: list[Outcome]) -> Run:
+    """The run of a header and its outcomes (read back by :func:`load_run`, or as
+    :func:`chaingeo.evaluation.runner.evaluate` returns them)."""
     return Run(
         path=Path(path),
         label=str(header.get("label") or header["agent"]["name"]),
         protocol=dict(header.get("protocol", {})),
         header=header,
-        outcomes=[Outcome.from_record(r) for r in latest],
-        errors=sum(1 for r in latest if r.get("status") == "error"),
+        outcomes=outcomes,
+        errors=sum(1 for o in outcomes if o.error is not None),
     )
 
 

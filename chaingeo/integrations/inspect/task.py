@@ -31,6 +31,7 @@ from chaingeo.core.level import Level, load_levels
 from chaingeo.core.suite import load_level, suite_folder
 from chaingeo.evaluation.episode import Episode, ProtocolConfig
 from chaingeo.evaluation.eval_config import EvalConfig, load_config
+from chaingeo.integrations.inspect._encoding import seed_o200k
 from chaingeo.integrations.inspect.scoring import METRICS, REDUCERS, success
 from chaingeo.integrations.inspect.solver import first_messages, play_level
 
@@ -128,6 +129,7 @@ def chain(
     config: str | None = None,
 ) -> Task:
     """CHAIN's levels played by a model (see the module docstring for the parameters)."""
+    seed_o200k()
     cfg = load_config(config) if config else EvalConfig()
     if agent not in ("model", "oracle"):
         raise TaskParameterError(f"agent={agent!r}: use model or oracle")

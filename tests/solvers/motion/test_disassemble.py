@@ -171,7 +171,7 @@ def test_limits_raise_clear_errors() -> None:
 def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, steps: int) -> None:
     """Cutler's pairwise matrix from the numba kernel equals the reference blocking_matrix."""
     from chaingeo.core.kinematics import DIRECTIONS, blocking_matrix
-    from chaingeo.solvers.motion import movement
+    from chaingeo.solvers.motion import kinematics_kernel
 
     state = random_walk(shapes, seed, steps)
     table = PieceTable(state.shapes)
@@ -180,7 +180,7 @@ def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, 
     off = np.array([state.offsets[n] for n in table.names], dtype=np.int64)
     n = len(members)
     gaps = np.empty((3, n, n), dtype=np.int64)
-    movement.pair_gaps(vox, starts, lo, hi, off, gaps)
+    kinematics_kernel.pair_gaps(vox, starts, lo, hi, off, gaps)
     for d, name in enumerate(DIRECTIONS):
         ref = blocking_matrix(state, name)
         axis, sign = d // 2, 1 if d % 2 == 0 else -1
@@ -189,4 +189,4 @@ def test_movement_matrix_matches_reference(shapes: dict[str, Shape], seed: int, 
                 continue
             i, j = table.index(a), table.index(b)
             got = int(gaps[axis, i, j] if sign > 0 else gaps[axis, j, i])
-            assert (None if got >= movement.INF else got) == free
+            assert (None if got >= kinematics_kernel.INF else got) == free

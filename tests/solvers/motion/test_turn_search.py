@@ -21,7 +21,7 @@ from chaingeo.core.kinematics import (
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion.disassemble import analyze_assembly, fast_legal_moves
-from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion.turns_kernel import TurnTable
 from chaingeo.solvers.motion.turnsearch import TurnPartSearch, fast_legal_turns
 from tests.support.puzzle_strategies import small_scenes
 from tests.support.scenes import luban3, turning_walk

@@ -1,4 +1,5 @@
-"""The fast turn sweep (:mod:`chaingeo.solvers.motion.sweep`, the turn kernel beyond its table, the
+"""The fast turn sweep (:mod:`chaingeo.solvers.motion.turns_sweep_kernel`, the turn kernel beyond
+its table, the
 env's turn checks) against the Python reference :mod:`chaingeo.core.turns`, and its cost as pieces
 wander."""
 
@@ -21,8 +22,8 @@ from chaingeo.core.turns import AXES, TurnMove, square_hit, swept_squares
 from chaingeo.envs.machines import puzzle_actions
 from chaingeo.evaluation.agents.base import AgentSpec
 from chaingeo.evaluation.play import EpisodeTask, run_episode
-from chaingeo.solvers.motion import sweep
-from chaingeo.solvers.motion.turnmoves import TurnTable
+from chaingeo.solvers.motion import turns_sweep_kernel as sweep
+from chaingeo.solvers.motion.turns_kernel import TurnTable
 from chaingeo.solvers.motion.turnsearch import fast_legal_turns, turn_problem, turn_rows
 from tests.support.jit import seconds_for
 from tests.support.puzzle_strategies import small_scenes

@@ -17,7 +17,7 @@ from chaingeo.envs.frames import render_frames
 from chaingeo.envs.gym import StackingEnv
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.observation import state_images
-from chaingeo.pictures import fastview, rasterjit
+from chaingeo.pictures import raster_kernel, scene_kernel
 from chaingeo.pictures.legend import clear_memo, draw_legend, paint_legend
 from chaingeo.pictures.scene import render_tray_image
 from chaingeo.pictures.sheet import tray_pixels
@@ -61,7 +61,7 @@ def test_rectangle_kernel_is_pillows_rectangle(
     fill = (0, 0, 0) if black else fill  # the outline is left out when it is the fill
     ImageDraw.Draw(image).rectangle([x, y, x + w, y + h], fill=fill, outline=(0, 0, 0))
     box = np.array([x, y, x + w, y + h])
-    rasterjit.rectangle(
+    raster_kernel.rectangle(
         arr, box, np.array(fill, np.uint8), np.zeros(3, np.uint8), fill != (0, 0, 0)
     )
     assert np.array_equal(np.asarray(image), arr)
@@ -103,7 +103,7 @@ def test_frames_along_random_placements_and_pickups_are_the_references(seed: int
         want = {n: np.asarray(im) for n, im in state_images(state, size, reference=True).items()}
         assert list(got) == list(want)
         assert all(np.array_equal(got[n], want[n]) for n in want)
-        fastview.clear()
+        scene_kernel.clear()
         fresh = render_frames(state, size)
         assert all(np.array_equal(fresh[n], want[n]) for n in want)
 
@@ -114,7 +114,7 @@ def test_reducing_a_rectangle_is_that_part_of_the_reduction(a: int, b: int, c: i
     big = np.random.default_rng(a * 33 + b).integers(0, 256, (64, 64, 3)).astype(np.uint8)
     x0, x1, y0, y1 = min(a, c), max(a, c), min(b, d), max(b, d)
     out = np.zeros((32, 32, 3), np.uint8)
-    rasterjit.reduce2_into(big, out, x0, y0, x1, y1)
+    raster_kernel.reduce2_into(big, out, x0, y0, x1, y1)
     want = np.zeros_like(out)
-    want[y0:y1, x0:x1] = rasterjit.reduce2(big)[y0:y1, x0:x1]
+    want[y0:y1, x0:x1] = raster_kernel.reduce2(big)[y0:y1, x0:x1]
     assert np.array_equal(out, want)

@@ -19,7 +19,7 @@ from chaingeo.envs.gym import PuzzleEnv, StackingEnv
 from chaingeo.envs.machines import new_state
 from chaingeo.envs.machines.state import BaseState
 from chaingeo.envs.observation import state_images
-from chaingeo.pictures import fastview, rasterjit
+from chaingeo.pictures import raster_kernel, scene_kernel
 
 SIZE = 64
 coord = st.floats(-12.0, SIZE + 12.0, allow_nan=False).map(lambda v: round(v * 4) / 4)
@@ -39,12 +39,12 @@ def test_kernels_draw_pillows_pixels(
 ) -> None:
     image, draw, arr = _both()
     xy = np.array(pts, dtype=np.float64)
-    kind = rasterjit.POLYGON if fill else rasterjit.POLYLINE
+    kind = raster_kernel.POLYGON if fill else raster_kernel.POLYLINE
     if fill:
         draw.polygon(pts, fill=color)
     else:
         draw.line(pts, fill=color, width=width)
-    rasterjit.draw_shapes(
+    raster_kernel.draw_shapes(
         arr,
         np.array([kind], np.int64),
         np.array([0, len(pts)], np.int64),
@@ -67,14 +67,14 @@ def test_face_kernel_fills_then_outlines_like_pillow(
         ring = [(p[0], p[1]) for p in quad]
         draw.polygon(ring, fill=tuple(color))
         draw.line([*ring, ring[0]], fill=(0, 0, 0), width=width)
-    rasterjit.draw_faces(arr, quads, fills, np.zeros(3, np.uint8), width)
+    raster_kernel.draw_faces(arr, quads, fills, np.zeros(3, np.uint8), width)
     assert np.array_equal(np.asarray(image), arr)
 
 
 def test_reduce_kernel_is_pillows_reduce() -> None:
     pixels = np.random.default_rng(7).integers(0, 256, (2 * SIZE, 2 * SIZE, 3)).astype(np.uint8)
     expected = np.asarray(Image.fromarray(pixels).reduce(2))
-    assert np.array_equal(rasterjit.reduce2(pixels), expected)
+    assert np.array_equal(raster_kernel.reduce2(pixels), expected)
 
 
 @cache
@@ -96,7 +96,7 @@ def _assert_same(state: BaseState, size: int) -> None:
 
 @pytest.mark.slow  # by default the next test compares the same drawing on 8 levels
 def test_every_shipped_level_starts_with_the_reference_pictures() -> None:
-    fastview.clear()
+    scene_kernel.clear()
     for level in _shipped():
         _assert_same(new_state(level), 128)
 

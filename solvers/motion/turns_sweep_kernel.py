@@ -1,5 +1,5 @@
 """Exact quarter-turn sweeps in int64 (numba): the one stencil table, and the test for cells
-beyond it.
+beyond it. The reference it must equal is :mod:`chaingeo.core.turns`.
 
 The question is :func:`chaingeo.core.turns.square_hit`'s: does unit square ``s``, turning
 counter-clockwise through 90 degrees about O, overlap fixed unit square ``f`` (doubled
@@ -25,6 +25,7 @@ from typing import NamedTuple
 import numpy as np
 
 from chaingeo.core.arrays import I64
+from chaingeo.core.turns import edge_roots
 from chaingeo.kernels.jit import njit
 
 #: Stencils cover relative positions up to this (doubled units, both coordinates): every cell of
@@ -101,6 +102,10 @@ def _compare(base: I64, p: I64, q: I64) -> int:
     return -_cross(p, q)
 
 
+#: The reference's own crossing test, compiled (inlined where it is called).
+_edge_roots = njit(cache=True, inline="always")(edge_roots)
+
+
 @njit(cache=True)
 def _on_circle(x: int, y: int, m: int, out: I64) -> int:
     """Write into ``out`` the points where the circle of squared radius ``m`` (quadrupled units)
@@ -109,18 +114,12 @@ def _on_circle(x: int, y: int, m: int, out: I64) -> int:
     for i in range(2):
         s_i = x if i == 0 else y
         s_o = y if i == 0 else x
-        lo = 2 * s_o - 2
-        hi = 2 * s_o + 2
         for k in (2 * s_i - 2, 2 * s_i + 2):
+            roots = _edge_roots(m, k, 2 * s_o - 2, 2 * s_o + 2)
             h = m - k * k
-            if h < 0:
-                continue
-            for sign in (1, -1):
-                if sign > 0:
-                    ok = (lo <= 0 or h >= lo * lo) and (hi >= 0 and h <= hi * hi)
-                else:
-                    ok = (lo <= 0 and h <= lo * lo) and (hi >= 0 or h >= hi * hi)
-                if ok:
+            for j in range(2):
+                if roots >> j & 1:
+                    sign = 1 - 2 * j
                     if i == 0:
                         out[n, 0], out[n, 1], out[n, 2], out[n, 3] = k, 1, sign, h
                     else:

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from chaingeo.pictures.facesjit import visible_faces as fast_faces
 from chaingeo.pictures.raster import visible_faces
+from chaingeo.pictures.raster_faces_kernel import visible_faces as fast_faces
 from chaingeo.pictures.scene import BACK_CAMERA, CAMERAS
 from tests.support.equivalence import assert_same
 

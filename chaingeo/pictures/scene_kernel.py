@@ -1,8 +1,9 @@
 """The renderer's pictures, byte for byte, drawn on arrays by kernels and partly kept.
+The reference it must equal is :mod:`chaingeo.pictures.scene`.
 
 A view is the frame's background (walls, floor grid, back frame edges), the pieces' faces, the
 front frame edges, then titles, axis ticks, depth labels and the legend. Here every shape and
-every label is drawn by kernels (:mod:`chaingeo.pictures.rasterjit`: Pillow's own algorithms
+every label is drawn by kernels (:mod:`chaingeo.pictures.raster_kernel`: Pillow's own algorithms
 in numba; :mod:`chaingeo.pictures.texts`: runs of labels and swatches in one call each) on a
 numpy array. A layout's plan (projector, packed walls and edges, label steps) is kept long, its
 pixels shorter. In a box (stacking) the frame stays put, so all but the faces, depth labels and
@@ -30,8 +31,7 @@ import numpy.typing as npt
 
 from chaingeo.core.arrays import F64
 from chaingeo.kernels.jit import mode as jit_mode
-from chaingeo.pictures import rasterjit
-from chaingeo.pictures.facesjit import visible_faces
+from chaingeo.pictures import raster_kernel
 from chaingeo.pictures.labels import (
     Step,
     depth_labels,
@@ -53,6 +53,7 @@ from chaingeo.pictures.raster import (
     Projector,
     scaled,
 )
+from chaingeo.pictures.raster_faces_kernel import visible_faces
 from chaingeo.pictures.scene import (
     _BACKGROUND,
     _FRAME,
@@ -89,8 +90,8 @@ class _Plan:
 
     proj: Projector
     k: int  # drawing scale
-    walls: rasterjit.Packed  # walls, floor grid and back frame edges, at drawing scale
-    front: rasterjit.Packed | None  # the front frame edges
+    walls: raster_kernel.Packed  # walls, floor grid and back frame edges, at drawing scale
+    front: raster_kernel.Packed | None  # the front frame edges
     steps: tuple[Step, ...]  # titles and ticks, in drawing order
 
 
@@ -167,18 +168,20 @@ def _plan(scene: _Scene, cam: Camera, size: int, title: str | None, key: Hashabl
     edges = _frame_edges(scene, cam, back=False) if scene.has_box else []
     front: list[Flat] = [(1, np.stack([big_proj(p), big_proj(q)]), _FRAME, k) for p, q in edges]
     steps = _label_steps(scene, cam, size, proj, title)
-    made = _Plan(proj, k, walls, rasterjit.pack(front) if front else None, steps)
+    made = _Plan(proj, k, walls, raster_kernel.pack(front) if front else None, steps)
     return _keep(_PLANS, key, made, PLAN_CAPACITY)
 
 
 def _back(plan: _Plan, size: int) -> _Back:
     """The plan's background drawn by the kernels: walls, grid, back frame edges."""
-    big = rasterjit.blank(size * plan.k, _BACKGROUND).copy()
-    rasterjit.paint_packed(big, plan.walls)
+    big = raster_kernel.blank(size * plan.k, _BACKGROUND).copy()
+    raster_kernel.paint_packed(big, plan.walls)
     return _Back(plan, big)
 
 
-def _packed_walls(walls: list[tuple[RGB, F64, F64]], edges: list[F64], k: int) -> rasterjit.Packed:
+def _packed_walls(
+    walls: list[tuple[RGB, F64, F64]], edges: list[F64], k: int
+) -> raster_kernel.Packed:
     """``_wall_shapes`` and then the back frame edges, packed from their pixel arrays as they
     come (a frame that follows the pieces draws its walls anew on most pictures)."""
     pts: list[F64] = []
@@ -192,14 +195,14 @@ def _packed_walls(walls: list[tuple[RGB, F64, F64]], edges: list[F64], k: int) -
     pts += edges
     meta += [(1, 2, k)] * len(edges)
     colors += [_FRAME] * len(edges)
-    return rasterjit.Packed(
+    return raster_kernel.Packed(
         np.array(meta, dtype=np.int64), np.concatenate(pts), np.array(colors, dtype=np.uint8)
     )
 
 
 def _finish(back: _Back, big: Pixels) -> Pixels:
-    rasterjit.paint_packed(big, back.plan.front)
-    return rasterjit.reduce2(big) if back.plan.k > 1 else big
+    raster_kernel.paint_packed(big, back.plan.front)
+    return raster_kernel.reduce2(big) if back.plan.k > 1 else big
 
 
 def _label_steps(
@@ -258,7 +261,7 @@ def _pieces(back: _Back, faces: Faces, size: int) -> tuple[Pixels, F64]:
         big = back.big.copy()
     pix = scaled(back.plan.proj, k).screen(faces.corners)
     width = _Layout.of(size).edge_px(k)
-    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
+    raster_kernel.draw_faces(big, pix, faces.fills, _EDGE, width)
     return _finish(back, big), pix
 
 
@@ -299,12 +302,12 @@ def _with_faces(st: _Static, faces: Faces, cam: Camera, size: int) -> Pixels:
         return out
     big = _scratch(size * k, 0)
     big[y0 * k : y1 * k, x0 * k : x1 * k] = back.big[y0 * k : y1 * k, x0 * k : x1 * k]
-    rasterjit.draw_faces(big, pix, faces.fills, _EDGE, width)
-    rasterjit.paint_packed(big, plan.front)
+    raster_kernel.draw_faces(big, pix, faces.fills, _EDGE, width)
+    raster_kernel.paint_packed(big, plan.front)
     image = big
     if k > 1:
         image = _scratch(size, 1)
-        rasterjit.reduce2_into(big, image, x0, y0, x1, y1)
+        raster_kernel.reduce2_into(big, image, x0, y0, x1, y1)
     rect = (x0, y0, x1, y1)
     paint_steps(image, [s for s in plan.steps if overlaps(s.box, rect)])
     paint_steps(image, labels)

@@ -1,4 +1,5 @@
 """The visible faces of a view in fewer numpy calls: the same :class:`Faces`, element for element.
+The reference it must equal is :mod:`chaingeo.pictures.raster` (``visible_faces``).
 
 :func:`chaingeo.pictures.raster.visible_faces` spends most of its time on some twenty numpy
 calls on arrays of a few dozen cells (a view of a small scene took ~0.17 ms, four times per

@@ -1,4 +1,5 @@
 """Movement analysis on flat integer arrays (numba): who blocks whom, which groups move, how far.
+The reference it must equal is :mod:`chaingeo.core.kinematics`.
 
 Cutler's / BurrTools' method: for each axis ``a`` and each ordered pair of pieces ``(i, j)`` the
 gap ``g[a, i, j]`` is how far ``i`` can travel along ``+a`` while ``j`` stays put (``INF``: never

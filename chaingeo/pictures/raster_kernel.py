@@ -1,4 +1,5 @@
 """Pillow's polygon fill, lines and 2x2 reduction as numba kernels on ``(h, w, 3)`` uint8 arrays.
+The reference it must equal is :mod:`chaingeo.pictures.raster` (Pillow's drawing).
 
 The renderer draws thousands of small polygons and lines per observation through Pillow, one
 Python call each. These kernels follow Pillow's own C code (``libImaging/Draw.c``: vertices
@@ -170,30 +171,21 @@ def _line(cv: Canvas, x0: int, y0: int, x1: int, y1: int, c: U8) -> None:
         for _ in range(dx):
             _point(cv, x0, y0, c)
             x0 += xs
-    elif dx > dy:
-        n = dx
-        dy += dy
-        e = dy - dx
-        dx += dx
+    else:  # a step along the longer axis each point, along the shorter when the error says
+        x_major = dx > dy
+        n, m = (dx, dy) if x_major else (dy, dx)
+        lx, ly = (xs, 0) if x_major else (0, ys)
+        sx, sy = (0, ys) if x_major else (xs, 0)
+        e = m + m - n
         for _ in range(n):
             _point(cv, x0, y0, c)
             if e >= 0:
-                y0 += ys
-                e -= dx
-            e += dy
-            x0 += xs
-    else:
-        n = dy
-        dx += dx
-        e = dx - dy
-        dy += dy
-        for _ in range(n):
-            _point(cv, x0, y0, c)
-            if e >= 0:
-                x0 += xs
-                e -= dy
-            e += dx
-            y0 += ys
+                x0 += sx
+                y0 += sy
+                e -= n + n
+            e += m + m
+            x0 += lx
+            y0 += ly
 
 
 @njit(cache=True, inline="always")

@@ -1,18 +1,22 @@
 """Turn moves on flat integer arrays (numba): which groups can turn 90 degrees about which line.
+The reference it must equal is :mod:`chaingeo.core.turns`.
 
 The semantics are :mod:`chaingeo.core.turns` and :func:`chaingeo.core.kinematics.legal_turns` (the
 reference): a group turns about a line parallel to axis ``a`` through cell centres or cell corners
 (``centre2``, doubled cell units, the two coordinates across ``a`` of one parity) inside the
 group's bounding box, legal when it sweeps through no other piece of its part.
 
-As for translations (:mod:`chaingeo.solvers.motion.movement`), the legal groups of one turn (axis,
+As for translations (:mod:`chaingeo.solvers.motion.kinematics_kernel`), the legal groups of one
+turn (axis,
 sense, centre) are the sets closed under a relation between pieces, here "turning alone, ``j`` would
 sweep through ``i``": a group sweeps through nothing outside it exactly when it holds everyone its
 members sweep through. The relation comes from the exact swept-cell *stencils* of
-:mod:`chaingeo.solvers.motion.sweep` (one fixed table of relative positions near the axis, looked up
+:mod:`chaingeo.solvers.motion.turns_sweep_kernel` (one fixed table of relative positions near the
+axis, looked up
 in a hash of the state's cells) and, for cells further out, the exact pair test against the other
 pieces' cells of the same slice; the closed sets come from
-:func:`chaingeo.solvers.motion.movement.closed_groups`, never from trying subsets. No table or grid
+:func:`chaingeo.solvers.motion.kinematics_kernel.closed_groups`, never from trying subsets. No
+table or grid
 grows with how far apart the pieces stand: the work per centre is bounded by the cells (the centres
 are those of the part's box).
 
@@ -33,12 +37,19 @@ from chaingeo.core.geometry import ROTATIONS, Shape, rotation_index
 from chaingeo.core.turns import quarter_index
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.motion import bfs_kernel as bfs
-from chaingeo.solvers.motion import movement as mv
-from chaingeo.solvers.motion.sweep import FAR_LIMIT, StencilArrays, rmax2, rmin2, turn_hit
+from chaingeo.solvers.motion import kinematics_kernel as mv
+from chaingeo.solvers.motion.turns_sweep_kernel import (
+    FAR_LIMIT,
+    StencilArrays,
+    rmax2,
+    rmin2,
+    turn_hit,
+)
 
 N_ROT = 24
 #: Extra status of the search kernel: a cell lies beyond
-#: :data:`chaingeo.solvers.motion.sweep.FAR_LIMIT` of a turn's axis, where the exact int64 test
+#: :data:`chaingeo.solvers.motion.turns_sweep_kernel.FAR_LIMIT` of a turn's axis, where the exact
+#: int64 test
 #: would overflow.
 TOO_FAR = 5
 #: Move kinds in the search's move rows: 0..5 translations (``DIRECTIONS`` order), then turns
@@ -124,7 +135,7 @@ def gather(
     vox_all: I64, starts_all: I64, lo_all: I64, hi_all: I64, rod_all: I64, rot: I64
 ) -> tuple[I64, I64, I64, I64, I64]:
     """The per-piece arrays of one state (piece ``i`` in orientation ``rot[i]``), in the layout
-    of :func:`chaingeo.solvers.motion.movement.node_moves`, and the rod axes aligned with
+    of :func:`chaingeo.solvers.motion.kinematics_kernel.node_moves`, and the rod axes aligned with
     ``vox[0]``."""
     n = rot.shape[0]
     starts = np.zeros(n + 1, dtype=np.int64)
@@ -181,10 +192,11 @@ def node_turns(
     """List the legal turns of one state into ``out`` rows ``(mask, axis, sense, c0, c1,
     c2)`` (sense 0: +90, 1: -90; ``c`` the doubled centre, its axis component 0). Returns the
     row count; -1 if ``out`` is too small, -2 past ``group_limit`` groups of one turn, -3 when
-    a cell lies beyond :data:`chaingeo.solvers.motion.sweep.FAR_LIMIT` of a centre.
+    a cell lies beyond :data:`chaingeo.solvers.motion.turns_sweep_kernel.FAR_LIMIT` of a centre.
 
     A cell within ``bound`` of the axis looks its stencil (``st_*``,
-    :mod:`chaingeo.solvers.motion.sweep`) up in a hash of the occupied cells; a cell further out is
+    :mod:`chaingeo.solvers.motion.turns_sweep_kernel`) up in a hash of the occupied cells; a cell
+    further out is
     tested pair by pair against the other pieces' cells of its slice. Memory is linear in the cells,
     whatever their spread."""
     n = starts.shape[0] - 1
