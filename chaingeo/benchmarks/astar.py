@@ -2,8 +2,9 @@
 
 Both searches run in this process on the same puzzle, one after the other (the machines are
 shared, so compare the ratios of one run, not seconds across runs). Instances: the shipped
-suite levels of at most 12 pieces (their own ``max_group``), AlPackino (problem 0 of
-``../shared/burrtools/AlPackino.xmpuzzle``, when present) and the 36-piece towers of the suite
+suite levels of at most 12 pieces (their own ``max_group``), BurrTools' AlPackino, PelikanBurr
+and DraculasDentalDesaster (problem 0, from ``$CHAIN_BURRTOOLS_EXAMPLES`` or
+``../shared/burrtools``, when present) and the 36-piece towers of the suite
 played with multi-piece moves (``max_group`` None instead of the file's 1). On towers (levels
 named ``burr12`` ... ``burr36``) the class bound of :mod:`chaingeo.solvers.optimal.classbound` over
 the burr units is printed too (``class_bound``, its ``class_bound_classes`` and seconds), and
@@ -17,7 +18,9 @@ stops at its cap (``CHAIN_BENCH_CLASS_SEARCH_SECONDS``, default 900).
 
 Per instance and search: ``o_i`` (or the cap it stopped at), ``seconds``, and the states:
 ``astar_expanded`` / ``astar_stored`` whole states, ``bfs_states`` the states the
-branch-and-bound search stored over all its part searches (:attr:`Analysis.states`), and
+branch-and-bound search stored over all its part searches (:attr:`Analysis.states`),
+``plain_*`` the same search without peeling free pieces
+(:mod:`chaingeo.solvers.motion.optimal_part`), and
 ``astar_bound``: A*'s proven lower bound when it stops at a cap. JIT compilation is excluded
 (a warm-up runs first). Caps: ``CHAIN_BENCH_ASTAR_STATES`` stored A* states (default
 2,000,000) and ``CHAIN_BENCH_ASTAR_SECONDS`` per search (default 60); ``CHAIN_BENCH_ASTAR_ONLY``:
@@ -41,6 +44,10 @@ from chaingeo.core.kinematics import SearchLimitError
 
 Instance = tuple[str, dict[str, Shape], int | None]
 
+#: BurrTools' example files benched (problem 0, its stored assembly), from
+#: ``$CHAIN_BURRTOOLS_EXAMPLES`` or ``../shared/burrtools`` when present.
+BT_FILES = ("AlPackino", "PelikanBurr", "DraculasDentalDesaster")
+
 
 def _instances(quick: bool) -> list[Instance]:
     from chaingeo.core.level import load_levels
@@ -63,11 +70,15 @@ def _instances(quick: bool) -> list[Instance]:
         return out
     env = os.environ.get("CHAIN_BURRTOOLS_DIR")
     bt = Path(env) if env else root.parent / "shared" / "burrtools"
-    if (bt / "AlPackino.xmpuzzle").is_file():
-        from chaingeo.core.formats.burrtools import read_xmpuzzle
+    examples = os.environ.get("CHAIN_BURRTOOLS_EXAMPLES")
+    folders = [*([Path(examples)] if examples else []), bt]
+    for name in BT_FILES:
+        path = next((p for f in folders if (p := f / f"{name}.xmpuzzle").is_file()), None)
+        if path is not None:
+            from chaingeo.core.formats.burrtools import read_xmpuzzle
 
-        (asm,) = read_xmpuzzle(bt / "AlPackino.xmpuzzle").assemblies(0)
-        out.append(("AlPackino", {f"p{k:02d}": s for k, s in asm.items()}, None))
+            (asm,) = read_xmpuzzle(path).assemblies(0)
+            out.append((name, {f"p{k:02d}": s for k, s in asm.items()}, None))
     for tower in [lv for lv in levels if re.search(r"burr36", lv.id)]:
         out.append((f"{tower.id} (max_group None)", tower.shapes, None))
     return out
@@ -154,23 +165,28 @@ def _astar(
     }
 
 
-def _bfs(shapes: Mapping[str, Shape], max_group: int | None, seconds: float) -> dict[str, object]:
+def _bfs(
+    shapes: Mapping[str, Shape], max_group: int | None, seconds: float, peel: bool = True
+) -> dict[str, object]:
+    """The branch and bound (``bfs_*``), or without peeling free pieces (``plain_*``)."""
     from chaingeo.solvers.limits import SearchLimits
     from chaingeo.solvers.motion.disassemble import analyze_assembly
 
+    key = "bfs" if peel else "plain"
+    limits = SearchLimits(seconds=seconds)
     t0 = time.perf_counter()
     try:
-        a = analyze_assembly(shapes, max_group=max_group, limits=SearchLimits(seconds=seconds))
+        a = analyze_assembly(shapes, max_group=max_group, limits=limits, peel=peel)
     except SearchLimitError as e:
         return {
-            "bfs_o_i": None,
-            "bfs_stopped": str(e).split(";")[0],
-            "bfs_seconds": round(time.perf_counter() - t0, 3),
+            f"{key}_o_i": None,
+            f"{key}_stopped": str(e).split(";")[0],
+            f"{key}_seconds": round(time.perf_counter() - t0, 3),
         }
     return {
-        "bfs_o_i": a.optimal_steps,
-        "bfs_states": a.states,
-        "bfs_seconds": round(time.perf_counter() - t0, 3),
+        f"{key}_o_i": a.optimal_steps,
+        f"{key}_states": a.states,
+        f"{key}_seconds": round(time.perf_counter() - t0, 3),
     }
 
 
@@ -187,6 +203,7 @@ def run(args: argparse.Namespace) -> int:
         row: dict[str, object] = {"instance": name, "pieces": len(shapes), "max_group": max_group}
         row.update(_astar(shapes, max_group, states, seconds))
         row.update(_bfs(shapes, max_group, seconds))
+        row.update(_bfs(shapes, max_group, seconds, peel=False))
         if max_group is None:
             row.update(_class_bound(name, shapes))
         a_s, b_s = row.get("astar_seconds"), row.get("bfs_seconds")

@@ -114,6 +114,7 @@ class GroupedSolver(_Solver):
             shapes, max_group, limits, deadline=deadline, separations=separations, order=order
         )
         self.groups = groups
+        self.peel = False  # a piece of a group may stay: taking it out first is no longer exact
         self.grouped: list[list[str]] = []  # the parts accepted by rule 2
 
     def min_removals(self, members: tuple[int, ...]) -> int:

@@ -110,9 +110,23 @@ def slide_children(
 
 
 @njit(cache=True)
+def single_removal(moves_buf: I64, rows: int, n: int) -> int:
+    """The first of ``rows`` slides that removes one piece alone (or all but one), else -1."""
+    for r in range(rows):
+        if moves_buf[r, 3]:
+            mask = moves_buf[r, 0]
+            bits = 0
+            for b in range(n):
+                bits += (mask >> b) & 1
+            if bits == 1 or bits == n - 1:
+                return r
+    return -1
+
+
+@njit(cache=True)
 def expand(
     tree: Tree, n_states: int, node: int, layers: I64, n_layers: int, max_depth: int,
-    budget: int, pieces: Pieces, seps: I64, n_seps: int,
+    budget: int, pieces: Pieces, seps: I64, n_seps: int, peel: bool,
 ) -> tuple[int, int, int, int, int]:  # fmt: skip
     """Breadth-first search, layer after layer in one call (no Python between layers).
 
@@ -125,7 +139,9 @@ def expand(
     Returns ``(status, next node, n_states, n_seps, n_layers)``; on a status asking for a
     buffer the caller grows it and calls again from ``next`` (that node is expanded again from
     scratch, so its removals are dropped first). ``layers`` holds two more entries than
-    ``states`` rows (every layer has a node).
+    ``states`` rows (every layer has a node). With ``peel`` a node where one piece comes
+    free alone yields that removal only and no children (its value is known exactly: see
+    :mod:`chaingeo.solvers.motion.optimal_part`).
     """
     states = tree.states
     vox, starts, lo, hi, max_group, group_limit, moves_buf, groups_buf = pieces
@@ -157,6 +173,17 @@ def expand(
                 return TOO_MANY_GROUPS, node, n_states, n_seps, n_layers
             if rows == -1:
                 return NEED_MOVES, node, n_states, n_seps, n_layers
+            free = single_removal(moves_buf, rows, n) if peel else -1
+            if free >= 0:
+                if n_seps >= seps.shape[0]:
+                    return NEED_SEPS, node, n_states, n_seps, n_layers
+                seps[n_seps, 0] = node
+                seps[n_seps, 1] = moves_buf[free, 0]
+                seps[n_seps, 2] = moves_buf[free, 1]
+                n_seps += 1
+                node += 1
+                done += 1
+                continue
             status, n_states, n_seps = slide_children(
                 tree, node, n, rows, moves_buf, child, seps, n_seps, n_states
             )

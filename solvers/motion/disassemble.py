@@ -15,7 +15,9 @@ Semantics are those of :mod:`chaingeo.core.kinematics` (the reference); the sear
 * **Optimal plan**: the fewest moves that take *every* piece apart, over all ways of doing it.
   Parts never interact after a removal, so ``f(part) = min over reachable states s and removals
   r at s of dist(s) + 1 + f(removed) + f(left)``; a part of ``m`` pieces needs at least
-  ``m - 1`` removals, which bounds the search (branch and bound, memoised per part state).
+  ``m - 1`` removals, which bounds the search (branch and bound, memoised per part state); a
+  state where one piece comes free alone is a leaf, its value that removal plus the rest's
+  (:mod:`chaingeo.solvers.motion.optimal_part`).
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from chaingeo.solvers.motion import btsearch as bt
 from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion import levelsearch as ls
 from chaingeo.solvers.motion.btorient import BTImage, symmetries_of
+from chaingeo.solvers.motion.optimal_part import OptimalParts, PartKey
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PartSearch, PieceTable
 
 # Per-state helpers, at home in chaingeo.solvers.motion.partsearch, still importable from here.
@@ -57,7 +60,6 @@ __all__ = [
     "move_rows",
 ]
 
-_UNSOLVABLE = 1 << 30
 #: Nodes the level kernel may expand before the Python search (with its deadline) takes over:
 #: the Python search's own chunk between two clock readings.
 KERNEL_NODES = 20000
@@ -139,7 +141,6 @@ class Analysis:
         return cls(True, level, moves, steps, tuple(plan), tree, states, first_level, burrtools)
 
 
-PartKey = tuple[tuple[int, ...], bytes]
 #: ``"first"``: BurrTools' disassembler (its first separation or nothing); ``"any"``: any
 #: separation whose parts come apart.
 Separations = Literal["first", "any"]
@@ -149,7 +150,7 @@ Separations = Literal["first", "any"]
 Rods = Mapping[str, Mapping[Cell, int]]
 
 
-class _Solver:
+class _Solver(OptimalParts):
     """Searches of one puzzle, sharing the piece table, the caps, the deadline and memos.
 
     With ``turns`` a part's configuration is ``(n, 4)`` poses (offset, rotation index) in real
@@ -189,6 +190,8 @@ class _Solver:
         #: ``[lo, hi]`` proven on the whole puzzle's o_i while :meth:`optimal` searches it (set
         #: by the caller that asks for them; None otherwise).
         self.bounds: list[int] | None = None
+        #: Take a single piece free at a part's start out first (exact without piece groups).
+        self.peel = not turns
 
     def key(self, members: tuple[int, ...], offsets: np.ndarray) -> PartKey:
         if self.turn_table is not None:
@@ -204,7 +207,9 @@ class _Solver:
                 "max_total_states",
             )
 
-    def search(self, members: tuple[int, ...], offsets: np.ndarray) -> PartSearch | TurnPartSearch:
+    def search(
+        self, members: tuple[int, ...], offsets: np.ndarray, peel: bool = False
+    ) -> PartSearch | TurnPartSearch:
         self.check_total()
         if self.turn_table is not None:
             from chaingeo.solvers.motion.turnsearch import TurnPartSearch
@@ -224,6 +229,7 @@ class _Solver:
             max_group=self.max_group,
             limits=self.limits,
             deadline=self.deadline,
+            peel=peel,
         )
 
     # -- BurrTools-style tree ------------------------------------------------------------------
@@ -399,93 +405,6 @@ class _Solver:
         tree = self.part_tree(members, offsets)
         return tree is not None, tree
 
-    # -- optimal full disassembly --------------------------------------------------------------
-    def min_removals(self, members: tuple[int, ...]) -> int:
-        """Removals any plan needs to finish the part: every piece comes apart (with piece
-        groups, :class:`chaingeo.solvers.assembly.groups.GroupedSolver` needs fewer)."""
-        return len(members) - 1
-
-    def optimal(
-        self, members: tuple[int, ...], offsets: np.ndarray, budget: int, floor: int = 0
-    ) -> tuple[int, list[Move | TurnMove] | None]:
-        """``(f, plan)`` with ``f`` the fewest moves to take the part apart if that is below
-        ``budget``; otherwise ``(lower bound >= budget, None)``. ``floor`` is a proven lower
-        bound on ``f`` from the caller: the search stops as soon as a plan meets it."""
-        least = self.min_removals(members)
-        if least == 0:
-            return 0, []
-        if least >= budget:
-            return least, None
-        k = self.key(members, offsets)
-        memo = self.opt_memo.get(k)
-        if memo is not None:
-            value, exact, plan = memo
-            if exact:
-                return (value, plan) if value < budget else (value, None)
-            if value >= budget:
-                return value, None
-        top, self.bounds = self.bounds, None  # only the outermost call proves the whole's bounds
-        try:
-            return self._optimal_part(members, offsets, budget, floor, k, top)
-        finally:
-            self.bounds = top
-
-    def _optimal_part(
-        self,
-        members: tuple[int, ...],
-        offsets: np.ndarray,
-        budget: int,
-        floor: int,
-        k: PartKey,
-        top: list[int] | None,
-    ) -> tuple[int, list[Move | TurnMove] | None]:
-        """:meth:`optimal` past its memo: the search itself (``top``: the whole puzzle's
-        bounds, updated as they are proved, when this is the outermost call)."""
-        after = self.min_removals(members) - 1  # removals still needed after the first
-        s = self.search(members, offsets)
-        best, best_plan = budget, None
-        while not s.exhausted and s.depth + 1 + after < best and best > floor:
-            if top is not None:
-                # Every removal above the next layer has been tried: a shorter plan first
-                # separates there or deeper, then needs ``after`` more removals.
-                top[0] = max(top[0], min(best, s.depth + 1 + after))
-            removals = s.expand_layers(best - 2 - after)
-            if top is not None and removals:
-                top[0] = max(top[0], min(best, removals[0].depth + 1 + after))
-            for sp in s.unique_splits(removals):
-                if best <= floor:
-                    break
-                r = sp.removal
-                rm, roff, lm, loff = sp.removed, sp.removed_offsets, sp.left, sp.left_offsets
-                base = r.depth + 1
-                left_least = self.min_removals(lm)
-                if base + self.min_removals(rm) + left_least >= best:
-                    continue
-                fa, pa = self.optimal(rm, roff, best - base - left_least)
-                if pa is None:
-                    continue
-                fb, pb = self.optimal(lm, loff, best - base - fa)
-                if pb is None:
-                    continue
-                best = base + fa + fb
-                if top is not None:
-                    top[1] = min(top[1], best)
-                best_plan = [
-                    *s.path_to(r.node),
-                    s.removal_move(r),
-                    *pb,
-                    *pa,
-                ]
-        self.states += s.n_states
-        if best_plan is not None:
-            self.opt_memo[k] = (best, True, best_plan)
-            return best, best_plan
-        if s.exhausted and budget >= _UNSOLVABLE:
-            self.opt_memo[k] = (_UNSOLVABLE, True, [])  # every state seen: it never comes apart
-            return _UNSOLVABLE, None
-        self.opt_memo[k] = (budget, False, [])
-        return budget, None
-
 
 def _bt_frame_tree(shapes: Mapping[str, Shape], solver: _Solver) -> Separation | None:
     """BurrTools' tree of the puzzle as :func:`chaingeo.core.formats.bt_write.assembled_puzzle`
@@ -579,6 +498,7 @@ def analyze_assembly(
     separations: Separations = "first",
     order: Sequence[str] | None = None,
     fallback: bool = True,
+    peel: bool = True,
 ) -> Analysis:
     """Level, total moves and (if ``optimal``) o_i with one optimal plan, from the assembled
     state (every piece at offset zero, one part). ``lower_bound``: a *proven* lower bound on
@@ -591,10 +511,13 @@ def analyze_assembly(
     ``order``: the pieces in BurrTools' order (default: sorted names). Where BurrTools' first
     separation leaves a part that cannot come apart, ``fallback`` answers with any separation
     (``Analysis.burrtools`` False: the puzzle still comes apart, o_i is still searched); without
-    it the analysis says it does not come apart, as BurrTools does."""
+    it the analysis says it does not come apart, as BurrTools does. ``peel``: take free single
+    pieces out first in the optimal search (exact, :mod:`chaingeo.solvers.motion.optimal_part`;
+    off only to check it against the plain search)."""
     solver = _Solver(
         shapes, max_group, limits or SearchLimits(), turns, rods, deadline, separations, order
     )
+    solver.peel = peel and not turns
     n = len(solver.table.names)
     members = tuple(range(n))
     offsets = np.zeros((n, 4 if turns else 3), dtype=np.int64)

@@ -184,7 +184,7 @@ def greedy(
                 max_states, params[BUDGET] - ctx[EXPANDED],
                 mv.Pieces(vox, starts, lo, hi, params[MAX_GROUP], params[GROUP_LIMIT],
                           moves_buf, groups_buf),
-                seps, n_seps,
+                seps, n_seps, False,
             )  # fmt: skip
             ctx[EXPANDED] += node - before
             if status == bfs.DONE:

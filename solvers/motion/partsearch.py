@@ -172,6 +172,25 @@ class PartSearch(LayeredSearch[PieceTable]):
 
     CHUNK = 20000
 
+    def __init__(
+        self,
+        table: PieceTable,
+        members: Sequence[int],
+        offsets: np.ndarray,
+        *,
+        max_group: int | None,
+        limits: SearchLimits,
+        deadline: Deadline,
+        chunk: int | None = None,
+        peel: bool = False,
+    ) -> None:
+        #: Stop at states where one piece comes free alone (the optimal search's pruning).
+        self.peel = peel
+        super().__init__(
+            table, members, offsets, max_group=max_group, limits=limits, deadline=deadline,
+            chunk=chunk,
+        )  # fmt: skip
+
     def _begin(self, offsets: np.ndarray) -> None:
         n, limits = self.n, self.limits
         vox, starts, lo, hi = self.table.part_arrays(self.members)
@@ -246,7 +265,7 @@ class PartSearch(LayeredSearch[PieceTable]):
             self.deadline.check()
             status, self.node, self.n_states, self.n_seps, self.n_layers = _expand(
                 self.tree, self.n_states, self.node, self.layers, self.n_layers, deepest,
-                self.chunk, self.pieces, self.seps, self.n_seps,
+                self.chunk, self.pieces, self.seps, self.n_seps, self.peel,
             )  # fmt: skip
             if status == bfs.DONE:
                 break
