@@ -76,7 +76,7 @@ class BoxStack(NamedTuple):
     chosen: I32
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _sums(sizes: Any, cnt: Any, hi: Any) -> Any:
     """Bit set of the region sizes (< 64) the unused pieces can fill: sums of sub-multisets."""
     can = _ONE
@@ -87,7 +87,7 @@ def _sums(sizes: Any, cnt: Any, hi: Any) -> Any:
     return can
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _regions_fit(placed: Any, empty: Any, nb: Any, can: Any) -> bool:
     """Does every empty region touching the piece just placed have a size in ``can``?
     (Regions of 64 cells or more pass.)"""
@@ -126,7 +126,7 @@ def _exact_min(lmask: Any, a: int, b: int, empty: Any, table: Any, tally: Any) -
     return best, best_n
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _filter(
     lmask: Any, lrow: Any, runs: Any, k: int, occ: Any, primary: Any, cnt: Any, hi: Any,
     lo: Any, counters: Any, pieces: Any, table: Any, tally: Any, br: Any,

@@ -29,9 +29,10 @@ canonicalised (:func:`canonical_forms`). ``iter_packings(distinct=True, symmetry
 lists one solution per class from the reduced search (the default keeps the plain order).
 
 *Engines*: ``"bitboard"`` (the default, as ``"auto"``) or ``"dlx"`` (dancing links, MRV). The
-bit-board branches on the most constrained cell (``"bitboard-mrv"``, any size; ``"bitboard"``
-runs it, see :func:`chaingeo.solvers.cover.search.auto_kernel`) or, by name, on the first empty
-cell (``"bitboard-first"``, at most 64 cells). Every function
+bit-board branches on the first empty cell (``"bitboard-first"``, at most 64 cells) or on the
+most constrained cell (``"bitboard-mrv"``, any size); ``"bitboard"`` picks between them by the
+rule of :func:`chaingeo.solvers.cover.search.auto_kernel` (first cell for one-layer targets).
+Every function
 also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``target``).
 ``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
 the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a
