@@ -10,13 +10,11 @@ alive rows (pieces win ties, as in :mod:`chaingeo.solvers.cover.dlx`). When ever
 or more rows (near the root only: 21 thousand of 3.4 million nodes on the 2x5x6 solid pentominoes)
 the counts are taken exactly, cell by cell. A cell with no alive row,
 an exact-once piece with no alive row, or a piece type with fewer alive rows than it still needs
-ends the branch at once; so does, in box targets of one word, a placement that cuts off an empty
-region no set of pieces can fill (:func:`chaingeo.solvers.cover.bitboard.regions_ok`, same scan
-order).
+ends the branch at once.
 
-Targets over 64 cells use ``W = ceil(cells / 64)`` words per mask (:func:`_expand_wide`); on
-one-word targets :func:`_expand` is the same algorithm on scalars; one driver :func:`mrv_run`
-serves both, compiled apart for each (its multi-word side is None on one-word targets).
+Masks take ``W = ceil(cells / 64)`` words (:func:`_expand_wide`). The search runs this kernel
+on targets over 64 cells; targets of one word go to :mod:`chaingeo.solvers.cover.boxmrv`, the
+same choices on packed lists, with region pruning.
 Piece types carry count ranges exactly as in :mod:`chaingeo.solvers.cover.dlx`. ``nodes``
 counts rows placed (as in the DLX kernel: a row that completes a cover or ends in a dead end
 counts too); ``updates`` counts rows tested by the filter (the unit of work here).
@@ -31,7 +29,7 @@ import numpy as np
 from chaingeo.core.arrays import I32, I64, U64
 from chaingeo.kernels.jit import njit
 from chaingeo.solvers.cover import kernels as kn
-from chaingeo.solvers.cover.bitboard import DEBRUIJN_TABLE, region_pruning, regions_ok, scan_order
+from chaingeo.solvers.cover.bitboard import DEBRUIJN_TABLE, scan_order
 from chaingeo.solvers.cover.problem import CoverProblem
 
 _ONE = np.uint64(1)
@@ -60,31 +58,10 @@ def _with_count(v: int, b0: Any, b1: Any, b2: Any, b3: Any, sat: Any) -> Any:
     return x
 
 
-@njit(cache=True)
-def _exact_min(live: Any, a: int, b: int, mask: Any, empty: Any, table: Any, tally: Any) -> Any:
-    """``(cell, count)`` of the empty cell with fewest rows of ``live[a:b]`` (lowest bit on
-    ties), counted one by one (used only when every count is saturated)."""
-    tally[:] = 0
-    for i in range(a, b):
-        m = mask[live[i]] & empty
-        while m != _NONE:
-            tally[_low(m, table)] += 1
-            m &= m - _ONE
-    best, best_n = -1, 1 << 30
-    e = empty
-    while e != _NONE:
-        c = _low(e, table)
-        if tally[c] < best_n:
-            best, best_n = c, tally[c]
-        e &= e - _ONE
-    return best, best_n
-
-
 class MRVRows(NamedTuple):
-    """The problem side of a search (read only): row masks (``mask``: the first word, all that
-    one-word targets use), types and their count ranges, region pruning."""
+    """The problem side of a search (read only): row types and their count ranges (the masks
+    are in :class:`MRVWide`)."""
 
-    mask: U64
     rtype: I32
     rid: I32
     allrows: I32
@@ -94,20 +71,16 @@ class MRVRows(NamedTuple):
     counters: I32
     pieces: I32
     table: I32
-    nb: U64
-    region_gcd: int
-    region_min: int
 
 
 class MRVStack(NamedTuple):
     """The search side, resumable: level ``k`` has the alive rows ``live[lstart[k] :
-    lstart[k + 1]]``, occupancy ``occ[k]`` (its first word; :class:`MRVWide` has them all) and
-    branches ``br[k, :nbr[k]]`` (tried up to ``pos[k]``); the rest is scratch."""
+    lstart[k + 1]]`` (:class:`MRVWide` has the occupancies) and branches ``br[k, :nbr[k]]``
+    (tried up to ``pos[k]``); the rest is scratch."""
 
     cnt: I32
     live: I32
     lstart: I64
-    occ: U64
     tcount: I32
     tally: I32
     br: I32
@@ -117,7 +90,7 @@ class MRVStack(NamedTuple):
 
 
 class MRVWide(NamedTuple):
-    """The multi-word side of a search over more than 64 cells: row masks (rows, ``W``), the
+    """The multi-word side of a search: row masks (rows, ``W``), the
     occupancy of every level (levels, ``W``), the bit-sliced counters (5, ``W``) and scratch
     (2, ``W``: the occupancy being placed, the empty cells)."""
 
@@ -161,66 +134,6 @@ def _branches(
                 br[k] = j
                 k += 1
     return k
-
-
-@njit(cache=True)
-def _expand(
-    src: Any, a: int, b: int, live: Any, w: int, occ: Any, primary: Any,
-    mask: Any, rtype: Any, lo: Any, hi: Any, cnt: Any, tcount: Any, counters: Any,
-    pieces: Any, table: Any, tally: Any, br: Any,
-) -> tuple[int, int]:  # fmt: skip
-    """Filter ``src[a:b]`` to the rows alive under ``occ`` (written from ``live[w]``), pick the
-    branching cell or piece and write its rows to ``br``; returns ``(end of the alive list,
-    number of branches)`` with 0 branches for a dead end."""
-    b0 = _NONE
-    b1 = _NONE
-    b2 = _NONE
-    b3 = _NONE
-    sat = _NONE
-    tcount[:] = 0
-    n = w
-    cur = 0  # rows come grouped by type: count each type's run in a register
-    run = 0
-    for i in range(a, b):  # branch-free keep test: it is unpredictable
-        j = src[i]
-        m = mask[j]
-        t = rtype[j]
-        if t != cur:
-            tcount[cur] += run
-            cur = t
-            run = 0
-        keep = ((m & occ) == _NONE) & (cnt[t] < hi[t])
-        live[n] = j
-        n += keep
-        run += keep
-        m &= _NONE - np.uint64(keep)
-        c0 = b0 & m
-        b0 ^= m
-        c1 = b1 & c0
-        b1 ^= c0
-        c2 = b2 & c1
-        b2 ^= c1
-        sat |= b3 & c2
-        b3 ^= c2
-    tcount[cur] += run
-    empty = primary & ~occ
-    if empty & ~(b0 | b1 | b2 | b3 | sat):
-        return n, 0  # an empty cell no row can fill
-    best_t, best_n = _short_or_best(counters, pieces, lo, cnt, tcount)
-    if best_t == -2:
-        return n, 0  # not enough rows left for a piece still needed
-    cell = -1
-    for v in range(1, min(best_n, SATURATED)):  # cells strictly below the best piece
-        x = empty & _with_count(v, b0, b1, b2, b3, sat)
-        if x != _NONE:
-            cell, best_n = _low(x, table), v
-            break
-    if cell < 0 and best_n > SATURATED:
-        c, cn = _exact_min(live, w, n, mask, empty, table, tally)
-        if cn < best_n:
-            cell, best_n = c, cn
-    bit = _ONE << np.uint64(cell) if cell >= 0 else _NONE
-    return n, _branches(live, w, n, mask, bit, rtype, best_t, br)
 
 
 @njit(cache=True)
@@ -284,7 +197,9 @@ def _expand_wide(
 def _exact_min_wide(
     live: Any, a: int, b: int, masks: Any, empty: Any, table: Any, tally: Any, cell: int, best: int
 ) -> tuple[int, int]:
-    """:func:`_exact_min` on ``W`` words, keeping ``(cell, best)`` unless a cell has fewer."""
+    """``(cell, count)`` of the empty cell with fewest rows of ``live[a:b]`` (lowest bit on
+    ties) counted one by one, when every count is saturated; ``(cell, best)`` unless a cell has
+    fewer."""
     W = masks.shape[1]
     tally[:] = 0
     for i in range(a, b):
@@ -315,42 +230,29 @@ def _place_wide(occ: Any, add: Any, primary: Any, here: Any) -> bool:
 
 
 @njit(cache=True)
-def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide | None) -> int:
+def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide) -> int:
     """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`
-    (:class:`MRVStack` describes the levels). ``wide`` is None on one-word targets: numba
-    prunes the branches on ``wide is None`` when it compiles, so one-word targets get a driver
-    with no multi-word code in its loop (the occupancy stays in a register; a test per node
-    and a 2-D occupancy cost the merged driver 4-7%) and wider ones call :func:`_expand_wide`."""
-    mask, rtype, rid, allrows, primary, lo, hi, counters, pieces, table = rows[:10]
-    nb, region_gcd, region_min = rows[10:]
-    cnt, live, lstart, occ, tcount, tally, br, nbr, pos, chosen = st
+    (:class:`MRVStack` describes the levels)."""
+    rtype, rid, allrows, primary, lo, hi, counters, pieces, table = rows
+    cnt, live, lstart, tcount, tally, br, nbr, pos, chosen = st
     regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
     status = regs[kn.REG_STATUS]
     if status == kn.DONE:
         return 0
-    p0 = primary[0]
     nodes = regs[kn.REG_NODES]
     updates = regs[kn.REG_UPDATES]
     found = 0
     n_out = 0
-    if wide is not None:  # read once: the loop below runs per node
-        masks, wocc, planes, scratch = wide
-        here, empty = scratch[0], scratch[1]
+    masks, wocc, planes, scratch = wide
+    here, empty = scratch[0], scratch[1]
     if status == kn.FRESH:
         k = 0
-        occ[0] = _NONE
         lstart[0] = 0
-        if wide is None:
-            end, n_br = _expand(
-                allrows, 0, len(allrows), live, 0, _NONE, p0, mask, rtype, lo, hi, cnt,
-                tcount, counters, pieces, table, tally, br[0],
-            )  # fmt: skip
-        else:
-            wocc[0, :] = _NONE
-            end, n_br = _expand_wide(
-                allrows, 0, len(allrows), live, 0, wocc[0], primary, masks, rtype, lo, hi, cnt,
-                tcount, counters, pieces, table, tally, planes, empty, br[0],
-            )  # fmt: skip
+        wocc[0, :] = _NONE
+        end, n_br = _expand_wide(
+            allrows, 0, len(allrows), live, 0, wocc[0], primary, masks, rtype, lo, hi, cnt,
+            tcount, counters, pieces, table, tally, planes, empty, br[0],
+        )  # fmt: skip
         updates += len(allrows)
         lstart[1] = end
         nbr[0] = n_br
@@ -369,11 +271,7 @@ def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide | None) 
             pos[k] += 1
             nodes += 1
             chosen[k] = r
-            h0 = occ[k] | mask[r]
-            if wide is None:  # noqa: SIM108 (one branch per word count, like the others)
-                full = (h0 & p0) == p0
-            else:
-                full = _place_wide(wocc[k], masks[r], primary, here)
+            full = _place_wide(wocc[k], masks[r], primary, here)
             t = rtype[r]
             cnt[t] += 1
             if full:  # every mandatory cell covered
@@ -386,28 +284,17 @@ def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide | None) 
                     if (max_store > 0 and n_out == max_store) or found == stop_after:
                         break
                 continue
-            if region_min > 0 and not regions_ok(mask[r], p0 & ~h0, nb, region_gcd, region_min):
-                cnt[t] -= 1  # cuts off a region no set of pieces can fill (one-word targets)
-                continue
             a, b = lstart[k], lstart[k + 1]
             updates += b - a
-            if wide is None:
-                end, n_br = _expand(
-                    live, a, b, live, b, h0, p0, mask, rtype, lo, hi, cnt,
-                    tcount, counters, pieces, table, tally, br[k + 1],
-                )  # fmt: skip
-            else:
-                end, n_br = _expand_wide(
-                    live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
-                    tcount, counters, pieces, table, tally, planes, empty, br[k + 1],
-                )  # fmt: skip
+            end, n_br = _expand_wide(
+                live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
+                tcount, counters, pieces, table, tally, planes, empty, br[k + 1],
+            )  # fmt: skip
             if n_br == 0:
                 cnt[t] -= 1
                 continue
             k += 1
-            occ[k] = h0
-            if wide is not None:
-                wocc[k, :] = here
+            wocc[k, :] = here
             lstart[k + 1] = end
             nbr[k] = n_br
             pos[k] = 0
@@ -429,7 +316,7 @@ class MRVArrays:
     def __init__(self, problem: CoverProblem, rows: I32) -> None:
         n_cells = problem.n_cells
         self.words = W = max(1, -(-n_cells // 64))
-        bit = scan_order(problem)  # the first-cell kernel's order: regions_ok relies on it
+        bit = scan_order(problem)  # the other kernels' order: the same ties
         optional = np.zeros(n_cells, dtype=bool)
         if problem.optional:
             optional[sorted(problem.optional)] = True
@@ -450,7 +337,6 @@ class MRVArrays:
         self.rid = np.ascontiguousarray(rows)
         self.rtype = np.ascontiguousarray(problem.row_type[rows]).astype(np.int32)
         self.masks = masks
-        self.mask = np.ascontiguousarray(masks[:, 0])  # the one-word kernel's masks
         self.primary = primary
         self.allrows = np.arange(len(rows), dtype=np.int32)
         T = len(problem.types)
@@ -464,13 +350,9 @@ class MRVArrays:
         self.max_depth = min(n_primary, int(self.hi.sum()))
         per_type = np.bincount(self.rtype, minlength=T) if T else np.zeros(1, np.int64)
         self.max_col = max(int(per_cell.max(initial=0)), int(per_type.max(initial=0)), 1)
-        if W == 1:
-            nb, gcd, smallest = region_pruning(problem)
-        else:
-            nb, gcd, smallest = np.zeros(8, np.uint64), 1, 0
         self.rows = MRVRows(
-            self.mask, self.rtype, self.rid, self.allrows, primary, self.lo, self.hi,
-            self.counters, self.pieces, DEBRUIJN_TABLE, nb, int(gcd), int(smallest),
+            self.rtype, self.rid, self.allrows, primary, self.lo, self.hi, self.counters,
+            self.pieces, DEBRUIJN_TABLE,
         )  # fmt: skip
 
     def stack(self, depth: int, n_types: int) -> MRVStack:
@@ -479,7 +361,6 @@ class MRVArrays:
             cnt=np.zeros(n_types, dtype=np.int32),
             live=np.zeros((depth + 1) * max(len(self.rid), 1), dtype=np.int32),
             lstart=np.zeros(depth + 2, dtype=np.int64),
-            occ=np.zeros(depth + 1, dtype=np.uint64),
             tcount=np.zeros(max(n_types, 1), dtype=np.int32),
             tally=np.zeros(64 * self.words, dtype=np.int32),
             br=np.zeros((depth, self.max_col), dtype=np.int32),
@@ -488,11 +369,9 @@ class MRVArrays:
             chosen=np.zeros(depth, dtype=np.int32),
         )
 
-    def wide(self, depth: int) -> MRVWide | None:
-        """The multi-word side for ``depth`` levels; None on one-word targets."""
+    def wide(self, depth: int) -> MRVWide:
+        """The multi-word side for ``depth`` levels."""
         W = self.words
-        if W == 1:
-            return None
         return MRVWide(
             self.masks,
             np.zeros((depth + 1, W), dtype=np.uint64),

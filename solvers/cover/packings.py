@@ -31,8 +31,8 @@ lists one solution per class from the reduced search (the default keeps the plai
 *Engines*: ``"bitboard"`` (the default, as ``"auto"``) or ``"dlx"`` (dancing links, MRV). The
 bit-board branches on the first empty cell (``"bitboard-first"``, at most 64 cells) or on the
 most constrained cell (``"bitboard-mrv"``, any size); ``"bitboard"`` picks between them by the
-rule of :func:`chaingeo.solvers.cover.search.first_cell_wins` (first cell for one-layer targets and
-targets of at most 32 cells). Every function
+rule of :func:`chaingeo.solvers.cover.search.auto_kernel` (first cell for one-layer targets).
+Every function
 also accepts a compiled :class:`CoverProblem` in place of ``pieces`` (then no ``target``).
 ``nodes`` in :class:`CoverStats` are rows placed (the generator's difficulty proxy), ``updates``
 the engine's unit of work. At ``node_limit`` nodes a :class:`CoverLimitError` (a

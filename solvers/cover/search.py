@@ -29,6 +29,7 @@ from chaingeo.core.kinematics import SearchLimitError
 from chaingeo.solvers.cover import kernels
 from chaingeo.solvers.cover.bitboard import MAX_CELLS, BitboardArrays, bitboard_run
 from chaingeo.solvers.cover.bitmrv import MRVArrays, mrv_run
+from chaingeo.solvers.cover.boxmrv import BoxArrays, box_run
 from chaingeo.solvers.cover.dlx import DLXArrays, dlx_run
 from chaingeo.solvers.cover.problem import CoverError, CoverProblem
 from chaingeo.solvers.deadline import Deadline
@@ -36,8 +37,6 @@ from chaingeo.solvers.deadline import Deadline
 Engine = Literal["auto", "dlx", "bitboard", "bitboard-first", "bitboard-mrv"]
 Kernel = Literal["dlx", "bitboard-first", "bitboard-mrv"]
 ENGINES: tuple[str, ...] = ("auto", "dlx", "bitboard", "bitboard-first", "bitboard-mrv")
-#: Targets of at most this many cells always branch on the first empty cell (``"bitboard"``).
-FIRST_CELL_SMALL = 32
 NO_LIMIT = np.iinfo(np.int64).max
 #: Wall time one slice of a search under a deadline aims at, and the node budget of its first
 #: slice (one node of a wide MRV search over a large problem may take ~0.1 ms).
@@ -79,26 +78,26 @@ class CoverLimitError(SearchLimitError):
         self.stats = stats
 
 
-def first_cell_wins(problem: CoverProblem) -> bool:
-    """The automatic branching rule of the bit-board (``engine="bitboard"`` or ``"auto"``).
+def auto_kernel(problem: CoverProblem) -> Kernel:
+    """The kernel of ``engine="auto"`` (and ``"bitboard"``): the first empty cell in scan order
+    for one-layer targets of at most 64 cells, the most constrained cell (MRV) otherwise.
 
-    Branch on the first empty cell in scan order when the target has at most 64 cells and is
-    one layer thick (a planar problem) or has at most :data:`FIRST_CELL_SMALL` cells; branch
-    on the most constrained cell otherwise. In a layer the first empty cell sits on the edge of
-    the filled part, so it already has few fits, and it is found with one bit scan; in thicker
-    targets that cell has many fits and counting (MRV) cuts the tree 13-fold (46.4 M to 3.4 M
-    nodes on the 2x5x6 solid pentominoes). Measured raw counts, best-of-3 CPU seconds
-    (first / MRV): pentominoes 6x10 1.18 / 1.37, 5x12 0.67 / 0.70, Soma 0.054 / 0.064, solid
-    pentominoes 2x5x6 9.2 / 1.96.
+    In a layer the first empty cell sits on the edge of the filled part, so it already has few
+    fits, and it is found with one bit scan; in thicker targets that cell has many fits and MRV
+    cuts the tree 13-fold (46.4 M to 3.4 M nodes on the 2x5x6 solid pentominoes). Since the
+    one-word MRV kernel reads its rows in order (:mod:`chaingeo.solvers.cover.boxmrv`) it wins
+    the unreduced planar counts too, but not the symmetry-reduced ones that ``chain cover``
+    runs. Measured CPU seconds on a loaded machine, first / MRV: Soma 0.045 / 0.039 reduced,
+    0.083 / 0.066 raw; 2x5x6 0.79 / 0.30 reduced, 14.5 / 1.8 raw; pentominoes 6x10 0.25 /
+    0.36 reduced, 1.92 / 1.38 raw; 5x12 0.16 / 0.25 reduced, 1.08 / 0.68 raw.
     """
-    ext = problem.target.extent
-    n = problem.n_cells
-    return n <= MAX_CELLS and (min(ext) == 1 or n <= FIRST_CELL_SMALL)
+    flat = min(problem.target.extent) == 1
+    return "bitboard-first" if flat and problem.n_cells <= MAX_CELLS else "bitboard-mrv"
 
 
 def choose_kernel(problem: CoverProblem, engine: Engine) -> Kernel:
     """The kernel an engine name runs on ``problem`` (``auto`` and ``bitboard``: the
-    bit-board, with the branching of :func:`first_cell_wins`)."""
+    bit-board, with the branching of :func:`auto_kernel`)."""
     if engine not in ENGINES:
         raise CoverError(f"engine: expected one of {', '.join(ENGINES)}, got {engine!r}")
     if engine == "bitboard-first" and problem.n_cells > MAX_CELLS:
@@ -109,7 +108,7 @@ def choose_kernel(problem: CoverProblem, engine: Engine) -> Kernel:
         return "dlx"
     if engine in ("bitboard-first", "bitboard-mrv"):
         return engine
-    return "bitboard-first" if first_cell_wins(problem) else "bitboard-mrv"
+    return auto_kernel(problem)
 
 
 def choose_engine(problem: CoverProblem, engine: Engine) -> Literal["dlx", "bitboard"]:
@@ -117,7 +116,7 @@ def choose_engine(problem: CoverProblem, engine: Engine) -> Literal["dlx", "bitb
     return "dlx" if choose_kernel(problem, engine) == "dlx" else "bitboard"
 
 
-Arrays = DLXArrays | BitboardArrays | MRVArrays
+Arrays = DLXArrays | BitboardArrays | MRVArrays | BoxArrays
 
 
 def _arrays(problem: CoverProblem, rows: I32, kernel: Kernel) -> Arrays:
@@ -128,12 +127,14 @@ def _arrays(problem: CoverProblem, rows: I32, kernel: Kernel) -> Arrays:
             hit = DLXArrays(problem, rows)
         elif kernel == "bitboard-first":
             hit = BitboardArrays(problem, rows)
+        elif problem.n_cells <= MAX_CELLS:
+            hit = BoxArrays(problem, rows)
         else:
             hit = MRVArrays(problem, rows)
         if len(problem._cache) > 32:
             problem._cache.clear()
         problem._cache[key] = hit
-    assert isinstance(hit, DLXArrays | BitboardArrays | MRVArrays)
+    assert isinstance(hit, DLXArrays | BitboardArrays | MRVArrays | BoxArrays)
     return hit
 
 
@@ -196,6 +197,8 @@ class CoverSearch:
         elif isinstance(a, BitboardArrays):
             self._occ = np.zeros(depth + 1, dtype=np.uint64)
             self._cnt = np.zeros(len(problem.types), dtype=np.int32)
+        elif isinstance(a, BoxArrays):
+            self._box = a.stack(depth, len(problem.types))
         else:
             self._stack = a.stack(depth, len(problem.types))
             self._wide = a.wide(depth)
@@ -237,6 +240,8 @@ class CoverSearch:
                 self._cnt, self._perm, self._nbuf, self._pos, self._aux, self._chosen
             )
             return bitboard_run(a.rows, self._occ, lv, ctl)
+        if isinstance(a, BoxArrays):
+            return box_run(a.rows, self._box, ctl)
         return mrv_run(a.rows, self._stack, ctl, self._wide)
 
     def _call(self, max_store: int, stop_after: int) -> I32:

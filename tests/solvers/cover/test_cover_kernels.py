@@ -96,7 +96,7 @@ def test_automatic_rule(box: tuple[int, int, int]) -> None:
     pieces = SOMA.pieces if box == (3, 3, 3) else PENTOMINOES.pieces
     problem = cover_problem(pieces, box)
     expected = {
-        (3, 3, 3): "bitboard-first",  # at most 32 cells
+        (3, 3, 3): "bitboard-mrv",  # thick
         (6, 10, 1): "bitboard-first",  # one layer
         (2, 5, 6): "bitboard-mrv",  # thick
         (4, 4, 5): "bitboard-mrv",  # over 64 cells
