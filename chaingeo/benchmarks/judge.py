@@ -38,8 +38,6 @@ TUNING: Final = 0
 HELD_OUT: Final = 1_000_000
 #: Verdict frames counted as the onset: this many before its first frame, after its last.
 EARLY, LATE = 2, 8
-#: The judge's older names for two kinds.
-_LEGACY: Final = {"lost": "disappear", "added": "appear"}
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -91,8 +89,7 @@ def score(case: Case, violations: list[Any]) -> bool:
         return bool(violations)
     accept = ACCEPT[case.kind]
     for e in violations:
-        kind = _LEGACY.get(e.kind, e.kind)
-        if kind not in accept or not case.frame - EARLY <= e.frame <= case.end + LATE:
+        if e.kind not in accept or not case.frame - EARLY <= e.frame <= case.end + LATE:
             continue
         named = {n.split("-")[0] for n in (e.piece, e.other) if n}
         if named & set(case.pieces) or _on_truth(case, e.masks):

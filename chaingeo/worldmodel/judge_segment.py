@@ -510,11 +510,24 @@ def unknown(frame: U8, masks: list[Bools]) -> Bools:
     border shows (a grey ground, its shadows, white): colours within BACKGROUND_CHROMA of its
     median chroma (CIELAB a*, b*), at any lightness. A gap through such pixels is no break."""
     lab = _table_lab()[_table_index(frame)]
-    ring = np.zeros(frame.shape[:2], dtype=bool)
+    near, piece = _near_ground(lab, masks)
+    out: Bools = ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
+    return out
+
+
+def ground(frame: U8, masks: list[Bools]) -> Bools:
+    """Pixels of no piece class whose chroma is the background's (see :func:`unknown`): open
+    ground, its shadows, white; not a piece of a colour the palette missed."""
+    near, piece = _near_ground(_table_lab()[_table_index(frame)], masks)
+    out: Bools = near & ~piece
+    return out
+
+
+def _near_ground(lab: F64, masks: list[Bools]) -> tuple[Bools, Bools]:
+    ring = np.zeros(lab.shape[:2], dtype=bool)
     ring[:3], ring[-3:], ring[:, :3], ring[:, -3:] = True, True, True, True
     piece = np.logical_or.reduce(masks) if masks else np.zeros_like(ring)
     edge = ring & ~piece
     a0, b0 = (float(np.median(lab[..., c][edge])) if edge.any() else 0.0 for c in (1, 2))
-    near = np.hypot(lab[..., 1] - a0, lab[..., 2] - b0) <= BACKGROUND_CHROMA
-    out: Bools = ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
-    return out
+    near: Bools = np.hypot(lab[..., 1] - a0, lab[..., 2] - b0) <= BACKGROUND_CHROMA
+    return near, piece

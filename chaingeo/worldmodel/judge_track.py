@@ -15,7 +15,7 @@ keeps its area, is reported as undecided rather than lost.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Final
 
 import numpy as np
@@ -64,8 +64,8 @@ class Obj:
 
 @dataclass(frozen=True)
 class Event:
-    """A change between frames ``frame - 1`` and ``frame``: a violation kind (lost, added,
-    split, merge, recolor), or a note (entered, left, hidden)."""
+    """A change between frames ``frame - 1`` and ``frame``: a violation kind (disappear, appear,
+    split, merge, recolour), or a note (entered, left, hidden)."""
 
     kind: str
     frame: int
@@ -76,9 +76,24 @@ class Event:
     #: How many of ``masks`` (the first ones) are seen in frame ``frame - 1``; the rest in
     #: ``frame``.
     before: int = 1
+    #: The last frame the change shows in (None: ``frame`` alone).
+    last: int | None = None
+
+    @property
+    def until(self) -> int:
+        return self.frame if self.last is None else self.last
 
 
-VIOLATIONS: Final = ("lost", "added", "split", "merge", "recolor", "teleport", "pass_through")
+VIOLATIONS: Final = (
+    "disappear",
+    "appear",
+    "recolour",
+    "split",
+    "merge",
+    "duplicate",
+    "teleport",
+    "pass_through",
+)
 
 
 def _boundary_points(mask: Bools, limit: int = 300) -> np.ndarray:
@@ -251,7 +266,7 @@ class Tracker:
         for e in self._identity():
             if not any(
                 o.piece == e.piece
-                and o.kind in ("recolor", "merge")
+                and o.kind in ("recolour", "merge")
                 and abs(o.frame - e.frame) <= 3
                 for o in out
             ):
@@ -314,11 +329,13 @@ class Tracker:
                 if moved > 0.3 * p.area:
                     continue  # the other colour moved elsewhere too: it came over this piece
                 name, other = self.names[p.cls], self.names[j]
+                # beside a piece of the new colour it reads as fused: still a recolour, as the
+                # piece keeps its place (a merge moves on with the other)
                 joined = bool((dilate(p.mask, 2) & was).any())
-                kind = "merge" if joined else "recolor"
-                how = "fused into" if joined else "turned"
+                kind = "recolour"
+                how = "turned (as if fused into)" if joined else "turned"
                 detail = f"the {name} piece {how} {other} over {lag} frames"
-                return Event(kind, b, name, other, detail, (p.mask, now[0]))
+                return Event(kind, b, name, other, detail, (p.mask, now[0]), last=t)
         return None
 
     def _jumps(self) -> list[Event]:
@@ -396,13 +413,16 @@ class Tracker:
             if gone:
                 other = self.names[gone[0].cls]
                 detail = f"the {other} piece turned {name}"
-                out.append(Event("recolor", b, other, name, detail, (gone[0].mask, c.mask)))
+                out.append(Event("recolour", b, other, name, detail, (gone[0].mask, c.mask)))
             elif self._against_others(c, b):
                 detail = f"a {name} part came into sight beside another piece"
                 out.append(Event("revealed", b, name, None, detail))
+            elif any(self._touching(o, before) for o in now if o is not c):
+                detail = f"a second {name} piece appeared in open view beside the first"
+                out.append(Event("duplicate", b, name, None, detail, (c.mask,), before=0))
             else:
                 detail = f"a {name} piece appeared in open view, away from the border"
-                out.append(Event("added", b, name, None, detail, (c.mask,), before=0))
+                out.append(Event("appear", b, name, None, detail, (c.mask,), before=0))
         return out
 
     def _fast_move(self, p: Obj, c: Obj) -> bool:
@@ -441,7 +461,9 @@ class Tracker:
                 detail = f"{len(hit)} separate {name} parts fused into one"
                 return [Event("merge", b, name, name, detail, masks, before=len(hit))]
         out = [self._vanished(p, b) for p in before if not self._touching(p, now)]
-        return [e for e in out if e.kind != "recolor"]  # a recolour is reported by the new class
+        # a recolour is reported by the new class, unless the new colour's piece just grew
+        return [replace(e, kind="recolour") if e.kind == "fused" else e for e in out
+                if e.kind != "recolour"]  # fmt: skip
 
     def _vanished(self, p: Obj, b: int) -> Event:
         name = self.names[p.cls]
@@ -452,7 +474,7 @@ class Tracker:
             return Event("hidden", b, name, None, detail, (p.mask,))
         if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
             return Event(
-                "lost", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
+                "disappear", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
             )
         others = [o for o in self.frames[b] if o.cls != p.cls]
         if not others:
@@ -462,11 +484,13 @@ class Tracker:
         was = [o for o in self.frames[b - 1] if o.cls == cover.cls]
         was_there = [o for o in was if (dilate(o.mask, self.reach) & cover.mask).any()]
         if not was_there:
-            return Event("recolor", b, name, other, f"the {name} piece turned {other}")
+            return Event("recolour", b, name, other, f"the {name} piece turned {other}")
         grew = cover.area - sum(o.area for o in was_there)
         if grew >= 0.7 * p.area and not self._of(b, p.cls):
-            detail = f"the {name} piece fused into the {other} piece (its area grew by {grew} px)"
-            return Event("merge", b, name, other, detail, (p.mask, cover.mask))
+            # the pixels took the other piece's colour; whether the two then move as one is
+            # not seen here, so it is named for what shows
+            detail = f"the {name} piece turned {other}, joined to the {other} piece (+{grew} px)"
+            return Event("fused", b, name, other, detail, (p.mask, cover.mask))
         detail = f"the {name} piece went out of sight behind the {other} piece"
         return Event("hidden", b, name, other, detail, (p.mask, cover.mask))
 
@@ -535,7 +559,7 @@ class Tracker:
             if all(len(x) == 1 and (x[0].mask & was.mask).sum() < 0.2 * x[0].area for x in later):
                 other = self.names[o.cls]
                 detail = f"the {other} piece now shows as {self.names[k]} (and the reverse)"
-                return Event("recolor", b, other, self.names[k], detail, (o.mask, c.mask))
+                return Event("recolour", b, other, self.names[k], detail, (o.mask, c.mask))
         return None
 
 

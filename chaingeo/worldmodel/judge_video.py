@@ -4,7 +4,8 @@ Video models asked to show a Lu Ban lock come apart push beams through each othe
 fuse, add and lose pieces (CHAIN judged this by hand). This judge reads a video (bounded by
 :mod:`chaingeo.core.limits` before decoding), segments pieces by their hinted colours
 (:mod:`chaingeo.worldmodel.judge_segment`), tracks them
-(:mod:`chaingeo.worldmodel.judge_track`) and, when the level is given and the video is drawn by
+(:mod:`chaingeo.worldmodel.judge_track`), reads each colour's existence from its pixels
+(:mod:`chaingeo.worldmodel.judge_exist`) and, when the level is given and the video is drawn by
 our own camera, checks every lattice move it can read against the kinematics
 (:mod:`chaingeo.worldmodel.judge_pose`). What it cannot decide it says in ``undecided``, never
 as a verdict.
@@ -25,6 +26,7 @@ from PIL import Image
 from chaingeo.core import limits
 from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.errors import ChainGeoError
+from chaingeo.worldmodel.judge_exist import Existence, join
 from chaingeo.worldmodel.judge_segment import (
     RENDER_SHADES,
     SHADES,
@@ -33,6 +35,7 @@ from chaingeo.worldmodel.judge_segment import (
     class_masks,
     confusable,
     dilate,
+    ground,
     min_area,
     palette_model,
     shrink,
@@ -213,6 +216,7 @@ class Verdict:
     def to_json(self, evidence: dict[int, str] | None = None) -> dict[str, Any]:
         def row(i: int, e: Event) -> dict[str, Any]:
             r: dict[str, Any] = {"kind": e.kind, "frame": e.frame, "piece": e.piece}
+            r["frames"] = [e.frame, e.until]
             if e.other is not None:
                 r["other"] = e.other
             r["detail"] = e.detail
@@ -255,6 +259,9 @@ def judge_frames(
     events = Tracker(objects, model.names).events()
     shape = frames[0].shape[:2]
     kept = [[_union(objs, k, shape) for k in range(len(model.names))] for objs, _ in objects]
+    solids = [solid for _, solid in objects]
+    grounds = [ground(f, m) for f, m in zip(frames, masks, strict=True)]
+    events = join(events, Existence(kept, grounds, model.names, area).events())
     undecided: list[str] = []
     if level is not None and colors:
         events, undecided = _with_level(level, colors, model.names, events, kept, area)
@@ -263,13 +270,13 @@ def judge_frames(
             "pass_through: motion through another piece is not decidable without the level's "
             "geometry and a known camera (give --level for a video drawn by chain video)"
         )
-    solids = [solid for _, solid in objects]
     events = [_sunk(e, masks, solids, model.names) for e in events]
     misread = [e for e in events if _misread(frames, masks, kept, e, model.names)]
     undecided += [f"frame {e.frame}: {e.detail} (but it was misread)" for e in misread]
     events = [e for e in events if e not in misread]
     hidden = [e for e in events if e.kind == "hidden"]
     undecided += [f"frame {e.frame}: {e.detail} (occluded, or lost)" for e in hidden]
+    events = [_spanned(e, kept, model.names) for e in events]
     violations = tuple(e for e in events if e.kind in VIOLATIONS)
     notes = tuple(e for e in events if e.kind not in VIOLATIONS)
     return Verdict(violations, notes, tuple(undecided), model, len(frames))
@@ -328,24 +335,45 @@ def _misread(
     """Whether a piece said to vanish (appear) is still there (already there) in the other
     frame: drawn alike in both, or its colour seen nearby in fragments each below the least area
     (small cells in a small picture): a misreading, not an event."""
-    if e.kind not in ("lost", "added") or not e.masks or e.frame < 1 or not e.masks[0].any():
+    if (
+        e.kind not in ("disappear", "appear", "duplicate")
+        or not e.masks
+        or e.frame < 1
+        or not e.masks[0].any()
+    ):
         return False
     m = e.masks[0]
     a, b = frames[e.frame - 1][m].astype(np.int64), frames[e.frame][m].astype(np.int64)
     if float(np.abs(a - b).mean()) < UNCHANGED:
         return True
-    other = e.frame if e.kind == "lost" else e.frame - 1
+    other = e.frame if e.kind == "disappear" else e.frame - 1
     k = names.index(e.piece)
     near = dilate(m, max(2, round(NEAR_SHARE * max(m.shape))))
     fragments = masks[other][k] & ~kept[other][k]
     return float((fragments & near).sum()) >= 0.5 * float(m.sum())
 
 
+def _spanned(e: Event, kept: list[list[Bools]], names: tuple[str, ...]) -> Event:
+    """The frame range of an event whose end the tracker left open: a piece that disappeared
+    stays gone (one that appeared stays) until its colour's area there turns back."""
+    if e.last is not None or e.kind not in ("disappear", "appear", "duplicate") or not e.masks:
+        return e
+    m, k = e.masks[0], names.index(e.piece)
+    gone = e.kind == "disappear"
+    last = len(kept) - 1
+    for u in range(e.frame + 1, len(kept)):
+        seen = float((kept[u][k] & m).sum()) >= 0.5 * float(m.sum())
+        if seen == gone:
+            last = u - 1
+            break
+    return replace(e, last=last)
+
+
 def _sunk(e: Event, masks: list[list[Bools]], solids: list[Bools], names: tuple[str, ...]) -> Event:
     """A piece said lost whose last silhouette was mostly surrounded by other pieces (or the
     box's wire frame) and whose colour still shows in fragments where it was: it went out of
     sight among them (a piece lowered into a box behind pieces placed before), not lost."""
-    if e.kind != "lost" or not e.masks or e.frame < 1:
+    if e.kind != "disappear" or not e.masks or e.frame < 1:
         return e
     m, k = e.masks[0], names.index(e.piece)
     ring = dilate(m, 2) & ~m

@@ -134,10 +134,10 @@ def test_a_piece_blanked_out_of_our_stacking_gif_is_still_lost(name: str) -> Non
     ]
     assert len(targets) >= 2
     for t, k in (targets[0], targets[-1]):  # a piece waiting early, one placed late
-        cut = frames[:t] + [_corrupt("lost", f, colors, k) for f in frames[t:]]
+        cut = frames[:t] + [_corrupt("disappear", f, colors, k) for f in frames[t:]]
         found = _kinds(cut, colors, lv)
         assert any(
-            kind == "lost" and abs(f - t) <= 2 and p == colors[k][0] for kind, f, p in found
+            kind == "disappear" and abs(f - t) <= 2 and p == colors[k][0] for kind, f, p in found
         ), (t, colors[k][0], found)
 
 
@@ -174,9 +174,9 @@ def _targets(name: str, kind: str) -> tuple[tuple[int, int], ...]:
     out = []
     for t in range(n // 5, n // 2, 3):
         for k in range(len(colors)):
-            need = [k, (k + 1) % len(colors)] if kind == "recolor" else [k]
+            need = [k, (k + 1) % len(colors)] if kind == "recolour" else [k]
             if all(_in_view(frames[u], colors, q) for u in range(t, t + 7) for q in need) and (
-                kind != "recolor" or all(_still(frames, colors, q, t) for q in need)
+                kind != "recolour" or all(_still(frames, colors, q, t) for q in need)
             ):
                 out.append((t, k))
     return tuple(out)
@@ -197,7 +197,7 @@ def corrupted(draw: st.DrawFn, kind: str) -> tuple[list[U8], Colors, int, set[st
     t, k = draw(st.sampled_from(options))
     for i in range(t, len(frames)):
         frames[i] = _corrupt(kind, frames[i], colors, k)
-    swapped = {colors[(k + 1) % len(colors)][0]} if kind == "recolor" else set()
+    swapped = {colors[(k + 1) % len(colors)][0]} if kind == "recolour" else set()
     return frames, colors, t, {colors[k][0], *swapped}, name
 
 
@@ -205,17 +205,17 @@ def _corrupt(kind: str, frame: U8, colors: Colors, k: int) -> U8:
     out = frame.copy()
     m = _mask(frame, colors, k)
     ys = np.nonzero(m)[0]
-    if kind == "lost":
+    if kind == "disappear":
         out[m] = BLANK
     elif kind == "split":  # a background band through the middle, across the piece
         cy = int(np.median(ys))
         band = np.zeros_like(m)
         band[cy - 4 : cy + 5] = True
         out[m & band] = BLANK
-    elif kind in ("recolor", "paint"):  # swapped with the next piece's colour / painted in it
+    elif kind in ("recolour", "paint"):  # swapped with the next piece's colour / painted in it
         other = (k + 1) % len(colors)
         _paint(out, frame, m, colors[other][1])
-        if kind == "recolor":
+        if kind == "recolour":
             _paint(out, frame, _mask(frame, colors, other), colors[k][1])
     return out
 
@@ -227,7 +227,7 @@ def _paint(out: U8, frame: U8, m: Bools, color: tuple[int, int, int]) -> None:
 
 
 @pytest.mark.parametrize("with_level", [False, True])
-@pytest.mark.parametrize("kind", ["lost", "split", "recolor"])
+@pytest.mark.parametrize("kind", ["disappear", "split", "recolour"])
 @settings(max_examples=3, deadline=None, derandomize=True)
 @given(data=st.data())
 def test_corruptions_are_caught_with_kind_and_frame(
@@ -265,7 +265,8 @@ def test_added_piece_is_caught(with_level: bool) -> None:
     for i in range(t, len(frames)):
         frames[i] = _paste(frames[i], frames[t], m, dy, dx)
     found = _kinds(frames, colors, _level(name) if with_level else None)
-    assert any(k == "added" and abs(f - t) <= 2 and p == colors[1][0] for k, f, p in found), found
+    copy = ("appear", "duplicate")  # a copy while the piece is in view: duplicate
+    assert any(k in copy and abs(f - t) <= 2 and p == colors[1][0] for k, f, p in found), found
 
 
 def test_merge_of_two_pieces_is_caught() -> None:
@@ -276,7 +277,7 @@ def test_merge_of_two_pieces_is_caught() -> None:
     for i in range(t, len(frames)):
         frames[i] = _corrupt("paint", frames[i], colors, 2)
     found = _kinds(frames, colors)
-    assert any(k in ("merge", "recolor") and f == t for k, f, _ in found), found
+    assert any(k in ("merge", "recolour") and f == t for k, f, _ in found), found
 
 
 def test_one_noisy_frame_is_not_a_violation() -> None:
@@ -323,7 +324,7 @@ def test_cli_verdict_and_exit_status(tmp_path: Path, capsys: pytest.CaptureFixtu
     colors = _colors(level)
     t = len(frames) // 2
     for i in range(t, len(frames)):
-        frames[i] = _corrupt("lost", frames[i], colors, 2)
+        frames[i] = _corrupt("disappear", frames[i], colors, 2)
     from PIL import Image
 
     images = [Image.fromarray(f) for f in frames]
@@ -333,8 +334,11 @@ def test_cli_verdict_and_exit_status(tmp_path: Path, capsys: pytest.CaptureFixtu
     code = main(["judge-video", str(path), "--level", str(level.id), "--evidence", str(ev)])
     report = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
     assert code == 1 and report["valid"] is False
-    assert {"kind", "frame", "piece"} <= set(report["violations"][0])
+    assert {"kind", "frame", "frames", "piece"} <= set(report["violations"][0])
     assert all(Path(v["evidence"]).is_file() for v in report["violations"])
+    gone = [v for v in report["violations"] if v["kind"] == "disappear"]
+    assert gone and all(v["frame"] <= v["frames"][1] <= len(frames) - 1 for v in gone)
+    assert all(v["frames"][1] > v["frames"][0] for v in gone)  # it stays gone a while
 
 
 @pytest.mark.slow

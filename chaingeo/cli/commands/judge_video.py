@@ -13,8 +13,8 @@ from typing import Any
 def register(sub: Any) -> None:
     p = sub.add_parser(
         "judge-video",
-        help="judge a generated video: pieces lost, added, split, merged, recoloured or "
-        "pushed through each other",
+        help="judge a generated video: pieces disappearing, appearing, split, merged, "
+        "recoloured, duplicated, teleported or pushed through each other",
     )
     p.add_argument("video", type=Path, help="an MP4 (or any video ffmpeg reads) or a GIF")
     p.add_argument(
@@ -46,7 +46,9 @@ def run(args: argparse.Namespace) -> int:
     except VideoJudgeError as e:
         raise CommandError(str(e)) from None
     for v in report["violations"]:
-        print(f"frame {v['frame']}: {v['kind']} ({v['piece']}): {v['detail']}")
+        first, last = v["frames"]
+        span = f"frame {first}" if first == last else f"frames {first}-{last}"
+        print(f"{span}: {v['kind']} ({v['piece']}): {v['detail']}")
     for u in report["undecided"]:
         print(f"undecided: {u}")
     print(json.dumps(report, sort_keys=True))
