@@ -31,6 +31,7 @@ each family, drawn to arrays (:func:`render_frames`, no cache), by the old rende
 from __future__ import annotations
 
 import argparse
+import gc
 import statistics
 import time
 from collections.abc import Callable
@@ -98,6 +99,7 @@ def _play(env: gymnasium.Env[Any, str], policy: str, steps: int) -> tuple[float,
     base.clear_picture_cache()
     env.action_space.seed(SEED)
     _, info = env.reset(seed=SEED)
+    gc.collect()  # a collection owed by earlier rows would land in this row's short window
     start, cpu = time.perf_counter(), time.process_time()
     for _ in range(steps):
         if policy == "plan":
