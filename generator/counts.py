@@ -7,9 +7,10 @@ the levels of a folder that do not yet hold complete counts (``--recount``: all 
 writes them back; :func:`chaingeo.generator.puzzle_suite.build_puzzle_suite` runs the same step
 on the levels it makes, reusing a stored count only for the same puzzle (the same bytes apart
 from the counts). Counting has no clock: the disassembler's state caps are ``chain analyze``'s
-caps, raised to :data:`COUNT_STATES` states a part (one assembly of a 36-piece tower needs more than
-``chain analyze``'s default), so every machine writes the same files; a count that meets a cap is
-an error (it would not be complete).
+caps, raised to :data:`COUNT_STATES` states a part (the program stored with the counts), so every
+machine writes the same files; a count that meets a cap is an error (it would not be complete).
+Every assembly is judged by BurrTools' rules, whatever the level's ``max_group`` (its BurrTools
+file has none).
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from typing import Any, Final
 
 from chaingeo.core.level import Level, level_bytes, load_level, revalidate, save_level
 from chaingeo.generator.batch import GenerationError
-from chaingeo.solvers.analysis import count_figures, level_max_group, level_packing
+from chaingeo.solvers.analysis import count_figures, level_packing
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.jobs import Farm
 from chaingeo.solvers.limits import SearchLimits
@@ -58,8 +59,7 @@ def count_level(level: Level, farm: Farm) -> Level:
     """The level with complete counts in its stats (see the module's docstring)."""
     out: dict[str, Any] = {}
     rep = count_figures(
-        level_packing(level), out, "drop", level_max_group(level), COUNT_LIMITS, Deadline(None),
-        "", farm,
+        level_packing(level), out, "drop", COUNT_LIMITS, Deadline(None), "", farm,
     )  # fmt: skip
     if not rep.complete:
         raise GenerationError(f"{level.id}: counting stopped ({out.get('limit')})")

@@ -269,7 +269,7 @@ class RowOptions:
 def level_analysis_row(level: Level, how: RowOptions) -> dict[str, Any]:
     """The figures of one of our puzzle levels (a dict, with ``plan``): BurrTools' assemblies and
     solutions of the level written as a BurrTools file (:func:`level_puzzle`: each piece its
-    own shape, so the counts are burrTxt's on that file; with the level's ``max_group``), then
+    own shape, so the counts are burrTxt's on that file, whatever the level's ``max_group``), then
     level, moves and o_i of the level's own assembly under its rules. All of it within
     ``deadline`` (default: one of ``limits.seconds``); counts cut short by a cap are kept as
     lower bounds (see :func:`count_figures`)."""
@@ -281,7 +281,7 @@ def level_analysis_row(level: Level, how: RowOptions) -> dict[str, Any]:
     out: dict[str, Any] = {"assemblies": None, "solutions": None}
     if how.assemble:
         packing = level_packing(level)
-        rep = count_figures(packing, out, mirrors, max_group, limits, deadline, "", jobs)
+        rep = count_figures(packing, out, mirrors, limits, deadline, "", jobs)
         deadline = deadline if rep.complete else grace_deadline(limits)
     out.update(
         disassembly_figures(
@@ -338,7 +338,6 @@ def count_figures(
     packing: Packing,
     out: dict[str, Any],
     mirrors: Mirrors,
-    max_group: int | None,
     limits: SearchLimits,
     deadline: Deadline,
     label: str,
@@ -346,12 +345,14 @@ def count_figures(
 ) -> BTReport:
     """Count BurrTools' assemblies and solutions into ``out``; a cap reached ends the count,
     and ``out`` then says so: ``counts_complete`` false, the counts lower bounds, ``limit``
-    the cap's reason and ``limit_cap`` the field of ``SearchLimits`` it names."""
+    the cap's reason and ``limit_cap`` the field of ``SearchLimits`` it names. Every assembly
+    is judged by BurrTools' rules (groups of any size move): a level's ``max_group`` is not in
+    its BurrTools file, and judging the first assembly by it, the rest by the file, mixed two
+    rules (and, where a capped part never comes apart, searched without end)."""
     deadline.progress.stage = f"{label}counting assemblies"
     rep = count_bt(
         packing,
         mirrors=mirrors,
-        max_group=max_group,
         limits=limits,
         deadline=deadline,
         partial=True,
@@ -392,9 +393,7 @@ def problem_analysis_row(puzzle: BTPuzzle, index: int, how: RowOptions) -> dict[
     first: Analysis | None = None
     if how.assemble:
         packing = compile_packing(bt_packing_spec(puzzle, index))
-        rep = count_figures(
-            packing, out, mirrors, None, limits, deadline, f"problem {index}: ", jobs
-        )
+        rep = count_figures(packing, out, mirrors, limits, deadline, f"problem {index}: ", jobs)
         if rep.first_packing is not None:
             found, first = (rep.first_packing, piece_groups(packing)), rep.first_analysis
         if not rep.complete:
