@@ -37,6 +37,7 @@ from chaingeo.solvers.limits import SearchLimits
 from chaingeo.solvers.motion import btsearch as bt
 from chaingeo.solvers.motion import kinematics_kernel as mv
 from chaingeo.solvers.motion import levelsearch as ls
+from chaingeo.solvers.motion.apart import apart_groups
 from chaingeo.solvers.motion.btorient import BTImage, symmetries_of
 from chaingeo.solvers.motion.optimal_part import OptimalParts, PartKey
 from chaingeo.solvers.motion.partsearch import DIRECTION_NAMES, PartSearch, PieceTable
@@ -238,6 +239,9 @@ class _Solver(OptimalParts):
         k = self.key(members, offsets)
         if k in self.greedy_memo:
             return self.greedy_memo[k]
+        if self.stuck_apart(members, offsets):
+            self.greedy_memo[k] = None
+            return None
         s = self.search(members, offsets)
         result: Separation | None = None
         while result is None and not s.exhausted:
@@ -261,6 +265,25 @@ class _Solver(OptimalParts):
             for node in range(1, s.n_states):
                 self.greedy_memo.setdefault(self.key(members, s.offsets_of(node)), None)
         return result
+
+    def stuck_apart(self, members: tuple[int, ...], offsets: np.ndarray) -> bool:
+        """Whether a group of the part's pieces that lies apart is proven stuck alone, and
+        so the part (:mod:`chaingeo.solvers.motion.apart`; translations only). A group's own
+        search past its state cap proves nothing: the part is then searched as before."""
+        if self.turn_table is not None or len(members) < 3:
+            return False
+        groups = apart_groups(self.table.lo, self.table.hi, members, offsets)
+        for group in groups if len(groups) > 1 else ():
+            if len(group) < 2:
+                continue
+            sub = tuple(members[i] for i in group)
+            try:
+                if self.greedy(sub, np.asarray(offsets)[group]) is None:
+                    return True
+            except SearchLimitError as e:
+                if e.cap != "max_states":
+                    raise
+        return False
 
     def first(self, members: tuple[int, ...], offsets: np.ndarray) -> Separation | None:
         """BurrTools' tree of a part: its first separation in BurrTools' order
