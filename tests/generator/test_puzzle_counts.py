@@ -22,7 +22,9 @@ from chaingeo.generator.counts import (
     reuse_counts,
     without_counts,
 )
+from chaingeo.solvers.analysis import RowOptions, level_analysis_row
 from chaingeo.solvers.jobs import Farm
+from chaingeo.solvers.limits import SearchLimits
 from tests.support.paths import LEVELS as LEVELS_DIR
 from tests.support.shipped import shipped
 
@@ -88,6 +90,20 @@ def test_counts_are_burrtxts_whatever_the_levels_max_group(seed: int) -> None:
     cap = max(len(m.pieces) for m in level.solution.moves) + int(rng.integers(2))
     capped = dataclasses.replace(level, rules=PuzzleRules(cap))
     assert _recount(capped, 1) == {k: level.stats[k] for k in COUNT_KEYS}
+
+
+@pytest.mark.parametrize("name", ["puzzle-mid-01-interlocking-cube", "puzzle-hard-05-burr6x8"])
+def test_chain_analyze_counts_a_capped_level_as_burrtxt_does(name: str) -> None:
+    """With a cap of one piece a move (which these levels' own plans break), ``chain analyze``
+    counts the level's BurrTools file still: judged by the cap, mid-01 counted 0 of its 16
+    solutions and hard-05 0 of 2."""
+    level = load_level(LEVELS_DIR / "puzzle" / f"{name}.json")
+    capped = dataclasses.replace(level, rules=PuzzleRules(1))
+    row = level_analysis_row(capped, RowOptions(SearchLimits(seconds=None), optimal=False))
+    assert (row["assemblies"], row["solutions"]) == (
+        level.stats["assemblies"],
+        level.stats["solutions"],
+    )
 
 
 def test_the_count_step_writes_what_is_missing_and_keeps_the_rest(tmp_path: Path) -> None:
