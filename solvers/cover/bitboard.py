@@ -168,105 +168,102 @@ class BitboardRows(NamedTuple):
     region_min: int
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def bitboard_run(rows: BitboardRows, occ: U64, lv: kn.Levels, ctl: kn.Control) -> int:
-    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`.
+    """Run (or resume) the search (:func:`chaingeo.solvers.cover.kernels.depth_first` with the
+    steps below).
 
-    ``pos[k]``/``end[k]`` index ``cand`` (fixed order) or level ``k``'s slice of ``perm``
-    (random order, ``width`` entries per level); ``occ[k]``: level ``k``'s occupancy.
+    ``lv.pos[k]``/``lv.nbuf[k]`` (position, end) index ``cand`` (fixed order) or level ``k``'s
+    slice of ``lv.buf`` (random order, ``width`` entries per level, from ``lv.aux[k]``);
+    ``occ[k]``: level ``k``'s occupancy.
     """
-    mask, rtype, rid, cand_ptr, cand, skip, type_ptr, exact1, mrv_depth, primary = rows[:10]
-    lo, hi, counters, table, nb, region_gcd, region_min = rows[10:]
-    cnt, perm, end, pos, base, chosen = lv
-    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
-    status = regs[kn.REG_STATUS]
-    if status == kn.DONE:
-        return 0
-    width = len(perm) // len(pos)
-    nodes = regs[kn.REG_NODES]
-    updates = regs[kn.REG_UPDATES]
-    found = 0
-    n_out = 0
-    if status == kn.FRESH:
-        k = 0
-        occ[0] = np.uint64(0)
-        c = _lowest_bit(primary, table)
-        a = cand_ptr[c]
-        n = cand_ptr[c + 1] - a
-        if mrv_depth > 0:
-            a, n, fits, work = _fewest_fits(
-                c, cand_ptr, cand, type_ptr, exact1, mask, rtype, cnt, hi, np.uint64(0)
-            )
-            updates += work
-        _enter(0, a, n, cand, perm, width, base, pos, end, shuffle, rng)
-    else:
-        k = regs[kn.REG_DEPTH]
-    regs[kn.REG_STATUS] = kn.RUNNING
-    src = perm if shuffle else cand
-    stop = False
-    while not stop:
-        # Find the next row that fits at level k.
-        p = pos[k]
-        e = end[k]
-        here = occ[k]
-        row = -1
-        free = np.uint64(0)
-        while p < e:
-            r = src[p]
-            t = rtype[r]
-            if cnt[t] >= hi[t]:
-                p = p + 1 if shuffle else skip[p]  # past this type's run
-                continue
-            p += 1
-            updates += 1
-            m = mask[r]
-            if (m & here) != 0:
-                continue
-            free = primary & ~(here | m)
-            if region_min > 0 and free != 0 and not regions_ok(m, free, nb, region_gcd, region_min):
-                continue
-            row = r
-            break
-        if row >= 0 and nodes >= node_limit:
-            pos[k] = p - 1
-            updates -= 1  # the row is tried again on resumption
-            regs[kn.REG_STATUS] = kn.LIMIT
-            break
-        pos[k] = p
-        if row < 0:  # level exhausted: backtrack
-            if k == 0:
-                regs[kn.REG_STATUS] = kn.DONE
-                break
-            k -= 1
-            cnt[rtype[chosen[k]]] -= 1
+    return kn.depth_first(_root, _peek, _place, _back, rows, (occ, lv), lv.chosen, rows.rid, ctl)
+
+
+@njit(cache=True, inline="always")
+def _root(rows: BitboardRows, state: Any, rng: Any, shuffle: bool) -> int:
+    """Level 0: the first mandatory cell's list (or a piece's, with the fewest fits)."""
+    occ, lv = state
+    occ[0] = np.uint64(0)
+    return _open(rows, occ, lv, 0, rows.primary, rng, shuffle)
+
+
+@njit(cache=True, inline="always")
+def _open(
+    rows: BitboardRows, occ: U64, lv: kn.Levels, k: int, free: Any, rng: Any, shuffle: bool
+) -> int:
+    """Level ``k`` tries the rows of the first empty mandatory cell of ``free`` (near the root:
+    or of the piece with fewest fits); returns the rows examined."""
+    c = _lowest_bit(free, rows.table)
+    a = rows.cand_ptr[c]
+    n = rows.cand_ptr[c + 1] - a
+    work = 0
+    if k < rows.mrv_depth:  # near the root: branch on the cell or piece with fewest fits
+        a, n, fits, work = _fewest_fits(
+            c, rows.cand_ptr, rows.cand, rows.type_ptr, rows.exact1, rows.mask, rows.rtype,
+            lv.cnt, rows.hi, occ[k],
+        )  # fmt: skip
+        if fits == 0:
+            n = 0
+    width = len(lv.buf) // len(lv.pos)
+    _enter(k, a, n, rows.cand, lv.buf, width, lv.aux, lv.pos, lv.nbuf, shuffle, rng)
+    return work
+
+
+@njit(cache=True, inline="always")
+def _peek(rows: BitboardRows, state: Any, k: int, shuffle: bool) -> kn.Step:
+    """The next row that fits at level ``k`` (its position left in ``pos[k]``) and the rows
+    tested before it."""
+    occ, lv = state
+    rtype, cnt, hi, mask, primary = rows.rtype, lv.cnt, rows.hi, rows.mask, rows.primary
+    nb, region_gcd, region_min = rows.nb, rows.region_gcd, rows.region_min
+    src = lv.buf if shuffle else rows.cand
+    p = lv.pos[k]
+    e = lv.nbuf[k]
+    here = occ[k]
+    tested = 0
+    while p < e:
+        r = src[p]
+        t = rtype[r]
+        if cnt[t] >= hi[t]:
+            p = p + 1 if shuffle else rows.skip[p]  # past this type's run
             continue
-        nodes += 1
-        t = rtype[row]
-        chosen[k] = row
-        if free == 0:  # every mandatory cell covered
-            if kn.counts_met(counters, cnt, lo, t):
-                found += 1
-                if max_store > 0:
-                    n_out = kn.store_solution(out, n_out, chosen, rid, k)
-                if (max_store > 0 and n_out == max_store) or found == stop_after:
-                    stop = True
+        p += 1
+        tested += 1
+        m = mask[r]
+        if (m & here) != 0:
             continue
-        cnt[t] += 1
-        k += 1
-        occ[k] = here | mask[row]
-        c = _lowest_bit(free, table)
-        a = cand_ptr[c]
-        n = cand_ptr[c + 1] - a
-        if k < mrv_depth:  # near the root: branch on the cell or piece with fewest fits
-            a, n, fits, work = _fewest_fits(
-                c, cand_ptr, cand, type_ptr, exact1, mask, rtype, cnt, hi, occ[k]
-            )
-            updates += work
-            if fits == 0:
-                n = 0
-        _enter(k, a, n, cand, perm, width, base, pos, end, shuffle, rng)
-    kn.save_registers(regs, k, nodes, updates, found)
-    return n_out
+        free = primary & ~(here | m)
+        if region_min > 0 and free != 0 and not regions_ok(m, free, nb, region_gcd, region_min):
+            continue
+        lv.pos[k] = p - 1
+        return r, tested - 1  # placing it counts its test (at a node limit: tried again)
+    lv.pos[k] = p
+    return -1, tested
+
+
+@njit(cache=True, inline="always")
+def _place(rows: BitboardRows, state: Any, k: int, r: int, rng: Any, shuffle: bool) -> kn.Step:
+    """Place row ``r`` on level ``k``: a cover, a dead end, or level ``k + 1``."""
+    occ, lv = state
+    lv.pos[k] += 1
+    t = rows.rtype[r]
+    lv.chosen[k] = r
+    here = occ[k] | rows.mask[r]
+    free = rows.primary & ~here
+    if free == 0:  # every mandatory cell covered
+        return (kn.COVER if kn.counts_met(rows.counters, lv.cnt, rows.lo, t) else kn.DEAD), 1
+    lv.cnt[t] += 1
+    occ[k + 1] = here
+    return kn.DOWN, 1 + _open(rows, occ, lv, k + 1, free, rng, shuffle)
+
+
+@njit(cache=True, inline="always")
+def _back(rows: BitboardRows, state: Any, k: int) -> None:
+    """Leave level ``k``: the row placed on level ``k - 1`` is free again."""
+    if k > 0:
+        lv = state[1]
+        lv.cnt[rows.rtype[lv.chosen[k - 1]]] -= 1
 
 
 def scan_axes(problem: CoverProblem) -> list[int]:

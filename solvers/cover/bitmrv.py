@@ -25,6 +25,7 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from chaingeo.core.arrays import I32, I64, U64
 from chaingeo.kernels.jit import njit
@@ -229,85 +230,76 @@ def _place_wide(occ: Any, add: Any, primary: Any, here: Any) -> bool:
     return full
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def mrv_run(rows: MRVRows, st: MRVStack, ctl: kn.Control, wide: MRVWide) -> int:
-    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`
-    (:class:`MRVStack` describes the levels)."""
-    rtype, rid, allrows, primary, lo, hi, counters, pieces, table = rows
-    cnt, live, lstart, tcount, tally, br, nbr, pos, chosen = st
-    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
-    status = regs[kn.REG_STATUS]
-    if status == kn.DONE:
-        return 0
-    nodes = regs[kn.REG_NODES]
-    updates = regs[kn.REG_UPDATES]
-    found = 0
-    n_out = 0
-    masks, wocc, planes, scratch = wide
-    here, empty = scratch[0], scratch[1]
-    if status == kn.FRESH:
-        k = 0
-        lstart[0] = 0
-        wocc[0, :] = _NONE
-        end, n_br = _expand_wide(
-            allrows, 0, len(allrows), live, 0, wocc[0], primary, masks, rtype, lo, hi, cnt,
-            tcount, counters, pieces, table, tally, planes, empty, br[0],
-        )  # fmt: skip
-        updates += len(allrows)
-        lstart[1] = end
-        nbr[0] = n_br
-        pos[0] = 0
-        if shuffle:
-            kn.shuffle_prefix(br[0], n_br, rng)
-    else:
-        k = regs[kn.REG_DEPTH]
-    regs[kn.REG_STATUS] = kn.RUNNING
-    while True:
-        if pos[k] < nbr[k]:
-            if nodes >= node_limit:
-                regs[kn.REG_STATUS] = kn.LIMIT
-                break
-            r = br[k, pos[k]]
-            pos[k] += 1
-            nodes += 1
-            chosen[k] = r
-            full = _place_wide(wocc[k], masks[r], primary, here)
-            t = rtype[r]
-            cnt[t] += 1
-            if full:  # every mandatory cell covered
-                ok = kn.counts_met(counters, cnt, lo, -1)
-                cnt[t] -= 1
-                if ok:
-                    found += 1
-                    if max_store > 0:
-                        n_out = kn.store_solution(out, n_out, chosen, rid, k)
-                    if (max_store > 0 and n_out == max_store) or found == stop_after:
-                        break
-                continue
-            a, b = lstart[k], lstart[k + 1]
-            updates += b - a
-            end, n_br = _expand_wide(
-                live, a, b, live, b, here, primary, masks, rtype, lo, hi, cnt,
-                tcount, counters, pieces, table, tally, planes, empty, br[k + 1],
-            )  # fmt: skip
-            if n_br == 0:
-                cnt[t] -= 1
-                continue
-            k += 1
-            wocc[k, :] = here
-            lstart[k + 1] = end
-            nbr[k] = n_br
-            pos[k] = 0
-            if shuffle:
-                kn.shuffle_prefix(br[k], n_br, rng)
-        else:
-            if k == 0:
-                regs[kn.REG_STATUS] = kn.DONE
-                break
-            k -= 1
-            cnt[rtype[chosen[k]]] -= 1
-    kn.save_registers(regs, k, nodes, updates, found)
-    return n_out
+    """Run (or resume) the search (:func:`chaingeo.solvers.cover.kernels.depth_first` with the
+    steps below; :class:`MRVStack` describes the levels)."""
+    return kn.depth_first(_root, _peek, _place, _back, rows, (st, wide), st.chosen, rows.rid, ctl)
+
+
+@njit(cache=True, inline="always")
+def _root(rows: MRVRows, state: Any, rng: Any, shuffle: bool) -> int:
+    """Level 0: every row filtered."""
+    st, wide = state
+    st.lstart[0] = 0
+    for w in range(wide.occ.shape[1]):
+        wide.occ[0, w] = _NONE
+    _open(rows, st, wide, 0, rows.allrows, 0, len(rows.allrows), 0, wide.occ[0], rng, shuffle)
+    return len(rows.allrows)
+
+
+@njit(cache=True, inline="always")
+def _open(
+    rows: MRVRows, st: MRVStack, wide: MRVWide, k: int, src: Any, a: int, b: int, w0: int,
+    occ: Any, rng: Any, shuffle: bool,
+) -> int:  # fmt: skip
+    """Level ``k``: the rows of ``src[a:b]`` alive under ``occ``, written from ``live[w0]``,
+    and its branches; returns how many."""
+    end, n_br = _expand_wide(
+        src, a, b, st.live, w0, occ, rows.primary, wide.masks, rows.rtype, rows.lo, rows.hi,
+        st.cnt, st.tcount, rows.counters, rows.pieces, rows.table, st.tally, wide.planes,
+        wide.scratch[1], st.br[k],
+    )  # fmt: skip
+    st.lstart[k + 1] = end
+    kn.open_level(st.br, st.nbr, st.pos, k, n_br, rng, shuffle)
+    return n_br
+
+
+@njit(cache=True, inline="always")
+def _peek(rows: MRVRows, state: Any, k: int, shuffle: bool) -> kn.Step:
+    st = state[0]
+    return kn.next_listed(st.br, st.nbr, st.pos, k)
+
+
+@njit(cache=True, inline="always")
+def _place(rows: MRVRows, state: Any, k: int, r: int, rng: Any, shuffle: bool) -> kn.Step:
+    """Place row ``r`` on level ``k``: a cover, a dead end, or level ``k + 1``."""
+    st, wide = state
+    st.pos[k] += 1
+    st.chosen[k] = r
+    here = wide.scratch[0]
+    full = _place_wide(wide.occ[k], wide.masks[r], rows.primary, here)
+    t = rows.rtype[r]
+    st.cnt[t] += 1
+    if full:  # every mandatory cell covered
+        ok = kn.counts_met(rows.counters, st.cnt, rows.lo, -1)
+        st.cnt[t] -= 1
+        return (kn.COVER if ok else kn.DEAD), 0
+    a, b = st.lstart[k], st.lstart[k + 1]
+    if _open(rows, st, wide, k + 1, st.live, a, b, b, here, rng, shuffle) == 0:
+        st.cnt[t] -= 1
+        return kn.DEAD, b - a
+    for w in range(len(here)):
+        wide.occ[k + 1, w] = here[w]
+    return kn.DOWN, b - a
+
+
+@njit(cache=True, inline="always")
+def _back(rows: MRVRows, state: Any, k: int) -> None:
+    """Leave level ``k``: the row placed on level ``k - 1`` is free again."""
+    if k > 0:
+        st = state[0]
+        st.cnt[rows.rtype[st.chosen[k - 1]]] -= 1
 
 
 class MRVArrays:
@@ -317,15 +309,8 @@ class MRVArrays:
         n_cells = problem.n_cells
         self.words = W = max(1, -(-n_cells // 64))
         bit = scan_order(problem)  # the other kernels' order: the same ties
-        optional = np.zeros(n_cells, dtype=bool)
-        if problem.optional:
-            optional[sorted(problem.optional)] = True
-        rows = np.asarray(rows, dtype=np.int32)
-        # Whole arrays, not a Python loop per row and cell (0.02 s on SolidSixPieceBurrs).
+        rows, optional = reachable_rows(problem, rows)
         owner, cells = _row_cells(problem, rows)
-        if len(rows):
-            rows = rows[~np.logical_and.reduceat(optional[cells], _starts(owner, len(rows)))]
-            owner, cells = _row_cells(problem, rows)
         masks = np.zeros((len(rows), W), dtype=np.uint64)
         per_cell = np.bincount(cells, minlength=n_cells).astype(np.int64)
         b = bit[cells]
@@ -378,6 +363,20 @@ class MRVArrays:
             np.zeros((5, W), dtype=np.uint64),
             np.zeros((2, W), dtype=np.uint64),
         )
+
+
+def reachable_rows(problem: CoverProblem, rows: I32) -> tuple[I32, npt.NDArray[np.bool_]]:
+    """``rows`` but those lying on optional cells only (a search that branches on mandatory
+    cells never reaches them), and which cells are optional (whole arrays: no Python loop
+    per row and cell)."""
+    optional = np.zeros(problem.n_cells, dtype=bool)
+    if problem.optional:
+        optional[sorted(problem.optional)] = True
+    rows = np.asarray(rows, dtype=np.int32)
+    owner, cells = _row_cells(problem, rows)
+    if len(rows):
+        rows = rows[~np.logical_and.reduceat(optional[cells], _starts(owner, len(rows)))]
+    return rows, optional
 
 
 def _row_cells(problem: CoverProblem, rows: I32) -> tuple[I32, I32]:

@@ -32,7 +32,13 @@ from chaingeo.solvers.cover.bitboard import (
     region_pruning,
     scan_order,
 )
-from chaingeo.solvers.cover.bitmrv import SATURATED, _low, _row_cells, _starts, _with_count
+from chaingeo.solvers.cover.bitmrv import (
+    SATURATED,
+    _low,
+    _row_cells,
+    _with_count,
+    reachable_rows,
+)
 from chaingeo.solvers.cover.problem import CoverProblem
 
 _ONE = np.uint64(1)
@@ -194,96 +200,74 @@ def _filter(
     return j, -1, tested
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def box_run(rows: BoxRows, st: BoxStack, ctl: kn.Control) -> int:
-    """Run (or resume) the search; same contract as :func:`chaingeo.solvers.cover.dlx.dlx_run`
-    (:class:`BoxStack` describes the levels)."""
-    mask, rtype, rid, root_runs, primary, lo, hi, counters, pieces, table = rows[:10]
-    nb, sizes, region = rows[10:]
-    cnt, lmask, lrow, runs, occ, tally, br, nbr, pos, chosen = st
-    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
-    status = regs[kn.REG_STATUS]
-    if status == kn.DONE:
-        return 0
-    nodes = regs[kn.REG_NODES]
-    updates = regs[kn.REG_UPDATES]
-    found = 0
-    n_out = 0
-    if status == kn.FRESH:
-        k = 0
-        occ[0] = _NONE
-        n = len(mask)
-        lmask[:n] = mask
-        lrow[:n] = np.arange(n, dtype=np.int32)
-        runs[0, :] = root_runs  # level "-1" is the root list itself, so filter it in place
-        runs[1, :] = root_runs
-        n_br, piece, tested = _filter(
-            lmask, lrow, runs, 0, _NONE, primary, cnt, hi, lo, counters, pieces, table,
-            tally, br[0],
-        )  # fmt: skip
-        _branches_of_piece(br[0], n_br, piece, runs[1])
-        updates += tested
-        nbr[0] = n_br
-        pos[0] = 0
-        if shuffle:
-            kn.shuffle_prefix(br[0], n_br, rng)
-    else:
-        k = regs[kn.REG_DEPTH]
-    regs[kn.REG_STATUS] = kn.RUNNING
-    while True:
-        if pos[k] < nbr[k]:
-            if nodes >= node_limit:
-                regs[kn.REG_STATUS] = kn.LIMIT
-                break
-            i = br[k, pos[k]]
-            pos[k] += 1
-            nodes += 1
-            m = lmask[i]
-            r = lrow[i]
-            chosen[k] = r
-            h0 = occ[k] | m
-            t = rtype[r]
-            cnt[t] += 1
-            if (h0 & primary) == primary:  # every mandatory cell covered
-                ok = True
-                for q in counters:
-                    if cnt[q] < lo[q]:
-                        ok = False
-                        break
-                cnt[t] -= 1
-                if ok:
-                    found += 1
-                    if max_store > 0:
-                        n_out = kn.store_solution(out, n_out, chosen, rid, k)
-                    if (max_store > 0 and n_out == max_store) or found == stop_after:
-                        break
-                continue
-            if region and not _regions_fit(m, primary & ~h0, nb, _sums(sizes, cnt, hi)):
-                cnt[t] -= 1  # cuts off a region no set of the unused pieces can fill
-                continue
-            n_br, piece, tested = _filter(
-                lmask, lrow, runs, k + 1, h0, primary, cnt, hi, lo, counters, pieces, table,
-                tally, br[k + 1],
-            )  # fmt: skip
-            updates += tested
-            if n_br == 0:
-                cnt[t] -= 1
-                continue
-            _branches_of_piece(br[k + 1], n_br, piece, runs[k + 2])
-            k += 1
-            occ[k] = h0
-            nbr[k] = n_br
-            pos[k] = 0
-            if shuffle:
-                kn.shuffle_prefix(br[k], n_br, rng)
-        else:
-            if k == 0:
-                regs[kn.REG_STATUS] = kn.DONE
-                break
-            k -= 1
-            cnt[rtype[chosen[k]]] -= 1
-    kn.save_registers(regs, k, nodes, updates, found)
-    return n_out
+    """Run (or resume) the search (:func:`chaingeo.solvers.cover.kernels.depth_first` with the
+    steps below; :class:`BoxStack` describes the levels)."""
+    return kn.depth_first(_root, _peek, _place, _back, rows, st, st.chosen, rows.rid, ctl)
+
+
+@njit(cache=True, inline="always")
+def _root(rows: BoxRows, st: BoxStack, rng: Any, shuffle: bool) -> int:
+    """Level 0: every row, filtered in place (level "-1" is the root list itself)."""
+    for i in range(len(rows.mask)):
+        st.lmask[i] = rows.mask[i]
+        st.lrow[i] = i
+    for t in range(len(rows.root_runs)):
+        st.runs[0, t] = st.runs[1, t] = rows.root_runs[t]
+    st.occ[0] = _NONE
+    return _open(rows, st, 0, _NONE, rng, shuffle)[1]
+
+
+@njit(cache=True, inline="always")
+def _open(rows: BoxRows, st: BoxStack, k: int, occ: Any, rng: Any, shuffle: bool) -> kn.Step:
+    """Filter level ``k``'s live list under ``occ`` and list its branches: ``(branches, rows
+    tested)``."""
+    n_br, piece, tested = _filter(
+        st.lmask, st.lrow, st.runs, k, occ, rows.primary, st.cnt, rows.hi, rows.lo,
+        rows.counters, rows.pieces, rows.table, st.tally, st.br[k],
+    )  # fmt: skip
+    _branches_of_piece(st.br[k], n_br, piece, st.runs[k + 1])
+    kn.open_level(st.br, st.nbr, st.pos, k, n_br, rng, shuffle)
+    return n_br, tested
+
+
+@njit(cache=True, inline="always")
+def _peek(rows: BoxRows, st: BoxStack, k: int, shuffle: bool) -> kn.Step:
+    return kn.next_listed(st.br, st.nbr, st.pos, k)
+
+
+@njit(cache=True, inline="always")
+def _place(rows: BoxRows, st: BoxStack, k: int, i: int, rng: Any, shuffle: bool) -> kn.Step:
+    """Place the live row ``i`` on level ``k``: a cover, a dead end, or level ``k + 1``."""
+    st.pos[k] += 1
+    m = st.lmask[i]
+    r = st.lrow[i]
+    st.chosen[k] = r
+    h0 = st.occ[k] | m
+    cnt, primary = st.cnt, rows.primary
+    t = rows.rtype[r]
+    cnt[t] += 1
+    if (h0 & primary) == primary:  # every mandatory cell covered
+        ok = kn.counts_met(rows.counters, cnt, rows.lo, -1)
+        cnt[t] -= 1
+        return (kn.COVER if ok else kn.DEAD), 0
+    if rows.region and not _regions_fit(m, primary & ~h0, rows.nb, _sums(rows.sizes, cnt, rows.hi)):
+        cnt[t] -= 1  # cuts off a region no set of the unused pieces can fill
+        return kn.DEAD, 0
+    n_br, tested = _open(rows, st, k + 1, h0, rng, shuffle)
+    if n_br == 0:
+        cnt[t] -= 1
+        return kn.DEAD, tested
+    st.occ[k + 1] = h0
+    return kn.DOWN, tested
+
+
+@njit(cache=True, inline="always")
+def _back(rows: BoxRows, st: BoxStack, k: int) -> None:
+    """Leave level ``k``: the row placed on level ``k - 1`` is free again."""
+    if k > 0:
+        st.cnt[rows.rtype[st.chosen[k - 1]]] -= 1
 
 
 @njit(cache=True, inline="always")
@@ -303,13 +287,7 @@ class BoxArrays:
         if n_cells > MAX_CELLS:
             raise ValueError(f"box kernel needs at most {MAX_CELLS} cells, got {n_cells}")
         bit = scan_order(problem)  # the first-cell kernel's order: _grow relies on it
-        optional = np.zeros(n_cells, dtype=bool)
-        if problem.optional:
-            optional[sorted(problem.optional)] = True
-        rows = np.asarray(rows, dtype=np.int32)
-        owner, cells = _row_cells(problem, rows)
-        if len(rows):
-            rows = rows[~np.logical_and.reduceat(optional[cells], _starts(owner, len(rows)))]
+        rows, optional = reachable_rows(problem, rows)
         rtype = problem.row_type[rows].astype(np.int64)
         rows = rows[np.lexsort((rows, rtype))]  # runs of one type, in row order
         owner, cells = _row_cells(problem, rows)

@@ -159,89 +159,61 @@ class Columns(NamedTuple):
     counters: I32
 
 
-@njit(cache=True, boundscheck=False)
+@njit(cache=True, boundscheck=False, _nrt=False)
 def dlx_run(links: Links, cols: Columns, lv: kn.Levels, ctl: kn.Control) -> int:
-    """Run (or resume) the search; returns how many solutions were written to ``out``.
+    """Run (or resume) the search (:func:`chaingeo.solvers.cover.kernels.depth_first` with the
+    steps below); a level's branches are the rows of its column ``lv.aux[k]``."""
+    return kn.depth_first(_root, _peek, _place, _back, (links, cols), lv, lv.chosen, links.RW, ctl)
 
-    Stops when ``max_store`` solutions are stored (if > 0), ``stop_after`` solutions were found
-    in this call (if > 0), the tree is exhausted (status DONE) or ``node_limit`` total nodes were
-    spent (status LIMIT). ``out[i, :depth]`` holds the chosen row ids, -1 padded.
-    """
-    HL, HR, U, D, TOP, RW, S = links
-    kind, lo, hi, counters = cols
-    cnt, buf, nbuf, pos, lcol, chosen = lv
-    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
-    status = regs[kn.REG_STATUS]
-    if status == kn.DONE:
-        return 0
-    nodes = regs[kn.REG_NODES]
-    updates = regs[kn.REG_UPDATES]
-    found = 0
-    n_out = 0
-    if status == kn.FRESH:
-        c = _choose(HR, S)
-        updates += _cover(c, HL, HR, U, D, TOP, S)
-        k = 0
-        n = 0
-        i = D[c]
-        while i != c:
-            buf[0, n] = i
-            n += 1
-            i = D[i]
-        if shuffle:
-            kn.shuffle_prefix(buf[0], n, rng)
-        nbuf[0] = n
-        pos[0] = 0
-        lcol[0] = c
-    else:
-        k = regs[kn.REG_DEPTH]
-    regs[kn.REG_STATUS] = kn.RUNNING
-    while True:
-        if pos[k] < nbuf[k]:
-            if nodes >= node_limit:
-                regs[kn.REG_STATUS] = kn.LIMIT
-                break
-            r = buf[k, pos[k]]
-            pos[k] += 1
-            nodes += 1
-            updates += _select(r, HL, HR, U, D, TOP, S, kind, hi, cnt)
-            chosen[k] = r
-            c = _choose(HR, S)
-            if c == 0:
-                ok = kn.counts_met(counters, cnt, lo, -1)
-                if ok:
-                    found += 1
-                    if max_store > 0:
-                        n_out = kn.store_solution(out, n_out, chosen, RW, k)
-                _unselect(r, HL, HR, U, D, TOP, S, kind, hi, cnt)
-                if ok and ((max_store > 0 and n_out == max_store) or found == stop_after):
-                    break
-                continue
-            if S[c] == 0:
-                _unselect(r, HL, HR, U, D, TOP, S, kind, hi, cnt)
-                continue
-            k += 1
-            updates += _cover(c, HL, HR, U, D, TOP, S)
-            n = 0
-            i = D[c]
-            while i != c:
-                buf[k, n] = i
-                n += 1
-                i = D[i]
-            if shuffle:
-                kn.shuffle_prefix(buf[k], n, rng)
-            nbuf[k] = n
-            pos[k] = 0
-            lcol[k] = c
-        else:
-            _uncover(lcol[k], HL, HR, U, D, TOP, S)
-            if k == 0:
-                regs[kn.REG_STATUS] = kn.DONE
-                break
-            k -= 1
-            _unselect(chosen[k], HL, HR, U, D, TOP, S, kind, hi, cnt)
-    kn.save_registers(regs, k, nodes, updates, found)
-    return n_out
+
+@njit(cache=True, boundscheck=False, inline="always")
+def _root(problem: Any, lv: kn.Levels, rng: Any, shuffle: bool) -> int:
+    return _open(problem[0], lv, 0, _choose(problem[0].HR, problem[0].S), rng, shuffle)
+
+
+@njit(cache=True, boundscheck=False, inline="always")
+def _open(links: Links, lv: kn.Levels, k: int, c: int, rng: Any, shuffle: bool) -> int:
+    """Level ``k`` branches on column ``c``'s rows (covered first); returns the link updates."""
+    HL, HR, U, D, TOP, _, S = links
+    upd = _cover(c, HL, HR, U, D, TOP, S)
+    n = 0
+    i = D[c]
+    while i != c:
+        lv.buf[k, n] = i
+        n += 1
+        i = D[i]
+    kn.open_level(lv.buf, lv.nbuf, lv.pos, k, n, rng, shuffle)
+    lv.aux[k] = c
+    return upd
+
+
+@njit(cache=True, boundscheck=False, inline="always")
+def _peek(problem: Any, lv: kn.Levels, k: int, shuffle: bool) -> kn.Step:
+    return kn.next_listed(lv.buf, lv.nbuf, lv.pos, k)
+
+
+@njit(cache=True, boundscheck=False, inline="always")
+def _place(problem: Any, lv: kn.Levels, k: int, r: int, rng: Any, shuffle: bool) -> kn.Step:
+    """Select row ``r`` on level ``k``: a cover, a dead end, or level ``k + 1``."""
+    (HL, HR, U, D, TOP, _, S), (kind, lo, hi, counters) = problem
+    lv.pos[k] += 1
+    upd = _select(r, HL, HR, U, D, TOP, S, kind, hi, lv.cnt)
+    lv.chosen[k] = r
+    c = _choose(HR, S)
+    if c == 0 or S[c] == 0:
+        ok = c == 0 and kn.counts_met(counters, lv.cnt, lo, -1)
+        _unselect(r, HL, HR, U, D, TOP, S, kind, hi, lv.cnt)
+        return (kn.COVER if ok else kn.DEAD), upd
+    return kn.DOWN, upd + _open(problem[0], lv, k + 1, c, rng, shuffle)
+
+
+@njit(cache=True, boundscheck=False, inline="always")
+def _back(problem: Any, lv: kn.Levels, k: int) -> None:
+    """Leave level ``k``: its column, then the row selected on level ``k - 1``."""
+    (HL, HR, U, D, TOP, _, S), (kind, _, hi, _) = problem
+    _uncover(lv.aux[k], HL, HR, U, D, TOP, S)
+    if k > 0:
+        _unselect(lv.chosen[k - 1], HL, HR, U, D, TOP, S, kind, hi, lv.cnt)
 
 
 class DLXArrays:

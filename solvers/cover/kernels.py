@@ -1,9 +1,12 @@
-"""Shared pieces of the numba search kernels: status codes, register layout, a seeded PRNG.
+"""The resumable depth-first search the numba exact-cover engines share, and its pieces: status
+codes, register layout, a seeded PRNG, solution storage.
 
-Both engines (:mod:`chaingeo.solvers.cover.dlx`, :mod:`chaingeo.solvers.cover.bitboard`) run a
-resumable depth-first search: all search state lives in arrays owned by the Python wrapper, so a
-call can stop after a batch of solutions (or at a node limit) and a later call continues exactly
-where it stopped.
+Every engine (:mod:`chaingeo.solvers.cover.dlx`, :mod:`chaingeo.solvers.cover.bitboard`,
+:mod:`chaingeo.solvers.cover.bitmrv`, :mod:`chaingeo.solvers.cover.boxmrv`) runs
+:func:`depth_first` with its own steps: all search state lives in arrays owned by the Python
+wrapper, so a call can stop after a batch of solutions (or at a node limit) and a later call
+continues exactly where it stopped. The protocol (status, counters, limits, solutions) is written
+once here; an engine says only how a level is opened, walked, entered and left.
 """
 
 from __future__ import annotations
@@ -20,6 +23,14 @@ FRESH = 0
 RUNNING = 1
 DONE = 2
 LIMIT = 3
+
+# What an engine's ``place`` step made of a branch.
+DEAD = 0  # no cover below it (the engine undid the branch)
+COVER = 1  # a solution: every mandatory cell covered and every count met (undone too)
+DOWN = 2  # the next level is open
+
+#: What an engine step returns: a branch or an outcome, and the work it did (``updates``).
+Step = tuple[int, int]
 
 # Register layout of the int64 ``regs`` array shared with Python.
 REG_STATUS = 0
@@ -110,3 +121,86 @@ def store_solution(
     for d in range(k + 1, out.shape[1]):
         out[n_out, d] = -1
     return n_out + 1
+
+
+@njit(cache=True, inline="always")
+def open_level(br: Any, nbr: Any, pos: Any, k: int, n: int, rng: Any, shuffle: bool) -> None:
+    """Level ``k`` branches on ``br[k, :n]`` from the first (shuffled in random mode)."""
+    nbr[k] = n
+    pos[k] = 0
+    if shuffle:
+        shuffle_prefix(br[k], n, rng)
+
+
+@njit(cache=True, inline="always")
+def next_listed(br: Any, nbr: Any, pos: Any, k: int) -> Step:
+    """``peek`` of an engine whose levels list their branches (:func:`open_level`)."""
+    if pos[k] < nbr[k]:
+        return br[k, pos[k]], 0
+    return -1, 0
+
+
+@njit(cache=True, inline="always")
+def depth_first(
+    root: Any, peek: Any, place: Any, back: Any, problem: Any, state: Any, chosen: Any,
+    row_ids: Any, ctl: Control,
+) -> int:  # fmt: skip
+    """Run (or resume) one engine's search; returns how many solutions were written to ``out``.
+
+    Stops when ``max_store`` solutions are stored (if > 0), ``stop_after`` solutions were found
+    in this call (if > 0), the tree is exhausted (status DONE) or ``node_limit`` total nodes were
+    spent (status LIMIT). ``out[i, :depth]`` holds the chosen rows' ``row_ids``, -1 padded.
+
+    The engine's steps, each given its ``problem`` and ``state`` (and returning the work done,
+    added to ``updates``): ``root(rng, shuffle)`` opens level 0; ``peek(k, shuffle)`` is level
+    ``k``'s next branch, not yet taken (-1: none left); ``place(k, b, rng, shuffle)`` takes it,
+    sets ``chosen[k]`` and says :data:`DEAD`, :data:`COVER` or :data:`DOWN`; ``back(k)`` leaves
+    level ``k``, undoing the branch taken at ``k - 1``.
+
+    Inlined into each engine's kernel, as are its steps: there they are the engine's own
+    functions (a call with functions as arguments would hold them as Python objects at run time,
+    and the kernel could not be cached). The kernel is compiled without reference counting
+    (numba's ``_nrt=False``): an inlined step binds the engine's tuples of arrays, and counting
+    references to each array at every node would cost more than the search. So nothing inlined
+    may allocate (numba refuses to compile it).
+    """
+    regs, rng, shuffle, out, max_store, stop_after, node_limit = ctl
+    status = regs[REG_STATUS]
+    if status == DONE:
+        return 0
+    nodes = regs[REG_NODES]
+    updates = regs[REG_UPDATES]
+    found = 0
+    n_out = 0
+    if status == FRESH:
+        k = 0
+        updates += root(problem, state, rng, shuffle)
+    else:
+        k = regs[REG_DEPTH]
+    regs[REG_STATUS] = RUNNING
+    while True:
+        b, work = peek(problem, state, k, shuffle)
+        updates += work
+        if b < 0:
+            back(problem, state, k)
+            if k == 0:
+                regs[REG_STATUS] = DONE
+                break
+            k -= 1
+            continue
+        if nodes >= node_limit:
+            regs[REG_STATUS] = LIMIT
+            break
+        nodes += 1
+        outcome, work = place(problem, state, k, b, rng, shuffle)
+        updates += work
+        if outcome == DOWN:
+            k += 1
+        elif outcome == COVER:
+            found += 1
+            if max_store > 0:
+                n_out = store_solution(out, n_out, chosen, row_ids, k)
+            if (max_store > 0 and n_out == max_store) or found == stop_after:
+                break
+    save_registers(regs, k, nodes, updates, found)
+    return n_out

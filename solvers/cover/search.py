@@ -225,7 +225,7 @@ class CoverSearch:
 
     def _kernel(self, out: I32, max_store: int, stop_after: int, node_limit: int) -> int:
         """One call of the search's kernel up to ``node_limit`` nodes in total; solutions go to
-        ``out`` (see :func:`chaingeo.solvers.cover.dlx.dlx_run`)."""
+        ``out`` (see :func:`chaingeo.solvers.cover.kernels.depth_first`)."""
         a = self._arr
         ctl = kernels.Control(
             self._regs, self._rng, self._shuffle, out, max_store, stop_after, node_limit
