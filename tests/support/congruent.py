@@ -5,6 +5,8 @@ shapes are listed in a random order (BurrTools' piece order is the shapes' order
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from chaingeo.core.formats.bt_model import BTPart, BTProblem, BTPuzzle, colored_shape
@@ -45,3 +47,28 @@ def congruent_puzzle(rng: np.random.Generator, kind: str) -> BTPuzzle:
     result = colored_shape("result", Shape([c for p in pieces for c in p]))
     problem = BTProblem(kind, tuple(BTPart(i, 1, 1) for i in range(len(shapes))), len(shapes))
     return BTPuzzle((*shapes, result), (problem,))
+
+
+def regrouped(puzzle: BTPuzzle, counts: tuple[int, ...], *, first: bool = False) -> BTPuzzle:
+    """Problem 0 of ``puzzle`` with its congruent single pieces (all but one, which stays on
+    its own, last or ``first``) as shapes used ``counts`` times each: BurrTools then counts
+    fewer relabellings of the same arrangements (hard-03's 11 sticks as 5 + 6: 462)."""
+    prob = puzzle.problem(0)
+    alone = [p for p in prob.parts if sum(q.shape == p.shape for q in prob.parts) == 1]
+    key = next(p for p in alone if not _congruent_to_another(puzzle, p.shape, prob))
+    rest = [p.shape for p in prob.parts if p.shape != key.shape]
+    parts, at = [], 0
+    for c in counts:
+        parts.append(BTPart(rest[at], c, c))
+        at += c
+    assert at == len(rest), "the counts must use every congruent piece"
+    parts.insert(0 if first else len(parts), key)
+    problem = dataclasses.replace(prob, parts=tuple(parts))
+    return dataclasses.replace(puzzle, problems=(problem,))
+
+
+def _congruent_to_another(puzzle: BTPuzzle, shape: int, prob: BTProblem) -> bool:
+    mine = puzzle.shapes[shape].filled.canonical()
+    return any(
+        puzzle.shapes[p.shape].filled.canonical() == mine for p in prob.parts if p.shape != shape
+    )

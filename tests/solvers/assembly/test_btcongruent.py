@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from chaingeo.core.formats.bt_level import level_puzzle
 from chaingeo.core.formats.bt_write import write_xmpuzzle
 from chaingeo.core.formats.burrtools import BTPuzzle
 from chaingeo.core.level import load_level
@@ -21,7 +22,7 @@ from chaingeo.solvers.assembly.btassemble import Mirrors, bt_packing_spec, iter_
 from chaingeo.solvers.assembly.btcount import count_bt
 from chaingeo.solvers.cover.constrained import canonical_keys, compile_packing
 from tests.support import burrtxt as bt
-from tests.support.congruent import KINDS, congruent_puzzle
+from tests.support.congruent import KINDS, congruent_puzzle, regrouped
 from tests.support.paths import LEVELS
 
 SEED = 38
@@ -200,3 +201,32 @@ def test_by_arrangement_is_burrtxts_count_on_more(
     binary: Path, kind: str, index: int, tmp_path: Path
 ) -> None:
     _agrees_with_burrtxt(binary, kind, index, tmp_path)
+
+
+#: hard-03 (11 congruent sticks and a key) with its sticks as fewer shapes used several times:
+#: BurrTools then judges every relabelling class of the one arrangement itself.
+HARD_03 = LEVELS / "puzzle" / "puzzle-hard-03-luban-separate-pieces.json"
+REGROUPED = {(5, 6): (462, False), (3, 4, 4): (11550, True), (2, 3, 3, 3): (92400, True)}
+
+
+def _regrouped_agrees(binary: Path, counts: tuple[int, ...], first: bool, tmp_path: Path) -> None:
+    puzzle = regrouped(level_puzzle(load_level(HARD_03)), counts, first=first)
+    path = write_xmpuzzle(puzzle, tmp_path / "hard-03-regrouped.xmpuzzle")
+    ref = bt.run(binary, path, 600)
+    assert ref is not None
+    got = bc.count_by_arrangement(_plan(puzzle), mirrors="drop", limits=COUNT_LIMITS).report
+    want = REGROUPED[counts][0]
+    assert (got.assemblies, got.solutions) == (ref.assemblies, ref.solutions) == (want, want)
+
+
+@pytest.mark.parametrize("first", [False, True])
+def test_hard_03_regrouped_is_burrtxts_count(binary: Path, first: bool, tmp_path: Path) -> None:
+    _regrouped_agrees(binary, (5, 6), first, tmp_path)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("counts", [c for c, (_, slow) in REGROUPED.items() if slow])
+def test_hard_03_regrouped_more_is_burrtxts_count(
+    binary: Path, counts: tuple[int, ...], tmp_path: Path
+) -> None:
+    _regrouped_agrees(binary, counts, False, tmp_path)
