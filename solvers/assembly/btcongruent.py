@@ -213,13 +213,31 @@ def relabellings(plan: Plan, checks: int, seed: int) -> Iterator[list[I64]]:
     seeded random ones."""
     first = first_labels(plan)
     if relabelling_count(plan) - 1 <= checks:
-        each = [sorted(set(itertools.permutations(lab.tolist()))) for lab in first]
+        each = [list(_distinct_permutations(lab.tolist())) for lab in first]
         for combo in itertools.islice(itertools.product(*each), 1, None):
             yield [np.asarray(c, dtype=np.int64) for c in combo]
         return
     rng = np.random.default_rng(seed)
     for _ in range(checks):
         yield [rng.permutation(lab) for lab in first]
+
+
+def _distinct_permutations(items: list[int]) -> Iterator[tuple[int, ...]]:
+    """Every distinct ordering of ``items``, in lexicographic order from the sorted one (the
+    next permutation, so repeated items cost nothing)."""
+    a = sorted(items)
+    while True:
+        yield tuple(a)
+        i = len(a) - 2
+        while i >= 0 and a[i] >= a[i + 1]:
+            i -= 1
+        if i < 0:
+            return
+        j = len(a) - 1
+        while a[j] <= a[i]:
+            j -= 1
+        a[i], a[j] = a[j], a[i]
+        a[i + 1 :] = reversed(a[i + 1 :])
 
 
 def relabelling_count(plan: Plan) -> int:

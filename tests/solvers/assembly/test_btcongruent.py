@@ -230,3 +230,11 @@ def test_hard_03_regrouped_more_is_burrtxts_count(
     binary: Path, counts: tuple[int, ...], tmp_path: Path
 ) -> None:
     _regrouped_agrees(binary, counts, False, tmp_path)
+
+
+def test_distinct_permutations_are_each_ordering_once() -> None:
+    rng = np.random.default_rng(SEED)
+    for _ in range(100):
+        items = rng.integers(0, 3, size=int(rng.integers(0, 7))).tolist()
+        got = list(bc._distinct_permutations(items))
+        assert got == sorted(set(itertools.permutations(items)))
