@@ -11,6 +11,12 @@ caps, raised to :data:`COUNT_STATES` states a part (the program stored with the 
 machine writes the same files; a count that meets a cap is an error (it would not be complete).
 Every assembly is judged by BurrTools' rules, whatever the level's ``max_group`` (its BurrTools
 file has none).
+
+A level whose congruent pieces are separate BurrTools shapes with at least
+:data:`BY_ARRANGEMENT_FROM` relabellings (hard-03's 11 sticks: 11!) is counted by arrangement
+(:mod:`chaingeo.solvers.assembly.btcongruent`): each arrangement judged once (and on
+:data:`CHECKS` relabellings, which must agree), its labelled classes counted exactly; its
+``program`` says so.
 """
 
 from __future__ import annotations
@@ -24,7 +30,14 @@ from typing import Any, Final
 
 from chaingeo.core.level import Level, level_bytes, load_level, revalidate, save_level
 from chaingeo.generator.batch import GenerationError
-from chaingeo.solvers.analysis import count_figures, level_packing
+from chaingeo.solvers.analysis import CONVENTIONS, count_figures, level_packing
+from chaingeo.solvers.assembly.btcongruent import (
+    Plan,
+    arrangement_plan,
+    count_by_arrangement,
+    relabelling_count,
+)
+from chaingeo.solvers.assembly.btcount import BTReport
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.jobs import Farm
 from chaingeo.solvers.limits import SearchLimits
@@ -37,6 +50,16 @@ COUNT_STATES: Final = 20_000_000
 COUNT_LIMITS: Final = SearchLimits(max_states=COUNT_STATES, seconds=None)
 #: How the counts were obtained (stored with them).
 PROGRAM: Final = f"chain analyze --no-optimal --max-states {COUNT_STATES}"
+#: Levels whose congruent pieces have this many relabellings or more are counted by arrangement.
+BY_ARRANGEMENT_FROM: Final = 1_000_000
+#: Relabellings of each arrangement judged besides its first when counting by arrangement.
+CHECKS: Final = 1000
+#: How counts by arrangement were obtained (stored with them).
+PROGRAM_BY_ARRANGEMENT: Final = (
+    f"chain generate puzzle-counts --max-states {COUNT_STATES}: each arrangement of congruent "
+    f"pieces judged once and on {CHECKS} seeded relabellings (all agreeing), times its "
+    "labelled classes (Burnside over its stabiliser)"
+)
 
 
 def has_counts(level: Level) -> bool:
@@ -57,23 +80,39 @@ def without_counts(level: Level) -> Level:
 
 def count_level(level: Level, farm: Farm) -> Level:
     """The level with complete counts in its stats (see the module's docstring)."""
-    out: dict[str, Any] = {}
-    rep = count_figures(
-        level_packing(level), out, "drop", COUNT_LIMITS, Deadline(None), "", farm,
-    )  # fmt: skip
-    if not rep.complete:
-        raise GenerationError(f"{level.id}: counting stopped ({out.get('limit')})")
+    packing = level_packing(level)
+    plan = arrangement_plan(packing)
+    program = PROGRAM
+    if plan is not None and relabelling_count(plan) >= BY_ARRANGEMENT_FROM:
+        rep = _by_arrangement(plan, level)
+        program = PROGRAM_BY_ARRANGEMENT
+    else:
+        out: dict[str, Any] = {}
+        rep = count_figures(packing, out, "drop", COUNT_LIMITS, Deadline(None), "", farm)
+        if not rep.complete:
+            raise GenerationError(f"{level.id}: counting stopped ({out.get('limit')})")
     counts = {
         "assemblies": rep.assemblies,
         "solutions": rep.solutions,
         "counts": {
             "complete": True,
-            "convention": out["convention"],
-            "program": PROGRAM,
+            "convention": CONVENTIONS["drop"],
+            "program": program,
             "version": version("chaingeo"),
         },
     }
     return revalidate(dataclasses.replace(level, stats={**without_counts(level).stats, **counts}))
+
+
+def _by_arrangement(plan: Plan, level: Level) -> BTReport:
+    """The counts by arrangement, in this process (a handful of verdicts)."""
+    got = count_by_arrangement(
+        plan, mirrors="drop", max_group=None, limits=COUNT_LIMITS,
+        deadline=Deadline(None), checks=CHECKS,
+    )  # fmt: skip
+    if not got.report.complete:
+        raise GenerationError(f"{level.id}: counting stopped ({got.report.limit})")
+    return got.report
 
 
 def reuse_counts(level: Level, stored: Iterable[Level]) -> Level | None:
