@@ -22,9 +22,12 @@ from chaingeo.core.arrays import F64, U8, Bools
 from chaingeo.worldmodel.judge_segment import dilate
 from chaingeo.worldmodel.judge_track import Event, Obj
 
-#: Frames over which a slide is looked for, and the least number of frames in its middle.
+#: Frames over which a slide is looked for, the least number of frames in its middle, and the
+#: frames its end must hold for (unless the piece moves off its place: a merged piece moves on
+#: with the other).
 WINDOW: Final = 14
-MIDDLE: Final = 2
+MIDDLE: Final = 1
+HELD: Final = 2
 #: Progress (0: the old colour, 1: the new) that counts as the start, the middle and the end.
 START: Final = 0.15
 MIDDLE_RANGE: Final = (0.2, 0.8)
@@ -38,17 +41,28 @@ SPREAD: Final = 0.25
 COVER: Final = 0.8
 #: Least distance between the two colours (chromaticity units): closer ones are not told apart.
 APART: Final = 0.08
-#: Brightest channel below which a pixel's chromaticity is too noisy to use.
+#: A pixel's chromaticity is used when its brightest channel reaches BRIGHT, its channel spread
+#: SATURATED of that, and it lies GROUND from the ground's chromaticity.
 BRIGHT: Final = 45
+SATURATED: Final = 0.15
+GROUND: Final = 0.04
 
 
 def chromaticities(frame: U8) -> tuple[F64, Bools]:
-    """(r, g) per pixel, and whether the pixel is bright enough to have a reliable one."""
+    """(r, g) per pixel, and whether the pixel can be a piece's: bright and saturated enough
+    for a reliable chromaticity, and away from the ground's (the median of the picture's
+    border): a piece moving off shows the ground, which lies between two complementary
+    colours on the line joining them."""
     f = frame.astype(np.float64)
     total = f.sum(axis=2) + 1e-9
     out = np.stack([f[..., 0] / total, f[..., 1] / total], axis=-1)
-    bright: Bools = f.max(axis=2) >= BRIGHT
-    return out, bright
+    hi, lo = f.max(axis=2), f.min(axis=2)
+    ring = np.concatenate([out[:2].reshape(-1, 2), out[-2:].reshape(-1, 2),
+                           out[:, :2].reshape(-1, 2), out[:, -2:].reshape(-1, 2)])  # fmt: skip
+    ground = np.median(ring, axis=0)
+    away = np.hypot(out[..., 0] - ground[0], out[..., 1] - ground[1]) >= GROUND
+    ok: Bools = (hi >= BRIGHT) & (hi - lo >= SATURATED * hi) & away
+    return out, ok
 
 
 def class_centres(chroma: list[F64], bright: list[Bools], objects: list[list[Obj]], n: int) -> F64:
@@ -134,7 +148,8 @@ def _progress(px: F64 | None, a: F64, d: F64) -> tuple[float, float, float]:
 def _slid(rows: list[tuple[float, float, float]]) -> tuple[int, int] | None:
     """The first and last rows of a slide (None: no slide): the first row at the start, then
     rows in the middle for at least MIDDLE frames (all on the line, pixels together, never
-    going back by more than SPREAD), ending at END held for two more frames."""
+    going back by more than SPREAD), ending at END, held for HELD more frames (or until the
+    piece leaves its place)."""
     if not rows or not (rows[0][0] <= START and rows[0][1] <= OFF_LINE):
         return None
     middle, best, first = 0, rows[0][0], 0
@@ -145,8 +160,7 @@ def _slid(rows: list[tuple[float, float, float]]) -> tuple[int, int] | None:
         if m <= START:
             first = i
         if m >= END:
-            after = rows[i + 1 : i + 3]
-            held = len(after) == 2 and all(x[0] >= END for x in after)
+            held = all(np.isnan(x[0]) or x[0] >= END for x in rows[i + 1 : i + 1 + HELD])
             return (first + 1, i) if held and middle >= MIDDLE else None
         if MIDDLE_RANGE[0] <= m <= MIDDLE_RANGE[1]:
             middle += 1

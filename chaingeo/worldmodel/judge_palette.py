@@ -44,11 +44,12 @@ JOIN_RADIUS: Final = 0.075
 #: A peak is another's colour overexposed when a scaling by up to OVEREXPOSE, clipped, brings
 #: it within EXPOSURE_TOL.
 OVEREXPOSE: Final = 1.3
+WASHED: Final = 1.5
 EXPOSURE_TOL: Final = 0.015
 #: Frames sampled for the palette (evenly over the video); a colour is a piece's when it covers
 #: SEEN_SHARE of the picture in SEEN_FRAMES of them (not a blip of one frame).
 PALETTE_FRAMES: Final = 12
-SEEN_FRAMES: Final = 2
+SEEN_FRAMES: Final = 1
 SEEN_SHARE: Final = 0.002
 #: A pixel votes for the palette when no channel changes by more than this (levels) across its
 #: 3 x 3 neighbourhood: the flat inside of a face, not an edge's blend.
@@ -180,8 +181,24 @@ def _same(smooth: F64, c: tuple[float, float], p: tuple[float, float], v: float)
     by a ridge that never drops to nothing (a highlight fades smoothly; two pieces of
     colours on one ray, a green and a forest green, leave empty chromaticities between)."""
     ridge = _ridge(smooth, c, p)
-    lit = _on_ray(c, p) or _overexposed(c, p)
+    lit = _on_ray(c, p) or _overexposed(c, p) or _washed(c, p)
     return ridge >= VALLEY * v or (lit and ridge >= LIT_VALLEY * v)
+
+
+def _washed(c: tuple[float, float], p: tuple[float, float]) -> bool:
+    """Whether the weaker peak ``c`` is ``p``'s colour overexposed by up to WASHED and with
+    white added (a lit face in a highlight), within EXPOSURE_TOL: only toward white, so a
+    more saturated colour (a rust beside an orange) is never the lit face of a paler one."""
+    white = 1 / 3
+    if np.hypot(c[0] - white, c[1] - white) > np.hypot(p[0] - white, p[1] - white):
+        return False
+    rgb = np.array([p[0], p[1], 1.0 - p[0] - p[1]])
+    rgb = rgb / max(float(rgb.max()), 1e-9)
+    k = np.linspace(1.0, WASHED, 11)[:, None, None]
+    s = np.linspace(0.0, 0.6, 25)[None, :, None]
+    lit = np.clip(rgb[None, None, :] * k + s, 0.0, 1.0).reshape(-1, 3)
+    chroma = lit[:, :2] / lit.sum(axis=1, keepdims=True)
+    return bool(np.hypot(chroma[:, 0] - c[0], chroma[:, 1] - c[1]).min() <= EXPOSURE_TOL)
 
 
 def _peaks(hist: F64, total: float) -> list[tuple[float, float]]:
