@@ -76,7 +76,7 @@ def _table(rgb: F64, centres: F64) -> U8:
     """The class of every table colour: its nearest centre if it joins it (0: none)."""
     chroma, _ = _chromaticity(rgb)
     dist = np.sqrt(((chroma[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2))
-    table = (np.argmin(dist, axis=1) + 1).astype(np.uint8)
+    table: U8 = (np.argmin(dist, axis=1) + 1).astype(np.uint8)
     table[~_joins(rgb, dist)] = 0
     return table
 
