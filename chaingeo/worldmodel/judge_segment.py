@@ -53,6 +53,11 @@ MERGE_DEGREES: Final = 25.0
 HUE_RADIUS: Final = 30.0
 #: Least area of a component, as a share of the working frame.
 MIN_AREA_SHARE: Final = 0.002
+#: Chroma distance (CIELAB a*, b*) from the background's within which a colour is background.
+BACKGROUND_CHROMA: Final = 12.0
+#: Unknown pixels are dark (a piece's face in its own shade; a pale or half-transparent blend
+#: of a piece with the ground, as video models draw a ghost, is no occluder).
+UNKNOWN_LIGHTNESS: Final = 40.0
 
 
 @dataclass(frozen=True)
@@ -180,151 +185,6 @@ def clustered_model(frame: U8) -> ColorModel:
     labels = table[_table_index(frame).ravel()]
     centres = np.array([lab[labels == i + 1].mean(axis=0) for i in range(len(peaks))])
     return ColorModel(_names(centres), centres, table, "first frame")
-
-
-#: Video palette (no level): a pixel is chromatic when its channel spread is this share of its
-#: brightest channel and that channel this bright; chromaticity peaks hold at least PEAK_SHARE
-#: of the chromatic pixels of the video within PEAK_RADIUS, are CHROMA_SEP apart, and a colour
-#: joins the nearest peak within JOIN_RADIUS.
-MIN_SATURATION: Final = 0.28
-MIN_BRIGHT: Final = 45
-CHROMA_BINS: Final = 64
-PEAK_SHARE: Final = 0.012
-PEAK_RADIUS: Final = 0.035
-CHROMA_SEP: Final = 0.04
-VALLEY: Final = 0.4
-RAY_DEGREES: Final = 4.5
-JOIN_RADIUS: Final = 0.075
-#: Chroma distance (CIELAB a*, b*) from the background's within which a colour is background.
-BACKGROUND_CHROMA: Final = 12.0
-#: Unknown pixels are dark (a piece's face in its own shade; a pale or half-transparent blend
-#: of a piece with the ground, as video models draw a ghost, is no occluder).
-UNKNOWN_LIGHTNESS: Final = 40.0
-#: Frames sampled for the palette (evenly over the video).
-PALETTE_FRAMES: Final = 12
-
-
-def _chromaticity(rgb: F64) -> tuple[F64, Bools]:
-    """(r, g) = (R, G) / (R + G + B) of sRGB colours, which a change of light intensity leaves
-    alone (sRGB is close to a power of linear light: scaling scales all three channels alike),
-    and whether each colour is saturated and bright enough to have a reliable one."""
-    hi, lo = rgb.max(axis=1), rgb.min(axis=1)
-    total = rgb.sum(axis=1) + 1e-9
-    chroma = np.stack([rgb[:, 0] / total, rgb[:, 1] / total], axis=1)
-    ok = (hi >= MIN_BRIGHT) & (hi - lo >= MIN_SATURATION * hi)
-    return chroma, ok
-
-
-def _smoothed(hist: F64) -> F64:
-    out = hist.copy()
-    for axis in (0, 1):
-        acc = np.zeros_like(out)
-        for d, w in ((-2, 1.0), (-1, 2.0), (0, 3.0), (1, 2.0), (2, 1.0)):
-            acc += w * np.roll(out, d, axis=axis)
-        out = acc / 9.0
-    return out
-
-
-def _ridge(smooth: F64, a: tuple[float, float], b: tuple[float, float]) -> float:
-    """The least smoothed density on the straight way from peak ``a`` to peak ``b``."""
-    n = CHROMA_BINS
-    ts = np.linspace(0.0, 1.0, 17)
-    ys = np.clip(((a[0] + ts * (b[0] - a[0])) * n).astype(np.int64), 0, n - 1)
-    xs = np.clip(((a[1] + ts * (b[1] - a[1])) * n).astype(np.int64), 0, n - 1)
-    return float(smooth[ys, xs].min())
-
-
-def _on_ray(a: tuple[float, float], b: tuple[float, float]) -> bool:
-    """Whether two chromaticities lie on one ray from white (within RAY_DEGREES): one colour
-    seen with more or less white light on it (a lit face's highlight)."""
-    ta = np.degrees(np.arctan2(a[1] - 1 / 3, a[0] - 1 / 3))
-    tb = np.degrees(np.arctan2(b[1] - 1 / 3, b[0] - 1 / 3))
-    return bool(abs((ta - tb + 180.0) % 360.0 - 180.0) <= RAY_DEGREES)
-
-
-def _peaks(hist: F64, total: float) -> list[tuple[float, float]]:
-    """Local maxima of the smoothed chromaticity histogram holding PEAK_SHARE of ``total``
-    within PEAK_RADIUS, strongest first; a weaker peak joined to a kept one by a ridge without
-    a valley (density never below VALLEY of its own) is the same colour (a highlight or a shadow
-    drags a colour's pixels toward grey): the number of colours is what this criterion keeps."""
-    n = CHROMA_BINS
-    smooth = _smoothed(hist)
-    r = max(1, round(PEAK_RADIUS * n))
-    mass = np.zeros_like(hist)
-    for dy in range(-r, r + 1):
-        for dx in range(-r, r + 1):
-            if dx * dx + dy * dy <= r * r:
-                mass += np.roll(np.roll(hist, dy, axis=0), dx, axis=1)
-    order = np.argsort(-smooth.ravel(), kind="stable")
-    out: list[tuple[float, float]] = []
-    heights: list[float] = []
-    for idx in order.tolist():
-        y, x = divmod(idx, n)
-        v = float(smooth[y, x])
-        if v <= 0:
-            break
-        if mass[y, x] < PEAK_SHARE * total:
-            continue
-        if v < smooth[max(0, y - 1) : y + 2, max(0, x - 1) : x + 2].max():
-            continue
-        c = ((y + 0.5) / n, (x + 0.5) / n)
-        if any(np.hypot(c[0] - a, c[1] - b) < CHROMA_SEP for a, b in out):
-            continue
-        if any(_ridge(smooth, c, p) >= VALLEY * v or _on_ray(c, p) for p in out):
-            continue
-        out.append(c)
-        heights.append(v)
-    return out
-
-
-def _border_chromaticity(frames: list[U8]) -> F64:
-    """The median chromaticity of the pictures' outer rows and columns: the background (a
-    tinted ground is saturated enough to pass for a piece colour, and its shadows share its
-    chromaticity)."""
-    ring = np.concatenate(
-        [np.concatenate([f[:3].reshape(-1, 3), f[-3:].reshape(-1, 3), f[:, :3].reshape(-1, 3),
-                         f[:, -3:].reshape(-1, 3)]) for f in frames]
-    ).astype(np.float64)  # fmt: skip
-    chroma, _ = _chromaticity(ring)
-    out: F64 = np.median(chroma, axis=0)
-    return out
-
-
-def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
-    """Classes from the chromatic colours of frames sampled over the whole video (a piece
-    brought in later has its colour too), clustered by chromaticity, the number of colours
-    chosen by the peak criterion of :func:`_peaks`; named after the nearest palette colour."""
-    picks = np.unique(np.linspace(0, len(frames) - 1, min(PALETTE_FRAMES, len(frames))).round())
-    counts = np.zeros(32768, dtype=np.float64)
-    for i in picks.astype(int).tolist():
-        counts += np.bincount(_table_index(frames[i]).ravel(), minlength=32768)
-    rgb = _table_rgb()
-    chroma, ok = _chromaticity(rgb)
-    weight = np.where(ok, counts, 0.0)
-    n = CHROMA_BINS
-    cell = np.clip((chroma * n).astype(np.int64), 0, n - 1)
-    hist = np.zeros((n, n))
-    np.add.at(hist, (cell[:, 0], cell[:, 1]), weight)
-    ground = _border_chromaticity([frames[i] for i in picks.astype(int).tolist()])
-    peaks = [
-        c
-        for c in _peaks(hist, float(weight.sum()))
-        if np.hypot(*(np.array(c) - ground)) > JOIN_RADIUS
-    ]
-    if not peaks:
-        raise ValueError("the video shows no coloured piece (nothing is saturated)")
-    centres = np.array(peaks)
-    dist = np.sqrt(((chroma[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2))
-    table = (np.argmin(dist, axis=1) + 1).astype(np.uint8)
-    table[(dist.min(axis=1) > JOIN_RADIUS) | ~ok] = 0
-    lab = _table_lab()
-    labs = []
-    for i in range(len(peaks)):
-        w = np.where(table == i + 1, counts, 0.0)
-        bright = lab[:, 0] >= np.percentile(lab[w > 0, 0], 50) if (w > 0).any() else w > 0
-        w = np.where(bright, w, 0.0)
-        labs.append((lab * w[:, None]).sum(axis=0) / max(w.sum(), 1e-9))
-    return ColorModel(_names(np.array(labs)), np.array(labs), table, "video")
 
 
 def _names(centres: F64) -> tuple[str, ...]:

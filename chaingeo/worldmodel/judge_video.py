@@ -26,7 +26,9 @@ from PIL import Image
 from chaingeo.core import limits
 from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.errors import ChainGeoError
+from chaingeo.worldmodel.judge_drift import Drift
 from chaingeo.worldmodel.judge_exist import Existence, join
+from chaingeo.worldmodel.judge_palette import video_model
 from chaingeo.worldmodel.judge_segment import (
     RENDER_SHADES,
     SHADES,
@@ -40,7 +42,6 @@ from chaingeo.worldmodel.judge_segment import (
     palette_model,
     shrink,
     unknown,
-    video_model,
 )
 from chaingeo.worldmodel.judge_track import (
     VIOLATIONS,
@@ -262,6 +263,7 @@ def judge_frames(
     solids = [solid for _, solid in objects]
     grounds = [ground(f, m) for f, m in zip(frames, masks, strict=True)]
     events = join(events, Existence(kept, grounds, model.names, area).events())
+    events = join(events, Drift(list(frames), [o for o, _ in objects], model.names).events())
     undecided: list[str] = []
     if level is not None and colors:
         events, undecided = _with_level(level, colors, model.names, events, kept, area)

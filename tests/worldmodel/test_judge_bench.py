@@ -139,10 +139,10 @@ FLOORS = {
     "vanish_background": 0.8,
     "vanish_white": 0.8,
     "vanish_neighbour": 0.8,
-    "recolour_abrupt": 0.75,
-    "recolour_gradual": 0.6,
+    "recolour_abrupt": 0.85,
+    "recolour_gradual": 0.8,
     "split": 0.8,
-    "merge": 0.7,
+    "merge": 0.85,
     "duplicate": 0.9,
     "teleport": 0.5,
 }

@@ -1,0 +1,101 @@
+"""The video palette finds every piece colour once under shading (lit and dark faces one
+class, look-alike colours of one level apart), and the drift test reads a gradual recolour
+but not another piece sliding over one, on seeded synthetic pictures."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from chaingeo.core.arrays import U8, Bools
+from chaingeo.worldmodel.judge_drift import Drift
+from chaingeo.worldmodel.judge_palette import video_model
+from chaingeo.worldmodel.judge_segment import classify
+from chaingeo.worldmodel.judge_track import Obj
+
+#: Colours of the judge's bench levels, look-alike pairs included (blue and cobalt, orange and
+#: rust, red and purple).
+COLOURS = (
+    (67, 99, 216),
+    (75, 75, 130),
+    (11, 93, 30),
+    (245, 130, 49),
+    (183, 65, 14),
+    (255, 225, 25),
+    (60, 180, 75),
+    (145, 30, 180),
+    (230, 25, 75),
+)
+SIZE = (160, 240)
+
+
+def _block(frame: np.ndarray, y: int, x: int, rgb: np.ndarray, shades: np.ndarray) -> Bools:
+    """A 36 x 36 block of three faces (top, left, right), each ``rgb`` scaled by its shade."""
+    mask = np.zeros(frame.shape[:2], dtype=bool)
+    for k, (dy, dx, h, w) in enumerate(((0, 0, 12, 36), (12, 0, 24, 18), (12, 18, 24, 18))):
+        frame[y + dy : y + dy + h, x + dx : x + dx + w] = np.clip(rgb * shades[k], 0, 255)
+        mask[y + dy : y + dy + h, x + dx : x + dx + w] = True
+    return mask
+
+
+def _scene(seed: int) -> tuple[list[U8], list[Bools], list[int]]:
+    """Frames of 3 to 5 shaded blocks of distinct colours on a grey ground with noise."""
+    rng = np.random.default_rng(seed)
+    picks = rng.choice(len(COLOURS), size=int(rng.integers(3, 6)), replace=False)
+    shades = rng.uniform(0.35, 1.2, (len(picks), 3))
+    grey = rng.uniform(90, 200)
+    frames, masks = [], []
+    for _ in range(8):
+        f = np.full((*SIZE, 3), grey)
+        ms = [
+            _block(f, 20 + 70 * (i // 4), 10 + 56 * (i % 4), np.array(COLOURS[c], float), s)
+            for i, (c, s) in enumerate(zip(picks, shades, strict=True))
+        ]
+        f += rng.normal(0, 2.0, f.shape)
+        frames.append(np.clip(f, 0, 255).astype(np.uint8))
+        masks = ms
+    return frames, masks, [int(c) for c in picks]
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_every_colour_is_one_class_under_shading(seed: int) -> None:
+    frames, masks, picks = _scene(seed)
+    model = video_model(frames)
+    assert len(model.names) == len(picks), model.names
+    labels = classify(frames[0], model)
+    owners = []
+    for m in masks:
+        got = np.bincount(labels[m], minlength=len(model.names) + 1)
+        owners.append(int(np.argmax(got[1:])) + 1)
+        assert got[owners[-1]] >= 0.9 * m.sum(), got
+    assert len(set(owners)) == len(owners)
+
+
+def _objects(masks: list[list[tuple[int, Bools]]]) -> list[list[Obj]]:
+    return [[Obj(k, m, 1) for k, m in frame] for frame in masks]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_gradual_recolour_drifts_and_a_piece_sliding_over_does_not(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    a, b = (np.array(COLOURS[c], float) for c in rng.choice([0, 3, 5, 6, 8], 2, replace=False))
+    start, steps = int(rng.integers(3, 8)), int(rng.integers(4, 9))
+    grey, shades = rng.uniform(90, 200), rng.uniform(0.5, 1.1, 3)
+    frames, slid, objs, objs_slid = [], [], [], []
+    for t in range(26):
+        w = min(1.0, max(0.0, (t - start + 1) / steps))
+        f = np.full((*SIZE, 3), grey)
+        m = _block(f, 40, 40, (1 - w) * a + w * b, shades)
+        other = _block(f, 40, 160, b, shades)
+        frames.append(np.clip(f + rng.normal(0, 2.0, f.shape), 0, 255).astype(np.uint8))
+        objs.append([(0 if w < 0.5 else 1, m), (1, other)])  # classed as it looks
+        g = np.full((*SIZE, 3), grey)  # the b block slides over the a block instead
+        m2 = _block(g, 40, 40, a, shades)
+        x = round(160 - 120 * w)
+        over = _block(g, 40, x, b, shades)
+        slid.append(np.clip(g + rng.normal(0, 2.0, g.shape), 0, 255).astype(np.uint8))
+        objs_slid.append([(0, m2 & ~over), (1, over)])
+    events = Drift(frames, _objects(objs), ("a", "b")).events()
+    assert [(e.kind, e.piece, e.other) for e in events] == [("recolour", "a", "b")]
+    assert abs(events[0].frame - start) <= 1 and events[0].until <= start + steps + 1
+    assert Drift(slid, _objects(objs_slid), ("a", "b")).events() == []
