@@ -47,9 +47,9 @@ COVERED: Final = 0.25
 #: Pixels from the picture's edge within which a silhouette touches the border.
 BORDER: Final = 3
 #: Frames of past silhouettes laid together (by their displacements) as a piece's full shape.
-HISTORY: Final = 6
+HISTORY: Final = 3
 #: Erosion (pixels) of both silhouettes before a pixel counts as inside them.
-INSIDE: Final = 2
+INSIDE: Final = 3
 #: A pass-through: within FLIP_WINDOW frames, FLIP_FRAMES frames with flips over FLIP_SHARE of
 #: the least area each, and FLIP_TOTAL of it in all (a single frame's flips are misreadings).
 FLIP_WINDOW: Final = 8

@@ -81,7 +81,7 @@ def _drawn(depth_red: float, tilt: float, x: float) -> list[np.ndarray]:
 def test_a_box_crossing_another_in_depth_is_a_pass_through(seed: int) -> None:
     rng = np.random.default_rng(seed)
     speed = float(rng.uniform(2.5, 4.0))
-    sink = float(rng.uniform(0.4, 0.6))  # the red box goes deeper as it slides on
+    sink = float(rng.uniform(0.8, 1.2))  # the red box goes deeper as it slides on
     kept = [_drawn(sink * i, 0.4, 30 + speed * i) for i in range(N)]
     found = [e for e in _events(kept) if e[0] == "pass_through"]
     assert found and {found[0][2]} <= set(NAMES)
