@@ -28,6 +28,7 @@ from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.worldmodel.judge_drift import Drift
 from chaingeo.worldmodel.judge_exist import Existence, join
+from chaingeo.worldmodel.judge_motion import Motion
 from chaingeo.worldmodel.judge_palette import video_model
 from chaingeo.worldmodel.judge_segment import (
     RENDER_SHADES,
@@ -264,13 +265,17 @@ def judge_frames(
     grounds = [ground(f, m) for f, m in zip(frames, masks, strict=True)]
     events = join(events, Existence(kept, grounds, model.names, area).events())
     events = join(events, Drift(list(frames), [o for o, _ in objects], model.names).events())
+    motion = Motion(kept, model.names, area)
+    events = join(events, motion.teleports())
     undecided: list[str] = []
     if level is not None and colors:
         events, undecided = _with_level(level, colors, model.names, events, kept, area)
     else:
+        events = join(events, motion.pass_throughs())
         undecided.append(
-            "pass_through: motion through another piece is not decidable without the level's "
-            "geometry and a known camera (give --level for a video drawn by chain video)"
+            "pass_through: read from silhouettes only (two pieces' depth order turning where "
+            "both lie); a crossing hidden from view needs the level's geometry and a known "
+            "camera (give --level for a video drawn by chain video)"
         )
     events = [_sunk(e, masks, solids, model.names) for e in events]
     misread = [e for e in events if _misread(frames, masks, kept, e, model.names)]

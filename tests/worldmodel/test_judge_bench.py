@@ -59,6 +59,8 @@ CAUGHT = (
     ("teleport", 8, "flat"),
     ("duplicate", 27, "flat"),
     ("vanish_neighbour", 12, "shaded"),
+    ("teleport", 78, "shaded"),
+    ("pass_through", 9, "flat"),
 )
 CLEAN = ((80, "flat"), (82, "shaded"))
 
@@ -144,7 +146,8 @@ FLOORS = {
     "split": 0.8,
     "merge": 0.85,
     "duplicate": 0.9,
-    "teleport": 0.5,
+    "teleport": 0.8,
+    "pass_through": 0.1,
 }
 MOST_FALSE_ALARMS = 0.06
 

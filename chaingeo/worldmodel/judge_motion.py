@@ -1,0 +1,330 @@
+"""Motion read from silhouettes alone: teleports and pass-throughs, no level needed.
+
+Each colour's pixels are laid on the next frame's by the translation that best fits them
+(cross-correlation of the two masks): a rigid piece keeps its silhouette while it moves, so a
+good fit gives its displacement per frame.
+
+``teleport``: a displacement far beyond what the piece did just before and just after (its own
+speed, which holds camera motion too), with the silhouette kept: motion, however fast, passes
+through places, and our own videos ease every move in and out.
+
+``pass_through``: where the silhouettes of two pieces both lie, each pixel shows the nearer of
+the two. Rigid pieces that do not meet keep their depth order there: a pixel inside both
+silhouettes in two frames shows the same piece in both, except where a piece's own fold sweeps
+by. A pixel that turns from one piece to the other while it stays inside both silhouettes means
+the two surfaces crossed in depth there: one piece moved through the other. Flips on
+:data:`FLIP_FRAMES` frames within :data:`FLIP_WINDOW` of a motion make the event (one frame's
+flips are a misreading). A crossing hidden behind other pieces, or along the line of sight,
+shows nothing here: only the level's geometry decides it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+
+from chaingeo.core.arrays import Bools
+from chaingeo.worldmodel.judge_segment import dilate
+from chaingeo.worldmodel.judge_track import Event
+
+#: Overlap (pixels) a shift's each pixel of distance from the step before costs.
+INERTIA: Final = 0.5
+#: Least share of the smaller silhouette that the best translation must lay on the other.
+FIT: Final = 0.7
+#: Least jump (share of the frame's longer side), and how many times the piece's own speed
+#: just before and after must go into the jump less the mean of those two steps.
+JUMP_MIN: Final = 0.05
+JUMP_RATIO: Final = 2.0
+#: Speed (pixels a frame) below which a piece counts as still when bounding a jump.
+JUMP_FLOOR: Final = 2.0
+#: Least area ratio of a silhouette across a jump (occlusion may change what shows of it).
+JUMP_AREA: Final = 0.3
+#: Share of the place a piece left (or took) that a moving piece covering it makes the change
+#: an occlusion, not a jump.
+COVERED: Final = 0.25
+#: Pixels from the picture's edge within which a silhouette touches the border.
+BORDER: Final = 3
+#: Frames of past silhouettes laid together (by their displacements) as a piece's full shape.
+HISTORY: Final = 3
+#: Erosion (pixels) of both silhouettes before a pixel counts as inside them.
+INSIDE: Final = 3
+#: A pass-through: within FLIP_WINDOW frames, FLIP_FRAMES frames with flips over FLIP_SHARE of
+#: the least area each, and FLIP_TOTAL of it in all (a single frame's flips are misreadings).
+FLIP_WINDOW: Final = 8
+FLIP_SHARE: Final = 0.05
+FLIP_FRAMES: Final = 4
+FLIP_TOTAL: Final = 0.5
+
+Shift = tuple[int, int]
+
+
+@dataclass(frozen=True)
+class Step:
+    """A colour's best translation from one frame to the next and how well it fits (share
+    of the smaller silhouette laid on the other); fit 0 when either frame lacks the colour."""
+
+    dy: int
+    dx: int
+    fit: float
+
+    @property
+    def length(self) -> float:
+        return float(np.hypot(self.dy, self.dx))
+
+
+NONE: Final = Step(0, 0, 0.0)
+
+
+def best_shift(a: Bools, b: Bools, prior: Shift = (0, 0)) -> Step:
+    """The translation laying ``a`` best on ``b``, by FFT cross-correlation on the box holding
+    both; each pixel of distance from ``prior`` (the step before: pieces keep their motion)
+    costs INERTIA pixels of overlap, which decides between shifts a piece partly hidden as it
+    moves fits equally well."""
+    na, nb = int(a.sum()), int(b.sum())
+    if na == 0 or nb == 0:
+        return NONE
+    ys, xs = np.nonzero(a | b)
+    y0, y1, x0, x1 = int(ys.min()), int(ys.max()) + 1, int(xs.min()), int(xs.max()) + 1
+    ca = a[y0:y1, x0:x1].astype(np.float64)
+    cb = b[y0:y1, x0:x1].astype(np.float64)
+    h, w = ca.shape
+    size = (2 * h, 2 * w)
+    corr = np.fft.irfft2(np.conj(np.fft.rfft2(ca, size)) * np.fft.rfft2(cb, size), size)
+    dy = np.arange(2 * h)
+    dy = np.where(dy >= h, dy - 2 * h, dy)
+    dx = np.arange(2 * w)
+    dx = np.where(dx >= w, dx - 2 * w, dx)
+    dist = np.hypot(dy[:, None] - prior[0], dx[None, :] - prior[1])
+    score = np.round(corr) - INERTIA * dist
+    i = int(np.argmax(score))
+    y, x = divmod(i, 2 * w)
+    return Step(int(dy[y]), int(dx[x]), float(np.round(corr[y, x])) / min(na, nb))
+
+
+def moved(mask: Bools, dy: int, dx: int) -> Bools:
+    """``mask`` translated by (dy, dx), what leaves the picture dropped."""
+    h, w = mask.shape
+    out = np.zeros_like(mask)
+    if abs(dy) >= h or abs(dx) >= w:
+        return out
+    src = mask[max(0, -dy) : h - max(0, dy), max(0, -dx) : w - max(0, dx)]
+    out[max(0, dy) : max(0, dy) + src.shape[0], max(0, dx) : max(0, dx) + src.shape[1]] = src
+    return out
+
+
+def _share(pixels: Bools, region: Bools) -> float:
+    return float((pixels & region).sum()) / max(1.0, float(region.sum()))
+
+
+def _erode(mask: Bools, r: int) -> Bools:
+    out: Bools = ~dilate(~mask, r)
+    return out
+
+
+def _on_border(m: Bools) -> bool:
+    b = BORDER
+    return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
+
+
+class Motion:
+    """The per-frame steps of each colour of ``kept[t][k]`` (a class's piece pixels), and the
+    motion events they show."""
+
+    def __init__(self, kept: list[list[Bools]], names: tuple[str, ...], least: int) -> None:
+        self.kept, self.names, self.least = kept, names, least
+        shape = kept[0][0].shape if kept and kept[0] else (1, 1)
+        self.side = max(shape)
+        self.area = [[int(m.sum()) for m in frame] for frame in kept]
+        n, c = len(kept), len(names)
+        self.steps: list[list[Step]] = [[NONE] * c]
+        for t in range(1, n):
+            row = []
+            for k in range(c):
+                if self.area[t - 1][k] < least or self.area[t][k] < least:
+                    row.append(NONE)
+                else:
+                    p = self.steps[-1][k]
+                    prior = (p.dy, p.dx) if p.fit >= FIT else (0, 0)
+                    row.append(best_shift(kept[t - 1][k], kept[t][k], prior))
+            self.steps.append(row)
+        self._shapes: dict[tuple[int, int], Bools] = {}
+
+    def events(self) -> list[Event]:
+        return self.teleports() + self.pass_throughs()
+
+    # -- teleports ----------------------------------------------------------------------------
+
+    def _spike(self, k: int, b: int) -> tuple[float, float] | None:
+        """Colour ``k``'s step at frame ``b`` less the mean of its steps just before and just
+        after (what smooth motion, eased or not, would have done), and the larger of those
+        two; None when a neighbouring frame lacks the colour or fits badly (undecidable)."""
+        if not 2 <= b < len(self.kept) - 1:
+            return None
+        s, p, q = self.steps[b][k], self.steps[b - 1][k], self.steps[b + 1][k]
+        if p.fit < FIT or q.fit < FIT:
+            return None
+        off = np.hypot(s.dy - (p.dy + q.dy) / 2, s.dx - (p.dx + q.dx) / 2)
+        return float(off), max(p.length, q.length)
+
+    def teleports(self) -> list[Event]:
+        out: list[Event] = []
+        for k, name in enumerate(self.names):
+            for b in range(2, len(self.kept) - 1):
+                s = self.steps[b][k]
+                if s.fit < FIT or s.length < JUMP_MIN * self.side:
+                    continue
+                a, c = self.area[b - 1][k], self.area[b][k]
+                if min(a, c) < JUMP_AREA * max(a, c):
+                    continue
+                was, now = self.kept[b - 1][k], self.kept[b][k]
+                if _on_border(was) or _on_border(now):
+                    continue
+                spike = self._spike(k, b)
+                if spike is None or spike[0] < JUMP_RATIO * max(spike[1], JUMP_FLOOR):
+                    continue
+                if self._covered(k, b):
+                    continue
+                detail = (
+                    f"the {name} piece jumped {s.length:.0f} px between two frames "
+                    f"(at most {spike[1]:.0f} px a frame just before and after)"
+                )
+                out.append(Event("teleport", b, name, None, detail, (was, now)))
+        return out
+
+    def _camera(self, t: int) -> Shift:
+        """The camera's step at frame ``t``: the least step of the well-fitted colours (a
+        piece at rest shows it)."""
+        got = [s for s in self.steps[t] if s.fit >= FIT]
+        if not got:
+            return (0, 0)
+        still = min(got, key=lambda s: (s.length, s.dy, s.dx))
+        return (still.dy, still.dx)
+
+    def _mover(self, j: int, t: int) -> bool:
+        """Whether colour ``j`` moves against the camera at frame ``t`` (or cannot be followed)."""
+        s = self.steps[t][j]
+        if s.fit < FIT:
+            return True
+        cy, cx = self._camera(t)
+        return bool(np.hypot(s.dy - cy, s.dx - cx) > JUMP_FLOOR)
+
+    def _covered(self, k: int, b: int) -> bool:
+        """Whether the place colour ``k`` left at frame ``b`` is now under a moving piece, or
+        the place it took was under one a frame before: an occluder passed, the piece did not
+        jump."""
+        was, now = self.kept[b - 1][k], self.kept[b][k]
+        left, took = was & ~now, now & ~was
+        for j in range(len(self.names)):
+            if j == k:
+                continue
+            if not (self._mover(j, b) or self._mover(j, min(b + 1, len(self.kept) - 1))):
+                continue
+            hid = _share(self.kept[b][j], left) >= COVERED
+            if hid or _share(self.kept[b - 1][j], took) >= COVERED:
+                return True
+        return False
+
+    # -- pass-throughs ------------------------------------------------------------------------
+
+    def _shape(self, k: int, t: int) -> Bools:
+        """Colour ``k``'s full silhouette at frame ``t``: its pixels of HISTORY frames on each
+        side laid where they are at ``t`` by the steps between (parts hidden at ``t`` but seen
+        before or after add up), along well-fitted steps only."""
+        key = (k, t)
+        if key in self._shapes:
+            return self._shapes[key]
+        out = self.kept[t][k].copy()
+        dy = dx = 0
+        for u in range(t, max(0, t - HISTORY), -1):
+            s = self.steps[u][k]
+            if s.fit < FIT:
+                break
+            dy, dx = dy + s.dy, dx + s.dx
+            out |= moved(self.kept[u - 1][k], dy, dx)
+        dy = dx = 0
+        for u in range(t + 1, min(len(self.kept), t + 1 + HISTORY)):
+            s = self.steps[u][k]
+            if s.fit < FIT:
+                break
+            dy, dx = dy - s.dy, dx - s.dx
+            out |= moved(self.kept[u][k], dy, dx)
+        self._shapes[key] = out
+        return out
+
+    def flips(self, k: int, j: int, t: int) -> tuple[int, Bools]:
+        """Pixels inside both silhouettes in frames ``t - 1`` and ``t`` that turn from one of
+        the two colours to the other."""
+        inside = np.ones_like(self.kept[t][k])
+        for u in (t - 1, t):
+            inside &= _erode(self._shape(k, u), INSIDE) & _erode(self._shape(j, u), INSIDE)
+        a0, a1 = self.kept[t - 1][k], self.kept[t][k]
+        b0, b1 = self.kept[t - 1][j], self.kept[t][j]
+        turned = inside & ((a0 & b1) | (b0 & a1))
+        return int(turned.sum()), turned
+
+    def _apart(self, k: int, j: int, t: int) -> bool:
+        """Whether colours ``k`` and ``j`` both follow well and step differently at frame
+        ``t``: only pieces moving against each other can cross in depth (a still scene's
+        flicker, or a camera drift that moves both alike, cannot)."""
+        a, b = self.steps[t][k], self.steps[t][j]
+        return a.fit >= FIT and b.fit >= FIT and (a.dy, a.dx) != (b.dy, b.dx)
+
+    def pass_throughs(self) -> list[Event]:
+        out: list[Event] = []
+        c = len(self.names)
+        for k in range(c):
+            for j in range(k + 1, c):
+                out.extend(self._pair(k, j))
+        return out
+
+    def _pair(self, k: int, j: int) -> list[Event]:
+        """Windows of FLIP_WINDOW frames, while one of colours ``k`` and ``j`` moves, with
+        flips on FLIP_FRAMES of them and FLIP_TOTAL of the least area in all; overlapping
+        windows are one event."""
+        empty = np.zeros_like(self.kept[0][k])
+        counts, turned = [0], [empty]
+        for t in range(1, len(self.kept)):
+            n, m = 0, empty
+            if min(self.area[t][k], self.area[t][j]) >= self.least and self._apart(k, j, t):
+                n, m = self.flips(k, j, t)
+            counts.append(n)
+            turned.append(m)
+        out: list[Event] = []
+        end = -1
+        for s in range(1, len(counts)):
+            w = range(s, min(len(counts), s + FLIP_WINDOW))
+            on = [t for t in w if counts[t] >= FLIP_SHARE * self.least]
+            total = sum(counts[t] for t in w)
+            if len(on) < FLIP_FRAMES or total < FLIP_TOTAL * self.least or on[0] <= end:
+                continue
+            out.append(self._event(k, j, on, total, turned[on[0]]))
+            end = w[-1]
+        return out
+
+    def _event(self, k: int, j: int, on: list[int], total: int, turned: Bools) -> Event:
+        """The pass-through over frames ``on``: named for the piece that travelled further,
+        with both silhouettes before and at its first frame and the pixels that turned."""
+        first, last = on[0], on[-1]
+        mover = k if self._travel(k, first, last) >= self._travel(j, first, last) else j
+        still = j if mover == k else k
+        a, b = self.names[mover], self.names[still]
+        detail = (
+            f"the {a} piece moved through the {b} piece: {total} px inside both silhouettes "
+            f"turned from one to the other over frames {first}-{last}"
+        )
+        f = first
+        masks = (
+            self.kept[f - 1][mover],
+            self.kept[f - 1][still],
+            self.kept[f][mover],
+            self.kept[f][still],
+            turned,
+        )
+        return Event("pass_through", first, a, b, detail, masks, before=2, last=last)
+
+    def _travel(self, k: int, first: int, last: int) -> float:
+        dy = sum(self.steps[u][k].dy for u in range(first, last + 1))
+        dx = sum(self.steps[u][k].dx for u in range(first, last + 1))
+        return float(np.hypot(dy, dx))
