@@ -312,10 +312,12 @@ def count_by_arrangement(
     deadline: Deadline | None = None,
     checks: int = CHECKS,
     seed: int = 0,
+    prove: bool = True,
 ) -> ArrangementReport:
     """BurrTools' assemblies and solutions of ``plan.labelled`` (as :func:`count_bt` counts
-    them) from the merged packing's arrangements (see the module's docstring). A cap reached
-    ends the count: the report then holds lower bounds and the error."""
+    them) from the merged packing's arrangements (see the module's docstring); ``prove``: each
+    verdict also proven for every labelling (unless ``max_group``). A cap reached ends the
+    count: the report then holds lower bounds and the error."""
     start = time.perf_counter()
     drop = mirrors == "drop"
     maps = plan.merged.row_maps(drop)
@@ -332,7 +334,7 @@ def count_by_arrangement(
             arrangements += 1
             weight = arrangement_weight(plan, rows, maps, proper)
             verdict = _verdict(plan, rows, judge, full, flips, checks, seed)
-            if max_group is None:
+            if prove and max_group is None:
                 proven += _proven(plan, rows, judge, verdict) is not None
             assemblies += weight
             if verdict:

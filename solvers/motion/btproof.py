@@ -86,6 +86,7 @@ def layer_candidates(part: bt.PartGaps, states: I16, nodes: I64) -> tuple[I64, I
     return out_node[:n], out_mask[:n]
 
 
+@njit(cache=True)
 def _depths(parent: I64, n_states: int) -> I64:
     """Breadth-first depth of each state (a state's parent is listed before it)."""
     depth = np.zeros(n_states, dtype=np.int64)
@@ -104,6 +105,7 @@ class OrderFree:
         self.deadline = deadline
         self.memo_rel, self.memo_gap = mv.gap_memo(len(self.table.names))
         self.memo: Memo = {} if memo is None else memo
+        self.local: dict[tuple[tuple[int, ...], bytes], Verdict] = {}
         # Each piece's voxels in lexicographic order, which a translation keeps.
         self.sorted = [v[np.lexsort(v.T[::-1])] for v in self.table.voxels]
         self.states = 0
@@ -118,10 +120,13 @@ class OrderFree:
         """The part's verdict for every order (``offsets``: its pieces', in ``members``' order)."""
         if len(members) < 2:
             return True
-        key = self.key(members, offsets)
-        if key not in self.memo:
-            self.memo[key] = self._search(members, offsets)
-        return self.memo[key]
+        here = (members, (offsets - offsets[0]).tobytes())  # this assembly's pieces: cheaper
+        if here not in self.local:
+            key = self.key(members, offsets)
+            if key not in self.memo:
+                self.memo[key] = self._search(members, offsets)
+            self.local[here] = self.memo[key]
+        return self.local[here]
 
     def _search(self, members: tuple[int, ...], offsets: I64) -> Verdict:
         self.deadline.check()
