@@ -16,7 +16,7 @@ A level whose congruent pieces are separate BurrTools shapes with at least
 :data:`BY_ARRANGEMENT_FROM` relabellings (hard-03's 11 sticks: 11!) is counted by arrangement
 (:mod:`chaingeo.solvers.assembly.btcongruent`): each arrangement judged once (and on
 :data:`CHECKS` relabellings, which must agree), its labelled classes counted exactly; its
-``program`` says so.
+``program`` says so, and whether each verdict is also proven for every labelling.
 """
 
 from __future__ import annotations
@@ -32,12 +32,12 @@ from chaingeo.core.level import Level, level_bytes, load_level, revalidate, save
 from chaingeo.generator.batch import GenerationError
 from chaingeo.solvers.analysis import CONVENTIONS, count_figures, level_packing
 from chaingeo.solvers.assembly.btcongruent import (
+    ArrangementReport,
     Plan,
     arrangement_plan,
     count_by_arrangement,
     relabelling_count,
 )
-from chaingeo.solvers.assembly.btcount import BTReport
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.jobs import Farm
 from chaingeo.solvers.limits import SearchLimits
@@ -58,6 +58,13 @@ CHECKS: Final = 1000
 PROGRAM_BY_ARRANGEMENT: Final = (
     f"chain generate puzzle-counts --max-states {COUNT_STATES}: each arrangement of congruent "
     f"pieces judged once and on {CHECKS} seeded relabellings (all agreeing), times its "
+    "labelled classes (Burnside over its stabiliser)"
+)
+#: The same, each arrangement's verdict also proven for every labelling (by geometry alone).
+PROGRAM_PROVEN: Final = (
+    f"chain generate puzzle-counts --max-states {COUNT_STATES}: each arrangement of congruent "
+    "pieces judged once, its verdict proven for every labelling (every separation BurrTools' "
+    f"first could be, recursively) and checked on {CHECKS} seeded relabellings, times its "
     "labelled classes (Burnside over its stabiliser)"
 )
 
@@ -84,8 +91,9 @@ def count_level(level: Level, farm: Farm) -> Level:
     plan = arrangement_plan(packing)
     program = PROGRAM
     if plan is not None and relabelling_count(plan) >= BY_ARRANGEMENT_FROM:
-        rep = _by_arrangement(plan, level)
-        program = PROGRAM_BY_ARRANGEMENT
+        got = _by_arrangement(plan, level)
+        rep = got.report
+        program = PROGRAM_PROVEN if got.all_proven else PROGRAM_BY_ARRANGEMENT
     else:
         out: dict[str, Any] = {}
         rep = count_figures(packing, out, "drop", COUNT_LIMITS, Deadline(None), "", farm)
@@ -104,7 +112,7 @@ def count_level(level: Level, farm: Farm) -> Level:
     return revalidate(dataclasses.replace(level, stats={**without_counts(level).stats, **counts}))
 
 
-def _by_arrangement(plan: Plan, level: Level) -> BTReport:
+def _by_arrangement(plan: Plan, level: Level) -> ArrangementReport:
     """The counts by arrangement, in this process (a handful of verdicts)."""
     got = count_by_arrangement(
         plan, mirrors="drop", max_group=None, limits=COUNT_LIMITS,
@@ -112,7 +120,7 @@ def _by_arrangement(plan: Plan, level: Level) -> BTReport:
     )  # fmt: skip
     if not got.report.complete:
         raise GenerationError(f"{level.id}: counting stopped ({got.report.limit})")
-    return got.report
+    return got
 
 
 def reuse_counts(level: Level, stored: Iterable[Level]) -> Level | None:

@@ -24,6 +24,9 @@ congruent piece sits where, and on which of an F-class's rotation classes is jud
 arrangement is judged on its first labelling, on its mirror image when that is in its class, and
 on ``checks`` seeded random relabellings (every one when there are no more); judgements are
 cached by labelled rows, and any disagreement raises :class:`RelabellingError`, never a count.
+Unless ``max_group`` is set, the verdict is also proven for every labelling and turn at once
+(:func:`chaingeo.solvers.motion.btproof.verdict_for_all_orders`, by geometry alone); it must
+agree, and the report says how many arrangements it decided (the sample stays, a cross-check).
 """
 
 from __future__ import annotations
@@ -54,6 +57,7 @@ from chaingeo.solvers.assembly.btcount import BTReport, RowVerdicts, StuckCheck
 from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
 from chaingeo.solvers.limits import SearchLimits
+from chaingeo.solvers.motion.btproof import Memo, Verdict, verdict_for_all_orders
 
 #: Relabellings judged an arrangement besides its first (all of them when there are fewer).
 CHECKS = 64
@@ -75,11 +79,18 @@ class Plan:
 
 @dataclass(frozen=True)
 class ArrangementReport:
-    """The counts (:class:`BTReport`) and what they took: arrangements met, labellings judged."""
+    """The counts (:class:`BTReport`) and what they took: arrangements met, labellings judged,
+    arrangements whose verdict is proven for every labelling."""
 
     report: BTReport
     arrangements: int
     judged: int
+    proven: int = 0
+
+    @property
+    def all_proven(self) -> bool:
+        """Every arrangement's verdict holds for every labelling (not just the sampled)."""
+        return self.report.complete and self.proven == self.arrangements
 
 
 def arrangement_plan(labelled: Packing) -> Plan | None:
@@ -263,6 +274,7 @@ class Judge:
         self.on_rows = RowVerdicts(packing, limits, False)
         self.frame = BTFrame(packing)
         self.cache: dict[bytes, bool] = {}
+        self.proofs: Memo = {}  # parts' verdicts for every labelling, by geometry
 
     def __call__(self, rows: I32) -> bool:
         key = rows.tobytes()
@@ -300,10 +312,12 @@ def count_by_arrangement(
     deadline: Deadline | None = None,
     checks: int = CHECKS,
     seed: int = 0,
+    prove: bool = True,
 ) -> ArrangementReport:
     """BurrTools' assemblies and solutions of ``plan.labelled`` (as :func:`count_bt` counts
-    them) from the merged packing's arrangements (see the module's docstring). A cap reached
-    ends the count: the report then holds lower bounds and the error."""
+    them) from the merged packing's arrangements (see the module's docstring); ``prove``: each
+    verdict also proven for every labelling (unless ``max_group``). A cap reached ends the
+    count: the report then holds lower bounds and the error."""
     start = time.perf_counter()
     drop = mirrors == "drop"
     maps = plan.merged.row_maps(drop)
@@ -312,7 +326,7 @@ def count_by_arrangement(
     flips = np.flatnonzero(~proper)
     full = plan.labelled.row_maps(drop)
     judge = Judge(plan.labelled, max_group, limits, deadline)
-    assemblies = solutions = arrangements = 0
+    assemblies = solutions = arrangements = proven = 0
     first: dict[str, Shape] | None = None
     limit: SearchLimitError | None = None
     try:
@@ -320,6 +334,8 @@ def count_by_arrangement(
             arrangements += 1
             weight = arrangement_weight(plan, rows, maps, proper)
             verdict = _verdict(plan, rows, judge, full, flips, checks, seed)
+            if prove and max_group is None:
+                proven += _proven(plan, rows, judge, verdict) is not None
             assemblies += weight
             if verdict:
                 solutions += weight
@@ -331,7 +347,24 @@ def count_by_arrangement(
     label = None if anchor is None else anchor.label
     seconds = time.perf_counter() - start
     rep = BTReport(assemblies, solutions, first, None, seconds, label, limit)
-    return ArrangementReport(rep, arrangements, len(judge.cache))
+    return ArrangementReport(rep, arrangements, len(judge.cache), proven)
+
+
+def _proven(plan: Plan, rows: I32, judge: Judge, verdict: bool) -> Verdict:
+    """The arrangement's verdict for every labelling (None: not decided within the caps);
+    :class:`RelabellingError` when it is not the judged one."""
+    image = judge.image(labelled_rows(plan, rows, first_labels(plan)))
+    try:
+        proof = verdict_for_all_orders(image, judge.limits, judge.deadline, judge.proofs)
+    except SearchLimitError as e:
+        if e.cap == "seconds":
+            raise
+        return None
+    if proof is not None and proof != verdict:
+        raise RelabellingError(
+            f"arrangement {rows.tolist()}: judged {verdict}, proven {proof} for every labelling"
+        )
+    return proof
 
 
 def _verdict(plan: Plan, rows: I32, judge: Judge, full: I32, flips: I64, checks: int,

@@ -21,6 +21,7 @@ from chaingeo.solvers.assembly import btcongruent as bc
 from chaingeo.solvers.assembly.btassemble import Mirrors, bt_packing_spec, iter_classes
 from chaingeo.solvers.assembly.btcount import count_bt
 from chaingeo.solvers.cover.constrained import canonical_keys, compile_packing
+from chaingeo.solvers.motion.btproof import verdict_for_all_orders
 from tests.support import burrtxt as bt
 from tests.support.congruent import KINDS, congruent_puzzle, regrouped
 from tests.support.paths import LEVELS
@@ -68,7 +69,9 @@ def _same_as_plain(kind: str, index: int) -> None:
     puzzle = _puzzle(kind, index)
     plan = _plan(puzzle)
     for mirrors in ("keep", "drop"):
-        got = bc.count_by_arrangement(plan, mirrors=mirrors).report
+        by = bc.count_by_arrangement(plan, mirrors=mirrors, prove=mirrors == "drop")
+        assert by.all_proven == (mirrors == "drop"), mirrors  # the count step's convention
+        got = by.report
         want = count_bt(plan.labelled, mirrors=mirrors)
         assert (got.assemblies, got.solutions) == (want.assemblies, want.solutions), mirrors
         maps = plan.merged.row_maps(mirrors == "drop")
@@ -146,6 +149,32 @@ def test_a_verdict_that_depends_on_labels_is_refused(monkeypatch: pytest.MonkeyP
     monkeypatch.setattr(bc.Judge, "_judge", lambda self, rows: bool(rows[0] % 2))
     with pytest.raises(bc.RelabellingError):
         bc.count_by_arrangement(plan, mirrors="drop")
+
+
+@pytest.mark.parametrize(("kind", "index"), CASES)
+def test_the_proof_is_every_labellings_verdict(kind: str, index: int) -> None:
+    """Each arrangement's verdict for every labelling (btproof) is the judged verdict of
+    every one of its labellings, all enumerated."""
+    plan = _plan(_puzzle(kind, index))
+    judge = bc.Judge(plan.labelled, None, None, None)
+    every = bc.relabelling_count(plan)
+    for rows in iter_classes(plan.merged, mirrors="drop"):
+        base = bc.labelled_rows(plan, rows, bc.first_labels(plan))
+        proof = verdict_for_all_orders(judge.image(base))
+        labellings = [base, *(bc.labelled_rows(plan, rows, lab)
+                              for lab in bc.relabellings(plan, every, 0))]  # fmt: skip
+        assert proof is not None and {judge(r) for r in labellings} == {proof}
+
+
+def test_a_proof_that_disagrees_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A proven verdict that is not the judged one raises, never counts."""
+    plan = _plan(_puzzle("bars", 0))
+    monkeypatch.setattr(bc, "verdict_for_all_orders", lambda *a: False)
+    with pytest.raises(bc.RelabellingError, match="proven False"):
+        bc.count_by_arrangement(plan, mirrors="drop")
+    monkeypatch.setattr(bc, "verdict_for_all_orders", lambda *a: None)
+    got = bc.count_by_arrangement(plan, mirrors="drop")
+    assert got.proven == 0 and not got.all_proven and got.report.complete
 
 
 def test_a_plan_only_where_congruent_parts_are_apart() -> None:
