@@ -61,7 +61,7 @@ Shift = tuple[int, int]
 
 
 @dataclass(frozen=True)
-class Step:
+class MaskShift:
     """A colour's best translation from one frame to the next and how well it fits (share
     of the smaller silhouette laid on the other); fit 0 when either frame lacks the colour."""
 
@@ -74,10 +74,10 @@ class Step:
         return float(np.hypot(self.dy, self.dx))
 
 
-NONE: Final = Step(0, 0, 0.0)
+NONE: Final = MaskShift(0, 0, 0.0)
 
 
-def best_shift(a: Bools, b: Bools, prior: Shift = (0, 0)) -> Step:
+def best_shift(a: Bools, b: Bools, prior: Shift = (0, 0)) -> MaskShift:
     """The translation laying ``a`` best on ``b``, by FFT cross-correlation on the box holding
     both; each pixel of distance from ``prior`` (the step before: pieces keep their motion)
     costs INERTIA pixels of overlap, which decides between shifts a piece partly hidden as it
@@ -100,7 +100,7 @@ def best_shift(a: Bools, b: Bools, prior: Shift = (0, 0)) -> Step:
     score = np.round(corr) - INERTIA * dist
     i = int(np.argmax(score))
     y, x = divmod(i, 2 * w)
-    return Step(int(dy[y]), int(dx[x]), float(np.round(corr[y, x])) / min(na, nb))
+    return MaskShift(int(dy[y]), int(dx[x]), float(np.round(corr[y, x])) / min(na, nb))
 
 
 def moved(mask: Bools, dy: int, dx: int) -> Bools:
@@ -128,7 +128,7 @@ def _on_border(m: Bools) -> bool:
     return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
 
 
-class Motion:
+class SilhouetteMotion:
     """The per-frame steps of each colour of ``kept[t][k]`` (a class's piece pixels), and the
     motion events they show."""
 
@@ -138,7 +138,7 @@ class Motion:
         self.side = max(shape)
         self.area = [[int(m.sum()) for m in frame] for frame in kept]
         n, c = len(kept), len(names)
-        self.steps: list[list[Step]] = [[NONE] * c]
+        self.steps: list[list[MaskShift]] = [[NONE] * c]
         for t in range(1, n):
             row = []
             for k in range(c):

@@ -28,7 +28,7 @@ from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.worldmodel.judge_drift import Drift
 from chaingeo.worldmodel.judge_exist import Existence, join
-from chaingeo.worldmodel.judge_motion import Motion
+from chaingeo.worldmodel.judge_motion import SilhouetteMotion
 from chaingeo.worldmodel.judge_palette import video_model
 from chaingeo.worldmodel.judge_segment import (
     RENDER_SHADES,
@@ -265,7 +265,7 @@ def judge_frames(
     grounds = [ground(f, m) for f, m in zip(frames, masks, strict=True)]
     events = join(events, Existence(kept, grounds, model.names, area).events())
     events = join(events, Drift(list(frames), [o for o, _ in objects], model.names).events())
-    motion = Motion(kept, model.names, area)
+    motion = SilhouetteMotion(kept, model.names, area)
     events = join(events, motion.teleports())
     undecided: list[str] = []
     if level is not None and colors:

@@ -260,7 +260,7 @@ def _multinomial(counts: tuple[int, ...]) -> int:
     return math.factorial(sum(counts)) // math.prod(math.factorial(c) for c in counts)
 
 
-class Judge:
+class ArrangementJudge:
     """BurrTools' verdict on a labelled assembly (sorted rows), as :func:`count_bt` gives it:
     nothing moves, the row kernel, else the general path; cached by rows."""
 
@@ -325,7 +325,7 @@ def count_by_arrangement(
     proper = np.array([s.proper for s in syms])
     flips = np.flatnonzero(~proper)
     full = plan.labelled.row_maps(drop)
-    judge = Judge(plan.labelled, max_group, limits, deadline)
+    judge = ArrangementJudge(plan.labelled, max_group, limits, deadline)
     assemblies = solutions = arrangements = proven = 0
     first: dict[str, Shape] | None = None
     limit: SearchLimitError | None = None
@@ -350,7 +350,7 @@ def count_by_arrangement(
     return ArrangementReport(rep, arrangements, len(judge.cache), proven)
 
 
-def _proven(plan: Plan, rows: I32, judge: Judge, verdict: bool) -> Verdict:
+def _proven(plan: Plan, rows: I32, judge: ArrangementJudge, verdict: bool) -> Verdict:
     """The arrangement's verdict for every labelling (None: not decided within the caps);
     :class:`RelabellingError` when it is not the judged one."""
     image = judge.image(labelled_rows(plan, rows, first_labels(plan)))
@@ -367,7 +367,7 @@ def _proven(plan: Plan, rows: I32, judge: Judge, verdict: bool) -> Verdict:
     return proof
 
 
-def _verdict(plan: Plan, rows: I32, judge: Judge, full: I32, flips: I64, checks: int,
+def _verdict(plan: Plan, rows: I32, judge: ArrangementJudge, full: I32, flips: I64, checks: int,
              seed: int) -> bool:  # fmt: skip
     """One arrangement's verdict: its first labelling's, checked against its mirror image's
     and its relabellings' (:class:`RelabellingError` when they differ)."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from chaingeo.worldmodel.judge_motion import Motion, best_shift, moved
+from chaingeo.worldmodel.judge_motion import SilhouetteMotion, best_shift, moved
 
 H, W, N = 120, 160, 16
 NAMES = ("red", "blue")
@@ -24,7 +24,7 @@ def _box(y: float, x: float, h: int = 18, w: int = 24) -> np.ndarray:
 
 
 def _events(kept: list[list[np.ndarray]]) -> list[tuple[str, int, str]]:
-    return [(e.kind, e.frame, e.piece) for e in Motion(kept, NAMES, LEAST).events()]
+    return [(e.kind, e.frame, e.piece) for e in SilhouetteMotion(kept, NAMES, LEAST).events()]
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -146,7 +146,7 @@ def test_by_arrangement_gives_the_shipped_levels_plain_counts() -> None:
 def test_a_verdict_that_depends_on_labels_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
     """Labellings of one arrangement judged differently raise, never count."""
     plan = _plan(_puzzle("bars", 0))
-    monkeypatch.setattr(bc.Judge, "_judge", lambda self, rows: bool(rows[0] % 2))
+    monkeypatch.setattr(bc.ArrangementJudge, "_judge", lambda self, rows: bool(rows[0] % 2))
     with pytest.raises(bc.RelabellingError):
         bc.count_by_arrangement(plan, mirrors="drop")
 
@@ -156,7 +156,7 @@ def test_the_proof_is_every_labellings_verdict(kind: str, index: int) -> None:
     """Each arrangement's verdict for every labelling (btproof) is the judged verdict of
     every one of its labellings, all enumerated."""
     plan = _plan(_puzzle(kind, index))
-    judge = bc.Judge(plan.labelled, None, None, None)
+    judge = bc.ArrangementJudge(plan.labelled, None, None, None)
     every = bc.relabelling_count(plan)
     for rows in iter_classes(plan.merged, mirrors="drop"):
         base = bc.labelled_rows(plan, rows, bc.first_labels(plan))
