@@ -83,8 +83,12 @@ def test_our_videos_of_legal_plans_pass(name: str, with_level: bool) -> None:
 #: Levels whose videos the judge once misread (occlusion read as a split, a colour revealed
 #: behind a moving piece read as a swap, a shaded grey read as another grey).
 #: With whether our camera is fitted on them (mid-02 starts with its pieces too small to fit).
-#: (easy-05, a colour revealed behind a moving piece once read as a swap, is in the slow sweep.)
-ONCE_MISREAD = (("puzzle-hard-10-cube4", True), ("puzzle-mid-02-interlocking-cube", False))
+#: (easy-05, a colour revealed behind a moving piece once read as a swap, is in the slow sweep;
+#: so is mid-02 here, for the time budget.)
+ONCE_MISREAD = (
+    ("puzzle-hard-10-cube4", True),
+    pytest.param("puzzle-mid-02-interlocking-cube", False, marks=pytest.mark.slow),
+)
 
 
 def _sweep_verdict(name: str) -> dict[str, object]:
@@ -109,7 +113,10 @@ def test_our_gif_of_a_once_misread_level_passes_with_the_level(name: str, fitted
 ONCE_MISREAD_STACKING = ("stacking-2x2x4-mid-s106-000001", "stacking-3x3x3-mid-s114-000003")
 
 
-@pytest.mark.parametrize("name", ONCE_MISREAD_STACKING)
+@pytest.mark.parametrize(
+    "name",
+    [ONCE_MISREAD_STACKING[0], pytest.param(ONCE_MISREAD_STACKING[1], marks=pytest.mark.slow)],
+)
 def test_our_gif_of_a_once_misread_stacking_level_passes_with_the_level(name: str) -> None:
     report = _sweep_verdict(name)
     notes = report["notes"]
@@ -228,7 +235,7 @@ def _paint(out: U8, frame: U8, m: Bools, color: tuple[int, int, int]) -> None:
 
 @pytest.mark.parametrize("with_level", [False, True])
 @pytest.mark.parametrize("kind", ["disappear", "split", "recolour"])
-@settings(max_examples=3, deadline=None, derandomize=True)
+@settings(max_examples=2, deadline=None, derandomize=True)
 @given(data=st.data())
 def test_corruptions_are_caught_with_kind_and_frame(
     kind: str, with_level: bool, data: st.DataObject
