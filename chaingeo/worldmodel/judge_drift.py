@@ -13,6 +13,7 @@ two groups, one of each colour, and a highlight moves them toward white, off the
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Final
 
 import numpy as np
@@ -22,30 +23,41 @@ from chaingeo.core.arrays import F64, U8, Bools
 from chaingeo.worldmodel.judge_segment import dilate
 from chaingeo.worldmodel.judge_track import Event, Obj
 
-#: Frames over which a slide is looked for, the least number of frames in its middle, and the
-#: frames its end must hold for (unless the piece moves off its place: a merged piece moves on
-#: with the other).
-WINDOW: Final = 14
-MIDDLE: Final = 1
-HELD: Final = 2
-#: Progress (0: the old colour, 1: the new) that counts as the start, the middle and the end.
-START: Final = 0.15
-MIDDLE_RANGE: Final = (0.2, 0.8)
-END: Final = 0.8
-#: Largest distance of a median from the line between the two colours (chromaticity units).
-OFF_LINE: Final = 0.04
-#: Least share of a piece's pixels within SPREAD (progress) of the median on each frame.
-TOGETHER: Final = 0.7
-SPREAD: Final = 0.25
-#: Least share of the region still showing a bright piece (not the ground) on every frame.
-COVER: Final = 0.8
-#: Least distance between the two colours (chromaticity units): closer ones are not told apart.
-APART: Final = 0.08
-#: A pixel's chromaticity is used when its brightest channel reaches BRIGHT, its channel spread
-#: SATURATED of that, and it lies GROUND from the ground's chromaticity.
-BRIGHT: Final = 45
-SATURATED: Final = 0.15
-GROUND: Final = 0.04
+
+@dataclass(frozen=True)
+class DriftRule:
+    """The thresholds of a slide (chromaticity in (r, g) units, progress from 0, the old
+    colour, to 1, the new).
+
+    A slide is looked for over ``window`` frames, with at least ``middle`` frames in its
+    middle, and its end must hold for ``held`` frames (unless the piece moves off its place: a
+    merged piece moves on with the other). ``start``, ``middle_range`` and ``end`` are the
+    progress that counts as the start, the middle and the end. A median lies at most
+    ``off_line`` from the line between the two colours; at least ``together`` of a piece's
+    pixels lie within ``spread`` (progress) of the median on each frame; at least ``cover`` of
+    the region still shows a bright piece (not the ground) on every frame; two colours closer
+    than ``apart`` are not told apart. A pixel's chromaticity is used when its brightest
+    channel reaches ``bright``, its channel spread ``saturated`` of that, and it lies
+    ``ground`` from the ground's chromaticity.
+    """
+
+    window: int = 14
+    middle: int = 1
+    held: int = 2
+    start: float = 0.15
+    middle_range: tuple[float, float] = (0.2, 0.8)
+    end: float = 0.8
+    off_line: float = 0.04
+    together: float = 0.7
+    spread: float = 0.25
+    cover: float = 0.8
+    apart: float = 0.08
+    bright: int = 45
+    saturated: float = 0.15
+    ground: float = 0.04
+
+
+RULE: Final = DriftRule()
 
 
 def chromaticities(frame: U8) -> tuple[F64, Bools]:
@@ -60,8 +72,8 @@ def chromaticities(frame: U8) -> tuple[F64, Bools]:
     ring = np.concatenate([out[:2].reshape(-1, 2), out[-2:].reshape(-1, 2),
                            out[:, :2].reshape(-1, 2), out[:, -2:].reshape(-1, 2)])  # fmt: skip
     ground = np.median(ring, axis=0)
-    away = np.hypot(out[..., 0] - ground[0], out[..., 1] - ground[1]) >= GROUND
-    ok: Bools = (hi >= BRIGHT) & (hi - lo >= SATURATED * hi) & away
+    away = np.hypot(out[..., 0] - ground[0], out[..., 1] - ground[1]) >= RULE.ground
+    ok: Bools = (hi >= RULE.bright) & (hi - lo >= RULE.saturated * hi) & away
     return out, ok
 
 
@@ -101,9 +113,9 @@ class Drift:
 
     def _pixels(self, idx: npt.NDArray[np.intp], t: int) -> F64 | None:
         """The chromaticities of the bright pixels ``idx`` (flat) at frame ``t``; None when
-        fewer than COVER of them are bright (the piece left, or the ground shows)."""
+        fewer than ``cover`` of them are bright (the piece left, or the ground shows)."""
         ok = self.bright[t].ravel()[idx]
-        if ok.sum() < COVER * len(idx):
+        if ok.sum() < RULE.cover * len(idx):
             return None
         out: F64 = self.chroma[t].reshape(-1, 2)[idx[ok]]
         return out
@@ -114,15 +126,15 @@ class Drift:
         if region.sum() < 12 or np.isnan(a).any():
             return None
         idx = np.flatnonzero(region)
-        last = min(len(self.objects) - 1, b + WINDOW)
+        last = min(len(self.objects) - 1, b + RULE.window)
         seen = [self._pixels(idx, t) for t in range(b - 1, last + 1)]
-        far = [x is not None and float(np.hypot(*(np.median(x, axis=0) - a))) > APART / 2
+        far = [x is not None and float(np.hypot(*(np.median(x, axis=0) - a))) > RULE.apart / 2
                for x in seen]  # fmt: skip
         if seen[0] is None or not any(far):
             return None
         for j in range(len(self.names)):
             d = self.centres[j] - a
-            if j == p.cls or np.isnan(d).any() or float(np.hypot(*d)) < APART:
+            if j == p.cls or np.isnan(d).any() or float(np.hypot(*d)) < RULE.apart:
                 continue
             got = _slid([_progress(x, a, d) for x in seen])
             if got is not None:
@@ -135,36 +147,36 @@ class Drift:
 
 def _progress(px: F64 | None, a: F64, d: F64) -> tuple[float, float, float]:
     """Median progress of chromaticities ``px`` from ``a`` along ``d``, the median distance
-    off that line, and the share of pixels within SPREAD of the median (NaN: no pixels)."""
+    off that line, and the share of pixels within ``spread`` of the median (NaN: no pixels)."""
     if px is None:
         return np.nan, np.nan, 0.0
     c = px - a
     along = c @ d / float(d @ d)
     off = np.abs(c @ np.array([-d[1], d[0]])) / float(np.hypot(*d))
     m = float(np.median(along))
-    return m, float(np.median(off)), float((np.abs(along - m) <= SPREAD).mean())
+    return m, float(np.median(off)), float((np.abs(along - m) <= RULE.spread).mean())
 
 
 def _slid(rows: list[tuple[float, float, float]]) -> tuple[int, int] | None:
     """The first and last rows of a slide (None: no slide): the first row at the start, then
-    rows in the middle for at least MIDDLE frames (all on the line, pixels together, never
-    going back by more than SPREAD), ending at END, held for HELD more frames (or until the
-    piece leaves its place)."""
-    if not rows or not (rows[0][0] <= START and rows[0][1] <= OFF_LINE):
+    rows in the middle for at least ``middle`` frames (all on the line, pixels together, never
+    going back by more than ``spread``), ending at ``end``, held for ``held`` more frames (or
+    until the piece leaves its place)."""
+    if not rows or not (rows[0][0] <= RULE.start and rows[0][1] <= RULE.off_line):
         return None
     middle, best, first = 0, rows[0][0], 0
     for i, (m, off, together) in enumerate(rows[1:], start=1):
-        if np.isnan(m) or off > OFF_LINE or together < TOGETHER or m < best - SPREAD:
+        if np.isnan(m) or off > RULE.off_line or together < RULE.together or m < best - RULE.spread:
             return None
         best = max(best, m)
-        if m <= START:
+        if m <= RULE.start:
             first = i
-        if m >= END:
-            held = all(np.isnan(x[0]) or x[0] >= END for x in rows[i + 1 : i + 1 + HELD])
-            return (first + 1, i) if held and middle >= MIDDLE else None
-        if MIDDLE_RANGE[0] <= m <= MIDDLE_RANGE[1]:
+        if m >= RULE.end:
+            held = all(np.isnan(x[0]) or x[0] >= RULE.end for x in rows[i + 1 : i + 1 + RULE.held])
+            return (first + 1, i) if held and middle >= RULE.middle else None
+        if RULE.middle_range[0] <= m <= RULE.middle_range[1]:
             middle += 1
-        elif m < MIDDLE_RANGE[0] and middle:
+        elif m < RULE.middle_range[0] and middle:
             return None
     return None
 

@@ -45,14 +45,7 @@ from chaingeo.core.arrays import I32, I64
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.core.geometry import Shape
 from chaingeo.core.kinematics import SearchLimitError
-from chaingeo.solvers.assembly.btassemble import (
-    BTFrame,
-    Mirrors,
-    choose_anchor,
-    disassemble,
-    iter_classes,
-    named_assembly,
-)
+from chaingeo.solvers.assembly import btassemble as bta
 from chaingeo.solvers.assembly.btcount import BTReport, RowVerdicts, StuckCheck
 from chaingeo.solvers.cover.constrained import Packing, compile_packing
 from chaingeo.solvers.deadline import Deadline
@@ -272,7 +265,7 @@ class ArrangementJudge:
         self.deadline = deadline
         self.stuck = StuckCheck(packing)
         self.on_rows = RowVerdicts(packing, limits, False)
-        self.frame = BTFrame(packing)
+        self.frame = bta.BTFrame(packing)
         self.cache: dict[bytes, bool] = {}
         self.proofs: Memo = {}  # parts' verdicts for every labelling, by geometry
 
@@ -291,22 +284,22 @@ class ArrangementJudge:
         fast = self.on_rows.verdict(rows)
         if fast is not None:
             return fast
-        asm = named_assembly(self.packing, rows)
+        asm = bta.named_assembly(self.packing, rows)
         if len(asm) < 2:
             return False  # BurrTools: one piece is no disassembly (disassembler_a.cpp)
-        return disassemble(
+        return bta.disassemble(
             self.packing, self.frame(asm), max_group=self.max_group, limits=self.limits,
             deadline=self.deadline,
         ).disassemblable  # fmt: skip
 
     def image(self, rows: I32) -> dict[str, Shape]:
-        return self.frame(named_assembly(self.packing, rows))
+        return self.frame(bta.named_assembly(self.packing, rows))
 
 
 def count_by_arrangement(
     plan: Plan,
     *,
-    mirrors: Mirrors = "keep",
+    mirrors: bta.Mirrors = "keep",
     max_group: int | None = None,
     limits: SearchLimits | None = None,
     deadline: Deadline | None = None,
@@ -330,7 +323,7 @@ def count_by_arrangement(
     first: dict[str, Shape] | None = None
     limit: SearchLimitError | None = None
     try:
-        for rows in iter_classes(plan.merged, mirrors=mirrors, deadline=deadline):
+        for rows in bta.iter_classes(plan.merged, mirrors=mirrors, deadline=deadline):
             arrangements += 1
             weight = arrangement_weight(plan, rows, maps, proper)
             verdict = _verdict(plan, rows, judge, full, flips, checks, seed)
@@ -343,7 +336,7 @@ def count_by_arrangement(
                     first = judge.image(labelled_rows(plan, rows, first_labels(plan)))
     except SearchLimitError as e:
         limit = e
-    anchor = choose_anchor(plan.merged) if plan.merged.n_rows else None
+    anchor = bta.choose_anchor(plan.merged) if plan.merged.n_rows else None
     label = None if anchor is None else anchor.label
     seconds = time.perf_counter() - start
     rep = BTReport(assemblies, solutions, first, None, seconds, label, limit)
