@@ -51,10 +51,7 @@ SEED = 20
 
 @pytest.fixture(scope="module")
 def binary() -> Path:
-    path = bt.burrtxt()
-    if path is None:
-        pytest.skip(f"burrTxt unavailable: {bt.REASON.text}")
-    return path
+    return bt.burrtxt_or_skip()
 
 
 def compare(

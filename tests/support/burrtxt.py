@@ -15,6 +15,7 @@ from functools import cache
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from chaingeo.benchmarks import burrtxt as oracle
 from chaingeo.core.formats.bt_model import BTPart, BTProblem, BTPuzzle, colored_shape
@@ -42,6 +43,14 @@ def burrtxt() -> Path | None:
     except oracle.BurrTxtError as e:
         REASON.text = str(e)
         return None
+
+
+def burrtxt_or_skip() -> Path:
+    """The burrTxt binary, or the calling test skipped with the reason it cannot be had."""
+    path = burrtxt()
+    if path is None:
+        pytest.skip(f"burrTxt unavailable: {REASON.text}")
+    return path
 
 
 @dataclass(frozen=True)

@@ -201,10 +201,7 @@ def test_relabellings_are_all_of_them_or_a_seeded_sample() -> None:
 
 @pytest.fixture(scope="module")
 def binary() -> Path:
-    path = bt.burrtxt()
-    if path is None:
-        pytest.skip(f"burrTxt unavailable: {bt.REASON.text}")
-    return path
+    return bt.burrtxt_or_skip()
 
 
 def _agrees_with_burrtxt(binary: Path, kind: str, index: int, tmp_path: Path) -> None:
