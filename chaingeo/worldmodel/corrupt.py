@@ -31,7 +31,7 @@ from chaingeo.worldmodel.shaded import Part, Shader, random_look
 from chaingeo.worldmodel.video import _puzzle_shots
 
 #: Bumped whenever the cases a seed gives change (cached cases are keyed by it), per class.
-VERSIONS: Final = {"split": 2}
+VERSIONS: Final = {"split": 2, "pass_through": 2}
 #: Corruption classes, and the verdict kinds that count as catching each.
 CLASSES: Final = (
     "vanish_background",
@@ -81,6 +81,12 @@ GRADUAL: Final = (5, 10)
 PASS_SPEED: Final = 0.34
 #: Least visible area of a piece a corruption starts on (share of the frame) and draws tried.
 MIN_SHARE: Final = 0.006
+#: A pass-through shows when, over its crossing, pixels inside both pieces' own silhouettes
+#: (each drawn alone) in two consecutive frames turn from one piece to the other (their
+#: surfaces' depth order crossing, uncovered by any third piece) over at least this share of
+#: the least visible area in all; a crossing behind other pieces or along the line of sight
+#: shows no such pixels and is drawn again.
+PASS_SEEN: Final = 0.5
 TRIES: Final = 40
 
 Colors = list[tuple[str, tuple[int, int, int]]]
@@ -217,6 +223,28 @@ class _Draft:
     def least(self) -> int:
         lab = self.labels(0)
         return max(150, round(MIN_SHARE * lab.size))
+
+    def silhouette(self, i: int, label: int) -> Bools:
+        """Where the part shows in frame ``i`` drawn alone: its full silhouette."""
+        p = self.part(i, label)
+        if p is None:
+            return np.zeros(self.labels(0).shape, dtype=bool)
+        key = ("alone", i, _key(p))
+        if key not in self._labels:
+            self._labels[key] = self.render.labels([p], i)
+        out: Bools = self._labels[key] > 0
+        return out
+
+    def crossed(self, i: int, k: int, j: int) -> int:
+        """Pixels inside both parts' silhouettes in frames ``i - 1`` and ``i`` that show one
+        of the two in one frame and the other in the next: where the depth order of the two
+        surfaces turned (a third part covering a pixel shows neither)."""
+        inside = np.ones(self.labels(i).shape, dtype=bool)
+        for u in (i - 1, i):
+            inside &= self.silhouette(u, k) & self.silhouette(u, j)
+        a, b = self.labels(i - 1), self.labels(i)
+        turned = inside & (((a == k) & (b == j)) | ((a == j) & (b == k)))
+        return int(turned.sum())
 
     def shown(self, i: int, label: int, share: float = 1.0) -> bool:
         """Visible enough, and off the picture's border."""
@@ -523,7 +551,10 @@ def pass_through(d: _Draft, rng: np.random.Generator) -> _Found:
     mid = min(LENGTH - 1, t + max(1, frames // 3))
     if not (d.shown(mid, k, 0.3) and d.shown(mid, j, 0.3)):
         return None
-    return t, min(LENGTH - 1, t + frames), (k, j)
+    end = min(LENGTH - 1, t + frames)
+    if sum(d.crossed(u, k, j) for u in range(t, end + 1)) < PASS_SEEN * d.least():
+        return None  # the crossing is hidden: no pixel shows it
+    return t, end, (k, j)
 
 
 CORRUPT: Final = {

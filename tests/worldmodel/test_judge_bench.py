@@ -38,6 +38,35 @@ def test_a_vanished_piece_is_gone_from_its_pixels() -> None:
     assert float(px.mean()) > 200  # white, through blur, noise and JPEG
 
 
+@pytest.mark.parametrize(
+    ("seed", "style"), [(9, "flat"), pytest.param(19, "shaded", marks=pytest.mark.slow)]
+)
+def test_a_pass_through_shows_its_crossing(
+    seed: int, style: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The kept draw turns, over its crossing, at least PASS_SEEN of the least area from one
+    piece to the other inside both pieces' own silhouettes; a draw below it is drawn again."""
+    from chaingeo.worldmodel import corrupt
+
+    seen: list[tuple[int, int, int]] = []
+    crossed = corrupt._Draft.crossed
+
+    def spy(d: corrupt._Draft, i: int, k: int, j: int) -> int:
+        n = crossed(d, i, k, j)
+        seen.append((i, n, d.least()))
+        return n
+
+    monkeypatch.setattr(corrupt._Draft, "crossed", spy)
+    case = make_case(seed, "pass_through", style)
+    last = seen[-(case.end - case.frame + 1) :]  # the kept draw's frames
+    assert [i for i, _, _ in last] == list(range(case.frame, case.end + 1))
+    assert sum(n for _, n, _ in last) >= corrupt.PASS_SEEN * last[0][2]
+    monkeypatch.setattr(corrupt, "PASS_SEEN", 1e9)  # no crossing shows that much
+    monkeypatch.setattr(corrupt, "TRIES", 2)
+    with pytest.raises(RuntimeError, match="no visible pass_through"):
+        make_case(seed, "pass_through", style)
+
+
 def test_verdict_kinds_are_the_issues_names() -> None:
     from chaingeo.worldmodel.judge_track import VIOLATIONS
 
@@ -61,6 +90,7 @@ CAUGHT = (
     ("vanish_neighbour", 12, "shaded"),
     ("teleport", 78, "shaded"),
     ("pass_through", 9, "flat"),
+    ("pass_through", 19, "shaded"),  # a bar sliding into another: caught since the 2x2 rule
 )
 CLEAN = ((80, "flat"), (82, "shaded"))
 
