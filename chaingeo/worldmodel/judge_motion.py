@@ -50,8 +50,10 @@ JUMP_AREA: Final = 0.3
 COVERED: Final = 0.25
 #: Pixels from the picture's edge within which a silhouette touches the border.
 BORDER: Final = 3
-#: Frames of past silhouettes laid together (by their displacements) as a piece's full shape.
-HISTORY: Final = 3
+#: Frames of past silhouettes laid together (by their displacements) as a piece's full shape:
+#: two whole-pixel steps err by a pixel at most, which MOVER_EDGE takes off (over three, a
+#: notched piece's silhouette smeared into its notch and the piece seen through it flipped).
+HISTORY: Final = 2
 #: A pass-through: within FLIP_WINDOW frames, FLIP_FRAMES frames with flips over FLIP_SHARE of
 #: the least area each, and FLIP_TOTAL of it in all (a single frame's flips are misreadings;
 #: a notched piece's fold sweeping past another, over a smeared silhouette, turns less than
@@ -60,7 +62,8 @@ FLIP_WINDOW: Final = 8
 FLIP_SHARE: Final = 0.05
 FLIP_FRAMES: Final = 4
 FLIP_TOTAL: Final = 2.0
-#: Erosion (pixels) of the moving colour's silhouette before a pixel counts as inside it.
+#: Erosion (pixels) of the moving colour's silhouette before a pixel counts as inside it: the
+#: rounding of HISTORY whole-pixel steps.
 MOVER_EDGE: Final = 1
 
 Shift = tuple[int, int]
