@@ -168,16 +168,9 @@ def smoothed_counts(raw: np.ndarray) -> np.ndarray:
 class Tracker:
     """Finds the events of a sequence of per-frame objects (see the module docstring)."""
 
-    def __init__(
-        self,
-        frames: list[tuple[list[Obj], Bools]],
-        names: tuple[str, ...],
-        dark: list[Bools] | None = None,
-    ) -> None:
+    def __init__(self, frames: list[tuple[list[Obj], Bools]], names: tuple[str, ...]) -> None:
         self.frames = [objs for objs, _ in frames]
         self.solid = [solid for _, solid in frames]
-        #: per frame, pixels too dark to classify that are not the ground (a face in shade)
-        self.dark = dark if dark is not None else [np.zeros_like(s) for s in self.solid]
         self.names = names
         shape = self.solid[0].shape if self.solid else (1, 1)
         self.reach = max(2, round(MOTION_SHARE * max(shape)))
@@ -430,9 +423,6 @@ class Tracker:
             return Event("hidden", b, name, None, detail, (p.mask,))
         u = self._settled(p, b)
         if float((self.solid[u] & p.mask).sum()) < 0.5 * p.area:
-            if float(((self.solid[u] | self.dark[u]) & p.mask).sum()) >= 0.5 * p.area:
-                detail = f"the {name} piece turned too dark to read (not the ground)"
-                return Event("hidden", b, name, None, detail, (p.mask,))
             return Event(
                 "disappear", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
             )

@@ -24,6 +24,9 @@ from chaingeo.worldmodel.judge_segment import ColorModel, dilate
 #: missing from (one face hidden behind another piece a moment).
 BOTH_FRAMES: Final = 4
 ALONE_SHARE: Final = 0.15
+#: The faces of one piece keep their areas' ratio: its 90th percentile over the frames both
+#: show in at most RATIO_SPREAD times its 10th (occlusion moves it some).
+RATIO_SPREAD: Final = 2.5
 #: Side by side: the pixels of one within TOUCH pixels of the other, at least TOUCH_SHARE of
 #: the smaller's area, in SIDE_SHARE of the frames where both show.
 TOUCH: Final = 2
@@ -66,6 +69,10 @@ def _together(
     either = int((seen_i | seen_j).sum())
     if len(both) < BOTH_FRAMES or either - len(both) > ALONE_SHARE * either:
         return False
+    ratio = area[both, i] / area[both, j]
+    lo, hi = np.percentile(ratio, [10, 90])
+    if hi > RATIO_SPREAD * lo:
+        return False  # one class is also something else some of the time
     side = 0
     for t in both:
         small = min(int(area[t, i]), int(area[t, j]))

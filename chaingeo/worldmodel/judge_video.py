@@ -265,7 +265,7 @@ def judge_frames(
         frame_objects(m, area, _wire(f, m) if wire else None, None if dark is None else dark[t])
         for t, (f, m) in enumerate(zip(frames, masks, strict=True))
     ]
-    events = Tracker(objects, model.names, dark).events()
+    events = Tracker(objects, model.names).events()
     shape = frames[0].shape[:2]
     kept = [[_union(objs, k, shape) for k in range(len(model.names))] for objs, _ in objects]
     solids = [solid for _, solid in objects]
