@@ -337,10 +337,12 @@ def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
         raise ValueError("the video shows no coloured piece (nothing is saturated)")
     table = _table(rgb, np.array(peaks))
     seen = _frames_seen(table, [frames[i] for i in picks.astype(int).tolist()], len(peaks))
-    peaks = [c for c, n in zip(peaks, seen, strict=True) if n >= min(SEEN_FRAMES, len(picks))]
-    if not peaks:
+    kept = [c for c, n in zip(peaks, seen, strict=True) if n >= min(SEEN_FRAMES, len(picks))]
+    if not kept:
         raise ValueError("the video shows no coloured piece (nothing is saturated)")
-    table = _table(rgb, np.array(peaks))  # names from the colours proper, not lit faces
+    if len(kept) < len(peaks):  # names from the colours proper, not lit faces
+        peaks = kept
+        table = _table(rgb, np.array(peaks))
     lab = _table_lab()
     labs = []
     for i in range(len(peaks)):

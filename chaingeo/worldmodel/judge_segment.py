@@ -389,6 +389,13 @@ def ground(frame: U8, masks: list[Bools]) -> Bools:
     return out
 
 
+def ground_and_unknown(frame: U8, masks: list[Bools]) -> tuple[Bools, Bools]:
+    """:func:`ground` and :func:`unknown` of one frame, the ground read once."""
+    lab = _table_lab()[_table_index(frame)]
+    near, piece = _near_ground(lab, masks, frame)
+    return near & ~piece, ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
+
+
 def _near_ground(lab: F64, masks: list[Bools], frame: U8) -> tuple[Bools, Bools]:
     ring = np.zeros(lab.shape[:2], dtype=bool)
     ring[:3], ring[-3:], ring[:, :3], ring[:, -3:] = True, True, True, True

@@ -38,11 +38,10 @@ from chaingeo.worldmodel.judge_segment import (
     class_masks,
     confusable,
     dilate,
-    ground,
+    ground_and_unknown,
     min_area,
     palette_model,
     shrink,
-    unknown,
 )
 from chaingeo.worldmodel.judge_track import (
     VIOLATIONS,
@@ -260,7 +259,8 @@ def judge_frames(
             model = unified(model, owner)
             masks = [class_masks(f, model) for f in frames]
     wire = level is not None and getattr(level, "box", None) is not None
-    dark = None if colors else [unknown(f, m) for f, m in zip(frames, masks, strict=True)]
+    read = [ground_and_unknown(f, m) for f, m in zip(frames, masks, strict=True)]
+    dark = None if colors else [u for _, u in read]
     objects = [
         frame_objects(m, area, _wire(f, m) if wire else None, None if dark is None else dark[t])
         for t, (f, m) in enumerate(zip(frames, masks, strict=True))
@@ -269,7 +269,7 @@ def judge_frames(
     shape = frames[0].shape[:2]
     kept = [[_union(objs, k, shape) for k in range(len(model.names))] for objs, _ in objects]
     solids = [solid for _, solid in objects]
-    grounds = [ground(f, m) for f, m in zip(frames, masks, strict=True)]
+    grounds = [g for g, _ in read]
     events = join(events, Existence(kept, grounds, model.names, area).events())
     events = join(events, Drift(list(frames), [o for o, _ in objects], model.names).events())
     motion = SilhouetteMotion(kept, model.names, area)
