@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.arrays import F64, U8, Bools
+from chaingeo.kernels.jit import njit
 from chaingeo.worldmodel.judge_segment import (
     ColorModel,
     _names,
@@ -48,7 +49,7 @@ WASHED: Final = 1.5
 EXPOSURE_TOL: Final = 0.015
 #: Frames sampled for the palette (evenly over the video); a colour is a piece's when it covers
 #: SEEN_SHARE of the picture in SEEN_FRAMES of them (not a blip of one frame).
-PALETTE_FRAMES: Final = 12
+PALETTE_FRAMES: Final = 24
 SEEN_FRAMES: Final = 1
 SEEN_SHARE: Final = 0.002
 #: A pixel votes for the palette when no channel changes by more than this (levels) across its
@@ -59,6 +60,13 @@ FLAT_RANGE: Final = 24
 #: nearest peak when the next nearest is DARK_MARGIN times as far.
 DARK_BRIGHT: Final = 20
 DARK_MARGIN: Final = 1.5
+#: A lit face (a highlight overexposes a colour and adds white) often lies past JOIN_RADIUS
+#: of its peak: a chromatic colour joins the peak whose lit colours (see :func:`_lit`) it is
+#: within LIT_TOL of, LIT_MARGIN times nearer than any other peak's, and not within
+#: JOIN_RADIUS of the ground; chromaticities are looked up on a LIT_GRID-square grid.
+LIT_TOL: Final = 0.02
+LIT_MARGIN: Final = 2.0
+LIT_GRID: Final = 128
 
 
 def _chromaticity(rgb: F64) -> tuple[F64, Bools]:
@@ -72,13 +80,51 @@ def _chromaticity(rgb: F64) -> tuple[F64, Bools]:
     return chroma, ok
 
 
-def _table(rgb: F64, centres: F64) -> U8:
-    """The class of every table colour: its nearest centre if it joins it (0: none)."""
-    chroma, _ = _chromaticity(rgb)
+def _table(rgb: F64, centres: F64, ground: F64 | None = None) -> U8:
+    """The class of every table colour: its nearest centre if it joins it, else the peak it
+    is a lit (whitened) face of (0: none)."""
+    chroma, ok = _chromaticity(rgb)
     dist = np.sqrt(((chroma[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2))
     table: U8 = (np.argmin(dist, axis=1) + 1).astype(np.uint8)
-    table[~_joins(rgb, dist)] = 0
+    joined = _joins(rgb, dist)
+    table[~joined] = 0
+    if ground is not None:
+        free = ~joined & ok & (np.hypot(*(chroma - ground).T) > JOIN_RADIUS)
+        table[free] = _lit(chroma[free], centres)
     return table
+
+
+def _lit(chroma: F64, centres: F64) -> U8:
+    """The peak (1-based; 0: none) each chromaticity is a lit face of: within LIT_TOL of the
+    colours the peak's takes overexposed by up to WASHED with white added (clipped; see
+    :func:`_washed`), and LIT_MARGIN times nearer those than any other peak's."""
+    idx = np.clip((chroma * LIT_GRID).astype(np.int64), 0, LIT_GRID - 1)
+    flat = idx[:, 0] * LIT_GRID + idx[:, 1]
+    used, back = np.unique(flat, return_inverse=True)
+    cells = (np.stack([used // LIT_GRID, used % LIT_GRID], axis=1) + 0.5) / LIT_GRID
+    dist = np.stack([_locus_distance(cells, c) for c in centres], axis=1)
+    best = np.argmin(dist, axis=1)
+    near = dist[np.arange(len(dist)), best]
+    second = np.sort(dist, axis=1)[:, 1] if dist.shape[1] > 1 else np.full(len(dist), np.inf)
+    ok = (near <= LIT_TOL) & (second >= LIT_MARGIN * near)
+    out: U8 = np.where(ok, best + 1, 0).astype(np.uint8)[back.ravel()]
+    return out
+
+
+def _locus_distance(points: F64, c: F64) -> F64:
+    """Distance from each chromaticity to the lit colours of peak ``c`` (see :func:`_lit`)."""
+    rgb = np.array([c[0], c[1], 1.0 - c[0] - c[1]])
+    rgb = rgb / max(float(rgb.max()), 1e-9)
+    k = np.linspace(1.0, WASHED, 11)[:, None, None]
+    s = np.linspace(0.0, 0.6, 25)[None, :, None]
+    lit = np.clip(rgb[None, None, :] * k + s, 0.0, 1.0).reshape(-1, 3)
+    locus = np.unique(np.round(lit[:, :2] / lit.sum(axis=1, keepdims=True) * 4 * LIT_GRID), axis=0)
+    locus /= 4 * LIT_GRID  # points closer than a quarter cell add nothing
+    out: F64 = np.full(len(points), np.inf)
+    for q in locus:
+        np.minimum(out, (points[:, 0] - q[0]) ** 2 + (points[:, 1] - q[1]) ** 2, out=out)
+    res: F64 = np.sqrt(out)
+    return res
 
 
 def _frames_seen(table: U8, frames: list[U8], n: int) -> npt.NDArray[np.int64]:
@@ -90,30 +136,56 @@ def _frames_seen(table: U8, frames: list[U8], n: int) -> npt.NDArray[np.int64]:
     return out
 
 
-def _histogram(pixels: F64) -> tuple[F64, float]:
-    """The chromaticity histogram (CHROMA_BINS per side) of the chromatic ``pixels``, from
-    their own 8-bit values (the 5-bit table's colours would bend a dark colour's chromaticity
-    by their rounding), and how many there are."""
-    chroma, ok = _chromaticity(pixels)
-    n = CHROMA_BINS
-    cell = np.clip((chroma[ok] * n).astype(np.int64), 0, n - 1)
-    hist = np.bincount(cell[:, 0] * n + cell[:, 1], minlength=n * n).astype(np.float64)
-    return hist.reshape(n, n), float(ok.sum())
+def _votes(frame: U8, hist: F64, counts: F64) -> int:
+    """Adds the flat inside of ``frame`` (see :func:`_vote_kernel`) to ``counts`` (per 5-bit
+    table colour) and its chromatic pixels to the chromaticity histogram ``hist``; returns
+    how many were chromatic."""
+    h, w = frame.shape[:2]
+    flat = np.ascontiguousarray(frame[..., :3]).ravel()
+    return int(
+        _vote_kernel(flat, h, w, FLAT_RANGE, CHROMA_BINS, MIN_BRIGHT, MIN_SATURATION, hist, counts)
+    )
 
 
-def _interior(frame: U8) -> Bools:
-    """Pixels whose 3 x 3 neighbourhood changes by at most FLAT_RANGE in every channel."""
-    f = frame.astype(np.int16)
-    h, w = f.shape[:2]
-    pad = np.pad(f, ((1, 1), (1, 1), (0, 0)), mode="edge")
-    hi, lo = f.copy(), f.copy()
-    for dy in range(3):
-        for dx in range(3):
-            s = pad[dy : dy + h, dx : dx + w]
-            np.maximum(hi, s, out=hi)
-            np.minimum(lo, s, out=lo)
-    out: Bools = (hi - lo).max(axis=2) <= FLAT_RANGE
-    return out
+@njit(cache=True)
+def _vote_kernel(
+    flat: U8, h: int, w: int, flat_range: int, bins: int, bright: int, sat: float,
+    hist: F64, counts: F64,
+) -> int:  # fmt: skip
+    """One pass over a frame: a pixel votes when no channel changes by more than
+    ``flat_range`` across its 3 x 3 neighbourhood (edges repeated), the flat inside of a face
+    and not an edge's blend; a chromatic one (see :func:`_chromaticity`) lands in the
+    histogram's cell of its own 8-bit chromaticity (the 5-bit table's colours would bend a
+    dark colour's by their rounding)."""
+    n = 0
+    for y in range(h):
+        for x in range(w):
+            i = (y * w + x) * 3
+            inside = True
+            for c in range(3):
+                hi = np.int64(flat[i + c])
+                lo = hi
+                for yy in range(max(y - 1, 0), min(y + 2, h)):
+                    for xx in range(max(x - 1, 0), min(x + 2, w)):
+                        v = np.int64(flat[(yy * w + xx) * 3 + c])
+                        hi = max(hi, v)
+                        lo = min(lo, v)
+                if hi - lo > flat_range:
+                    inside = False
+                    break
+            if not inside:
+                continue
+            r, g, b = np.int64(flat[i]), np.int64(flat[i + 1]), np.int64(flat[i + 2])
+            counts[((r >> 3) << 10) | ((g >> 3) << 5) | (b >> 3)] += 1.0
+            top, bottom = max(r, g, b), min(r, g, b)
+            if top < bright or top - bottom < sat * top:
+                continue
+            total = float(r + g + b) + 1e-9
+            cy = min(int(r / total * bins), bins - 1)
+            cx = min(int(g / total * bins), bins - 1)
+            hist[cy * bins + cx] += 1.0
+            n += 1
+    return n
 
 
 def _joins(rgb: F64, dist: F64) -> Bools:
@@ -255,12 +327,9 @@ def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
     chosen by the peak criterion of :func:`_peaks`; named after the nearest palette colour."""
     picks = np.unique(np.linspace(0, len(frames) - 1, min(PALETTE_FRAMES, len(frames))).round())
     counts = np.zeros(32768, dtype=np.float64)
-    votes = []
-    for i in picks.astype(int).tolist():
-        flat = _interior(frames[i])
-        counts += np.bincount(_table_index(frames[i])[flat], minlength=32768)
-        votes.append(frames[i][flat])
-    hist, total = _histogram(np.concatenate(votes).astype(np.float64))
+    votes = np.zeros(CHROMA_BINS * CHROMA_BINS, dtype=np.float64)
+    total = float(sum(_votes(frames[i], votes, counts) for i in picks.astype(int).tolist()))
+    hist = votes.reshape(CHROMA_BINS, CHROMA_BINS)
     rgb = _table_rgb()
     ground = _border_chromaticity([frames[i] for i in picks.astype(int).tolist()])
     peaks = [c for c in _peaks(hist, total) if np.hypot(*(np.array(c) - ground)) > JOIN_RADIUS]
@@ -268,10 +337,12 @@ def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
         raise ValueError("the video shows no coloured piece (nothing is saturated)")
     table = _table(rgb, np.array(peaks))
     seen = _frames_seen(table, [frames[i] for i in picks.astype(int).tolist()], len(peaks))
-    peaks = [c for c, n in zip(peaks, seen, strict=True) if n >= min(SEEN_FRAMES, len(picks))]
-    if not peaks:
+    kept = [c for c, n in zip(peaks, seen, strict=True) if n >= min(SEEN_FRAMES, len(picks))]
+    if not kept:
         raise ValueError("the video shows no coloured piece (nothing is saturated)")
-    table = _table(rgb, np.array(peaks))
+    if len(kept) < len(peaks):  # names from the colours proper, not lit faces
+        peaks = kept
+        table = _table(rgb, np.array(peaks))
     lab = _table_lab()
     labs = []
     for i in range(len(peaks)):
@@ -279,4 +350,5 @@ def video_model(frames: list[U8] | tuple[U8, ...]) -> ColorModel:
         bright = lab[:, 0] >= np.percentile(lab[w > 0, 0], 50) if (w > 0).any() else w > 0
         w = np.where(bright, w, 0.0)
         labs.append((lab * w[:, None]).sum(axis=0) / max(w.sum(), 1e-9))
+    table = _table(rgb, np.array(peaks), ground)
     return ColorModel(_names(np.array(labs)), np.array(labs), table, "video")

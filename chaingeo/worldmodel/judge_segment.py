@@ -58,6 +58,12 @@ BACKGROUND_CHROMA: Final = 12.0
 #: Unknown pixels are dark (a piece's face in its own shade; a pale or half-transparent blend
 #: of a piece with the ground, as video models draw a ghost, is no occluder).
 UNKNOWN_LIGHTNESS: Final = 40.0
+#: A dark pixel is the ground's only if its chromaticity, (R, G) / (R + G + B), is within
+#: GROUND_CHROMATICITY of the ground's, a reach growing as its brightest channel falls below
+#: DARK_FACE (noisier); below DARKEST (levels) a pixel has no reliable chromaticity at all.
+GROUND_CHROMATICITY: Final = 0.05
+DARK_FACE: Final = 45.0
+DARKEST: Final = 16.0
 
 
 @dataclass(frozen=True)
@@ -370,7 +376,7 @@ def unknown(frame: U8, masks: list[Bools]) -> Bools:
     border shows (a grey ground, its shadows, white): colours within BACKGROUND_CHROMA of its
     median chroma (CIELAB a*, b*), at any lightness. A gap through such pixels is no break."""
     lab = _table_lab()[_table_index(frame)]
-    near, piece = _near_ground(lab, masks)
+    near, piece = _near_ground(lab, masks, frame)
     out: Bools = ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
     return out
 
@@ -378,16 +384,33 @@ def unknown(frame: U8, masks: list[Bools]) -> Bools:
 def ground(frame: U8, masks: list[Bools]) -> Bools:
     """Pixels of no piece class whose chroma is the background's (see :func:`unknown`): open
     ground, its shadows, white; not a piece of a colour the palette missed."""
-    near, piece = _near_ground(_table_lab()[_table_index(frame)], masks)
+    near, piece = _near_ground(_table_lab()[_table_index(frame)], masks, frame)
     out: Bools = near & ~piece
     return out
 
 
-def _near_ground(lab: F64, masks: list[Bools]) -> tuple[Bools, Bools]:
+def ground_and_unknown(frame: U8, masks: list[Bools]) -> tuple[Bools, Bools]:
+    """:func:`ground` and :func:`unknown` of one frame, the ground read once."""
+    lab = _table_lab()[_table_index(frame)]
+    near, piece = _near_ground(lab, masks, frame)
+    return near & ~piece, ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
+
+
+def _near_ground(lab: F64, masks: list[Bools], frame: U8) -> tuple[Bools, Bools]:
     ring = np.zeros(lab.shape[:2], dtype=bool)
     ring[:3], ring[-3:], ring[:, :3], ring[:, -3:] = True, True, True, True
     piece = np.logical_or.reduce(masks) if masks else np.zeros_like(ring)
     edge = ring & ~piece
     a0, b0 = (float(np.median(lab[..., c][edge])) if edge.any() else 0.0 for c in (1, 2))
     near: Bools = np.hypot(lab[..., 1] - a0, lab[..., 2] - b0) <= BACKGROUND_CHROMA
+    # a dark face has little CIELAB chroma at any hue, so it passes the test above; its
+    # chromaticity (which shade leaves alone) still differs from the ground's
+    red, green, blue = (frame[..., c].astype(np.float32) for c in range(3))  # per channel
+    total = red + green + blue + np.float32(1e-6)
+    r0, g0 = (float(np.median((c / total)[edge])) if edge.any() else 1 / 3 for c in (red, green))
+    ask = near & ~piece  # only these can change
+    rr, gg, tt = red[ask] / total[ask], green[ask] / total[ask], total[ask]
+    hi = np.maximum(np.maximum(red[ask], green[ask]), blue[ask])
+    reach = GROUND_CHROMATICITY * np.maximum(1.0, DARK_FACE / np.maximum(hi, 1.0))
+    near[ask] = (np.hypot(rr - r0, gg - g0) <= reach) | (hi < DARKEST) | (tt <= 0)
     return near, piece

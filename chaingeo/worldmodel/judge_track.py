@@ -19,19 +19,22 @@ from dataclasses import dataclass, field, replace
 from typing import Final
 
 import numpy as np
-import numpy.typing as npt
 
 from chaingeo.core.arrays import F64, Bools
-from chaingeo.kernels.jit import njit
+from chaingeo.worldmodel.judge_gap import gap_covered as gap_covered
 from chaingeo.worldmodel.judge_segment import close, components, dilate
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
 #: hold.
 WINDOW: Final = 5
 PERSIST: Final = 3
-#: Share of the gap between two same-coloured parts that other pieces must cover for the parts
-#: to count as one occluded piece.
-OCCLUDED_GAP: Final = 0.6
+#: Frames a vanished piece's place may take to settle on its new colour (a blend passes
+#: through others on the way).
+SETTLE: Final = 3
+#: Pixels a piece at rest may seem to move by between frames (camera drift, blur), and the
+#: share of a vanished piece's area the pieces around it may change by and still be at rest.
+DRIFT: Final = 2
+STILL_SHARE: Final = 0.2
 #: Furthest move (share of the frame's longer side) of a piece between two frames.
 FAST_SHARE: Final = 0.25
 #: Frames after which a piece's place is looked at again for another colour.
@@ -94,70 +97,6 @@ VIOLATIONS: Final = (
     "teleport",
     "pass_through",
 )
-
-
-def _boundary_points(mask: Bools, limit: int = 300) -> np.ndarray:
-    edge = mask & ~(
-        np.roll(mask, 1, 0) & np.roll(mask, -1, 0) & np.roll(mask, 1, 1) & np.roll(mask, -1, 1)
-    )
-    pts = np.argwhere(edge if edge.any() else mask)
-    step = max(1, len(pts) // limit)
-    return pts[::step]
-
-
-def gap_covered(a: Bools, b: Bools, others: Bools) -> bool:
-    """Whether the gap between ``a`` and ``b`` (the pixels within half their distance plus a
-    little of both) lies mostly on other pieces (an occluder) rather than on background."""
-    pa, pb = _boundary_points(a), _boundary_points(b)
-    gap = float(np.sqrt(((pa[:, None, :] - pb[None, :, :]) ** 2).sum(axis=2).min()))
-    if gap <= 4:
-        return True
-    r = int(gap) + 3
-    ys, xs = np.nonzero(a | b)
-    y0, y1 = max(0, int(ys.min()) - r), int(ys.max()) + r + 1
-    x0, x1 = max(0, int(xs.min()) - r), int(xs.max()) + r + 1
-    da, db = _distances(a[y0:y1, x0:x1], r), _distances(b[y0:y1, x0:x1], r)
-    lens = (da > 0) & (db > 0) & (da + db <= int(np.ceil(gap)) + 2)
-    if not lens.any():
-        return False
-    return float((lens & others[y0:y1, x0:x1]).sum()) >= OCCLUDED_GAP * float(lens.sum())
-
-
-def _distances(mask: Bools, r: int) -> np.ndarray:
-    """Chessboard distance to ``mask`` (0 on it), capped at r + 1: what growing the mask a
-    pixel at a time within the picture gives (a shortest chessboard path stays within the
-    box of its ends), in two passes instead of r growths."""
-    h, w = mask.shape
-    flat = np.ascontiguousarray(mask, dtype=np.bool_).ravel()
-    return _chessboard_kernel(flat, h, w, r + 1).reshape(h, w)
-
-
-@njit(cache=True)
-def _chessboard_kernel(flat: Bools, h: int, w: int, cap: int) -> npt.NDArray[np.int64]:
-    """Two-pass chamfer over the 8 neighbours, all steps 1: exact for the chessboard metric."""
-    out = np.full(h * w, cap, dtype=np.int64)
-    for i in range(h * w):
-        if flat[i]:
-            out[i] = 0
-    for y in range(h):
-        for x in range(w):
-            d = out[y * w + x]
-            if x > 0:
-                d = min(d, out[y * w + x - 1] + 1)
-            if y > 0:
-                for xx in range(max(0, x - 1), min(w, x + 2)):
-                    d = min(d, out[(y - 1) * w + xx] + 1)
-            out[y * w + x] = d
-    for y in range(h - 1, -1, -1):
-        for x in range(w - 1, -1, -1):
-            d = out[y * w + x]
-            if x < w - 1:
-                d = min(d, out[y * w + x + 1] + 1)
-            if y < h - 1:
-                for xx in range(max(0, x - 1), min(w, x + 2)):
-                    d = min(d, out[(y + 1) * w + xx] + 1)
-            out[y * w + x] = d
-    return out
 
 
 def _centroid(mask: Bools) -> F64:
@@ -407,8 +346,8 @@ class Tracker:
                 o
                 for o in self.frames[b - 1]
                 if o.cls != k
-                and (o.mask & c.mask).sum() >= 0.5 * min(o.area, c.area)
                 and not self._touching(o, self._of(b, o.cls))
+                and (self._carried(o, b - 1) & c.mask).sum() >= 0.5 * min(o.area, c.area)
             ]
             if gone:
                 other = self.names[gone[0].cls]
@@ -424,6 +363,16 @@ class Tracker:
                 detail = f"a {name} piece appeared in open view, away from the border"
                 out.append(Event("appear", b, name, None, detail, (c.mask,), before=0))
         return out
+
+    def _carried(self, o: Obj, t: int) -> Bools:
+        """``o`` (seen at frame ``t``) and where it is one step further along its own motion
+        (its centroid's step from frame ``t - 1``, when the piece kept its area): a piece
+        that changes colour while it moves shows the new colour there."""
+        was = [x for x in self._of(t - 1, o.cls) if (dilate(x.mask, self.reach) & o.mask).any()]
+        if t < 1 or len(was) != 1 or not _alike(was[0], o):
+            return o.mask
+        dy, dx = np.round(_centroid(o.mask) - _centroid(was[0].mask)).astype(int).tolist()
+        return _translated(o.mask, dy, dx) | o.mask
 
     def _fast_move(self, p: Obj, c: Obj) -> bool:
         """Whether ``c`` may be ``p`` moved fast: alike in area, within FAST_SHARE of the
@@ -472,11 +421,12 @@ class Tracker:
         if self._shrinking(p, b - 1) and self._against_others(p, b - 1):
             detail = f"the {name} piece shrank out of sight beside another piece"
             return Event("hidden", b, name, None, detail, (p.mask,))
-        if float((self.solid[b] & p.mask).sum()) < 0.5 * p.area:
+        u = self._settled(p, b)
+        if float((self.solid[u] & p.mask).sum()) < 0.5 * p.area:
             return Event(
                 "disappear", b, name, None, f"the {name} piece vanished in open view", (p.mask,)
             )
-        others = [o for o in self.frames[b] if o.cls != p.cls]
+        others = [o for o in self.frames[u] if o.cls != p.cls]
         if not others:
             return Event("hidden", b, name, None, f"the {name} piece shrank out of sight")
         cover = max(others, key=lambda o: int((o.mask & p.mask).sum()))
@@ -486,13 +436,51 @@ class Tracker:
         if not was_there:
             return Event("recolour", b, name, other, f"the {name} piece turned {other}")
         grew = cover.area - sum(o.area for o in was_there)
-        if grew >= 0.7 * p.area and not self._of(b, p.cls):
+        if grew >= 0.7 * p.area and not self._of(u, p.cls):
             # the pixels took the other piece's colour; whether the two then move as one is
             # not seen here, so it is named for what shows
             detail = f"the {name} piece turned {other}, joined to the {other} piece (+{grew} px)"
             return Event("fused", b, name, other, detail, (p.mask, cover.mask))
+        if self._resting(p, b - 2) and self._still_around(p, b, u):
+            detail = f"the {name} piece vanished at rest (what it hid shows in its place)"
+            return Event("disappear", b, name, None, detail, (p.mask,))
         detail = f"the {name} piece went out of sight behind the {other} piece"
         return Event("hidden", b, name, other, detail, (p.mask, cover.mask))
+
+    def _still_around(self, p: Obj, b: int, u: int) -> bool:
+        """Whether the pieces covering ``p``'s place at frame ``u`` kept their pixels beyond
+        it from frame ``b - 1`` (within a camera's drift): nothing came in front of ``p``, so
+        what shows there was behind it (to go behind a piece at rest, ``p`` must move)."""
+        place = dilate(p.mask, 2)
+        over = [o for o in self.frames[u] if o.cls != p.cls and (o.mask & p.mask).any()]
+        if not over:
+            return False
+        changed = 0
+        for k in {o.cls for o in over}:
+            now, was = self._class_pixels(u, k) & ~place, self._class_pixels(b - 1, k) & ~place
+            changed += int((now & ~dilate(was, DRIFT)).sum() + (was & ~dilate(now, DRIFT)).sum())
+        return changed < STILL_SHARE * p.area
+
+    def _settled(self, p: Obj, b: int) -> int:
+        """The frame from ``b`` on (within SETTLE) where ``p``'s place shows what it turned
+        into: a colour blended gradually passes through colours (or none) for a frame or two,
+        which the tracker's smoothing never reports. Skipped: frames where no piece covers the
+        place, or a colour that shows neither before ``b`` nor two frames later covers it."""
+        last = len(self.frames) - 1
+        for u in range(b, min(b + SETTLE, last + 1)):
+            c = self._cover(p, u)
+            if c is not None and (self._of(b - 1, c) or self._of(min(u + 2, last), c)):
+                return u
+        return b
+
+    def _cover(self, p: Obj, u: int) -> int | None:
+        """The class of the other piece covering half of ``p``'s place (grown by a frame's
+        reach: it may move on at once) at frame ``u``; None if none does."""
+        place = dilate(p.mask, self.reach)
+        best = max(self.frames[u], key=lambda o: int((o.mask & place).sum()), default=None)
+        if best is None or best.cls == p.cls or (best.mask & place).sum() < 0.5 * p.area:
+            return None
+        return best.cls
 
     def _shrinking(self, p: Obj, t: int) -> bool:
         """Whether ``p`` (seen at frame ``t``) is under half the area its colour showed near it
@@ -561,6 +549,16 @@ class Tracker:
                 detail = f"the {other} piece now shows as {self.names[k]} (and the reverse)"
                 return Event("recolour", b, other, self.names[k], detail, (o.mask, c.mask))
         return None
+
+
+def _translated(mask: Bools, dy: int, dx: int) -> Bools:
+    """``mask`` moved by (dy, dx), what leaves the picture dropped."""
+    h, w = mask.shape
+    out = np.zeros_like(mask)
+    if abs(dy) < h and abs(dx) < w:
+        src = mask[max(0, -dy) : h - max(0, dy), max(0, -dx) : w - max(0, dx)]
+        out[max(0, dy) : max(0, dy) + src.shape[0], max(0, dx) : max(0, dx) + src.shape[1]] = src
+    return out
 
 
 def _alike(a: Obj, b: Obj) -> bool:

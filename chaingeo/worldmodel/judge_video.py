@@ -38,11 +38,10 @@ from chaingeo.worldmodel.judge_segment import (
     class_masks,
     confusable,
     dilate,
-    ground,
+    ground_and_unknown,
     min_area,
     palette_model,
     shrink,
-    unknown,
 )
 from chaingeo.worldmodel.judge_track import (
     VIOLATIONS,
@@ -51,6 +50,7 @@ from chaingeo.worldmodel.judge_track import (
     Tracker,
     frame_objects,
 )
+from chaingeo.worldmodel.judge_unify import one_piece_groups, unified
 
 #: The evidence picture: the two frames around an event, each at this many times working size.
 EVIDENCE_ZOOM: Final = 2
@@ -253,16 +253,23 @@ def judge_frames(
         raise VideoJudgeError(str(e)) from None
     area = min_area(frames[0].shape)
     masks = [class_masks(f, model) for f in frames]
+    if not colors:
+        owner = one_piece_groups(masks, len(model.names), area)
+        if owner != list(range(len(owner))):
+            model = unified(model, owner)
+            masks = [class_masks(f, model) for f in frames]
     wire = level is not None and getattr(level, "box", None) is not None
+    read = [ground_and_unknown(f, m) for f, m in zip(frames, masks, strict=True)]
+    dark = None if colors else [u for _, u in read]
     objects = [
-        frame_objects(m, area, _wire(f, m) if wire else None, None if colors else unknown(f, m))
-        for f, m in zip(frames, masks, strict=True)
+        frame_objects(m, area, _wire(f, m) if wire else None, None if dark is None else dark[t])
+        for t, (f, m) in enumerate(zip(frames, masks, strict=True))
     ]
     events = Tracker(objects, model.names).events()
     shape = frames[0].shape[:2]
     kept = [[_union(objs, k, shape) for k in range(len(model.names))] for objs, _ in objects]
     solids = [solid for _, solid in objects]
-    grounds = [ground(f, m) for f, m in zip(frames, masks, strict=True)]
+    grounds = [g for g, _ in read]
     events = join(events, Existence(kept, grounds, model.names, area).events())
     events = join(events, Drift(list(frames), [o for o, _ in objects], model.names).events())
     motion = SilhouetteMotion(kept, model.names, area)

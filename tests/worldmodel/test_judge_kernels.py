@@ -15,6 +15,7 @@ from chaingeo.core.arrays import F64, U8, Bools
 from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import suite_folder
 from chaingeo.pictures.scene import CAMERAS
+from chaingeo.worldmodel.judge_gap import _distances
 from chaingeo.worldmodel.judge_pose import _iou, _pieces, _PoseScene, _Target
 from chaingeo.worldmodel.judge_segment import (
     _spread,
@@ -24,7 +25,6 @@ from chaingeo.worldmodel.judge_segment import (
     dilate,
     palette_model,
 )
-from chaingeo.worldmodel.judge_track import _distances
 from chaingeo.worldmodel.judge_video import _wire
 
 LEVELS = ("puzzle-easy-09-cube3", "puzzle-mid-08-burr3", "puzzle-hard-10-cube4")

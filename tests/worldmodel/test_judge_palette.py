@@ -10,7 +10,7 @@ import pytest
 from chaingeo.core.arrays import U8, Bools
 from chaingeo.worldmodel.judge_drift import Drift
 from chaingeo.worldmodel.judge_palette import video_model
-from chaingeo.worldmodel.judge_segment import classify
+from chaingeo.worldmodel.judge_segment import _table_index, classify
 from chaingeo.worldmodel.judge_track import Obj
 
 #: Colours of the judge's bench levels, look-alike pairs included (blue and cobalt, orange and
@@ -99,3 +99,77 @@ def test_a_gradual_recolour_drifts_and_a_piece_sliding_over_does_not(seed: int) 
     assert [(e.kind, e.piece, e.other) for e in events] == [("recolour", "a", "b")]
     assert abs(events[0].frame - start) <= 1 and events[0].until <= start + steps + 1
     assert Drift(slid, _objects(objs_slid), ("a", "b")).events() == []
+
+
+def _lit_scene(seed: int) -> tuple[list[U8], list[Bools]]:
+    """Blocks whose top face is lit as the shaded renderer lights one: its colour scaled up
+    and white added (a highlight), clipped; the other two faces in shade."""
+    rng = np.random.default_rng(seed)
+    # no look-alike pair: a lit forest is a green (motion tells them apart, not colour)
+    picks = rng.choice([0, 3, 5, 6, 7], size=int(rng.integers(2, 5)), replace=False)
+    grey = rng.uniform(90, 160)
+    f = np.full((*SIZE, 3), grey)
+    masks = []
+    for i, c in enumerate(picks):
+        rgb = np.array(COLOURS[c], float)
+        masks.append(
+            _block(f, 20 + 70 * (i // 4), 10 + 56 * (i % 4), rgb, rng.uniform(0.5, 1.0, 3))
+        )
+        y, x = 20 + 70 * (i // 4), 10 + 56 * (i % 4)
+        k, white = rng.uniform(1.0, 1.3), rng.uniform(0.2, 0.4) * 255
+        glow = np.linspace(0.0, 1.0, 36)[None, :, None] ** 2  # the highlight's falloff
+        f[y : y + 12, x : x + 36] = np.clip(rgb * (0.8 + 0.2 * k * glow) + white * glow, 0, 255)
+    frames = [np.clip(f + rng.normal(0, 2.0, f.shape), 0, 255).astype(np.uint8) for _ in range(6)]
+    return frames, masks
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_a_lit_face_joins_its_colour(seed: int) -> None:
+    frames, masks = _lit_scene(seed)
+    model = video_model(frames)
+    labels = classify(frames[0], model)
+    owners = []
+    for m in masks:
+        got = np.bincount(labels[m], minlength=len(model.names) + 1)
+        owners.append(int(np.argmax(got[1:])) + 1)
+        assert got[owners[-1]] >= 0.9 * m.sum(), (model.names, got)
+    assert len(set(owners)) == len(owners)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_colour_seen_in_two_frames_is_in_the_palette(seed: int) -> None:
+    """A piece shown only briefly (brought in, then recoloured) still has its class."""
+    rng = np.random.default_rng(seed)
+    a, b = rng.choice(len(COLOURS), 2, replace=False)
+    n, when = 36, int(rng.integers(1, 34))
+    frames = []
+    for t in range(n):
+        f = np.full((*SIZE, 3), 128.0)
+        _block(f, 20, 20, np.array(COLOURS[a], float), np.array([1.0, 0.8, 0.6]))
+        if t in (when, when + 1):
+            _block(f, 90, 150, np.array(COLOURS[b], float), np.array([1.0, 0.8, 0.6]))
+        frames.append(np.clip(f + rng.normal(0, 2.0, f.shape), 0, 255).astype(np.uint8))
+    assert len(video_model(frames).names) == 2
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_vote_kernel_matches_numpy(seed: int) -> None:
+    """One pass (flat inside, chromaticity histogram, table counts) equals the array code."""
+    from chaingeo.worldmodel import judge_palette as P
+
+    rng = np.random.default_rng(seed)
+    frame = np.repeat(np.repeat(rng.integers(0, 256, (20, 30, 3)), 3, 0), 3, 1).astype(np.uint8)
+    frame = np.clip(frame + rng.integers(-8, 9, frame.shape), 0, 255).astype(np.uint8)
+    hist, counts = np.zeros(P.CHROMA_BINS**2), np.zeros(32768)
+    total = P._votes(frame, hist, counts)
+    f = frame.astype(np.int16)
+    pad = np.pad(f, ((1, 1), (1, 1), (0, 0)), mode="edge")
+    shifts = [pad[dy : dy + 60, dx : dx + 90] for dy in range(3) for dx in range(3)]
+    flat = (np.max(shifts, axis=0) - np.min(shifts, axis=0)).max(axis=2) <= P.FLAT_RANGE
+    px = frame[flat].astype(np.float64)
+    chroma, ok = P._chromaticity(px)
+    cell = np.clip((chroma[ok] * P.CHROMA_BINS).astype(np.int64), 0, P.CHROMA_BINS - 1)
+    want = np.bincount(cell[:, 0] * P.CHROMA_BINS + cell[:, 1], minlength=P.CHROMA_BINS**2)
+    assert total == int(ok.sum()) and np.array_equal(hist, want)
+    idx = _table_index(frame)[flat]
+    assert np.array_equal(counts, np.bincount(idx, minlength=32768))

@@ -1,0 +1,52 @@
+"""The tracker on seeded synthetic clips without a level: a colour blended into a touching
+piece's through a passing colour is still caught, a piece at rest that vanishes while what it
+hid shows is lost (not hidden)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from chaingeo.core.arrays import U8
+from chaingeo.worldmodel.judge_video import judge_frames
+
+BLUE, ORANGE, GREEN, PURPLE = (67, 99, 216), (245, 130, 49), (60, 180, 75), (145, 30, 180)
+SIZE = (160, 240)
+
+
+def _noisy(f: np.ndarray, rng: np.random.Generator) -> U8:
+    return np.clip(f + rng.normal(0, 2.0, f.shape), 0, 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_blend_through_a_passing_colour_into_a_neighbour_is_caught(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    grey, s = rng.uniform(110, 170), int(rng.integers(8, 14))
+    frames = []
+    for t in range(30):
+        f = np.full((*SIZE, 3), grey)
+        x = 40 + 6 * max(0, t - s - 1)  # the two move on together once fused
+        colour = BLUE if t < s else PURPLE if t < s + 2 else ORANGE
+        f[50:90, x : x + 40] = colour
+        f[50:90, x + 40 : x + 80] = ORANGE
+        frames.append(_noisy(f, rng))
+    v = judge_frames(frames)
+    assert any(
+        e.kind in ("recolour", "merge", "disappear") and s - 1 <= e.frame <= s + 3
+        for e in v.violations
+    ), (v.model.names, v.violations)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_piece_at_rest_vanishing_before_another_is_lost(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    grey, s = rng.uniform(110, 170), int(rng.integers(8, 14))
+    frames = []
+    for t in range(24):
+        f = np.full((*SIZE, 3), grey)
+        f[40:100, 64:170] = GREEN  # behind: the blue block's right part lies on it
+        if t < s:
+            f[40:100, 40:100] = BLUE
+        frames.append(_noisy(f, rng))
+    v = judge_frames(frames)
+    assert any(e.kind == "disappear" and abs(e.frame - s) <= 1 for e in v.violations), v
