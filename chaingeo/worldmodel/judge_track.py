@@ -104,7 +104,8 @@ def _centroid(mask: Bools) -> F64:
     return out
 
 
-def _root(group: list[int], i: int) -> int:
+def forest_root(group: list[int], i: int) -> int:
+    """The root of ``i`` in a union-find forest of parent indices."""
     while group[i] != i:
         i = group[i]
     return i
@@ -138,11 +139,11 @@ def frame_objects(
         others = (solid if unknown is None else solid | unknown) & ~mask
         for i in range(len(comps)):
             for j in range(i + 1, len(comps)):
-                ri, rj = _root(group, i), _root(group, j)
+                ri, rj = forest_root(group, i), forest_root(group, j)
                 if ri != rj and gap_covered(comps[i], comps[j], others):
                     group[rj] = ri
-        for r in sorted({_root(group, i) for i in range(len(comps))}):
-            members = [c for i, c in enumerate(comps) if _root(group, i) == r]
+        for r in sorted({forest_root(group, i) for i in range(len(comps))}):
+            members = [c for i, c in enumerate(comps) if forest_root(group, i) == r]
             out.append(Obj(k, np.logical_or.reduce(members), len(members)))
     return out, solid
 

@@ -19,6 +19,7 @@ import numpy.typing as npt
 from chaingeo.core.arrays import Bools
 from chaingeo.worldmodel.judge_motion import FIT, NONE, MaskShift, best_shift
 from chaingeo.worldmodel.judge_segment import ColorModel, dilate
+from chaingeo.worldmodel.judge_track import forest_root
 
 #: Least frames both classes show in; share of the frames either shows in that the other may be
 #: missing from (one face hidden behind another piece a moment).
@@ -111,15 +112,9 @@ def one_piece_groups(masks: list[list[Bools]], classes: int, least: int) -> list
     steps = {k: _steps(masks, k, least) for k in range(classes)}
     for i, j in pairs:
         if _comoving(steps, i, j):
-            ri, rj = _root(owner, i), _root(owner, j)
+            ri, rj = forest_root(owner, i), forest_root(owner, j)
             owner[max(ri, rj)] = min(ri, rj)
-    return [_root(owner, k) for k in range(classes)]
-
-
-def _root(owner: list[int], k: int) -> int:
-    while owner[k] != k:
-        k = owner[k]
-    return k
+    return [forest_root(owner, k) for k in range(classes)]
 
 
 def unified(model: ColorModel, owner: list[int]) -> ColorModel:
