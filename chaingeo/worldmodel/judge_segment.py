@@ -370,27 +370,12 @@ def class_masks(frame: U8, model: ColorModel) -> list[Bools]:
     return [clean(raw == i + 1) for i in range(len(model.names))]
 
 
-def unknown(frame: U8, masks: list[Bools]) -> Bools:
-    """Pixels of no piece class that do not look like the background either and are dark: a
-    piece's face too dark to classify. The background is what the picture's
-    border shows (a grey ground, its shadows, white): colours within BACKGROUND_CHROMA of its
-    median chroma (CIELAB a*, b*), at any lightness. A gap through such pixels is no break."""
-    lab = _table_lab()[_table_index(frame)]
-    near, piece = _near_ground(lab, masks, frame)
-    out: Bools = ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
-    return out
-
-
-def ground(frame: U8, masks: list[Bools]) -> Bools:
-    """Pixels of no piece class whose chroma is the background's (see :func:`unknown`): open
-    ground, its shadows, white; not a piece of a colour the palette missed."""
-    near, piece = _near_ground(_table_lab()[_table_index(frame)], masks, frame)
-    out: Bools = near & ~piece
-    return out
-
-
 def ground_and_unknown(frame: U8, masks: list[Bools]) -> tuple[Bools, Bools]:
-    """:func:`ground` and :func:`unknown` of one frame, the ground read once."""
+    """Two readings of one frame's pixels of no piece class. Ground: whose chroma is the
+    background's (open ground, its shadows, white; not a piece of a colour the palette missed).
+    Unknown: not the background's and dark (a piece's face too dark to classify; a gap through
+    such pixels is no break). The background is what the picture's border shows: colours within
+    BACKGROUND_CHROMA of its median chroma (CIELAB a*, b*), at any lightness."""
     lab = _table_lab()[_table_index(frame)]
     near, piece = _near_ground(lab, masks, frame)
     return near & ~piece, ~near & ~piece & (lab[..., 0] <= UNKNOWN_LIGHTNESS)
