@@ -25,8 +25,8 @@ from chaingeo.core.level import Level, load_level
 from chaingeo.core.suite import suite_folder
 from chaingeo.pictures.raster import Posed, parse_color
 from chaingeo.pictures.scene import render_frame
+from chaingeo.worldmodel.judge_gap import gap_covered
 from chaingeo.worldmodel.judge_segment import components, dilate, shrink
-from chaingeo.worldmodel.judge_track import gap_covered
 from chaingeo.worldmodel.shaded import Part, Shader, random_look
 from chaingeo.worldmodel.video import _puzzle_shots
 

@@ -21,7 +21,7 @@ from typing import Final
 import numpy as np
 
 from chaingeo.core.arrays import F64, Bools
-from chaingeo.worldmodel.judge_gap import gap_covered as gap_covered
+from chaingeo.worldmodel.judge_gap import gap_covered
 from chaingeo.worldmodel.judge_segment import close, components, dilate
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
