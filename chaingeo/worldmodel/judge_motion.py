@@ -15,15 +15,19 @@ by. A pixel that turns from one piece to the other while it stays inside both si
 the two surfaces crossed in depth there: one piece moved through the other. The moving piece's
 silhouette is laid by whole-pixel steps, so a pixel of its edge is uncertain; the other's is its
 own pixels; and turned pixels count in blobs two pixels across (ragged colour edges turn single
-pixels). Flips on :data:`FLIP_FRAMES` frames within :data:`FLIP_WINDOW` of a motion make the
-event (one frame's flips are a misreading). A crossing hidden behind other pieces, or along the
-line of sight, shows nothing here: only the level's geometry decides it. Nor does a crossing
-whose cut moves with the moving piece (a face sliding into a face along a lattice axis, as
-drawn with a depth buffer): a notched piece sliding past another draws the same pixels.
+pixels). Pixels of no colour and no ground (dark edges, blends) first go to the colour next to
+them (:func:`filled`), or the edge between two colours eats the band that turns. Flips on
+:data:`FLIP_FRAMES` frames within :data:`FLIP_WINDOW` of a motion make the event (one frame's
+flips are a misreading); a silhouette cut by the picture's border is not read. A crossing
+hidden behind other pieces, or along the line of sight, shows nothing here: only the level's
+geometry decides it. Nor does a crossing whose cut moves with the moving piece (a face sliding
+into a face along a lattice axis, as drawn with a depth buffer): a notched piece sliding past
+another draws the same pixels.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Final
 
@@ -65,6 +69,15 @@ FLIP_TOTAL: Final = 2.0
 #: Erosion (pixels) of the moving colour's silhouette before a pixel counts as inside it: the
 #: rounding of HISTORY whole-pixel steps.
 MOVER_EDGE: Final = 1
+#: Steps (one pixel each) by which each colour takes the pixels next to it that are neither a
+#: colour nor ground, in strips narrower than 2 EDGE + 1 pixels, before pass-throughs are read:
+#: a piece's dark edges, a moving edge's blend. The band where one piece cuts into another is a
+#: few pixels wide, and an unclaimed edge between the two colours would eat it. Wider dark
+#: regions are faces in shade, which a neighbour taking them would flip as it slides past them
+#: (on the tuning seeds, filling those too caught more crossings but raised clean clips' alarms
+#: threefold).
+FILL: Final = 3
+EDGE: Final = 2
 
 Shift = tuple[int, int]
 
@@ -144,6 +157,32 @@ def _thick(m: Bools) -> Bools:
     out[:-1, 1:] |= core
     out[1:, 1:] |= core
     return out
+
+
+def filled(frame: list[Bools], ground: Bools, steps: int = FILL) -> list[Bools]:
+    """A frame's colour masks, each grown by ``steps`` one-pixel steps into the pixels of no
+    colour and no ground that lie in strips narrower than 2 EDGE + 1 pixels; a pixel two
+    colours reach in the same step stays unclaimed."""
+    out = [m.copy() for m in frame]
+    if not out:
+        return out
+    free = ~ground & ~np.logical_or.reduce(out)
+    edges = free & ~dilate(_erode(free, EDGE), EDGE)
+    for _ in range(steps):
+        claims = [dilate(m, 1) & edges for m in out]
+        once = np.sum(claims, axis=0) == 1
+        for m, c in zip(out, claims, strict=True):
+            m |= c & once
+        edges &= ~np.logical_or.reduce(out)
+    return out
+
+
+def pass_throughs(
+    kept: list[list[Bools]], grounds: list[Bools], names: tuple[str, ...], least: int
+) -> list[Event]:
+    """The pass-throughs of :class:`SilhouetteMotion` over the colour masks :func:`filled`."""
+    solid = [filled(f, g) for f, g in zip(kept, grounds, strict=True)]
+    return SilhouetteMotion(solid, names, least).pass_throughs()
 
 
 def _on_border(m: Bools) -> bool:
@@ -314,26 +353,54 @@ class SilhouetteMotion:
     def _pair(self, k: int, j: int) -> list[Event]:
         """Windows of FLIP_WINDOW frames, while one of colours ``k`` and ``j`` moves, with
         flips on FLIP_FRAMES of them and FLIP_TOTAL of the least area in all; overlapping
-        windows are one event."""
+        windows are one event, dated by the one with the most flipped frames."""
         empty = np.zeros_like(self.kept[0][k])
         counts, turned = [0], [empty]
         for t in range(1, len(self.kept)):
             n, m = 0, empty
-            if min(self.area[t][k], self.area[t][j]) >= self.least and self._apart(k, j, t):
+            if self._readable(k, j, t):
                 n, m = self.flips(k, j, t)
             counts.append(n)
             turned.append(m)
         out: list[Event] = []
-        end = -1
-        for s in range(1, len(counts)):
-            w = range(s, min(len(counts), s + FLIP_WINDOW))
-            on = [t for t in w if counts[t] >= FLIP_SHARE * self.least]
-            total = sum(counts[t] for t in w)
-            if len(on) < FLIP_FRAMES or total < FLIP_TOTAL * self.least or on[0] <= end:
+        s = 1
+        while s < len(counts):
+            if self._window(counts, s) is None:
+                s += 1
                 continue
+            # of the windows overlapping this one, the one with the most flipped frames (then
+            # the most flips): a stray flip just before a crossing does not date it
+            best = max(range(s, min(len(counts), s + FLIP_WINDOW)), key=self._rank(counts))
+            on, total = self._window(counts, best) or ([], 0)
             out.append(self._event(k, j, on, total, turned[on[0]]))
-            end = w[-1]
+            s = best + FLIP_WINDOW
         return out
+
+    def _window(self, counts: list[int], s: int) -> tuple[list[int], int] | None:
+        """The flipped frames and the flips of the window from frame ``s``, if they make an
+        event: FLIP_FRAMES frames over FLIP_SHARE of the least area, FLIP_TOTAL of it in all."""
+        w = range(s, min(len(counts), s + FLIP_WINDOW))
+        on = [t for t in w if counts[t] >= FLIP_SHARE * self.least]
+        total = sum(counts[t] for t in w)
+        if len(on) < FLIP_FRAMES or total < FLIP_TOTAL * self.least:
+            return None
+        return on, total
+
+    def _rank(self, counts: list[int]) -> Callable[[int], tuple[int, int]]:
+        def rank(s: int) -> tuple[int, int]:
+            w = self._window(counts, s)
+            return (-1, -1) if w is None else (len(w[0]), w[1])
+
+        return rank
+
+    def _readable(self, k: int, j: int, t: int) -> bool:
+        """Whether frame ``t``'s flips between colours ``k`` and ``j`` can be read: both show,
+        move against each other (:meth:`_apart`), and keep off the picture's border in this
+        frame and the one before (a piece entering or leaving the picture has a silhouette its
+        history cannot lay whole)."""
+        if min(self.area[t][k], self.area[t][j]) < self.least or not self._apart(k, j, t):
+            return False
+        return not any(_on_border(self.kept[u][q]) for u in (t - 1, t) for q in (k, j))
 
     def _event(self, k: int, j: int, on: list[int], total: int, turned: Bools) -> Event:
         """The pass-through over frames ``on``: named for the piece that travelled further,

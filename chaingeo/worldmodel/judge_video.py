@@ -28,7 +28,7 @@ from chaingeo.core.arrays import U8, Bools
 from chaingeo.core.errors import ChainGeoError
 from chaingeo.worldmodel.judge_drift import Drift
 from chaingeo.worldmodel.judge_exist import Existence, join
-from chaingeo.worldmodel.judge_motion import SilhouetteMotion
+from chaingeo.worldmodel.judge_motion import SilhouetteMotion, pass_throughs
 from chaingeo.worldmodel.judge_palette import video_model
 from chaingeo.worldmodel.judge_segment import (
     RENDER_SHADES,
@@ -278,7 +278,7 @@ def judge_frames(
     if level is not None and colors:
         events, undecided = _with_level(level, colors, model.names, events, kept, area)
     else:
-        events = join(events, motion.pass_throughs())
+        events = join(events, pass_throughs(kept, grounds, model.names, area))
         undecided.append(
             "pass_through: read from silhouettes only (two pieces' depth order turning where "
             "both lie); a crossing hidden from view needs the level's geometry and a known "
