@@ -177,7 +177,7 @@ FLOORS = {
     "merge": 0.9,
     "duplicate": 0.95,
     "teleport": 0.85,
-    "pass_through": 0.2,
+    "pass_through": 0.4,
 }
 MOST_FALSE_ALARMS = 0.04
 
