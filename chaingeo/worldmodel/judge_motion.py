@@ -27,7 +27,6 @@ another draws the same pixels.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Final
 
@@ -80,6 +79,8 @@ FILL: Final = 3
 EDGE: Final = 2
 
 Shift = tuple[int, int]
+#: A window's flipped frames and its flips in all.
+Window = tuple[list[int], int]
 
 
 @dataclass(frozen=True)
@@ -183,6 +184,10 @@ def pass_throughs(
     """The pass-throughs of :class:`SilhouetteMotion` over the colour masks :func:`filled`."""
     solid = [filled(f, g) for f, g in zip(kept, grounds, strict=True)]
     return SilhouetteMotion(solid, names, least).pass_throughs()
+
+
+def _rank(w: Window | None) -> tuple[int, int]:
+    return (-1, -1) if w is None else (len(w[0]), w[1])
 
 
 def _on_border(m: Bools) -> bool:
@@ -362,21 +367,26 @@ class SilhouetteMotion:
                 n, m = self.flips(k, j, t)
             counts.append(n)
             turned.append(m)
+        windows: list[Window | None] = [None]
+        windows += [self._window(counts, s) for s in range(1, len(counts))]
         out: list[Event] = []
         s = 1
         while s < len(counts):
-            if self._window(counts, s) is None:
+            if windows[s] is None:
                 s += 1
                 continue
             # of the windows overlapping this one, the one with the most flipped frames (then
             # the most flips): a stray flip just before a crossing does not date it
-            best = max(range(s, min(len(counts), s + FLIP_WINDOW)), key=self._rank(counts))
-            on, total = self._window(counts, best) or ([], 0)
+            near = range(s, min(len(counts), s + FLIP_WINDOW))
+            best = max(near, key=lambda u: _rank(windows[u]))
+            got = windows[best]
+            assert got is not None  # it ranks as high as the window from s, which qualifies
+            on, total = got
             out.append(self._event(k, j, on, total, turned[on[0]]))
             s = best + FLIP_WINDOW
         return out
 
-    def _window(self, counts: list[int], s: int) -> tuple[list[int], int] | None:
+    def _window(self, counts: list[int], s: int) -> Window | None:
         """The flipped frames and the flips of the window from frame ``s``, if they make an
         event: FLIP_FRAMES frames over FLIP_SHARE of the least area, FLIP_TOTAL of it in all."""
         w = range(s, min(len(counts), s + FLIP_WINDOW))
@@ -385,13 +395,6 @@ class SilhouetteMotion:
         if len(on) < FLIP_FRAMES or total < FLIP_TOTAL * self.least:
             return None
         return on, total
-
-    def _rank(self, counts: list[int]) -> Callable[[int], tuple[int, int]]:
-        def rank(s: int) -> tuple[int, int]:
-            w = self._window(counts, s)
-            return (-1, -1) if w is None else (len(w[0]), w[1])
-
-        return rank
 
     def _readable(self, k: int, j: int, t: int) -> bool:
         """Whether frame ``t``'s flips between colours ``k`` and ``j`` can be read: both show,
