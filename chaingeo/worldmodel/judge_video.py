@@ -43,6 +43,7 @@ from chaingeo.worldmodel.judge_segment import (
     palette_model,
     shrink,
 )
+from chaingeo.worldmodel.judge_shape import broken_pieces
 from chaingeo.worldmodel.judge_track import (
     VIOLATIONS,
     Event,
@@ -272,6 +273,9 @@ def judge_frames(
     grounds = [g for g, _ in read]
     events = join(events, Existence(kept, grounds, model.names, area).events())
     events = join(events, Drift(list(frames), [o for o, _ in objects], model.names).events())
+    parts = [[sum(o.parts for o in objs if o.cls == k) for k in range(len(model.names))]
+             for objs, _ in objects]  # fmt: skip
+    events = join(events, broken_pieces(frames, kept, grounds, parts, model.names, area))
     motion = SilhouetteMotion(kept, model.names, area)
     events = join(events, motion.teleports())
     undecided: list[str] = []
