@@ -117,6 +117,16 @@ class Existence:
         s = _share(self.kept[b - 2][k], region)
         return s >= REST if present else s <= FLICKER
 
+    def _left_from(self, c: Bools, went: list[Bools], k: int, b: int) -> Bools | None:
+        """The place colour ``k`` left, far from ``c``, in the frame ``c`` came out of open
+        ground, the colour steady there before: one piece, so the one that appeared is the one
+        that left (a teleport), whatever its old place shows now (a piece it hid, partly)."""
+        for g in went:
+            far = float(np.hypot(*(_centre(c) - _centre(g)))) >= self.jump
+            if far and self._steady(g, k, b, True):
+                return g
+        return None
+
     def _at(self, b: int, k: int, came: list[Bools], went: list[Bools]) -> list[Event]:
         out: list[Event] = []
         name = self.names[k]
@@ -141,7 +151,12 @@ class Existence:
             if not self._area_moved(k, b, int(c.sum())):
                 continue
             stays = self.kept[b][k] & self.kept[b - 1][k] & ~dilate(c, self.reach)
-            if int(stays.sum()) >= self.least:
+            left = self._left_from(c, went, k, b)
+            if left is not None:
+                went = [g for g in went if g is not left]
+                detail = f"the {name} piece jumped to another place between two frames"
+                out.append(Event("teleport", b, name, None, detail, (left, c)))
+            elif int(stays.sum()) >= self.least:
                 detail = f"a second {name} piece appeared in open view beside the first"
                 out.append(Event("duplicate", b, name, None, detail, (c,), before=0))
             else:

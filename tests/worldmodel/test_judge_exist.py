@@ -56,3 +56,17 @@ def test_motion_and_occlusion_are_no_event(seed: int) -> None:
     over = [_box(a[0] - 2, a[1] - 2, 22, 28) if i >= t else blue[i] for i in range(N)]
     hidden = [[_box(*a) & ~over[i], over[i]] for i in range(N)]
     assert not [e for e in _run(hidden) if e[2] == "red"]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_jump_out_from_behind_a_piece_is_a_teleport(seed: int) -> None:
+    # red, mostly behind a blue box, shows far off in open ground whole the next frame: the
+    # one red piece left its place (what shows there is blue and ground), so it jumped
+    rng = np.random.default_rng(seed)
+    a, b, t = _scene(rng)
+    cover = _box(a[0] - 2, a[1] - 2, 22, 20)
+    there = _box(a[0] + 50, a[1] + 50)
+    kept = [[_box(*a) & ~cover if i < t else there, cover | _box(*b)] for i in range(N)]
+    got = _run(kept)
+    assert ("teleport", t, "red") in got
+    assert not [e for e in got if e[0] in ("appear", "disappear")]
