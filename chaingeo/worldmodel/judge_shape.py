@@ -166,11 +166,25 @@ def _break(
         return None
     gu = _erode(_steady(grounds, range(u - STEADY + 1, u + 1)), EDGE)
     gt = _erode(_steady(grounds, range(t, t + STEADY)), EDGE)
+    if _laid_at_rest(was, now, gu, gt, CONFLICT * least):
+        return None
     n = least_on_ground(was, now, gu, gt)[2]
     if n < CONFLICT * least or not _one_hue(frames[t], components(kept[t][k], least)):
         return None
     first = next((v for v in range(u + 1, t + 1) if parts[v][k] > parts[u][k]), u + 1)
     return first, n, (kept[first - 1][k], kept[first][k])
+
+
+def _laid_at_rest(
+    was: Bools, now: Bools, ground_was: Bools, ground_now: Bools, most: float
+) -> bool:
+    """Whether the zero shift (a piece at rest, the common case) already lays the silhouettes
+    with fewer than ``most`` pixels on ground, and overlaps them as well as
+    :func:`least_on_ground` asks of any shift: then its least is below ``most`` too, and
+    the correlations need not be computed."""
+    if float((was & now).sum()) < OVERLAP * min(float(was.sum()), float(now.sum())):
+        return False
+    return int((was & ground_now).sum() + (now & ground_was).sum()) < most
 
 
 def _steady(grounds: list[Bools], frames: range) -> Bools:

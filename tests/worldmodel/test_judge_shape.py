@@ -150,3 +150,16 @@ def test_a_rigid_piece_always_has_a_translation_off_the_ground(
         return
     got = least_on_ground(seen_was, seen_now, ~(piece | occ_was), ~(later | occ_now))
     assert got[2] == 0
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_at_rest_shortcut_agrees_with_the_full_search(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    was = _box(*[int(v) for v in rng.integers([20, 20, 10, 10], [60, 80, 40, 60])])
+    now = moved(was, *[int(v) for v in rng.integers(-3, 4, 2)])
+    now |= _box(*[int(v) for v in rng.integers([20, 20, 5, 5], [90, 130, 20, 20])])
+    ground_was = ~was & (rng.random((H, W)) < 0.9)
+    ground_now = ~now & (rng.random((H, W)) < 0.9)
+    most = float(rng.integers(1, 400))
+    if judge_shape._laid_at_rest(was, now, ground_was, ground_now, most):
+        assert least_on_ground(was, now, ground_was, ground_now)[2] < most
