@@ -173,10 +173,10 @@ FLOORS = {
     "vanish_neighbour": 0.85,
     "recolour_abrupt": 0.85,
     "recolour_gradual": 0.85,
-    "split": 0.85,
+    "split": 0.9,
     "merge": 0.9,
     "duplicate": 0.95,
-    "teleport": 0.85,
+    "teleport": 0.9,
     "pass_through": 0.4,
 }
 MOST_FALSE_ALARMS = 0.04
