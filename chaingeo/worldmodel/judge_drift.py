@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.arrays import F64, U8, Bools
-from chaingeo.worldmodel.judge_segment import dilate
+from chaingeo.worldmodel.judge_segment import dilate, on_border
 from chaingeo.worldmodel.judge_track import Event, Obj
 
 
@@ -103,7 +103,7 @@ class Drift:
         done: dict[int, int] = {}
         for b in range(1, len(self.objects) - 2):
             for p in self.objects[b - 1]:
-                if done.get(p.cls, -1) >= b or _on_border(p.mask):
+                if done.get(p.cls, -1) >= b or on_border(p.mask):
                     continue
                 ev = self._slide(p, b)
                 if ev is not None:
@@ -179,7 +179,3 @@ def _slid(rows: list[tuple[float, float, float]]) -> tuple[int, int] | None:
         elif m < RULE.middle_range[0] and middle:
             return None
     return None
-
-
-def _on_border(m: Bools, b: int = 3) -> bool:
-    return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())

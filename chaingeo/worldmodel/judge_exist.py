@@ -19,7 +19,7 @@ from typing import Final
 import numpy as np
 
 from chaingeo.core.arrays import F64, Bools
-from chaingeo.worldmodel.judge_segment import components, dilate
+from chaingeo.worldmodel.judge_segment import components, dilate, on_border
 from chaingeo.worldmodel.judge_track import JUMP_SHARE, Event
 
 #: Frames a change must hold after its first frame (its least duration).
@@ -38,16 +38,10 @@ STILL: Final = 0.9
 AREA: Final = 0.6
 #: A region is this many times the least area at least (a sliver is no piece).
 LEAST_TIMES: Final = 2
-BORDER: Final = 3
 
 
 def _share(pixels: Bools, region: Bools) -> float:
     return float((pixels & region).sum()) / max(1.0, float(region.sum()))
-
-
-def _on_border(m: Bools) -> bool:
-    b = BORDER
-    return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
 
 
 def _centre(m: Bools) -> F64:
@@ -137,14 +131,14 @@ class Existence:
             g = pair[0]
             came = [x for x in came if x is not c]
             went = [x for x in went if x is not g]
-            if _on_border(c) or _on_border(g) or not self._held(c, k, b, True):
+            if on_border(c) or on_border(g) or not self._held(c, k, b, True):
                 continue  # motion in or out through the border
             far = float(np.hypot(*(_centre(c) - _centre(g)))) >= self.jump
             if far and self._steady(g, k, b, True) and _share(self.ground[b], g) >= OPEN:
                 detail = f"the {name} piece jumped to another place between two frames"
                 out.append(Event("teleport", b, name, None, detail, (g, c)))
-        came = [c for c in came if not _on_border(c) and self._held(c, k, b, True)]
-        went = [g for g in went if not _on_border(g) and self._held(g, k, b, False)]
+        came = [c for c in came if not on_border(c) and self._held(c, k, b, True)]
+        went = [g for g in went if not on_border(g) and self._held(g, k, b, False)]
         for c in came:
             if _share(self.ground[b - 1], c) < OPEN or not self._steady(c, k, b, False):
                 continue

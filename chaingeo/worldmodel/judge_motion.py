@@ -33,7 +33,7 @@ from typing import Final
 import numpy as np
 
 from chaingeo.core.arrays import Bools
-from chaingeo.worldmodel.judge_segment import dilate
+from chaingeo.worldmodel.judge_segment import dilate, erode, on_border
 from chaingeo.worldmodel.judge_track import Event
 
 #: Overlap (pixels) a shift's each pixel of distance from the step before costs.
@@ -51,8 +51,6 @@ JUMP_AREA: Final = 0.3
 #: Share of the place a piece left (or took) that a moving piece covering it makes the change
 #: an occlusion, not a jump.
 COVERED: Final = 0.25
-#: Pixels from the picture's edge within which a silhouette touches the border.
-BORDER: Final = 3
 #: Frames of past silhouettes laid together (by their displacements) as a piece's full shape:
 #: two whole-pixel steps err by a pixel at most, which MOVER_EDGE takes off (over three, a
 #: notched piece's silhouette smeared into its notch and the piece seen through it flipped).
@@ -141,11 +139,6 @@ def _share(pixels: Bools, region: Bools) -> float:
     return float((pixels & region).sum()) / max(1.0, float(region.sum()))
 
 
-def _erode(mask: Bools, r: int) -> Bools:
-    out: Bools = ~dilate(~mask, r)
-    return out
-
-
 def _thick(m: Bools) -> Bools:
     """``m`` opened by a 2x2 square: one-pixel slivers go (two colours' edge jittering by a
     pixel, anti-aliasing), while a surface sweeping through another turns a band at least
@@ -168,7 +161,7 @@ def filled(frame: list[Bools], ground: Bools, steps: int = FILL) -> list[Bools]:
     if not out:
         return out
     free = ~ground & ~np.logical_or.reduce(out)
-    edges = free & ~dilate(_erode(free, EDGE), EDGE)
+    edges = free & ~dilate(erode(free, EDGE), EDGE)
     for _ in range(steps):
         claims = [dilate(m, 1) & edges for m in out]
         once = np.sum(claims, axis=0) == 1
@@ -188,11 +181,6 @@ def pass_throughs(
 
 def _rank(w: Window | None) -> tuple[int, int]:
     return (-1, -1) if w is None else (len(w[0]), w[1])
-
-
-def _on_border(m: Bools) -> bool:
-    b = BORDER
-    return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
 
 
 class SilhouetteMotion:
@@ -246,7 +234,7 @@ class SilhouetteMotion:
                 if min(a, c) < JUMP_AREA * max(a, c):
                     continue
                 was, now = self.kept[b - 1][k], self.kept[b][k]
-                if _on_border(was) or _on_border(now):
+                if on_border(was) or on_border(now):
                     continue
                 spike = self._spike(k, b)
                 if spike is None or spike[0] < JUMP_RATIO * max(spike[1], JUMP_FLOOR):
@@ -330,7 +318,7 @@ class SilhouetteMotion:
         for u in (t - 1, t):
             for q in (k, j):
                 shape = self._shape(q, u)
-                inside &= _erode(shape, MOVER_EDGE) if q == mover else shape
+                inside &= erode(shape, MOVER_EDGE) if q == mover else shape
         a0, a1 = self.kept[t - 1][k], self.kept[t][k]
         b0, b1 = self.kept[t - 1][j], self.kept[t][j]
         turned = _thick(inside & ((a0 & b1) | (b0 & a1)))
@@ -403,7 +391,7 @@ class SilhouetteMotion:
         history cannot lay whole)."""
         if min(self.area[t][k], self.area[t][j]) < self.least or not self._apart(k, j, t):
             return False
-        return not any(_on_border(self.kept[u][q]) for u in (t - 1, t) for q in (k, j))
+        return not any(on_border(self.kept[u][q]) for u in (t - 1, t) for q in (k, j))
 
     def _event(self, k: int, j: int, on: list[int], total: int, turned: Bools) -> Event:
         """The pass-through over frames ``on``: named for the piece that travelled further,

@@ -30,6 +30,9 @@ from chaingeo.pictures.raster import SHADE
 
 #: Longer side of a frame once shrunk: enough for pieces, cheap for every later step.
 WORK_SIZE: Final = 320
+#: Pixels from the picture's edge within which a piece touches the border (cleaning may eat
+#: the outer column): a piece there may be entering or leaving the picture.
+BORDER: Final = 3
 #: CIEDE2000 distance within which a pixel takes a level colour (the palette's colours are at
 #: least 12 apart, and the nearest one always wins).
 DELTA_E: Final = 11.0
@@ -275,6 +278,17 @@ def _spread_kernel(flat: U8, h: int, w: int, r: int, grow: bool) -> U8:
 
 def dilate(mask: Bools, r: int) -> Bools:
     return _spread(mask, r, True)
+
+
+def erode(mask: Bools, r: int) -> Bools:
+    out: Bools = ~dilate(~mask, r)
+    return out
+
+
+def on_border(mask: Bools, margin: int = BORDER) -> bool:
+    """Whether ``mask`` has a pixel within ``margin`` pixels of the picture's edge."""
+    b = margin
+    return bool(mask[:b].any() or mask[-b:].any() or mask[:, :b].any() or mask[:, -b:].any())
 
 
 def close(mask: Bools, r: int = 2) -> Bools:

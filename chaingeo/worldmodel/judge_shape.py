@@ -26,8 +26,8 @@ from typing import Final
 import numpy as np
 
 from chaingeo.core.arrays import U8, Bools
-from chaingeo.worldmodel.judge_segment import components, dilate
-from chaingeo.worldmodel.judge_track import BORDER, Event
+from chaingeo.worldmodel.judge_segment import components, erode, on_border
+from chaingeo.worldmodel.judge_track import Event
 
 #: Frames between the two silhouettes compared (a break that drifts apart over a few frames
 #: shows whole).
@@ -48,16 +48,6 @@ STEADY: Final = 3
 SEEN: Final = 0.5
 #: Largest distance between two parts' median chromaticities (r, g) for them to be one piece's.
 SAME_HUE: Final = 0.03
-
-
-def _erode(mask: Bools, r: int) -> Bools:
-    out: Bools = ~dilate(~mask, r)
-    return out
-
-
-def _on_border(m: Bools) -> bool:
-    b = BORDER
-    return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
 
 
 def _box(m: Bools) -> tuple[int, int, int, int]:
@@ -157,15 +147,15 @@ def _break(
     u = t - LAG
     if parts[t][k] < 2:
         return None
-    if any(_on_border(kept[v][k]) for v in range(u, t + 1)):
+    if any(on_border(kept[v][k]) for v in range(u, t + 1)):
         return None
-    was, now = _erode(kept[u][k], EDGE), _erode(kept[t][k], EDGE)
+    was, now = erode(kept[u][k], EDGE), erode(kept[t][k], EDGE)
     if not was.any() or not now.any():
         return None
     if min(int(was.sum()), int(now.sum())) < SEEN * max(int(was.sum()), int(now.sum())):
         return None
-    gu = _erode(_steady(grounds, range(u - STEADY + 1, u + 1)), EDGE)
-    gt = _erode(_steady(grounds, range(t, t + STEADY)), EDGE)
+    gu = erode(_steady(grounds, range(u - STEADY + 1, u + 1)), EDGE)
+    gt = erode(_steady(grounds, range(t, t + STEADY)), EDGE)
     if _laid_at_rest(was, now, gu, gt, CONFLICT * least):
         return None
     n = least_on_ground(was, now, gu, gt)[2]

@@ -22,7 +22,7 @@ import numpy as np
 
 from chaingeo.core.arrays import F64, Bools
 from chaingeo.worldmodel.judge_gap import gap_covered
-from chaingeo.worldmodel.judge_segment import close, components, dilate
+from chaingeo.worldmodel.judge_segment import close, components, dilate, on_border
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
 #: hold.
@@ -41,8 +41,6 @@ FAST_SHARE: Final = 0.25
 LAGS: Final = (2, 6, 11)
 #: Least jump of a teleport (share of the frame's longer side).
 JUMP_SHARE: Final = 0.1
-#: Pixels from the picture's edge within which a part touches the border.
-BORDER: Final = 3
 #: Growth (share of the frame's longer side) of a mask when matching across one frame.
 MOTION_SHARE: Final = 0.03
 
@@ -60,9 +58,7 @@ class Obj:
         return int(self.mask.sum())
 
     def touches_border(self) -> bool:
-        """Within BORDER pixels of the picture's edge (cleaning may eat the outer column)."""
-        m, b = self.mask, BORDER
-        return bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
+        return on_border(self.mask)
 
 
 @dataclass(frozen=True)
