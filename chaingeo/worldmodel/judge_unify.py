@@ -17,8 +17,8 @@ import numpy as np
 import numpy.typing as npt
 
 from chaingeo.core.arrays import Bools
-from chaingeo.worldmodel.judge_motion import FIT, NONE, MaskShift, best_shift
 from chaingeo.worldmodel.judge_segment import ColorModel, dilate
+from chaingeo.worldmodel.judge_shift import FIT, NONE, MaskShift, best_shift
 from chaingeo.worldmodel.judge_track import forest_root
 
 #: Least frames both classes show in; share of the frames either shows in that the other may be

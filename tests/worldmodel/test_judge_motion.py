@@ -9,16 +9,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from chaingeo.worldmodel.judge_motion import (
-    EDGE,
-    FILL,
-    SilhouetteMotion,
-    best_shift,
-    filled,
-    moved,
-    pass_throughs,
-)
+from chaingeo.worldmodel.judge_motion import EDGE, FILL, SilhouetteMotion, filled, pass_throughs
 from chaingeo.worldmodel.judge_segment import dilate
+from chaingeo.worldmodel.judge_shift import best_shift, moved
 
 H, W, N = 120, 160, 16
 NAMES = ("red", "blue")

@@ -11,9 +11,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from chaingeo.worldmodel import judge_shape
-from chaingeo.worldmodel.judge_motion import moved
 from chaingeo.worldmodel.judge_segment import components
 from chaingeo.worldmodel.judge_shape import LAG, broken_pieces, least_on_ground
+from chaingeo.worldmodel.judge_shift import moved
 
 H, W, N = 120, 160, 14
 LEAST = 40
