@@ -45,9 +45,11 @@ JUMP_SHARE: Final = 0.1
 MOTION_SHARE: Final = 0.03
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Obj:
-    """One piece as seen in one frame: its colour class (0-based), pixels and parts."""
+    """One piece as seen in one frame: its colour class (0-based), pixels and parts. Objects
+    compare by identity: two of one colour are two pieces however alike (and masks have no
+    truth value to compare by)."""
 
     cls: int
     mask: Bools

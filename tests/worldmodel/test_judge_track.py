@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from chaingeo.core.arrays import U8
+from chaingeo.core.arrays import U8, Bools
+from chaingeo.worldmodel.judge_track import Obj
 from chaingeo.worldmodel.judge_video import judge_frames
 
 BLUE, ORANGE, GREEN, PURPLE = (67, 99, 216), (245, 130, 49), (60, 180, 75), (145, 30, 180)
@@ -50,3 +51,18 @@ def test_a_piece_at_rest_vanishing_before_another_is_lost(seed: int) -> None:
         frames.append(_noisy(f, rng))
     v = judge_frames(frames)
     assert any(e.kind == "disappear" and abs(e.frame - s) <= 1 for e in v.violations), v
+
+
+def _box(y: int, x: int, h: int, w: int) -> Bools:
+    m = np.zeros(SIZE, dtype=bool)
+    m[y : y + h, x : x + w] = True
+    return m
+
+
+def test_objects_compare_by_identity() -> None:
+    """A list of one colour's objects drops the one asked for (value equality would compare
+    masks, which have no truth value, and fail)."""
+    a, b = Obj(0, _box(0, 0, 4, 4), 1), Obj(0, _box(9, 9, 4, 4), 1)
+    objs = [a, b]
+    objs.remove(b)
+    assert objs == [a] and a != Obj(0, a.mask, 1)
