@@ -23,6 +23,7 @@ import numpy as np
 from chaingeo.core.arrays import F64, Bools
 from chaingeo.worldmodel.judge_gap import gap_covered
 from chaingeo.worldmodel.judge_segment import close, components, dilate, on_border
+from chaingeo.worldmodel.judge_shift import FIT, best_shift, moved
 
 #: Frames of the median filter over object counts (odd), and frames an identity change must
 #: hold.
@@ -39,6 +40,11 @@ STILL_SHARE: Final = 0.2
 FAST_SHARE: Final = 0.25
 #: Frames after which a piece's place is looked at again for another colour.
 LAGS: Final = (2, 6, 11)
+#: Another colour that moved took a piece's place by moving over it when its own step lays
+#: its earlier pixels on this share of what it took; past OVER_LAG frames one step cannot be
+#: followed (the silhouette changes as the piece turns, hides and shows), so it is assumed.
+OVER_EXPLAINED: Final = 0.5
+OVER_LAG: Final = 6
 #: Least jump of a teleport (share of the frame's longer side).
 JUMP_SHARE: Final = 0.1
 #: Growth (share of the frame's longer side) of a mask when matching across one frame.
@@ -262,10 +268,8 @@ class Tracker:
                 was = self._class_pixels(b - 1, j)
                 if min(_share(m, p.mask) for m in now) < 0.6 or _share(was, p.mask) > 0.2:
                     continue
-                ring = ~dilate(p.mask, 3)
-                moved = float((now[0] & ring ^ was & ring).sum())
-                if moved > 0.3 * p.area:
-                    continue  # the other colour moved elsewhere too: it came over this piece
+                if self._came_over(j, p, b, t):
+                    continue
                 name, other = self.names[p.cls], self.names[j]
                 # beside a piece of the new colour it reads as fused: still a recolour, as the
                 # piece keeps its place (a merge moves on with the other)
@@ -275,6 +279,23 @@ class Tracker:
                 detail = f"the {name} piece {how} {other} over {lag} frames"
                 return Event(kind, b, name, other, detail, (p.mask, now[0]), last=t)
         return None
+
+    def _came_over(self, j: int, p: Obj, b: int, t: int) -> bool:
+        """Whether colour ``j`` took ``p``'s place from frame ``b - 1`` to ``t`` by moving over
+        it: it changed elsewhere too (by 0.3 of ``p``'s area, outside ``p``), and its own
+        step lays its earlier pixels on OVER_EXPLAINED of what it took, or cannot be read (a
+        lag past OVER_LAG, a poor fit, a piece at the picture's border, which shows in part)."""
+        was, now = self._class_pixels(b - 1, j), self._class_pixels(t, j)
+        ring = ~dilate(p.mask, 3)
+        if float((now & ring ^ was & ring).sum()) <= 0.3 * p.area:
+            return False
+        border = any(o.touches_border() for u in range(b - 1, t + 1) for o in self._of(u, j))
+        step = best_shift(was, now)
+        if t - b > OVER_LAG or border or step.fit < FIT:
+            return True
+        took = now & p.mask
+        laid = dilate(moved(was, step.dy, step.dx), 1) & took
+        return bool(laid.sum() >= OVER_EXPLAINED * took.sum())
 
     def _jumps(self) -> list[Event]:
         """Teleports: a piece at rest in one place, then at rest in another JUMP_SHARE of the

@@ -1,6 +1,7 @@
 """The tracker on seeded synthetic clips without a level: a colour blended into a touching
 piece's through a passing colour is still caught, a piece at rest that vanishes while what it
-hid shows is lost (not hidden)."""
+hid shows is lost (not hidden), a recolour to a colour moving elsewhere is read and a piece
+sliding over another is not."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import numpy as np
 import pytest
 
 from chaingeo.core.arrays import U8, Bools
-from chaingeo.worldmodel.judge_track import Obj
+from chaingeo.worldmodel.judge_track import Obj, Tracker, frame_objects
 from chaingeo.worldmodel.judge_video import judge_frames
 
 BLUE, ORANGE, GREEN, PURPLE = (67, 99, 216), (245, 130, 49), (60, 180, 75), (145, 30, 180)
@@ -53,10 +54,40 @@ def test_a_piece_at_rest_vanishing_before_another_is_lost(seed: int) -> None:
     assert any(e.kind == "disappear" and abs(e.frame - s) <= 1 for e in v.violations), v
 
 
+def _identity(blue: list[Bools], orange: list[Bools]) -> list[tuple[str, int, str]]:
+    frames = [frame_objects([b, o], 40) for b, o in zip(blue, orange, strict=True)]
+    found = Tracker(frames, ("blue", "orange"))._identity()
+    return [(e.kind, e.frame, e.piece) for e in found]
+
+
 def _box(y: int, x: int, h: int, w: int) -> Bools:
     m = np.zeros(SIZE, dtype=bool)
     m[y : y + h, x : x + w] = True
     return m
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_recolour_while_that_colour_moves_elsewhere_is_read(seed: int) -> None:
+    """The blue box turns orange while an orange box slides on elsewhere: the orange colour
+    changed outside the blue box too, but its own step explains none of the blue box's place."""
+    rng = np.random.default_rng(seed)
+    s, speed = int(rng.integers(6, 12)), int(rng.integers(6, 10))
+    place = _box(30, 40, 40, 40)
+    blue = [place if t < s else ~place & place for t in range(26)]
+    orange = [(place if t >= s else ~place & place) | _box(110, 5 + speed * t, 30, 40)
+              for t in range(26)]  # fmt: skip
+    assert _identity(blue, orange) == [("recolour", s, "blue")]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_box_sliding_over_another_is_no_recolour(seed: int) -> None:
+    """The orange box slides over the blue one and stays: its own step explains the cover."""
+    rng = np.random.default_rng(seed)
+    speed = int(rng.integers(6, 10))
+    place = _box(30, 40, 40, 40)
+    orange = [_box(26, max(30, 200 - speed * t), 48, 60) for t in range(26)]
+    blue = [place & ~o for o in orange]
+    assert _identity(blue, orange) == []
 
 
 def test_objects_compare_by_identity() -> None:
