@@ -8,7 +8,8 @@ flat inside of faces votes (a pixel whose neighbourhood hardly changes): the ble
 between two pieces (anti-aliasing, blur, JPEG's halved chroma) would otherwise fill the valley
 between two colours and fuse them, or form a colour of their own. The number of colours is the
 number of density peaks kept by that valley criterion. Dark faces are classified too, with a
-reach that grows as their chromaticity gets noisier.
+reach that grows as their chromaticity gets noisier, and a dark colour vivid enough votes
+for its own peak (a piece with no face in the light still has its class).
 """
 
 from __future__ import annotations
@@ -55,6 +56,12 @@ SEEN_SHARE: Final = 0.002
 #: A pixel votes for the palette when no channel changes by more than this (levels) across its
 #: 3 x 3 neighbourhood: the flat inside of a face, not an edge's blend.
 FLAT_RANGE: Final = 24
+#: A dark pixel (brightest channel from DARK_VOTE_BRIGHT to MIN_BRIGHT) votes for a peak when
+#: its channel spread is DARK_VOTE_SATURATION of that channel: a forest green with every face
+#: in shade has no bright face to make its peak, while grey shadows and a tinted ground's dark
+#: pixels are far less saturated.
+DARK_VOTE_BRIGHT: Final = 25
+DARK_VOTE_SATURATION: Final = 0.6
 #: Dark colours (brightest channel from DARK_BRIGHT to MIN_BRIGHT) join a peak within
 #: JOIN_RADIUS * MIN_BRIGHT / brightest channel (their chromaticity is noisier), and only the
 #: nearest peak when the next nearest is DARK_MARGIN times as far.
@@ -143,20 +150,23 @@ def _votes(frame: U8, hist: F64, counts: F64) -> int:
     h, w = frame.shape[:2]
     flat = np.ascontiguousarray(frame[..., :3]).ravel()
     return int(
-        _vote_kernel(flat, h, w, FLAT_RANGE, CHROMA_BINS, MIN_BRIGHT, MIN_SATURATION, hist, counts)
-    )
+        _vote_kernel(
+            flat, h, w, FLAT_RANGE, CHROMA_BINS, MIN_BRIGHT, MIN_SATURATION, hist, counts,
+            DARK_VOTE_BRIGHT, DARK_VOTE_SATURATION,
+        )
+    )  # fmt: skip
 
 
 @njit(cache=True)
 def _vote_kernel(
     flat: U8, h: int, w: int, flat_range: int, bins: int, bright: int, sat: float,
-    hist: F64, counts: F64,
+    hist: F64, counts: F64, dark: int, dark_sat: float,
 ) -> int:  # fmt: skip
     """One pass over a frame: a pixel votes when no channel changes by more than
     ``flat_range`` across its 3 x 3 neighbourhood (edges repeated), the flat inside of a face
     and not an edge's blend; a chromatic one (see :func:`_chromaticity`) lands in the
     histogram's cell of its own 8-bit chromaticity (the 5-bit table's colours would bend a
-    dark colour's by their rounding)."""
+    dark colour's by their rounding); below ``bright``, only a vivid one (``dark_sat``)."""
     n = 0
     for y in range(h):
         for x in range(w):
@@ -178,7 +188,8 @@ def _vote_kernel(
             r, g, b = np.int64(flat[i]), np.int64(flat[i + 1]), np.int64(flat[i + 2])
             counts[((r >> 3) << 10) | ((g >> 3) << 5) | (b >> 3)] += 1.0
             top, bottom = max(r, g, b), min(r, g, b)
-            if top < bright or top - bottom < sat * top:
+            vivid = top >= dark and top - bottom >= dark_sat * top
+            if (top < bright and not vivid) or top - bottom < sat * top:
                 continue
             total = float(r + g + b) + 1e-9
             cy = min(int(r / total * bins), bins - 1)

@@ -1,6 +1,7 @@
 """The video palette finds every piece colour once under shading (lit and dark faces one
-class, look-alike colours of one level apart), and the drift test reads a gradual recolour
-but not another piece sliding over one, on seeded synthetic pictures."""
+class, look-alike colours of one level apart, a colour with every face in shade), and the
+drift test reads a gradual recolour but not another piece sliding over one, on seeded
+synthetic pictures."""
 
 from __future__ import annotations
 
@@ -168,8 +169,41 @@ def test_the_vote_kernel_matches_numpy(seed: int) -> None:
     flat = (np.max(shifts, axis=0) - np.min(shifts, axis=0)).max(axis=2) <= P.FLAT_RANGE
     px = frame[flat].astype(np.float64)
     chroma, ok = P._chromaticity(px)
+    hi, lo = px.max(axis=1), px.min(axis=1)
+    vivid = (hi >= P.DARK_VOTE_BRIGHT) & (hi - lo >= P.DARK_VOTE_SATURATION * hi)
+    ok |= vivid & (hi - lo >= P.MIN_SATURATION * hi)
     cell = np.clip((chroma[ok] * P.CHROMA_BINS).astype(np.int64), 0, P.CHROMA_BINS - 1)
     want = np.bincount(cell[:, 0] * P.CHROMA_BINS + cell[:, 1], minlength=P.CHROMA_BINS**2)
     assert total == int(ok.sum()) and np.array_equal(hist, want)
     idx = _table_index(frame)[flat]
     assert np.array_equal(counts, np.bincount(idx, minlength=32768))
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_a_dark_vivid_piece_is_a_colour_of_its_own(seed: int) -> None:
+    """A forest green whose every face is in shade (brightest channel under MIN_BRIGHT) still
+    has a class, apart from the lit piece beside it; grey shadows on the ground make none."""
+    from chaingeo.worldmodel import judge_palette as P
+
+    rng = np.random.default_rng(seed)
+    forest, other = np.array(COLOURS[2], float), np.array(COLOURS[int(rng.choice([0, 3, 5]))])
+    shades = rng.uniform(P.DARK_VOTE_BRIGHT + 4, P.MIN_BRIGHT - 6, 3) / forest.max()
+    grey = rng.uniform(110, 190)
+    frames, masks = [], []
+    for _ in range(8):
+        f = np.full((*SIZE, 3), grey)
+        f[100:150, 20:220] = grey * rng.uniform(0.25, 0.45)  # a shadow on the ground
+        masks = [
+            _block(f, 30, 40, forest, shades),
+            _block(f, 30, 150, other.astype(float), np.array([1.0, 0.8, 0.6])),
+        ]
+        frames.append(np.clip(f + rng.normal(0, 2.0, f.shape), 0, 255).astype(np.uint8))
+    model = video_model(frames)
+    assert len(model.names) == 2, model.names
+    labels = classify(frames[0], model)
+    owners = []
+    for m in masks:
+        got = np.bincount(labels[m], minlength=3)
+        owners.append(int(np.argmax(got[1:])) + 1)
+        assert got[owners[-1]] >= 0.9 * m.sum(), (model.names, got)
+    assert owners[0] != owners[1]
