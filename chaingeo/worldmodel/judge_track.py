@@ -251,6 +251,9 @@ class Tracker:
         return border or area[1] > area[0] - 0.6 * p.area
 
     def _changed(self, p: Obj, b: int) -> Event | None:
+        """The recolour of ``p`` (seen at frame ``b - 1``) read LAGS frames on, if any; dated at
+        the first frame the new colour covers half its place (a piece passing over it may have
+        dimmed its colour a few frames before)."""
         n = len(self.frames)
         for lag in LAGS:
             t = b + lag
@@ -277,7 +280,10 @@ class Tracker:
                 kind = "recolour"
                 how = "turned (as if fused into)" if joined else "turned"
                 detail = f"the {name} piece {how} {other} over {lag} frames"
-                return Event(kind, b, name, other, detail, (p.mask, now[0]), last=t)
+                first = next(
+                    u for u in range(b, t + 1) if _share(self._class_pixels(u, j), p.mask) >= 0.5
+                )
+                return Event(kind, first, name, other, detail, (p.mask, now[0]), last=t)
         return None
 
     def _came_over(self, j: int, p: Obj, b: int, t: int) -> bool:

@@ -1,7 +1,7 @@
 """The tracker on seeded synthetic clips without a level: a colour blended into a touching
 piece's through a passing colour is still caught, a piece at rest that vanishes while what it
 hid shows is lost (not hidden), a recolour to a colour moving elsewhere is read and a piece
-sliding over another is not."""
+sliding over another is not, and a recolour is dated when the new colour shows."""
 
 from __future__ import annotations
 
@@ -97,3 +97,18 @@ def test_objects_compare_by_identity() -> None:
     objs = [a, b]
     objs.remove(b)
     assert objs == [a] and a != Obj(0, a.mask, 1)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_recolour_is_dated_when_the_new_colour_shows(seed: int) -> None:
+    """A strip passing over the blue box just before it turns orange dims it first: the
+    recolour is dated at the frame orange takes the place, not at the dimming."""
+    rng = np.random.default_rng(seed)
+    s, width = int(rng.integers(8, 14)), int(rng.integers(10, 16))
+    place, none = _box(30, 40, 40, 40), np.zeros(SIZE, dtype=bool)
+    strip = [_box(20, 40, 60, width) if s - 3 <= t < s else none for t in range(26)]
+    blue = [place & ~strip[t] if t < s else none for t in range(26)]
+    orange = [place if t >= s else none for t in range(26)]
+    frames = [frame_objects(list(m), 40) for m in zip(blue, orange, strip, strict=True)]
+    found = Tracker(frames, ("blue", "orange", "green"))._identity()
+    assert [(e.kind, e.frame, e.piece) for e in found] == [("recolour", s, "blue")]
