@@ -1,7 +1,7 @@
 """A colour's translation between two frames, read from its pixels alone: the shift that lays
 one frame's mask best on the next (FFT cross-correlation), and how well it fits. A rigid piece
-keeps its silhouette while it moves, so a good fit is its displacement; the motion, merge and
-identity readings all follow pieces by it."""
+keeps its silhouette while it moves, so a good fit is its displacement; the motion, identity
+and class-unifying readings all follow pieces by it."""
 
 from __future__ import annotations
 

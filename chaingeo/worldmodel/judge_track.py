@@ -295,9 +295,12 @@ class Tracker:
         ring = ~dilate(p.mask, 3)
         if float((now & ring ^ was & ring).sum()) <= 0.3 * p.area:
             return False
-        border = any(o.touches_border() for u in range(b - 1, t + 1) for o in self._of(u, j))
+        if t - b > OVER_LAG or any(
+            o.touches_border() for u in range(b - 1, t + 1) for o in self._of(u, j)
+        ):
+            return True
         step = best_shift(was, now)
-        if t - b > OVER_LAG or border or step.fit < FIT:
+        if step.fit < FIT:
             return True
         took = now & p.mask
         laid = dilate(moved(was, step.dy, step.dx), 1) & took
