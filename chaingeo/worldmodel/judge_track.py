@@ -271,7 +271,7 @@ class Tracker:
                 was = self._class_pixels(b - 1, j)
                 if min(_share(m, p.mask) for m in now) < 0.6 or _share(was, p.mask) > 0.2:
                     continue
-                if self._came_over(j, p, b, t):
+                if self._came_over(p, j, (was, now[0]), (b, t)):
                     continue
                 name, other = self.names[p.cls], self.names[j]
                 # beside a piece of the new colour it reads as fused: still a recolour, as the
@@ -286,12 +286,15 @@ class Tracker:
                 return Event(kind, first, name, other, detail, (p.mask, now[0]), last=t)
         return None
 
-    def _came_over(self, j: int, p: Obj, b: int, t: int) -> bool:
-        """Whether colour ``j`` took ``p``'s place from frame ``b - 1`` to ``t`` by moving over
-        it: it changed elsewhere too (by 0.3 of ``p``'s area, outside ``p``), and its own
-        step lays its earlier pixels on OVER_EXPLAINED of what it took, or cannot be read (a
-        lag past OVER_LAG, a poor fit, a piece at the picture's border, which shows in part)."""
-        was, now = self._class_pixels(b - 1, j), self._class_pixels(t, j)
+    def _came_over(
+        self, p: Obj, j: int, pixels: tuple[Bools, Bools], frames: tuple[int, int]
+    ) -> bool:
+        """Whether colour ``j`` (its ``pixels`` in frames ``b - 1`` and ``t``, ``frames`` being
+        ``(b, t)``) took ``p``'s place by moving over it: it changed elsewhere too (by 0.3 of
+        ``p``'s area, outside ``p``), and its own step lays its earlier pixels on
+        OVER_EXPLAINED of what it took, or cannot be read (a lag past OVER_LAG, a poor fit, a
+        piece at the picture's border, which shows in part)."""
+        (was, now), (b, t) = pixels, frames
         ring = ~dilate(p.mask, 3)
         if float((now & ring ^ was & ring).sum()) <= 0.3 * p.area:
             return False
